@@ -1,0 +1,31 @@
+// rsibr: reflection-space image-based rendering from photographed spheres and computed maps.
+#include "cli/verbs.h"
+
+#include <exception>
+#include <iostream>
+#include <map>
+
+int main(int argc, char** argv) {
+  CLI::App app{"rsibr: radiance environment maps from photographed spheres and computed lighting\n"
+               "integrals, warped and blended in reflection space. 'rsibr <verb> --help' for each verb."};
+  app.set_version_flag("--version", std::string("rsibr ") + RSIBR_VERSION);
+  app.require_subcommand(1);
+  std::map<std::string, rsibr::cli::Runner> runners;
+  runners["convert"] = rsibr::cli::add_convert(app);
+  runners["info"] = rsibr::cli::add_info(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  for (auto& [name, run] : runners) {
+    if (!app.got_subcommand(name)) continue;
+    try {
+      return run();
+    } catch (const std::exception& e) {
+      std::cerr << "rsibr " << name << ": error: " << e.what() << "\n";
+      return 1;
+    }
+  }
+  return 2;
+}

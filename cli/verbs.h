@@ -1,0 +1,15 @@
+// Each verb registers its subcommand on the app; the callback runs it and returns the exit code.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace rsibr::cli {
+
+using Runner = std::function<int()>;
+
+Runner add_convert(CLI::App& app);
+Runner add_info(CLI::App& app);
+
+}  // namespace rsibr::cli

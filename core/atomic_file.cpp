@@ -1,0 +1,33 @@
+#include "core/atomic_file.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <stdexcept>
+
+namespace rsibr {
+
+void write_atomically(const std::filesystem::path& target,
+                      const std::function<void(const std::string&)>& writer) {
+  static std::atomic<int> counter{0};
+  // Keep the extension last so format-sniffing writers (OpenCV) still see it.
+  std::filesystem::path tmp = target;
+  tmp.replace_filename("." + target.stem().string() + ".tmp" + std::to_string(::getpid()) + "-" +
+                       std::to_string(counter++) + target.extension().string());
+  try {
+    writer(tmp.string());
+    std::filesystem::rename(tmp, target);
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw;
+  }
+}
+
+void check_not_same_file(const std::filesystem::path& input, const std::filesystem::path& output) {
+  std::error_code ec;
+  if (std::filesystem::exists(output, ec) && std::filesystem::equivalent(input, output, ec))
+    throw std::invalid_argument(output.string() + ": output would overwrite the input");
+}
+
+}  // namespace rsibr

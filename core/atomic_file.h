@@ -1,0 +1,19 @@
+// Writes that never leave a partial file: the writer fills a temporary name next to the target,
+// which is renamed over the target only when the writer returns; on an exception the temporary
+// is removed and the exception propagates. The target's folder must exist.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+
+namespace rsibr {
+
+void write_atomically(const std::filesystem::path& target,
+                      const std::function<void(const std::string& temporary_path)>& writer);
+
+// Throws std::invalid_argument when output names the same file as input (inputs are never
+// overwritten).
+void check_not_same_file(const std::filesystem::path& input, const std::filesystem::path& output);
+
+}  // namespace rsibr

@@ -1,0 +1,266 @@
+#include "core/exr_io.h"
+
+#include "core/atomic_file.h"
+#include "core/colour.h"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfChromaticitiesAttribute.h>
+#include <OpenEXR/ImfEnvmapAttribute.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStandardAttributes.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfCompression.h>
+#include <Imath/half.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace rsibr {
+namespace {
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+  throw std::runtime_error(path + ": " + what);
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+const char* pixel_type_name(Imf::PixelType t) {
+  switch (t) {
+    case Imf::UINT: return "uint";
+    case Imf::HALF: return "half";
+    case Imf::FLOAT: return "float";
+    default: return "?";
+  }
+}
+
+std::string compression_name(Imf::Compression c) {
+  switch (c) {
+    case Imf::NO_COMPRESSION: return "none";
+    case Imf::RLE_COMPRESSION: return "rle";
+    case Imf::ZIPS_COMPRESSION: return "zips";
+    case Imf::ZIP_COMPRESSION: return "zip";
+    case Imf::PIZ_COMPRESSION: return "piz";
+    case Imf::PXR24_COMPRESSION: return "pxr24 (lossy)";
+    case Imf::B44_COMPRESSION: return "b44 (lossy)";
+    case Imf::B44A_COMPRESSION: return "b44a (lossy)";
+    case Imf::DWAA_COMPRESSION: return "dwaa (lossy)";
+    case Imf::DWAB_COMPRESSION: return "dwab (lossy)";
+    default: return "unknown";
+  }
+}
+
+bool same_chromaticities(const Imf::Chromaticities& a, const Imf::Chromaticities& b) {
+  auto close = [](const Imath::V2f& p, const Imath::V2f& q) { return (p - q).length() < 1e-4f; };
+  return close(a.red, b.red) && close(a.green, b.green) && close(a.blue, b.blue) && close(a.white, b.white);
+}
+
+LayoutKind layout_from_shape(const std::string& path, int w, int h) {
+  if (w == 2 * h) return LayoutKind::LatLong;
+  if (h == 6 * w) return LayoutKind::Cube;
+  fail(path, "cannot tell the layout of a " + std::to_string(w) + "x" + std::to_string(h) +
+                 " image (not 2:1 lat-long nor 1:6 cube, no envmap or rsibr.layout attribute); pass --layout");
+}
+
+EnvMap read_exr(const std::string& path, std::optional<LayoutKind> hint, EnvReadReport& report) {
+  Imf::InputFile file(path.c_str());
+  const Imf::Header& h = file.header();
+  const Imath::Box2i dw = h.dataWindow();
+  const int W = dw.max.x - dw.min.x + 1, H = dw.max.y - dw.min.y + 1;
+  report.format = "exr";
+  report.compression = compression_name(h.compression());
+
+  const Imf::ChannelList& chans = h.channels();
+  std::ostringstream names;
+  for (auto it = chans.begin(); it != chans.end(); ++it)
+    names << (it == chans.begin() ? "" : " ") << it.name() << ":" << pixel_type_name(it.channel().type);
+  report.channels = names.str();
+  const bool rgb = chans.findChannel("R") && chans.findChannel("G") && chans.findChannel("B");
+  const bool luminance = chans.findChannel("Y") != nullptr;
+  if (!rgb && !luminance) fail(path, "no R, G, B (or Y) channels; it has: " + report.channels);
+
+  EnvMap map;
+  map.pixels = cv::Mat(H, W, CV_32FC3);
+  Imf::FrameBuffer fb;
+  char* base = reinterpret_cast<char*>(map.pixels.ptr<float>());
+  const std::size_t xs = 3 * sizeof(float), ys = xs * std::size_t(W);
+  const char* chan_names[3] = {"R", "G", "B"};
+  for (int k = 0; k < 3; ++k)
+    fb.insert(rgb ? chan_names[k] : "Y",
+              Imf::Slice::Make(Imf::FLOAT, base + k * sizeof(float), dw, xs, ys, 1, 1, 0.0));
+  file.setFrameBuffer(fb);
+  file.readPixels(dw.min.y, dw.max.y);
+
+  // Layout.
+  LayoutKind kind;
+  if (Imf::hasEnvmap(h)) {
+    kind = Imf::envmap(h) == Imf::ENVMAP_CUBE ? LayoutKind::Cube : LayoutKind::LatLong;
+    report.layout_source = "envmap attribute";
+  } else if (const auto* a = h.findTypedAttribute<Imf::StringAttribute>("rsibr.layout")) {
+    try {
+      kind = parse_layout_kind(a->value());
+    } catch (const std::exception& e) {
+      fail(path, e.what());
+    }
+    report.layout_source = "rsibr.layout attribute";
+  } else if (hint) {
+    kind = *hint;
+    report.layout_source = "--layout";
+  } else {
+    kind = layout_from_shape(path, W, H);
+    report.layout_source = "shape";
+  }
+  try {
+    map.layout = Layout(kind, W, H);
+  } catch (const std::exception& e) {
+    fail(path, e.what());
+  }
+
+  // Colour: from the file's primaries to the working space.
+  if (Imf::hasChromaticities(h) && !same_chromaticities(Imf::chromaticities(h), Imf::Chromaticities())) {
+    const Eigen::Matrix3f m = working_from_chromaticities(Imf::chromaticities(h)).cast<float>();
+    map.pixels.forEach<cv::Vec3f>([&](cv::Vec3f& p, const int*) {
+      const Eigen::Vector3f v = m * Eigen::Vector3f(p[0], p[1], p[2]);
+      p = cv::Vec3f(v.x(), v.y(), v.z());
+    });
+    report.chromaticities_converted = true;
+  }
+
+  for (auto it = h.begin(); it != h.end(); ++it) {
+    const std::string name = it.name();
+    if (name.rfind("rsibr.", 0) != 0 || name == "rsibr.layout") continue;
+    if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+      map.attributes[name.substr(6)] = s->value();
+  }
+  return map;
+}
+
+EnvMap read_hdr(const std::string& path, std::optional<LayoutKind> hint, EnvReadReport& report) {
+  cv::Mat bgr = cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
+  if (bgr.empty()) fail(path, "not a readable Radiance .hdr file");
+  if (bgr.type() != CV_32FC3) bgr.convertTo(bgr, CV_32FC3);
+  EnvMap map;
+  cv::cvtColor(bgr, map.pixels, cv::COLOR_BGR2RGB);
+  report.format = "hdr";
+  report.channels = "RGBE";
+  report.compression = "rle";
+  const LayoutKind kind = hint ? *hint : layout_from_shape(path, bgr.cols, bgr.rows);
+  report.layout_source = hint ? "--layout" : "shape";
+  try {
+    map.layout = Layout(kind, bgr.cols, bgr.rows);
+  } catch (const std::exception& e) {
+    fail(path, e.what());
+  }
+  return map;
+}
+
+}  // namespace
+
+EnvMap read_environment(const std::string& path, std::optional<LayoutKind> hint, EnvReadReport* report_out) {
+  EnvReadReport report;
+  if (!std::filesystem::exists(path)) fail(path, "no such file");
+  if (std::filesystem::is_directory(path)) fail(path, "is a folder, not an image");
+  std::ifstream probe(path, std::ios::binary);
+  unsigned char magic[4] = {0, 0, 0, 0};
+  probe.read(reinterpret_cast<char*>(magic), 4);
+  const bool is_exr = probe.gcount() == 4 && magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01;
+  probe.close();
+
+  EnvMap map;
+  try {
+    if (is_exr) {
+      map = read_exr(path, hint, report);
+    } else if (lower_extension(path) == ".hdr" || lower_extension(path) == ".pic") {
+      map = read_hdr(path, hint, report);
+    } else {
+      fail(path, "not an OpenEXR or Radiance .hdr file");
+    }
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    if (msg.rfind(path + ":", 0) == 0) throw;
+    fail(path, msg);  // OpenEXR's own exceptions (Iex) derive from std::runtime_error
+  }
+  for (int r = 0; r < map.pixels.rows; ++r) {
+    const float* p = map.pixels.ptr<float>(r);
+    for (int i = 0; i < map.pixels.cols * map.pixels.channels(); ++i) {
+      if (std::isnan(p[i])) ++report.nan_values;
+      else if (std::isinf(p[i])) ++report.inf_values;
+      else if (p[i] < 0) ++report.negative_values;
+    }
+  }
+  if (report_out) *report_out = report;
+  return map;
+}
+
+void write_environment(const std::string& path, const EnvMap& map, const ExrWriteOptions& options) {
+  const int W = map.pixels.cols, H = map.pixels.rows, ch = map.pixels.channels();
+  if (map.pixels.depth() != CV_32F || (ch != 1 && ch != 3 && ch != 4))
+    fail(path, "internal: pixels must be float with 1, 3 or 4 channels");
+  if (W != map.layout.width() || H != map.layout.height()) fail(path, "internal: pixels do not match the layout");
+
+  Imf::Header header(W, H);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  Imf::addChromaticities(header, Imf::Chromaticities());
+  if (map.layout.kind() == LayoutKind::LatLong) Imf::addEnvmap(header, Imf::ENVMAP_LATLONG);
+  if (map.layout.kind() == LayoutKind::Cube) Imf::addEnvmap(header, Imf::ENVMAP_CUBE);
+  header.insert("rsibr.layout", Imf::StringAttribute(to_string(map.layout.kind())));
+  for (const auto& [key, value] : map.attributes) {
+    const std::string name = "rsibr." + key;
+    if (name.size() > kMaxAttributeName) fail(path, "attribute name '" + name + "' is longer than 31 characters");
+    header.insert(name, Imf::StringAttribute(value));
+  }
+
+  const char* names1[] = {"Y"};
+  const char* names3[] = {"R", "G", "B", "A"};
+  const char** names = ch == 1 ? names1 : names3;
+  const Imf::PixelType type = options.half ? Imf::HALF : Imf::FLOAT;
+  for (int k = 0; k < ch; ++k) header.channels().insert(names[k], Imf::Channel(type));
+
+  // Interleaved source buffer for the slices: converted halves, or the float pixels themselves.
+  std::vector<Imath::half> halves;
+  cv::Mat contiguous = map.pixels.isContinuous() ? map.pixels : map.pixels.clone();
+  char* base = reinterpret_cast<char*>(contiguous.data);
+  std::size_t elem = sizeof(float);
+  if (options.half) {
+    halves.resize(std::size_t(W) * H * ch);
+    const float* p = contiguous.ptr<float>();
+    for (std::size_t i = 0; i < halves.size(); ++i) {
+      if (std::isfinite(p[i]) && std::abs(p[i]) > 65504.f) {
+        std::ostringstream msg;
+        msg << "value " << p[i] << " at pixel (" << (i / ch) % W << ", " << i / ch / W
+            << ") exceeds the half-float range (65504); write float32 instead";
+        fail(path, msg.str());
+      }
+      halves[i] = Imath::half(p[i]);
+    }
+    base = reinterpret_cast<char*>(halves.data());
+    elem = sizeof(Imath::half);
+  }
+  Imf::FrameBuffer fb;
+  for (int k = 0; k < ch; ++k)
+    fb.insert(names[k], Imf::Slice(type, base + k * elem, ch * elem, ch * elem * std::size_t(W)));
+  try {
+    write_atomically(path, [&](const std::string& tmp) {
+      Imf::OutputFile out(tmp.c_str(), header);
+      out.setFrameBuffer(fb);
+      out.writePixels(H);
+    });
+  } catch (const std::exception& e) {
+    fail(path, e.what());
+  }
+}
+
+}  // namespace rsibr

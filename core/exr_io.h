@@ -1,0 +1,42 @@
+// Reading and writing environment maps: OpenEXR (any channel type, read by channel name), and
+// Radiance .hdr on input. Provenance travels in the header as rsibr.* string attributes.
+//
+// Layout of an input file: the standard `envmap` attribute (lat-long, cube), else the
+// `rsibr.layout` attribute, else the caller's hint, else the shape (2:1 lat-long, 1:6 cube);
+// anything else is an error that asks for --layout. Pixels are converted from the file's
+// `chromaticities` (Rec.709/D65 when absent) to the working space.
+#pragma once
+
+#include "core/env_map.h"
+
+#include <optional>
+#include <string>
+
+namespace rsibr {
+
+struct EnvReadReport {
+  std::string format;            // "exr" or "hdr"
+  std::string channels;          // channel names and types as stored, e.g. "B:half G:half R:half"
+  std::string compression;       // EXR compression name
+  std::string layout_source;     // "envmap attribute", "rsibr.layout attribute", "--layout", "shape"
+  bool chromaticities_converted = false;
+  long nan_values = 0, inf_values = 0, negative_values = 0;  // counted over all channels
+};
+
+// Throws std::runtime_error("<path>: <problem>") on any failure.
+EnvMap read_environment(const std::string& path, std::optional<LayoutKind> layout_hint = std::nullopt,
+                        EnvReadReport* report = nullptr);
+
+struct ExrWriteOptions {
+  bool half = false;  // half float output; values beyond +-65504 are an error, never a silent Inf
+};
+
+// Writes atomically (temporary name, then rename). Writes `envmap` for lat-long and cube,
+// `rsibr.layout` always, Rec.709 `chromaticities`, and map.attributes as string attributes
+// (names must stay under 32 characters). Throws std::runtime_error("<path>: <problem>").
+void write_environment(const std::string& path, const EnvMap& map, const ExrWriteOptions& options = {});
+
+// Attribute names longer than this break older OpenEXR readers.
+inline constexpr std::size_t kMaxAttributeName = 31;
+
+}  // namespace rsibr

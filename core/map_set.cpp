@@ -1,0 +1,188 @@
+#include "core/map_set.h"
+
+#include "core/atomic_file.h"
+#include "core/exr_io.h"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfChromaticitiesAttribute.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputPart.h>
+#include <OpenEXR/ImfMatrixAttribute.h>
+#include <OpenEXR/ImfMultiPartInputFile.h>
+#include <OpenEXR/ImfMultiPartOutputFile.h>
+#include <OpenEXR/ImfOutputPart.h>
+#include <OpenEXR/ImfPartType.h>
+#include <OpenEXR/ImfStandardAttributes.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfVecAttribute.h>
+
+#include <cstdio>
+#include <stdexcept>
+
+namespace rsibr {
+namespace {
+
+std::string part_name(std::size_t i) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "view.%03zu", i);
+  return buf;
+}
+
+const std::vector<std::string> kReserved = {"view", "worldFromView", "warp", "source", "material"};
+
+}  // namespace
+
+ViewSet MapSet::view_set() const {
+  std::vector<Vec3> dirs;
+  for (const MapView& v : views) dirs.push_back(v.view);
+  return ViewSet(dirs);
+}
+
+void validate(const MapSet& set) {
+  if (set.views.empty()) throw std::invalid_argument("map set has no views");
+  for (std::size_t i = 0; i < set.views.size(); ++i) {
+    const MapView& v = set.views[i];
+    const std::string who = part_name(i) + ": ";
+    if (v.rgb.empty() || v.rgb.type() != CV_32FC3) throw std::invalid_argument(who + "pixels must be float RGB");
+    if (v.rgb.size() != set.views.front().rgb.size()) throw std::invalid_argument(who + "size differs from view.000");
+    if (!v.confidence.empty() && (v.confidence.type() != CV_32FC1 || v.confidence.size() != v.rgb.size()))
+      throw std::invalid_argument(who + "confidence must be one float channel of the map's size");
+    if (!v.view.allFinite() || std::abs(v.view.norm() - 1.0) > 1e-5)
+      throw std::invalid_argument(who + "view direction is not a unit vector");
+    const Mat3& T = v.world_from_view;
+    if (!T.allFinite() || (T.transpose() * T - Mat3::Identity()).cwiseAbs().maxCoeff() > 1e-5 || T.determinant() < 0)
+      throw std::invalid_argument(who + "worldFromView is not a rotation");
+    if ((T.col(2) - v.view).norm() > 1e-5)
+      throw std::invalid_argument(who + "worldFromView's third column is not the view direction");
+    if (v.warp != "mirror" && v.warp != "normal") throw std::invalid_argument(who + "warp must be 'mirror' or 'normal'");
+    if (v.source != "computed" && v.source != "captured")
+      throw std::invalid_argument(who + "source must be 'computed' or 'captured'");
+    for (const auto& [key, value] : v.attributes) {
+      for (const std::string& r : kReserved)
+        if (key == r) throw std::invalid_argument(who + "attribute '" + key + "' is reserved");
+      if (("rsibr." + key).size() > kMaxAttributeName)
+        throw std::invalid_argument(who + "attribute name 'rsibr." + key + "' is longer than 31 characters");
+    }
+  }
+}
+
+void write_map_set(const std::string& path, const MapSet& set) {
+  try {
+    validate(set);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+  const int W = set.width(), H = set.height();
+  std::vector<Imf::Header> headers;
+  for (std::size_t i = 0; i < set.views.size(); ++i) {
+    const MapView& v = set.views[i];
+    Imf::Header h(W, H);
+    h.setName(part_name(i));
+    h.setType(Imf::SCANLINEIMAGE);
+    h.compression() = Imf::ZIP_COMPRESSION;
+    Imf::addChromaticities(h, Imf::Chromaticities());
+    h.insert("rsibr.view", Imf::V3fAttribute(Imath::V3f(float(v.view.x()), float(v.view.y()), float(v.view.z()))));
+    Imath::M33f m;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) m[r][c] = float(v.world_from_view(r, c));
+    h.insert("rsibr.worldFromView", Imf::M33fAttribute(m));
+    h.insert("rsibr.warp", Imf::StringAttribute(v.warp));
+    h.insert("rsibr.source", Imf::StringAttribute(v.source));
+    h.insert("rsibr.material", Imf::StringAttribute(v.material));
+    for (const auto& [key, value] : v.attributes) h.insert("rsibr." + key, Imf::StringAttribute(value));
+    for (const char* c : {"R", "G", "B"}) h.channels().insert(c, Imf::Channel(Imf::FLOAT));
+    if (!v.confidence.empty()) h.channels().insert("confidence", Imf::Channel(Imf::FLOAT));
+    headers.push_back(h);
+  }
+  try {
+    write_atomically(path, [&](const std::string& tmp) {
+      Imf::MultiPartOutputFile file(tmp.c_str(), headers.data(), int(headers.size()));
+      for (std::size_t i = 0; i < set.views.size(); ++i) {
+        const MapView& v = set.views[i];
+        const cv::Mat rgb = v.rgb.isContinuous() ? v.rgb : v.rgb.clone();
+        const cv::Mat conf = v.confidence.empty() || v.confidence.isContinuous() ? v.confidence : v.confidence.clone();
+        Imf::FrameBuffer fb;
+        char* base = reinterpret_cast<char*>(rgb.data);
+        const char* names[] = {"R", "G", "B"};
+        for (int k = 0; k < 3; ++k)
+          fb.insert(names[k], Imf::Slice(Imf::FLOAT, base + k * sizeof(float), 3 * sizeof(float), 3 * sizeof(float) * std::size_t(W)));
+        if (!conf.empty())
+          fb.insert("confidence", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(conf.data), sizeof(float), sizeof(float) * std::size_t(W)));
+        Imf::OutputPart part(file, int(i));
+        part.setFrameBuffer(fb);
+        part.writePixels(H);
+      }
+    });
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+}
+
+bool is_map_set_file(const std::string& path) {
+  try {
+    Imf::MultiPartInputFile file(path.c_str());
+    return file.parts() >= 1 && file.header(0).hasName() && file.header(0).name() == "view.000";
+  } catch (...) {
+    return false;
+  }
+}
+
+MapSet read_map_set(const std::string& path) {
+  MapSet set;
+  try {
+    Imf::MultiPartInputFile file(path.c_str());
+    for (int i = 0; i < file.parts(); ++i) {
+      const Imf::Header& h = file.header(i);
+      const std::string who = "part " + std::to_string(i) + ": ";
+      if (!h.hasName() || h.name() != part_name(std::size_t(i)))
+        throw std::runtime_error(who + "expected a part named " + part_name(std::size_t(i)) + " (not a map set?)");
+      const auto* view = h.findTypedAttribute<Imf::V3fAttribute>("rsibr.view");
+      const auto* T = h.findTypedAttribute<Imf::M33fAttribute>("rsibr.worldFromView");
+      const auto* warp = h.findTypedAttribute<Imf::StringAttribute>("rsibr.warp");
+      const auto* source = h.findTypedAttribute<Imf::StringAttribute>("rsibr.source");
+      if (!view || !T || !warp || !source)
+        throw std::runtime_error(who + "missing rsibr.view, rsibr.worldFromView, rsibr.warp or rsibr.source");
+      if (!h.channels().findChannel("R") || !h.channels().findChannel("G") || !h.channels().findChannel("B"))
+        throw std::runtime_error(who + "missing an R, G or B channel");
+      MapView v;
+      v.view = Vec3(view->value().x, view->value().y, view->value().z);
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) v.world_from_view(r, c) = T->value()[r][c];
+      v.warp = warp->value();
+      v.source = source->value();
+      if (const auto* m = h.findTypedAttribute<Imf::StringAttribute>("rsibr.material")) v.material = m->value();
+      for (auto it = h.begin(); it != h.end(); ++it) {
+        const std::string name = it.name();
+        if (name.rfind("rsibr.", 0) != 0) continue;
+        const std::string key = name.substr(6);
+        bool reserved = false;
+        for (const std::string& r : kReserved) reserved = reserved || key == r;
+        if (reserved) continue;
+        if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) v.attributes[key] = s->value();
+      }
+      const Imath::Box2i dw = h.dataWindow();
+      const int W = dw.max.x - dw.min.x + 1, H = dw.max.y - dw.min.y + 1;
+      v.rgb = cv::Mat(H, W, CV_32FC3);
+      Imf::FrameBuffer fb;
+      char* base = reinterpret_cast<char*>(v.rgb.data);
+      const char* names[] = {"R", "G", "B"};
+      for (int k = 0; k < 3; ++k)
+        fb.insert(names[k], Imf::Slice::Make(Imf::FLOAT, base + k * sizeof(float), dw, 3 * sizeof(float), 3 * sizeof(float) * std::size_t(W)));
+      if (h.channels().findChannel("confidence")) {
+        v.confidence = cv::Mat(H, W, CV_32FC1);
+        fb.insert("confidence", Imf::Slice::Make(Imf::FLOAT, v.confidence.data, dw, sizeof(float), sizeof(float) * std::size_t(W)));
+      }
+      Imf::InputPart part(file, i);
+      part.setFrameBuffer(fb);
+      part.readPixels(dw.min.y, dw.max.y);
+      set.views.push_back(std::move(v));
+    }
+    validate(set);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+  return set;
+}
+
+}  // namespace rsibr

@@ -1,0 +1,58 @@
+// Map sets: radiance environment maps, one sphere map per view, captured or computed alike
+// (DESIGN.md, "File formats"). On disk: one multi-part OpenEXR file, part "view.NNN" per view, with
+//   rsibr.view           V3f   view direction (world, unit, toward the viewer)
+//   rsibr.worldFromView  M33f  the paper's T: columns are the view frame's axes in world
+//                              (stored as Imath m[row][col] = T(row, col))
+//   rsibr.warp           "mirror" | "normal"   which central direction the runtime warps
+//   rsibr.source         "computed" | "captured"
+//   rsibr.material       the BRDF spec as text
+//   rsibr.<key>          provenance strings (MapView::attributes)
+//   chromaticities       Rec.709 / D65 (the working space)
+// Channels R, G, B (float32), plus "confidence" for captured maps. Texel p of view v holds the
+// radiance leaving a surface with normal world_from_view * g_normal(p) toward a viewer at infinity
+// along v (core/sphere_map.h).
+#pragma once
+
+#include "core/view_set.h"
+
+#include <opencv2/core.hpp>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace rsibr {
+
+struct MapView {
+  Vec3 view = Vec3(0, 0, 1);          // world, unit; stored as float on disk
+  Mat3 world_from_view = Mat3::Identity();
+  std::string warp = "mirror";        // "mirror" | "normal"
+  std::string source = "computed";    // "computed" | "captured"
+  std::string material;
+  std::map<std::string, std::string> attributes;  // provenance, written as rsibr.<key>
+  cv::Mat rgb;                        // CV_32FC3, RGB order, sphere-map layout (square or not)
+  cv::Mat confidence;                 // empty, or CV_32FC1 of the same size
+};
+
+struct MapSet {
+  std::vector<MapView> views;
+
+  // The triangulated view set of the views' directions (recomputed, never stored).
+  ViewSet view_set() const;
+  int width() const { return views.empty() ? 0 : views.front().rgb.cols; }
+  int height() const { return views.empty() ? 0 : views.front().rgb.rows; }
+};
+
+// Checks the invariants (non-empty, equal sizes, unit views, world_from_view a rotation whose
+// third column is the view, known warp/source values); throws std::invalid_argument naming the
+// view and the problem.
+void validate(const MapSet& set);
+
+// Both throw std::runtime_error("<path>: <problem>"). Writing is atomic.
+void write_map_set(const std::string& path, const MapSet& set);
+MapSet read_map_set(const std::string& path);
+
+// True when the file is a multi-part EXR whose first part is named "view.000".
+bool is_map_set_file(const std::string& path);
+
+}  // namespace rsibr

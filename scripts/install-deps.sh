@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package rsibr needs to build, test and benchmark.
+# Idempotent: packages already present are left as they are. Run as root.
+set -euo pipefail
+
+packages=(
+  # toolchain
+  build-essential cmake ninja-build pkg-config git ca-certificates
+  # core
+  libeigen3-dev libtbb-dev libopenexr-dev libimath-dev libopencolorio-dev
+  libopencv-dev
+  libcli11-dev libyaml-cpp-dev nlohmann-json3-dev
+  # bake / capture / calib / hdr
+  libqhull-dev
+  libembree-dev libceres-dev libmrcal-dev libmrgingham-dev mrgingham mrcal libexiv2-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+  # real-data fetch (npm registry) and docs plots
+  python3 python3-numpy python3-matplotlib
+)
+# node and npm: some images ship a nodejs that bundles npm (and conflicts with
+# Debian's npm package); only ask apt for them when they are absent.
+command -v node >/dev/null || packages+=(nodejs)
+command -v npm >/dev/null || packages+=(npm)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if ((${#missing[@]})); then
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update
+  apt-get install -y --no-install-recommends "${missing[@]}"
+else
+  echo "install-deps: all ${#packages[@]} packages already installed"
+fi
