@@ -24,6 +24,7 @@ struct ConvertArgs {
   int size = 0;
   int max_subsamples = 32;
   double supersampling = 4.0;
+  double energy_tolerance = 1e-4;
   bool half = false, sanitize = false, quiet = false;
   float preview_exposure = 0.f;
 };
@@ -77,6 +78,7 @@ int run_convert(const ConvertArgs& a) {
   ResampleOptions options;
   options.max_subsamples = a.max_subsamples;
   options.supersampling = a.supersampling;
+  options.energy_tolerance = a.energy_tolerance;
   auto bar = std::make_shared<Progress>("convert", !a.quiet && Progress::stderr_is_terminal());
   options.progress = [bar](double f) { bar->update(f); };
   EnvMap out = resample(src, dst, options);
@@ -144,6 +146,9 @@ Runner add_convert(CLI::App& app) {
   c->add_option("--supersampling", a->supersampling,
                 "Taps per source texel across an output texel's footprint (1: area sampling; default 4 keeps a "
                 "one-texel sun's energy to ~1e-3)")->check(CLI::Range(1.0, 16.0));
+  c->add_option("--energy-tolerance", a->energy_tolerance,
+                "Energy budget per texel relative to the map's (extra taps where the input is far brighter than "
+                "its mean, e.g. a sun; 0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--max-subsamples", a->max_subsamples, "Cap on n for the n x n taps per output texel")->check(CLI::Range(1, 64));
   c->add_option("--preview", a->preview, "Also write a display-encoded PNG of the output");
   c->add_option("--preview-exposure", a->preview_exposure, "Exposure of the preview in stops");

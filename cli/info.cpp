@@ -103,14 +103,16 @@ int info_environment(const InfoArgs& a) {
   j["dynamic_range"] = median > 0 ? peak / median : INFINITY;
   j["attributes"] = env.attributes;
 
-  std::cout << a.input << ": " << to_string(env.layout.kind()) << " " << env.layout.width() << "x"
+  // With --json - stdout carries the JSON alone.
+  std::ostream& text = a.json == "-" ? std::cerr : std::cout;
+  text << a.input << ": " << to_string(env.layout.kind()) << " " << env.layout.width() << "x"
             << env.layout.height() << " (" << rep.layout_source << "), " << rep.format << " " << rep.channels
             << ", compression " << rep.compression << "\n"
             << "  colour:   " << j["colour"].get<std::string>() << "\n";
   for (const char* ch : {"R", "G", "B"})
-    std::cout << "  " << ch << ":        min " << j["values"][ch]["min"].get<double>() << "  max "
+    text << "  " << ch << ":        min " << j["values"][ch]["min"].get<double>() << "  max "
               << j["values"][ch]["max"].get<double>() << "  mean " << j["values"][ch]["mean"].get<double>() << "\n";
-  std::cout << "  mean radiance (solid-angle weighted) " << integ[0] / (4 * kPi) << " " << integ[1] / (4 * kPi) << " "
+  text << "  mean radiance (solid-angle weighted) " << integ[0] / (4 * kPi) << " " << integ[1] / (4 * kPi) << " "
             << integ[2] / (4 * kPi) << "\n"
             << "  peak luminance " << peak << " at pixel (" << pc << ", " << pr << "), direction (" << peak_dir.x()
             << ", " << peak_dir.y() << ", " << peak_dir.z() << "); median " << median << "; dynamic range "
@@ -118,7 +120,7 @@ int info_environment(const InfoArgs& a) {
             << "  suspicious values: " << rep.nan_values << " NaN, " << rep.inf_values << " Inf, " << rep.negative_values
             << " negative" << (rep.negative_values ? " (lossy-compression ringing? see --sanitize in convert)" : "")
             << "\n";
-  for (const auto& [k, v] : env.attributes) std::cout << "  rsibr." << k << ": " << v << "\n";
+  for (const auto& [k, v] : env.attributes) text << "  rsibr." << k << ": " << v << "\n";
   write_summary(a.json, j);
   return 0;
 }
@@ -134,7 +136,8 @@ int info_map_set(const InfoArgs& a) {
   j["height"] = set.height();
   j["triangles"] = vs.triangles().size();
   j["surrounds_sphere"] = vs.surrounds();
-  std::cout << a.input << ": map set, " << set.views.size() << " views of " << set.width() << "x" << set.height()
+  std::ostream& text = a.json == "-" ? std::cerr : std::cout;
+  text << a.input << ": map set, " << set.views.size() << " views of " << set.width() << "x" << set.height()
             << ", " << vs.triangles().size() << " triangles, "
             << (vs.surrounds() ? "surrounds the sphere" : "does not surround the sphere") << "\n";
   nlohmann::json views = nlohmann::json::array();
@@ -154,7 +157,7 @@ int info_map_set(const InfoArgs& a) {
          << "  " << v.source << (v.confidence.empty() ? "" : "  +confidence");
     const std::string first_line = v.material.substr(0, v.material.find('\n'));
     if (!first_line.empty()) line << "  material: " << first_line;
-    std::cout << line.str() << "\n";
+    text << line.str() << "\n";
     views.push_back(jv);
   }
   j["parts"] = views;

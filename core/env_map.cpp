@@ -89,6 +89,10 @@ void sample_bilinear(const EnvMap& map, const Vec3& dir, float* out) {
     }
     case LayoutKind::Sphere: {
       Vec2 xy = sphere_map::g_mirror_inv(dir);
+      if (xy.norm() > 1.0 - 2.0 / std::min(W, H)) {
+        sample_nearest(map, dir, out);
+        return;
+      }
       for (int attempt = 0;; ++attempt) {
         const Vec2 p = sphere_map::pixel_from_disc(xy, W, H);
         clamped_taps(p, 0, W - 1, 0, H - 1, taps);
@@ -113,6 +117,22 @@ void sample_bilinear(const EnvMap& map, const Vec3& dir, float* out) {
     }
   }
   accumulate(map.pixels, taps, 4, out);
+}
+
+void sample_nearest(const EnvMap& map, const Vec3& dir, float* out) {
+  const Layout& L = map.layout;
+  const int W = L.width(), H = L.height();
+  Vec2 p = L.pixel(dir);
+  int c = int(std::floor(p.x() + 0.5)), r = int(std::floor(p.y() + 0.5));
+  c = std::clamp(c, 0, W - 1);
+  if (L.kind() == LayoutKind::Cube) {
+    const int face = std::clamp(int(std::floor((p.y() + 0.5) / W)), 0, 5);
+    r = std::clamp(r, face * W, face * W + W - 1);
+  } else {
+    r = std::clamp(r, 0, H - 1);
+  }
+  const Tap tap{c, r, 1.f};
+  accumulate(map.pixels, &tap, 1, out);
 }
 
 cv::Mat texel_solid_angles(const Layout& layout) {

@@ -31,7 +31,14 @@ inline constexpr int kMaxChannels = 4;
 // lat-long and cube never need a neighbour across a seam (their edge texels lie on it); the
 // octahedral map wraps through its fold symmetry; the sphere map ignores texels whose centres are
 // outside the disc and renormalises. Writes channels() floats to out.
+// Within one texel of a sphere map's rim (the cap around -Z, squeezed into a ring a texel wide and
+// stretched ~10 degrees radially) the lookup is the containing texel instead, which keeps the
+// energy of that cap (bilinear weights renormalised against the rim would not).
 void sample_bilinear(const EnvMap& map, const Vec3& dir, float* out);
+
+// The texel whose cell contains the direction (piecewise-constant reconstruction: integrating it
+// over the sphere gives exactly sum_p L(p) Omega(p)). Writes channels() floats.
+void sample_nearest(const EnvMap& map, const Vec3& dir, float* out);
 
 // Solid-angle-weighted integral over the sphere, per channel: sum_p L(p) * Omega(p).
 std::vector<double> integral(const EnvMap& map);

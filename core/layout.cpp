@@ -127,12 +127,21 @@ std::optional<Vec3> Layout::direction(const Vec2& p) const {
       return octahedral_direction(uv.cwiseMax(-1.0).cwiseMin(1.0));
     }
     case LayoutKind::Sphere: {
+      // A rim point computed from a direction may land a rounding error outside the disc.
       const Vec2 xy = sphere_map::disc_from_pixel(p, width_, height_);
-      if (xy.squaredNorm() > 1.0) return std::nullopt;
+      if (xy.squaredNorm() > 1.0 + 1e-9) return std::nullopt;
       return sphere_map::g_mirror(xy);
     }
   }
   return std::nullopt;
+}
+
+std::optional<Vec3> Layout::texel_direction(int c, int r) const {
+  if (auto d = direction(Vec2(c, r))) return d;
+  if (kind_ != LayoutKind::Sphere) return std::nullopt;
+  const Vec2 centre(0.5 * width_ - 0.5, 0.5 * height_ - 0.5);
+  const Vec2 q(std::clamp(centre.x(), c - 0.5, c + 0.5), std::clamp(centre.y(), r - 0.5, r + 0.5));
+  return direction(q);
 }
 
 Vec2 Layout::pixel(const Vec3& d) const {

@@ -50,6 +50,10 @@ class Layout {
   // unit disc. Positions slightly outside the image extrapolate smoothly (used by footprint
   // estimates).
   std::optional<Vec3> direction(const Vec2& pixel) const;
+  // A direction representing texel (c, r): its centre's, or for a sphere-map texel whose centre is
+  // outside the disc but whose cell is not, the direction of the cell's point nearest the disc's
+  // centre. nullopt only for texels with no solid angle.
+  std::optional<Vec3> texel_direction(int c, int r) const;
   // Pixel position of a direction; defined for every non-zero direction. For the sphere layout
   // -Z (behind the ball) maps to a rim point.
   Vec2 pixel(const Vec3& dir) const;

@@ -3,6 +3,8 @@
 #include "core/parallel.h"
 #include "core/sphere_map.h"
 
+#include <opencv2/imgproc.hpp>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -34,6 +36,27 @@ EnvMap resample(const EnvMap& src, const Layout& dst, const ResampleOptions& opt
   const int ch = src.channels();
   const int max_n = std::max(1, options.max_subsamples);
   std::atomic<int> rows_done{0};
+  const auto lookup = options.reconstruction == Reconstruction::Nearest ? &sample_nearest : &sample_bilinear;
+
+  // Local peak magnitude of the source (max over channels and the 3x3 neighbourhood) and the
+  // energy of |L|, for the energy-driven tap count.
+  EnvMap peak;
+  double energy = 0;
+  if (options.energy_tolerance > 0) {
+    peak.layout = src.layout;
+    cv::Mat magnitude(src.pixels.rows, src.pixels.cols, CV_32FC1);
+    for (int r = 0; r < src.pixels.rows; ++r) {
+      const float* p = src.pixels.ptr<float>(r);
+      float* m = magnitude.ptr<float>(r);
+      for (int c = 0; c < src.pixels.cols; ++c) {
+        float v = 0;
+        for (int k = 0; k < ch; ++k) v = std::max(v, std::isfinite(p[c * ch + k]) ? std::abs(p[c * ch + k]) : 0.f);
+        m[c] = v;
+      }
+    }
+    cv::dilate(magnitude, peak.pixels, cv::Mat::ones(3, 3, CV_8U));
+    energy = integral(EnvMap{src.layout, magnitude, {}})[0];
+  }
 
   parallel_for_rows(dst.height(), [&](int r) {
     float* row = out.pixels.ptr<float>(r);
@@ -63,9 +86,16 @@ EnvMap resample(const EnvMap& src, const Layout& dst, const ResampleOptions& opt
         n = std::clamp(int(std::ceil(options.supersampling * k - 1e-9)), 1, max_n);
       }
       if (partial_rim) n = std::max(n, 8);  // resolve the disc's edge inside the texel
+      if (dir && energy > 0) {
+        float local_peak = 0;
+        sample_nearest(peak, *dir, &local_peak);
+        const double omega = dst.solid_angle_density(centre);
+        const double need = std::sqrt(local_peak * omega / (options.energy_tolerance * energy));
+        if (need > n) n = std::min(max_n, int(std::ceil(need)));
+      }
 
       if (n == 1) {
-        sample_bilinear(src, *dir, px);
+        lookup(src, *dir, px);
         continue;
       }
       for (int k = 0; k < ch; ++k) acc[k] = 0.0;
@@ -77,14 +107,16 @@ EnvMap resample(const EnvMap& src, const Layout& dst, const ResampleOptions& opt
           if (!(w > 0)) continue;
           const std::optional<Vec3> d = dst.direction(q);
           if (!d) continue;
-          sample_bilinear(src, *d, tap);
+          lookup(src, *d, tap);
           for (int k = 0; k < ch; ++k) acc[k] += w * tap[k];
           wsum += w;
         }
       if (wsum > 0) {
         for (int k = 0; k < ch; ++k) px[k] = float(acc[k] / wsum);
       } else if (dir) {
-        sample_bilinear(src, *dir, px);
+        lookup(src, *dir, px);
+      } else if (const auto d = dst.texel_direction(c, r)) {
+        lookup(src, *d, px);  // a sliver of the disc that no tap reached
       }
     }
     if (options.progress) {

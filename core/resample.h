@@ -15,12 +15,23 @@
 
 namespace rsibr {
 
+enum class Reconstruction {
+  Bilinear,  // smooth; what views and renders want
+  Nearest,   // piecewise constant: integrates exactly to sum L*Omega (MIP levels, energy budgets)
+};
+
 struct ResampleOptions {
+  Reconstruction reconstruction = Reconstruction::Bilinear;
   // Taps per source texel along the footprint's longest side: n = ceil(supersampling * k) where k
   // is the footprint in source texels. 1 is plain area sampling; 4 integrates a one-texel sun to
   // ~1e-3 of its energy. Enlarging by more than this factor is plain bilinear (n = 1).
   double supersampling = 4.0;
   int max_subsamples = 32;  // cap on n (n x n taps per destination texel)
+  // Energy budget per texel, relative to the whole map's energy: where the source is much brighter
+  // than its mean (a sun, or ringing around one), n also grows until
+  //   peak * Omega_texel / n^2 <= energy_tolerance * integral(|L|),
+  // so a compact source keeps its energy. Costs taps only at those few texels; 0 disables.
+  double energy_tolerance = 1e-4;
   // Called with the fraction done (0..1), from worker threads (must be thread-safe); may be empty.
   std::function<void(double)> progress;
 };

@@ -40,8 +40,8 @@ double disc_rect_area(double x0, double x1, double y0, double y1) {
     if (!(b > a)) continue;
     const double m = 0.5 * (a + b);
     const double hm = std::sqrt(std::max(0.0, 1.0 - m * m));
-    const bool top_is_h = hm < y1;    // min(y1, h) = h on this piece
-    const bool bot_is_h = -hm > y0;   // max(y0, -h) = -h on this piece
+    const bool top_is_h = hm <= y1;   // min(y1, h) = h on this piece
+    const bool bot_is_h = -hm >= y0;  // max(y0, -h) = -h on this piece
     const double top = top_is_h ? hm : y1;
     const double bot = bot_is_h ? -hm : y0;
     if (!(top > bot)) continue;

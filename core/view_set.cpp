@@ -23,6 +23,14 @@ constexpr double kPlanarEps = 1e-9;  // relative size below which a set is treat
 
 double det3(const Vec3& a, const Vec3& b, const Vec3& c) { return a.dot(b.cross(c)); }
 
+// v / |v| for any finite non-zero v: rescaled first where |v|^2 would overflow or underflow.
+Vec3 unit(const Vec3& v) {
+  const double sq = v.squaredNorm();
+  if (sq > 1e-290 && sq < 1e290) return v.normalized();
+  return (v / v.cwiseAbs().maxCoeff()).normalized();
+}
+bool finite_nonzero(const Vec3& v) { return v.allFinite() && v.cwiseAbs().maxCoeff() > 0; }
+
 // Canonical form of a counter-clockwise triangle: smallest index first, orientation kept.
 std::array<int, 3> canonical(std::array<int, 3> t) {
   while (t[0] > t[1] || t[0] > t[2]) t = {t[1], t[2], t[0]};
@@ -91,7 +99,9 @@ std::array<double, 3> triangle_weights(const Vec3& p, const Vec3& a, const Vec3&
   if (p == b) return {0, 1, 0};
   if (p == c) return {0, 0, 1};
   // Signed volumes decide which side of each edge p is on; negative means outside, clamp to 0.
-  const double da = det3(p, b, c), db = det3(a, p, c), dc = det3(a, b, p);
+  // Written with differences of nearby unit vectors (exact or nearly), so that they keep full
+  // relative precision for tiny triangles (det(p,b,c) = det(p, b-p, c-p), and so on).
+  const double da = det3(p, b - p, c - p), db = det3(a, p - a, c - a), dc = det3(a, b - a, p - a);
   std::array<double, 3> w{std::max(0.0, da), std::max(0.0, db), std::max(0.0, dc)};
   if (kind == Barycentric::SolidAngle) {
     if (w[0] > 0) w[0] = spherical_triangle_solid_angle(p, b, c);
@@ -112,9 +122,9 @@ ViewSet::ViewSet(std::vector<Vec3> views) : views_(std::move(views)) {
   if (views_.empty()) throw std::invalid_argument("view set: no views");
   for (std::size_t i = 0; i < views_.size(); ++i) {
     const Vec3& v = views_[i];
-    if (!v.allFinite() || !(v.norm() > 0))
+    if (!finite_nonzero(v))
       throw std::invalid_argument("view set: view " + std::to_string(i) + " is zero or not finite");
-    views_[i] = v.normalized();
+    views_[i] = unit(v);
   }
   for (std::size_t i = 0; i < views_.size(); ++i)
     for (std::size_t j = i + 1; j < views_.size(); ++j)
@@ -128,18 +138,28 @@ void ViewSet::triangulate() {
   const int n = int(views_.size());
   if (n == 1) return;
 
-  // Planarity: the smallest principal extent of the points.
+  // Planarity: the smallest principal extent of the points, relative to the largest (a tiny
+  // cluster of views is thin in absolute terms but is not planar: its hull is its triangulation).
   Vec3 centroid = Vec3::Zero();
   for (const Vec3& v : views_) centroid += v;
   centroid /= n;
   Mat3 cov = Mat3::Zero();
   for (const Vec3& v : views_) cov += (v - centroid) * (v - centroid).transpose();
   Eigen::SelfAdjointEigenSolver<Mat3> eig(cov / n);
-  const bool planar = n <= 3 || std::sqrt(std::max(0.0, eig.eigenvalues()(0))) < kPlanarEps;
+  bool planar = n <= 3 || std::sqrt(std::max(0.0, eig.eigenvalues()(0))) <
+                             kPlanarEps * std::sqrt(std::max(0.0, eig.eigenvalues()(2)));
+  std::vector<QhullFace> faces;
+  if (!planar) {
+    try {
+      faces = qhull_faces(views_);
+    } catch (const std::runtime_error&) {
+      planar = true;  // thinner than qhull can resolve in double precision: treat as planar
+    }
+  }
 
   std::vector<std::array<int, 3>> tris;
   if (!planar) {
-    for (const QhullFace& f : qhull_faces(views_)) {
+    for (const QhullFace& f : faces) {
       if (!(f.offset < -kPlanarEps)) continue;  // origin on or beyond the face: a gap, not a triangle
       std::array<int, 3> t = f.v;
       const Vec3 &a = views_[std::size_t(t[0])], &b = views_[std::size_t(t[1])], &c = views_[std::size_t(t[2])];
@@ -248,11 +268,11 @@ ViewSet ViewSet::named(const std::string& name) {
     ++lineno;
     const auto hash = line.find('#');
     if (hash != std::string::npos) line.resize(hash);
+    if (line.find_first_not_of(" \t\r\f\v") == std::string::npos) continue;  // blank or comment line
     std::istringstream ls(line);
     double x, y, z;
-    if (!(ls >> x)) continue;  // blank or comment line
     std::string rest;
-    if (!(ls >> y >> z) || (ls >> rest))
+    if (!(ls >> x >> y >> z) || (ls >> rest))
       throw std::invalid_argument(name + ":" + std::to_string(lineno) + ": expected three numbers 'x y z'");
     views.emplace_back(x, y, z);
   }
@@ -309,8 +329,8 @@ ViewWeights ViewSet::on_arc(const Vec3& p, const Arc& arc, Barycentric kind, dou
 }
 
 ViewWeights ViewSet::locate(const Vec3& dir, Barycentric kind) const {
-  if (!dir.allFinite() || !(dir.norm() > 0)) throw std::invalid_argument("view set: locate() needs a finite non-zero direction");
-  const Vec3 p = dir.normalized();
+  if (!finite_nonzero(dir)) throw std::invalid_argument("view set: locate() needs a finite non-zero direction");
+  const Vec3 p = unit(dir);
   ViewWeights out;
   if (views_.size() == 1) {
     out.count = 1;

@@ -31,7 +31,8 @@ enum class Barycentric {
   // The paper's: w_a : w_b : w_c = Omega(p,b,c) : Omega(a,p,c) : Omega(a,b,p), the solid angles of
   // the sub-triangles (computed with the stable atan2 formula, not the paper's acos dihedral
   // angles). Equals the areal definition exactly, but jumps across edges shared by triangles of
-  // different shape (up to ~3% for 60-degree triangles; tests/core/view_set_test.cpp).
+  // different shape (measured in tests/core/view_set_test.cpp: max 4e-5 on the 42 set, whose
+  // triangles are nearly congruent, but 0.11 on a random 30-view set).
   SolidAngle,
 };
 
