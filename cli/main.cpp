@@ -10,9 +10,16 @@ int main(int argc, char** argv) {
                "integrals, warped and blended in reflection space. 'rsibr <verb> --help' for each verb."};
   app.set_version_flag("--version", std::string("rsibr ") + RSIBR_VERSION);
   app.require_subcommand(1);
+  // Parse errors are one line naming the verb, like every other error.
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) {
+    std::string verb;
+    for (const CLI::App* sub : a->get_subcommands()) verb += " " + sub->get_name();
+    return "rsibr" + verb + ": error: " + e.what() + " (see --help)\n";
+  });
   std::map<std::string, rsibr::cli::Runner> runners;
   runners["convert"] = rsibr::cli::add_convert(app);
   runners["info"] = rsibr::cli::add_info(app);
+  runners["pattern"] = rsibr::cli::add_pattern(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

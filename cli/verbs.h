@@ -11,5 +11,6 @@ using Runner = std::function<int()>;
 
 Runner add_convert(CLI::App& app);
 Runner add_info(CLI::App& app);
+Runner add_pattern(CLI::App& app);
 
 }  // namespace rsibr::cli

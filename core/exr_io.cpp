@@ -98,11 +98,14 @@ EnvMap read_exr(const std::string& path, std::optional<LayoutKind> hint, EnvRead
   char* base = reinterpret_cast<char*>(map.pixels.ptr<float>());
   const std::size_t xs = 3 * sizeof(float), ys = xs * std::size_t(W);
   const char* chan_names[3] = {"R", "G", "B"};
-  for (int k = 0; k < 3; ++k)
+  // A FrameBuffer holds one slice per channel name: a luminance-only file is read into R, then
+  // copied to G and B.
+  for (int k = 0; k < (rgb ? 3 : 1); ++k)
     fb.insert(rgb ? chan_names[k] : "Y",
               Imf::Slice::Make(Imf::FLOAT, base + k * sizeof(float), dw, xs, ys, 1, 1, 0.0));
   file.setFrameBuffer(fb);
   file.readPixels(dw.min.y, dw.max.y);
+  if (!rgb) map.pixels.forEach<cv::Vec3f>([](cv::Vec3f& p, const int*) { p[1] = p[2] = p[0]; });
 
   // Layout.
   LayoutKind kind;
@@ -188,10 +191,13 @@ EnvMap read_environment(const std::string& path, std::optional<LayoutKind> hint,
     } else {
       fail(path, "not an OpenEXR or Radiance .hdr file");
     }
-  } catch (const std::runtime_error& e) {
-    const std::string msg = e.what();
+  } catch (const std::exception& e) {
+    std::string msg = e.what();
     if (msg.rfind(path + ":", 0) == 0) throw;
-    fail(path, msg);  // OpenEXR's own exceptions (Iex) derive from std::runtime_error
+    // OpenEXR's own exceptions (Iex::BaseExc) derive from std::exception only, not
+    // std::runtime_error; keep the message on one line.
+    std::replace(msg.begin(), msg.end(), '\n', ' ');
+    fail(path, msg);
   }
   for (int r = 0; r < map.pixels.rows; ++r) {
     const float* p = map.pixels.ptr<float>(r);

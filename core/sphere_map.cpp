@@ -33,7 +33,9 @@ double disc_rect_area(double x0, double x1, double y0, double y1) {
     }
   }
   cuts[n++] = x1;
-  std::sort(cuts.begin(), cuts.begin() + n);
+  for (int i = 1; i < n; ++i)  // insertion sort of <= 6 values (std::sort trips GCC 12's -Warray-bounds)
+    for (int j = i; j > 0 && cuts[std::size_t(j)] < cuts[std::size_t(j - 1)]; --j)
+      std::swap(cuts[std::size_t(j)], cuts[std::size_t(j - 1)]);
   double area = 0.0;
   for (int i = 0; i + 1 < n; ++i) {
     const double a = cuts[i], b = cuts[i + 1];

