@@ -1,6 +1,7 @@
 #include "core/map_set.h"
 
 #include "core/atomic_file.h"
+#include "core/colour.h"
 #include "core/exr_io.h"
 
 #include <OpenEXR/ImfChannelList.h>
@@ -176,6 +177,19 @@ MapSet read_map_set(const std::string& path) {
       Imf::InputPart part(file, i);
       part.setFrameBuffer(fb);
       part.readPixels(dw.min.y, dw.max.y);
+      // Pixels in other primaries (a map set written by another tool) go to the working space.
+      if (Imf::hasChromaticities(h)) {
+        const Imf::Chromaticities c = Imf::chromaticities(h), rec709;
+        auto close = [](const Imath::V2f& p, const Imath::V2f& q) { return (p - q).length() < 1e-4f; };
+        if (!(close(c.red, rec709.red) && close(c.green, rec709.green) && close(c.blue, rec709.blue) &&
+              close(c.white, rec709.white))) {
+          const Eigen::Matrix3f m = working_from_chromaticities(c).cast<float>();
+          v.rgb.forEach<cv::Vec3f>([&](cv::Vec3f& p, const int*) {
+            const Eigen::Vector3f q = m * Eigen::Vector3f(p[0], p[1], p[2]);
+            p = cv::Vec3f(q.x(), q.y(), q.z());
+          });
+        }
+      }
       set.views.push_back(std::move(v));
     }
     validate(set);

@@ -12,6 +12,27 @@
 namespace rsibr {
 
 PixelFootprint pixel_footprint(const Layout& layout, const Vec2& p) {
+  // Closed forms where the Jacobian is simple; central differences otherwise.
+  switch (layout.kind()) {
+    case LayoutKind::LatLong: {
+      // Latitude step pi/(H-1); longitude step 2 pi/(W-1), shortened by cos(latitude).
+      const double dlat = kPi / (layout.height() - 1), dlon = 2 * kPi / (layout.width() - 1);
+      const double across = std::abs(std::cos(0.5 * kPi - dlat * p.y())) * dlon;
+      return {std::min(dlat, across), std::max(dlat, across)};
+    }
+    case LayoutKind::Sphere: {
+      // Mirror ball, rho = |(x,y)|: radially d(theta)/d(rho) = 2/sqrt(1-rho^2), tangentially
+      // 2 sqrt(1-rho^2); one pixel is 2/W (2/H) in disc units.
+      const Vec2 xy = sphere_map::disc_from_pixel(p, layout.width(), layout.height());
+      const double z = std::sqrt(std::max(1e-12, 1.0 - xy.squaredNorm()));
+      if (xy.squaredNorm() > 1.0) return {};
+      const double fine = 2.0 / std::max(layout.width(), layout.height());
+      const double coarse = 2.0 / std::min(layout.width(), layout.height());
+      return {2 * z * fine, 2 / z * coarse};
+    }
+    default:
+      break;
+  }
   const double h = 0.25;
   const std::optional<Vec3> d0 = layout.direction(p);
   if (!d0) return {};

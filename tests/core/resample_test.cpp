@@ -64,12 +64,12 @@ TEST(Resample, IntegralOfAnalyticEnvironmentsIsKept) {
 
 TEST(Resample, ShrinkingIsAreaWeightedAndDoesNotAlias) {
   // A 1-degree checker shrunk to coarser layouts must equal the checker's exact average over each
-  // output texel (rendered analytically with 48 x 48 points per texel); one bilinear tap per texel
+  // output texel (rendered analytically with 24 x 24 points per texel); one bilinear tap per texel
   // (point sampling) aliases and misses it by far more.
   const auto checker = patterns::latlong_checker(1.0);
   const EnvMap fine = render_pattern(checker, Layout::with_size(LayoutKind::LatLong, 2048), 1);
   for (const Layout& to : targets()) {
-    const EnvMap truth = render_pattern(checker, to, 48);
+    const EnvMap truth = render_pattern(checker, to, 24);
     const EnvMap area = resample(fine, to);
     ResampleOptions point;
     point.supersampling = 1e-3;  // forces n = 1: one bilinear tap per texel
@@ -138,8 +138,16 @@ TEST(Resample, SamplingIsContinuousAcrossSeamsFoldsAndTheRim) {
 }
 
 TEST(Resample, RoundTripThroughEveryLayoutKeepsTheIntegralOfRealEnvironments) {
-  const auto files = testing::real_environments();
+  auto files = testing::real_environments();
   if (files.empty()) GTEST_SKIP() << testing::kNoAssets;
+#if defined(__SANITIZE_ADDRESS__)
+  // Under the sanitizers (10x slower) the four hardest maps check memory safety; the release
+  // build checks all of them.
+  std::erase_if(files, [](const auto& f) {
+    const auto s = f.stem().string();
+    return s != "sky" && s != "park" && s != "night" && s != "esplanade";
+  });
+#endif
   for (const auto& file : files) {
     const EnvMap ll = read_environment(file.string());
     const EnvMap cube = resample(ll, Layout::with_size(LayoutKind::Cube, 148));
