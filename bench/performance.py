@@ -48,8 +48,8 @@ def main():
         for name, b in sorted(by_name.items()):
             if not name.startswith(family + "/"):
                 continue
-            arg = name.split("/", 1)[1]
-            ref = by_name.get(f"{base}/{arg}")
+            arg = "/".join(p for p in name.split("/")[1:] if not p.startswith("min_time"))
+            ref = by_name.get(f"{base}/{arg.split('/')[0]}")
             if not ref:
                 continue
             unit = b["time_unit"]

@@ -50,16 +50,18 @@ void BM_OpenCvRemap(benchmark::State& state) {
 void BM_Resample(benchmark::State& state) {
   const EnvMap& src = source();
   const Layout dst = target(int(state.range(0)));
+  ResampleOptions options;
+  options.supersampling = double(state.range(1));
   for (auto _ : state) {
-    EnvMap out = resample(src, dst);
+    EnvMap out = resample(src, dst, options);
     benchmark::DoNotOptimize(out.pixels.data);
   }
-  state.SetLabel(to_string(dst.kind()));
+  state.SetLabel(to_string(dst.kind()) + ", supersampling " + std::to_string(state.range(1)));
   state.counters["texels"] = double(dst.texel_count());
 }
 
 BENCHMARK(BM_OpenCvRemap)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Resample)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MinTime(0.5);
+BENCHMARK(BM_Resample)->ArgsProduct({{0, 1, 2}, {1, 4}})->Unit(benchmark::kMillisecond)->MinTime(0.5);
 
 }  // namespace
 }  // namespace rsibr
