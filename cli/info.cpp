@@ -136,15 +136,20 @@ int info_map_set(const InfoArgs& a) {
   j["height"] = set.height();
   j["triangles"] = vs.triangles().size();
   j["surrounds_sphere"] = vs.surrounds();
+  j["colour"] = "linear Rec.709 D65";
   std::ostream& text = a.json == "-" ? std::cerr : std::cout;
   text << a.input << ": map set, " << set.views.size() << " views of " << set.width() << "x" << set.height()
-            << ", " << vs.triangles().size() << " triangles, "
+            << ", linear Rec.709 D65, " << vs.triangles().size() << " triangles, "
             << (vs.surrounds() ? "surrounds the sphere" : "does not surround the sphere") << "\n";
   nlohmann::json views = nlohmann::json::array();
   for (std::size_t i = 0; i < set.views.size(); ++i) {
     const MapView& v = set.views[i];
     nlohmann::json jv;
     jv["view"] = {v.view.x(), v.view.y(), v.view.z()};
+    nlohmann::json T = nlohmann::json::array();
+    for (int r = 0; r < 3; ++r) T.push_back({v.world_from_view(r, 0), v.world_from_view(r, 1), v.world_from_view(r, 2)});
+    jv["world_from_view"] = T;
+    jv["channels"] = v.confidence.empty() ? "R G B" : "R G B confidence";
     jv["warp"] = v.warp;
     jv["source"] = v.source;
     jv["material"] = v.material;
@@ -153,7 +158,8 @@ int info_map_set(const InfoArgs& a) {
     jv["attributes"] = v.attributes;
     std::ostringstream line;
     line << std::fixed << std::setprecision(4) << "  view." << std::setw(3) << std::setfill('0') << i
-         << std::setfill(' ') << "  v=(" << v.view.x() << ", " << v.view.y() << ", " << v.view.z() << ")  " << v.warp
+         << std::setfill(' ') << "  v=(" << v.view.x() << ", " << v.view.y() << ", " << v.view.z() << ")  up=("
+         << v.world_from_view(0, 1) << ", " << v.world_from_view(1, 1) << ", " << v.world_from_view(2, 1) << ")  " << v.warp
          << "  " << v.source << (v.confidence.empty() ? "" : "  +confidence");
     const std::string first_line = v.material.substr(0, v.material.find('\n'));
     if (!first_line.empty()) line << "  material: " << first_line;

@@ -3,6 +3,7 @@
 #include "cli/verbs.h"
 
 #include "core/exr_io.h"
+#include "core/map_set.h"
 #include "core/patterns.h"
 
 #include <cmath>
@@ -13,7 +14,7 @@ namespace rsibr::cli {
 namespace {
 
 struct PatternArgs {
-  std::string kind = "direction", to = "latlong", output, json;
+  std::string kind = "direction", to = "latlong", output, json, views;
   int size = 256;
   double sun_intensity = 1e5, sun_radius_deg = 0.27, checker_deg = 10;
   std::vector<double> sun_dir{0.3, 0.6, -0.5};
@@ -35,6 +36,34 @@ int run_pattern(const PatternArgs& a) {
                               Vec3(0.9, 0.9, 0.85));
   } else {
     throw std::invalid_argument("unknown pattern '" + a.kind + "' (direction, white, checker, sun-sky)");
+  }
+  if (!a.views.empty()) {
+    // A computed map set of a perfect mirror without Fresnel: view independent, so any view's map
+    // is exactly known. Texel p of view v holds L(T_v g_mirror(p)); the sphere layout's direction
+    // is g_mirror in the view frame, so each map is the pattern rotated into that frame.
+    const ViewSet set = ViewSet::named(a.views);
+    const Layout sphere = Layout::with_size(LayoutKind::Sphere, a.size);
+    MapSet maps;
+    for (const Vec3& v : set.views()) {
+      MapView mv;
+      mv.view = v;
+      mv.world_from_view = world_from_view_for(v);
+      mv.warp = "mirror";
+      mv.source = "computed";
+      mv.material = "type: mirror  # perfect mirror, no Fresnel (rsibr pattern " + a.kind + ")";
+      mv.attributes["version"] = RSIBR_VERSION;
+      const Mat3 T = mv.world_from_view;
+      mv.rgb = render_pattern([&](const Vec3& d) { return f(T * d); }, sphere, a.subsamples).pixels;
+      maps.views.push_back(std::move(mv));
+    }
+    write_map_set(a.output, maps);
+    nlohmann::json j;
+    j["output"] = a.output;
+    j["pattern"] = a.kind;
+    j["views"] = maps.views.size();
+    j["size"] = a.size;
+    write_summary(a.json, j);
+    return 0;
   }
   const Layout layout = Layout::with_size(parse_layout_kind(a.to), a.size);
   int m = a.subsamples;
@@ -75,6 +104,9 @@ Runner add_pattern(CLI::App& app) {
   c->add_option("--sun-radius", a->sun_radius_deg, "sun-sky: sun angular radius in degrees")->check(CLI::Range(1e-4, 90.0));
   c->add_option("--sun-dir", a->sun_dir, "sun-sky: direction toward the sun (world, +Y up)")->expected(3);
   c->add_option("--checker", a->checker_deg, "checker: square size in degrees")->check(CLI::Range(0.01, 180.0));
+  c->add_option("--map-set", a->views,
+                "Write instead a map set of a perfect mirror (no Fresnel) lit by the pattern, one sphere map per view "
+                "of this view set (icosa, 42, 162, 642 or a file of 'x y z' lines)");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   return [a] { return run_pattern(*a); };
 }

@@ -61,6 +61,11 @@ done
 "$rsibr" convert "$work/sky.exr" "$work/again.exr" --to octahedral -q
 check "same input, same bytes" cmp -s "$work/octahedral.exr" "$work/again.exr"
 check "info --json - is pure JSON" bash -c "'$rsibr' info '$work/cube.exr' --json - 2>/dev/null | python3 -m json.tool >/dev/null"
+"$rsibr" pattern direction "$work/mirror.exr" --map-set icosa --size 32 >/dev/null
+check "map-set info lists 12 views and 20 triangles" bash -c "'$rsibr' info '$work/mirror.exr' | grep -q '12 views.*20 triangles'"
+check "map-set info JSON has frames" bash -c "'$rsibr' info '$work/mirror.exr' --json - 2>/dev/null | python3 -c 'import json,sys; j=json.load(sys.stdin); assert len(j[\"parts\"][0][\"world_from_view\"]) == 3'"
+printf '1 0 0\n0 1 0\nnot a view\n' >"$work/views.txt"
+expect_error "malformed view file" "views.txt:3" pattern direction "$work/bad-set.exr" --map-set "$work/views.txt"
 check "no temporaries after success" no_temporaries "$work"
 
 echo "cli: $pass passed, $fail failed"
