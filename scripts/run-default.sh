@@ -17,7 +17,8 @@ env=cache/assets/hdri/sky.exr
 mkdir -p "$out"
 "$rsibr" info "$env" --json "$out/sky-info.json"
 for layout in cube octahedral sphere latlong; do
-  "$rsibr" convert "$env" "$out/sky-$layout.exr" --to "$layout" --preview "$out/sky-$layout.png" \
+  # --sanitize: the CC0 maps are DWAB-compressed and ring to negative values around the sun.
+  "$rsibr" convert "$env" "$out/sky-$layout.exr" --to "$layout" --sanitize --preview "$out/sky-$layout.png" \
     --json "$out/sky-$layout.json"
 done
 "$rsibr" info "$out/sky-octahedral.exr"
