@@ -1,0 +1,136 @@
+#include "runtime/warp.h"
+
+#include "analytic_map_set.h"
+#include "core/sphere_map.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace rsibr {
+namespace {
+
+using testing::random_directions;
+
+// A random rotation (world_from_view for a random view and a random up).
+Mat3 random_frame(std::mt19937& rng) {
+  std::normal_distribution<double> g;
+  return world_from_view_for(Vec3(g(rng), g(rng), g(rng)), Vec3(g(rng), g(rng), g(rng)));
+}
+
+TEST(Warp, WarpDirectionAgreesBitwiseWithCoreInverses) {
+  for (const Vec3& d : random_directions(2000, 1)) {
+    const WarpSample m = warp_direction(WarpKind::Mirror, d);
+    const Vec2 core_m = sphere_map::g_mirror_inv(d);
+    EXPECT_EQ(m.disc.x(), core_m.x());
+    EXPECT_EQ(m.disc.y(), core_m.y());
+    // rim = z of the half vector = sqrt(1 - |disc|^2) = sin(phi/2), phi = angle(d, -z).
+    EXPECT_NEAR(m.rim, std::sin(0.5 * angle_between(d, Vec3(0, 0, -1))), 1e-12);
+    const WarpSample n = warp_direction(WarpKind::Normal, d);
+    const Vec2 core_n = sphere_map::g_normal_inv(d);
+    EXPECT_EQ(n.disc.x(), core_n.x());
+    EXPECT_EQ(n.disc.y(), core_n.y());
+    EXPECT_NEAR(n.rim, d.z(), 1e-15);
+  }
+}
+
+TEST(Warp, SingularDirectionsGiveAFixedRimPointWithZeroRim) {
+  const WarpSample m = warp_direction(WarpKind::Mirror, Vec3(0, 0, -1));
+  EXPECT_EQ(m.disc, Vec2(0, -1));
+  EXPECT_EQ(m.rim, 0.0);
+  const WarpSample n = warp_direction(WarpKind::Normal, Vec3(0, 0, -2));
+  EXPECT_EQ(n.disc, Vec2(0, -1));
+  EXPECT_EQ(n.rim, -1.0);
+  const WarpSample z = warp_direction(WarpKind::Mirror, Vec3(0, 0, 0));
+  EXPECT_TRUE(z.disc.allFinite());
+  EXPECT_EQ(z.rim, 0.0);
+}
+
+// The invariant itself: the destination texel and the source point it warps to have the same
+// central direction in world space (mirror direction for the mirror warp, normal for the normal warp).
+TEST(Warp, ExactWarpLandsWhereTheSourceShowsTheSameCentralDirection) {
+  std::mt19937 rng(7);
+  const ExactWarp warp;
+  const int W = 48, H = 48;
+  for (int trial = 0; trial < 20; ++trial) {
+    const Mat3 T_d = random_frame(rng), T_s = random_frame(rng);
+    for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal}) {
+      for (int r = 0; r < H; ++r) {
+        const auto [c0, c1] = disc_span(r, W, H);
+        std::vector<WarpSample> out(std::size_t(std::max(0, c1 - c0)));
+        warp.warp_row(kind, T_s.transpose() * T_d, W, H, r, c0, c1, out.data());
+        for (int c = c0; c < c1; ++c) {
+          const WarpSample& s = out[std::size_t(c - c0)];
+          ASSERT_LE(s.disc.squaredNorm(), 1.0 + 1e-12);
+          if (s.rim < 1e-3) continue;  // near the singularity the disc point is ill-conditioned
+          const Vec3 dest = T_d * central_direction(kind, sphere_map::disc_from_pixel(Vec2(c, r), W, H));
+          const Vec3 src = T_s * central_direction(kind, s.disc);
+          ASSERT_LT((dest - src).norm(), 1e-9) << to_string(kind) << " texel " << c << "," << r;
+        }
+      }
+    }
+  }
+}
+
+TEST(Warp, IdentityFrameMapsEveryTexelCentreToItself) {
+  const ExactWarp warp;
+  const int W = 64, H = 64;
+  for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal})
+    for (int r = 0; r < H; ++r) {
+      const auto [c0, c1] = disc_span(r, W, H);
+      std::vector<WarpSample> out(std::size_t(std::max(0, c1 - c0)));
+      warp.warp_row(kind, Mat3::Identity(), W, H, r, c0, c1, out.data());
+      for (int c = c0; c < c1; ++c) {
+        const Vec2 p = sphere_map::pixel_from_disc(out[std::size_t(c - c0)].disc, W, H);
+        ASSERT_NEAR(p.x(), c, 1e-9);
+        ASSERT_NEAR(p.y(), r, 1e-9);
+      }
+    }
+}
+
+TEST(Warp, DiscSpanHoldsExactlyTheTexelsWhoseCentreIsInsideTheDisc) {
+  for (auto [W, H] : {std::pair{64, 64}, std::pair{33, 33}, std::pair{40, 24}, std::pair{2, 2}, std::pair{1, 1}})
+    for (int r = 0; r < H; ++r) {
+      const auto [c0, c1] = disc_span(r, W, H);
+      for (int c = 0; c < W; ++c) {
+        const bool inside = sphere_map::disc_from_pixel(Vec2(c, r), W, H).squaredNorm() <= 1.0;
+        EXPECT_EQ(inside, c >= c0 && c < c1) << W << "x" << H << " texel " << c << "," << r;
+      }
+    }
+}
+
+TEST(Warp, PrecomputedWarpMatchesExactWarp) {
+  std::mt19937 rng(11);
+  const ExactWarp exact;
+  for (auto [W, H] : {std::pair{64, 64}, std::pair{37, 29}}) {
+    const PrecomputedWarp pre(W, H);
+    EXPECT_TRUE(pre.supports(W, H));
+    EXPECT_FALSE(pre.supports(W + 1, H));
+    double worst = 0;
+    for (int trial = 0; trial < 10; ++trial) {
+      const Mat3 M = random_frame(rng).transpose() * random_frame(rng);
+      for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal})
+        for (int r = 0; r < H; ++r) {
+          const auto [c0, c1] = disc_span(r, W, H);
+          std::vector<WarpSample> a(std::size_t(std::max(0, c1 - c0))), b(a.size());
+          exact.warp_row(kind, M, W, H, r, c0, c1, a.data());
+          pre.warp_row(kind, M, W, H, r, c0, c1, b.data());
+          for (std::size_t i = 0; i < a.size(); ++i) {
+            worst = std::max({worst, (a[i].disc - b[i].disc).norm(), std::abs(a[i].rim - b[i].rim)});
+          }
+        }
+    }
+    EXPECT_LE(worst, 1e-12) << W << "x" << H;  // same arithmetic: bitwise in practice
+    std::vector<WarpSample> out(4);
+    EXPECT_THROW(pre.warp_row(WarpKind::Mirror, Mat3::Identity(), W + 2, H, 0, 0, 1, out.data()), std::invalid_argument);
+  }
+}
+
+TEST(Warp, UnknownWarpNameIsAnError) {
+  EXPECT_EQ(warp_kind_from_string("mirror"), WarpKind::Mirror);
+  EXPECT_EQ(warp_kind_from_string("normal"), WarpKind::Normal);
+  EXPECT_THROW(warp_kind_from_string("Mirror"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace rsibr
