@@ -1,0 +1,215 @@
+#include "bake/brdf_spec.h"
+
+#include "bake/blinn_phong.h"
+#include "bake/clear_coat.h"
+#include "bake/ggx.h"
+#include "bake/lambert.h"
+#include "bake/phong.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+namespace rsibr {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+  throw std::invalid_argument(path + ": " + what);
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+// A mapping node with its key path; checks keys against the allowed set up front.
+class MapSpec {
+ public:
+  MapSpec(const YAML::Node& node, std::string path, const std::vector<std::string>& allowed)
+      : node_(node), path_(std::move(path)) {
+    if (!node_ || !node_.IsMap()) fail(path_, "expected a mapping");
+    for (const auto& kv : node_) {
+      if (!kv.first.IsScalar()) fail(path_, "keys must be strings");
+      const std::string key = kv.first.as<std::string>();
+      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
+        fail(at(key), "unknown key (expected one of: " + join(allowed) + ")");
+    }
+  }
+
+  std::string at(const std::string& key) const { return path_ + "." + key; }
+
+  YAML::Node get(const std::string& key) const {
+    const YAML::Node v = node_[key];
+    if (!v || v.IsNull()) fail(at(key), "missing");
+    return v;
+  }
+
+  std::string string(const std::string& key) const {
+    const YAML::Node v = get(key);
+    if (!v.IsScalar()) fail(at(key), "expected a string");
+    return v.as<std::string>();
+  }
+
+  double number(const std::string& key) const { return as_number(get(key), at(key)); }
+
+  Vec3 rgb(const std::string& key) const {
+    const YAML::Node v = get(key);
+    if (!v.IsSequence() || v.size() != 3) fail(at(key), "expected a sequence of 3 numbers");
+    Vec3 c;
+    for (std::size_t i = 0; i < 3; ++i) c[int(i)] = as_number(v[i], at(key) + "[" + std::to_string(i) + "]");
+    return c;
+  }
+
+  static double as_number(const YAML::Node& v, const std::string& path) {
+    if (!v.IsScalar()) fail(path, "expected a number");
+    double x;
+    try {
+      x = v.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(path, "expected a number, got '" + v.as<std::string>() + "'");
+    }
+    if (!std::isfinite(x)) fail(path, "must be finite");
+    return x;
+  }
+
+ private:
+  YAML::Node node_;
+  std::string path_;
+};
+
+std::string fmt(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
+double in_range(double x, const std::string& path, double lo, bool lo_open, double hi, bool hi_open) {
+  const bool ok = (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi);
+  if (!ok) {
+    const std::string range = std::string(lo_open ? "(" : "[") + fmt(lo) + "," +
+                              (std::isinf(hi) ? "inf" : fmt(hi)) + (hi_open ? ")" : "]");
+    fail(path, "must be in " + range + ", got " + fmt(x));
+  }
+  return x;
+}
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double roughness(const MapSpec& m) { return in_range(m.number("roughness"), m.at("roughness"), 0, true, 1, false); }
+double positive(const MapSpec& m, const std::string& key) {
+  return in_range(m.number(key), m.at(key), 0, true, kInf, true);
+}
+Vec3 rgb_in(const MapSpec& m, const std::string& key, double lo, bool lo_open, double hi, bool hi_open) {
+  const Vec3 c = m.rgb(key);
+  for (int i = 0; i < 3; ++i) in_range(c[i], m.at(key) + "[" + std::to_string(i) + "]", lo, lo_open, hi, hi_open);
+  return c;
+}
+Vec3 unit_rgb(const MapSpec& m, const std::string& key) { return rgb_in(m, key, 0, false, 1, false); }
+
+// The "type" of a mapping, read before its other keys are checked.
+std::string type_of(const YAML::Node& node, const std::string& path, const std::vector<std::string>& types) {
+  if (!node || !node.IsMap()) fail(path, "expected a mapping");
+  const YAML::Node t = node["type"];
+  if (!t || t.IsNull()) fail(path + ".type", "missing");
+  if (!t.IsScalar()) fail(path + ".type", "expected a string");
+  const std::string type = t.as<std::string>();
+  if (std::find(types.begin(), types.end(), type) == types.end())
+    fail(path + ".type", "unknown type '" + type + "' (expected one of: " + join(types) + ")");
+  return type;
+}
+
+}  // namespace
+
+std::shared_ptr<const Fresnel> make_fresnel(const YAML::Node& spec, const std::string& path) {
+  const std::string type = type_of(spec, path, {"none", "schlick", "dielectric", "conductor"});
+  if (type == "none") {
+    MapSpec m(spec, path, {"type"});
+    return std::make_shared<NoFresnel>();
+  }
+  if (type == "schlick") {
+    MapSpec m(spec, path, {"type", "f0"});
+    return std::make_shared<SchlickFresnel>(unit_rgb(m, "f0"));
+  }
+  if (type == "dielectric") {
+    MapSpec m(spec, path, {"type", "ior"});
+    return std::make_shared<DielectricFresnel>(positive(m, "ior"));
+  }
+  MapSpec m(spec, path, {"type", "eta", "k"});
+  return std::make_shared<ConductorFresnel>(rgb_in(m, "eta", 0, true, kInf, true),
+                                            rgb_in(m, "k", 0, false, kInf, true));
+}
+
+std::unique_ptr<Brdf> make_brdf(const YAML::Node& spec, const std::string& path) {
+  const std::string type = type_of(spec, path, {"lambert", "phong", "blinn_phong", "ggx", "clearcoat"});
+  if (type == "lambert") {
+    MapSpec m(spec, path, {"type", "albedo"});
+    return std::make_unique<LambertBrdf>(unit_rgb(m, "albedo"));
+  }
+  if (type == "phong" || type == "blinn_phong") {
+    MapSpec m(spec, path, {"type", "albedo", "exponent"});
+    const Vec3 rho = unit_rgb(m, "albedo");
+    const double e = positive(m, "exponent");
+    if (type == "phong") return std::make_unique<PhongBrdf>(rho, e);
+    return std::make_unique<BlinnPhongBrdf>(rho, e);
+  }
+  if (type == "ggx") {
+    MapSpec m(spec, path, {"type", "roughness", "fresnel"});
+    const double a = roughness(m);
+    return std::make_unique<GgxBrdf>(a, make_fresnel(m.get("fresnel"), m.at("fresnel")));
+  }
+  MapSpec m(spec, path, {"type", "coat", "flakes", "base"});
+  ClearCoatParams p;
+  {
+    MapSpec coat(m.get("coat"), m.at("coat"), {"ior", "roughness"});
+    p.coat_ior = in_range(coat.number("ior"), coat.at("ior"), 1, true, kInf, true);
+    p.coat_roughness = roughness(coat);
+  }
+  {
+    MapSpec flakes(m.get("flakes"), m.at("flakes"), {"coverage", "roughness", "fresnel"});
+    p.flake_coverage = in_range(flakes.number("coverage"), flakes.at("coverage"), 0, false, 1, false);
+    p.flake_roughness = roughness(flakes);
+    p.flake_fresnel = make_fresnel(flakes.get("fresnel"), flakes.at("fresnel"));
+  }
+  {
+    MapSpec base(m.get("base"), m.at("base"), {"albedo"});
+    p.base_albedo = unit_rgb(base, "albedo");
+  }
+  return std::make_unique<ClearCoatBrdf>(std::move(p));
+}
+
+std::unique_ptr<Brdf> parse_brdf(const std::string& yaml_text) {
+  YAML::Node node;
+  try {
+    node = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument("brdf: invalid YAML: " + e.msg);
+  }
+  return make_brdf(node);
+}
+
+std::unique_ptr<Brdf> load_brdf(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::invalid_argument(file.string() + ": cannot read BRDF spec");
+  std::ostringstream text;
+  text << in.rdbuf();
+  YAML::Node node;
+  try {
+    node = YAML::Load(text.str());
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(file.string() + ":" + std::to_string(e.mark.line + 1) + ":" +
+                                std::to_string(e.mark.column + 1) + ": invalid YAML: " + e.msg);
+  }
+  try {
+    return make_brdf(node);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(file.string() + ": " + e.what());
+  }
+}
+
+}  // namespace rsibr
