@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   runners["convert"] = rsibr::cli::add_convert(app);
   runners["info"] = rsibr::cli::add_info(app);
   runners["pattern"] = rsibr::cli::add_pattern(app);
+  runners["blend"] = rsibr::cli::add_blend(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

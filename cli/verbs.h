@@ -12,5 +12,6 @@ using Runner = std::function<int()>;
 Runner add_convert(CLI::App& app);
 Runner add_info(CLI::App& app);
 Runner add_pattern(CLI::App& app);
+Runner add_blend(CLI::App& app);
 
 }  // namespace rsibr::cli

@@ -25,7 +25,7 @@ expect_error() {
 }
 no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
 
-for verb in convert info pattern; do
+for verb in convert info pattern blend; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
 done
 check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
@@ -66,6 +66,11 @@ check "map-set info lists 12 views and 20 triangles" bash -c "'$rsibr' info '$wo
 check "map-set info JSON has frames" bash -c "'$rsibr' info '$work/mirror.exr' --json - 2>/dev/null | python3 -c 'import json,sys; j=json.load(sys.stdin); assert len(j[\"parts\"][0][\"world_from_view\"]) == 3'"
 printf '1 0 0\n0 1 0\nnot a view\n' >"$work/views.txt"
 expect_error "malformed view file" "views.txt:3" pattern direction "$work/bad-set.exr" --map-set "$work/views.txt"
+"$rsibr" blend "$work/mirror.exr" "$work/novel.exr" --view 0.3 0.5 0.8 --preview "$work/novel.png" >/dev/null
+check "blend writes a one-view map set with confidence" bash -c "'$rsibr' info '$work/novel.exr' | grep -q '1 views.*' && '$rsibr' info '$work/novel.exr' | grep -q confidence"
+expect_error "blend with a zero view" "non-zero" blend "$work/mirror.exr" "$work/novel2.exr" --view 0 0 0
+expect_error "blend of a plain environment" "view.000" blend "$work/sky.exr" "$work/novel3.exr"
+check "no output from failed blends" test ! -e "$work/novel2.exr" -a ! -e "$work/novel3.exr"
 check "no temporaries after success" no_temporaries "$work"
 
 echo "cli: $pass passed, $fail failed"
