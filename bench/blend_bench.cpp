@@ -3,6 +3,7 @@
 // lookups per texel, no warp maths, no fades), in the same run.
 #include "core/patterns.h"
 #include "runtime/blend.h"
+#include "runtime/tessellated_warp.h"
 
 #include <benchmark/benchmark.h>
 #include <opencv2/imgproc.hpp>
@@ -17,7 +18,8 @@ const MapSet& mirror_set(int size) {
   if (it != cache.end()) return it->second;
   MapSet set;
   const auto f = patterns::direction_coded();
-  for (const Vec3& v : ViewSet::icosahedron().views()) {
+  const ViewSet icosa = ViewSet::icosahedron();  // named: views() refers into it
+  for (const Vec3& v : icosa.views()) {
     MapView mv;
     mv.view = v;
     mv.world_from_view = world_from_view_for(v);
@@ -50,21 +52,24 @@ void BM_RemapThreeMaps(benchmark::State& state) {
 
 void BM_Blend(benchmark::State& state) {
   const int n = int(state.range(0));
-  const bool precomputed = state.range(1) != 0;
+  const int kind = int(state.range(1));  // 0 exact, 1 precomputed, 2 tessellated (16 x 64)
   const MapSet& set = mirror_set(n);
   const ViewSet views = set.view_set();
   const PrecomputedWarp table(n, n);
+  const TessellatedWarp mesh(n, n);
   BlendOptions options;
-  if (precomputed) options.warp = &table;
+  if (kind == 1) options.warp = &table;
+  if (kind == 2) options.warp = &mesh;
   for (auto _ : state) {
     BlendResult r = blend(set, views, kView, Vec3(0, 1, 0), options);
     benchmark::DoNotOptimize(r.rgb.data);
   }
-  state.SetLabel(std::to_string(n) + "^2, " + (precomputed ? "precomputed directions" : "exact warp"));
+  const char* names[] = {"exact warp", "precomputed directions", "tessellated disk 16x64"};
+  state.SetLabel(std::to_string(n) + "^2, " + names[kind]);
 }
 
 BENCHMARK(BM_RemapThreeMaps)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Blend)->ArgsProduct({{256, 512}, {0, 1}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Blend)->ArgsProduct({{256, 512}, {0, 1, 2}})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace rsibr

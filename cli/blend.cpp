@@ -7,6 +7,7 @@
 #include "core/colour.h"
 #include "core/map_set.h"
 #include "runtime/blend.h"
+#include "runtime/tessellated_warp.h"
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -21,6 +22,7 @@ struct BlendArgs {
   std::string maps, output, warp = "precomputed", preview, json;
   std::vector<double> view{0, 0, 1}, up{0, 1, 0};
   int size = 0;
+  int rings = 16;
   double rim_fade = 0.4;
   float preview_exposure = 0.f;
 };
@@ -36,13 +38,15 @@ int run_blend(const BlendArgs& a) {
   options.width = w;
   options.height = h;
   options.rim_fade = a.rim_fade;
-  std::unique_ptr<PrecomputedWarp> table;
+  std::unique_ptr<Warp> warp;
   if (a.warp == "precomputed") {
-    table = std::make_unique<PrecomputedWarp>(w, h);
-    options.warp = table.get();
+    warp = std::make_unique<PrecomputedWarp>(w, h);
+  } else if (a.warp == "tessellated") {
+    warp = std::make_unique<TessellatedWarp>(w, h, TessellationOptions{a.rings, 4 * a.rings});
   } else if (a.warp != "exact") {
-    throw std::invalid_argument("--warp must be 'exact' or 'precomputed', not '" + a.warp + "'");
+    throw std::invalid_argument("--warp must be 'exact', 'precomputed' or 'tessellated', not '" + a.warp + "'");
   }
+  options.warp = warp.get();
   const auto t0 = std::chrono::steady_clock::now();
   const BlendResult r = blend(set, views, view, up, options);
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -101,7 +105,10 @@ Runner add_blend(CLI::App& app) {
   c->add_option("--view", a->view, "View direction (world, toward the viewer)")->expected(3);
   c->add_option("--up", a->up, "Up hint for the view frame (world)")->expected(3);
   c->add_option("--size", a->size, "Output map size (default: the map set's)")->check(CLI::Range(2, 8192));
-  c->add_option("--warp", a->warp, "exact or precomputed (per-texel directions cached; same result)");
+  c->add_option("--warp", a->warp,
+                "exact, precomputed (per-texel directions cached; same result) or tessellated (the paper's mesh: "
+                "vertices warped exactly, texture coordinates interpolated)");
+  c->add_option("--rings", a->rings, "tessellated: rings of the disc mesh (4x as many segments)")->check(CLI::Range(1, 1024));
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--preview", a->preview, "Also write a display-encoded PNG");
   c->add_option("--preview-exposure", a->preview_exposure, "Exposure of the preview in stops");

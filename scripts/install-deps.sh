@@ -10,6 +10,8 @@ packages=(
   libeigen3-dev libtbb-dev libopenexr-dev libimath-dev libopencolorio-dev
   libopencv-dev
   libcli11-dev libyaml-cpp-dev nlohmann-json3-dev
+  # meshes (core/mesh.cpp)
+  libtinyobjloader-dev libtinygltf-dev libdraco-dev
   # bake / capture / calib / hdr
   libqhull-dev
   libembree-dev libceres-dev libmrcal-dev libmrgingham-dev mrgingham mrcal libexiv2-dev

@@ -68,6 +68,9 @@ printf '1 0 0\n0 1 0\nnot a view\n' >"$work/views.txt"
 expect_error "malformed view file" "views.txt:3" pattern direction "$work/bad-set.exr" --map-set "$work/views.txt"
 "$rsibr" blend "$work/mirror.exr" "$work/novel.exr" --view 0.3 0.5 0.8 --preview "$work/novel.png" >/dev/null
 check "blend writes a one-view map set with confidence" bash -c "'$rsibr' info '$work/novel.exr' | grep -q '1 views.*' && '$rsibr' info '$work/novel.exr' | grep -q confidence"
+"$rsibr" blend "$work/mirror.exr" "$work/novel-t.exr" --view 0.3 0.5 0.8 --warp tessellated >/dev/null
+check "blend with the tessellated warp" test -s "$work/novel-t.exr"
+expect_error "blend with an unknown warp" "tessellated" blend "$work/mirror.exr" "$work/novel4.exr" --warp fancy
 expect_error "blend with a zero view" "non-zero" blend "$work/mirror.exr" "$work/novel2.exr" --view 0 0 0
 expect_error "blend of a plain environment" "view.000" blend "$work/sky.exr" "$work/novel3.exr"
 check "no output from failed blends" test ! -e "$work/novel2.exr" -a ! -e "$work/novel3.exr"
