@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   runners["info"] = rsibr::cli::add_info(app);
   runners["pattern"] = rsibr::cli::add_pattern(app);
   runners["blend"] = rsibr::cli::add_blend(app);
+  runners["bake"] = rsibr::cli::add_bake(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -13,5 +13,6 @@ Runner add_convert(CLI::App& app);
 Runner add_info(CLI::App& app);
 Runner add_pattern(CLI::App& app);
 Runner add_blend(CLI::App& app);
+Runner add_bake(CLI::App& app);
 
 }  // namespace rsibr::cli

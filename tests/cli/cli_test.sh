@@ -25,7 +25,7 @@ expect_error() {
 }
 no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
 
-for verb in convert info pattern blend; do
+for verb in convert info pattern blend bake; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
 done
 check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
@@ -74,6 +74,20 @@ expect_error "blend with an unknown warp" "tessellated" blend "$work/mirror.exr"
 expect_error "blend with a zero view" "non-zero" blend "$work/mirror.exr" "$work/novel2.exr" --view 0 0 0
 expect_error "blend of a plain environment" "view.000" blend "$work/sky.exr" "$work/novel3.exr"
 check "no output from failed blends" test ! -e "$work/novel2.exr" -a ! -e "$work/novel3.exr"
+# bake: a small GGX map set, deterministic bytes, strict specs.
+printf 'type: ggx\nroughness: 0.3\nfresnel: {type: schlick, f0: [0.9, 0.7, 0.4]}\n' >"$work/ggx.yaml"
+printf 'type: lambert\nalbedo: [0.18, 0.18, 0.18]\n' >"$work/grey.yaml"
+printf 'type: ggx\nroughnes: 0.3\n' >"$work/typo.yaml"
+for i in 1 2; do
+  "$rsibr" bake --env "$work/sky.exr" --brdf "$work/ggx.yaml" --views icosa --res 16 --method mis --samples 8 --seed 7 -q "$work/baked$i.exr"
+done
+check "bake: same seed, same bytes" cmp -s "$work/baked1.exr" "$work/baked2.exr"
+check "bake: a 12-view mirror-warped map set" bash -c "'$rsibr' info '$work/baked1.exr' | grep -q '12 views.*20 triangles' && '$rsibr' info '$work/baked1.exr' | grep -q 'mirror  computed'"
+"$rsibr" bake --env "$work/sky.exr" --brdf "$work/grey.yaml" --views icosa --res 16 --method sh -q "$work/grey.exr"
+check "bake: lambert is normal-warped" bash -c "'$rsibr' info '$work/grey.exr' | grep -q 'normal  computed'"
+expect_error "bake: unknown spec key" "roughnes" bake --env "$work/sky.exr" --brdf "$work/typo.yaml" --res 16 "$work/typo.exr"
+expect_error "bake: sh needs lambert" "lambert" bake --env "$work/sky.exr" --brdf "$work/ggx.yaml" --res 16 --method sh "$work/sh.exr"
+check "bake: no output after errors" test ! -e "$work/typo.exr" -a ! -e "$work/sh.exr"
 check "no temporaries after success" no_temporaries "$work"
 
 echo "cli: $pass passed, $fail failed"

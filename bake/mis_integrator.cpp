@@ -1,0 +1,63 @@
+#include "bake/mis_integrator.h"
+
+#include "core/resample.h"
+
+#include <stdexcept>
+
+namespace rsibr {
+
+EnvMap as_latlong(const EnvMap& env) {
+  if (env.layout.kind() == LayoutKind::LatLong) return env;
+  // About as many texels as the source.
+  const int h = std::max(4, int(std::lround(std::sqrt(double(env.layout.texel_count()) / 2.0))));
+  return resample(env, Layout(LayoutKind::LatLong, 2 * h, h));
+}
+
+MisIntegrator::MisIntegrator(const EnvMap& env) : env_(as_latlong(env)), dist_(env_) {
+  const int ch = env_.channels();
+  radiance_.resize(std::size_t(env_.layout.texel_count()));
+  for (int r = 0; r < env_.layout.height(); ++r) {
+    const float* row = env_.pixels.ptr<float>(r);
+    for (int c = 0; c < env_.layout.width(); ++c)
+      radiance_[std::size_t(r) * env_.layout.width() + c] = Vec3(row[c * ch], row[c * ch + 1], row[c * ch + 2]);
+  }
+}
+
+cv::Mat MisIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Mat3& world_from_view, int size,
+                                    const IntegratorOptions& options,
+                                    const std::function<void(int)>& progress) const {
+  if (options.samples < 1) throw std::invalid_argument("mis: samples must be >= 1");
+  const int n = options.samples;
+  return integrator_detail::for_each_texel(
+      size, view, world_from_view,
+      [&](long index, const Vec3&, const Mat3& frame, const Vec3& wo) {
+        // Stratified: a Hammersley set per sampler, rotated by the texel's own random shifts.
+        integrator_detail::TexelRng rng(options.seed, std::uint64_t(index));
+        const Vec2 shift_b = rng.uniform2(), shift_e = rng.uniform2();
+        Vec3 sum = Vec3::Zero();
+        for (int i = 0; i < n; ++i) {
+          // BRDF sample.
+          const BrdfSample b = brdf.sample(wo, integrator_detail::rotated_hammersley(i, n, shift_b));
+          if (b.valid) {
+            const Vec3 w = frame * b.wi;
+            const double pe = dist_.pdf(w);
+            const Vec3 f = brdf.eval(wo, b.wi);
+            sum += f.cwiseProduct(radiance_[std::size_t(dist_.texel_of(w))]) / (b.pdf + pe);
+          }
+          // Environment sample.
+          const EnvironmentDistribution::Sample e = dist_.sample(integrator_detail::rotated_hammersley(i, n, shift_e));
+          if (e.pdf > 0) {
+            const Vec3 wi = frame.transpose() * e.dir;
+            if (wi.z() > 0) {
+              const Vec3 f = brdf.eval(wo, wi);
+              if (f != Vec3::Zero())
+                sum += f.cwiseProduct(radiance_[std::size_t(e.texel)]) / (brdf.pdf(wo, wi) + e.pdf);
+            }
+          }
+        }
+        return Vec3(sum / n);
+      },
+      progress);
+}
+
+}  // namespace rsibr

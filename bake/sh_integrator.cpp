@@ -1,0 +1,60 @@
+#include "bake/sh_integrator.h"
+
+#include "bake/lambert.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace rsibr {
+
+std::array<double, 9> ShIntegrator::basis(const Vec3& d) {
+  const double x = d.x(), y = d.y(), z = d.z();
+  // Normalisation constants in full precision: sqrt(1/4pi), sqrt(3/4pi), sqrt(15/4pi),
+  // sqrt(5/16pi), sqrt(15/16pi) (R&H print them rounded to 6 digits).
+  static const double k0 = std::sqrt(1 / (4 * kPi)), k1 = std::sqrt(3 / (4 * kPi)), k2 = std::sqrt(15 / (4 * kPi)),
+                      k20 = std::sqrt(5 / (16 * kPi)), k22 = std::sqrt(15 / (16 * kPi));
+  return {k0, k1 * y, k1 * z, k1 * x, k2 * x * y, k2 * y * z, k20 * (3 * z * z - 1), k2 * x * z, k22 * (x * x - y * y)};
+}
+
+ShIntegrator::ShIntegrator(const EnvMap& env) {
+  const Layout& l = env.layout;
+  const int ch = env.channels();
+  if (ch < 3) throw std::invalid_argument("sh: the environment needs 3 channels");
+  for (auto& c : coeffs_) c = Vec3::Zero();
+  for (int r = 0; r < l.height(); ++r) {
+    const float* row = env.pixels.ptr<float>(r);
+    for (int c = 0; c < l.width(); ++c) {
+      const auto d = l.texel_direction(c, r);
+      const double omega = l.texel_solid_angle(c, r);
+      if (!d || !(omega > 0)) continue;
+      const Vec3 L = Vec3(row[c * ch], row[c * ch + 1], row[c * ch + 2]) * omega;
+      const auto y = basis(d->normalized());
+      for (int k = 0; k < 9; ++k) coeffs_[std::size_t(k)] += L * y[std::size_t(k)];
+    }
+  }
+}
+
+Vec3 ShIntegrator::irradiance(const Vec3& n) const {
+  static constexpr double A[9] = {kPi,           2 * kPi / 3,  2 * kPi / 3,  2 * kPi / 3, kPi / 4,
+                                  kPi / 4,       kPi / 4,      kPi / 4,      kPi / 4};
+  const auto y = basis(n);
+  Vec3 e = Vec3::Zero();
+  for (int k = 0; k < 9; ++k) e += A[k] * y[std::size_t(k)] * coeffs_[std::size_t(k)];
+  // The truncated series rings below zero opposite a strong, small source (a sun): clamp.
+  return e.cwiseMax(0.0);
+}
+
+cv::Mat ShIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Mat3& world_from_view, int size,
+                                   const IntegratorOptions&, const std::function<void(int)>& progress) const {
+  const auto* lambert = dynamic_cast<const LambertBrdf*>(&brdf);
+  if (!lambert)
+    throw std::invalid_argument("sh: spherical harmonics irradiance supports only the lambert BRDF (got " +
+                                brdf.spec() + ")");
+  const Vec3 rho = lambert->rho();
+  return integrator_detail::for_each_texel(
+      size, view, world_from_view,
+      [&](long, const Vec3& n, const Mat3&, const Vec3&) { return Vec3(rho.cwiseProduct(irradiance(n)) / kPi); },
+      progress);
+}
+
+}  // namespace rsibr

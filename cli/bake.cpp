@@ -1,0 +1,142 @@
+// rsibr bake: a computed map set, the lighting integral of a BRDF against an environment, one
+// sphere map per view (bake/integrator.h for what a texel holds).
+#include "cli/summary.h"
+#include "cli/verbs.h"
+
+#include "bake/brdf_spec.h"
+#include "bake/integrator.h"
+#include "core/exr_io.h"
+#include "core/map_set.h"
+#include "core/progress.h"
+#include "core/view_set.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+
+namespace rsibr::cli {
+namespace {
+
+struct BakeArgs {
+  std::string env, brdf, views = "icosa", method = "mis", layout, json, output;
+  int res = 128;
+  int samples = 64;
+  int reference_width = 0;
+  std::uint64_t seed = 0;
+  bool sanitize = false, quiet = false;
+};
+
+int run_bake(const BakeArgs& a) {
+  if (std::filesystem::path(a.output).extension() != ".exr")
+    throw std::invalid_argument(a.output + ": the output must be an .exr file");
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::optional<LayoutKind> hint =
+      a.layout.empty() ? std::nullopt : std::optional<LayoutKind>(parse_layout_kind(a.layout));
+  EnvReadReport report;
+  EnvMap env = read_environment(a.env, hint, &report);
+  if ((report.nan_values || report.inf_values) && !a.sanitize)
+    throw std::runtime_error(a.env + ": " + std::to_string(report.nan_values) + " NaN and " +
+                             std::to_string(report.inf_values) + " Inf values; pass --sanitize to zero them");
+  if (a.sanitize) {
+    const int ch = env.channels();
+    for (int r = 0; r < env.pixels.rows; ++r) {
+      float* row = env.pixels.ptr<float>(r);
+      for (int i = 0; i < env.pixels.cols * ch; ++i)
+        if (!std::isfinite(row[i]) || row[i] < 0) row[i] = 0.f;
+    }
+  }
+  const std::unique_ptr<Brdf> brdf = load_brdf(a.brdf);
+  const ViewSet views = ViewSet::named(a.views);
+  const auto integrator = make_integrator(a.method, env);
+  IntegratorOptions options;
+  options.samples = a.samples;
+  options.seed = a.seed;
+  options.reference_width = a.reference_width;
+  const auto t1 = std::chrono::steady_clock::now();
+
+  const std::string warp = brdf->central_direction() == Lobe::Normal ? "normal" : "mirror";
+  const bool stochastic = a.method == "mis" || a.method == "fis";
+  Progress bar("bake", !a.quiet && Progress::stderr_is_terminal());
+  const double total_rows = double(views.views().size()) * a.res;
+  std::atomic<long> rows_before{0};
+  MapSet set;
+  for (const Vec3& v : views.views()) {
+    MapView mv;
+    mv.view = v;
+    mv.world_from_view = world_from_view_for(v);
+    mv.warp = warp;
+    mv.source = "computed";
+    mv.material = brdf->spec();
+    mv.attributes["version"] = RSIBR_VERSION;
+    mv.attributes["environment"] = std::filesystem::path(a.env).filename().string();
+    mv.attributes["method"] = a.method;
+    mv.attributes["samples"] = stochastic ? std::to_string(a.samples) : "n/a";
+    mv.attributes["seed"] = stochastic ? std::to_string(a.seed) : "n/a";
+    if (a.method == "reference")
+      mv.attributes["referenceWidth"] = a.reference_width > 0 ? std::to_string(a.reference_width) : "full";
+    const long before = rows_before.load();
+    mv.rgb = integrator->radiance_map(*brdf, v, mv.world_from_view, a.res, options,
+                                      [&](int done) { bar.update((before + done) / total_rows); });
+    rows_before += a.res;
+    set.views.push_back(std::move(mv));
+  }
+  bar.done();
+  const auto t2 = std::chrono::steady_clock::now();
+  write_map_set(a.output, set);
+  const auto t3 = std::chrono::steady_clock::now();
+
+  auto secs = [](auto d) { return std::chrono::duration<double>(d).count(); };
+  if (!a.quiet)
+    std::cerr << "rsibr bake: " << set.views.size() << " views x " << a.res << "^2, " << a.method
+              << (stochastic ? " (" + std::to_string(a.samples) + " samples)" : std::string()) << ", " << secs(t2 - t1)
+              << " s (" << secs(t2 - t1) / double(set.views.size()) << " s per map)\n";
+  nlohmann::json j;
+  j["output"] = a.output;
+  j["environment"] = a.env;
+  j["environment_layout"] = to_string(env.layout.kind());
+  j["environment_size"] = {env.layout.width(), env.layout.height()};
+  j["material"] = brdf->spec();
+  j["warp"] = warp;
+  j["method"] = a.method;
+  j["samples"] = a.samples;
+  j["seed"] = a.seed;
+  j["views"] = set.views.size();
+  j["res"] = a.res;
+  j["seconds"] = {{"setup", secs(t1 - t0)}, {"integrate", secs(t2 - t1)}, {"write", secs(t3 - t2)},
+                  {"per_map", secs(t2 - t1) / double(set.views.size())}};
+  write_summary(a.json, j);
+  return 0;
+}
+
+}  // namespace
+
+Runner add_bake(CLI::App& app) {
+  auto a = std::make_shared<BakeArgs>();
+  CLI::App* c = app.add_subcommand("bake", "Compute a map set: a BRDF lit by an environment, one sphere map per view");
+  c->footer("Methods: reference (quadrature over every environment texel; exact, slow), mis (Monte Carlo, BRDF and "
+            "environment sampling combined), fis (filtered importance sampling over a MIP pyramid), sh (spherical "
+            "harmonics order 2, lambert only). The same inputs and --seed give the same bytes.");
+  c->add_option("output", a->output, "Output map set (.exr)")->required();
+  c->add_option("--env", a->env, "Environment map (EXR or .hdr)")->required();
+  c->add_option("--brdf", a->brdf, "BRDF spec (YAML)")->required();
+  c->add_option("--views", a->views, "View set: icosa, 42, 162, 642 or a file of 'x y z' lines");
+  c->add_option("--res", a->res, "Sphere-map size (square)")->check(CLI::Range(1, 8192));
+  c->add_option("--method", a->method, "reference, mis, fis or sh")
+      ->check(CLI::IsMember({"reference", "mis", "fis", "sh"}));
+  c->add_option("--samples", a->samples, "mis, fis: samples per texel")->check(CLI::Range(1, 1 << 20));
+  c->add_option("--seed", a->seed, "Random seed (mis, fis)");
+  c->add_option("--reference-width", a->reference_width,
+                "reference: integrate over the MIP level at most this wide (0: the full environment)")
+      ->check(CLI::Range(0, 1 << 20));
+  c->add_option("--layout", a->layout, "Layout of the environment when its header and shape do not tell");
+  c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and negative environment values instead of failing");
+  c->add_flag("-q,--quiet", a->quiet, "No progress bar or summary line");
+  c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
+  return [a] { return run_bake(*a); };
+}
+
+}  // namespace rsibr::cli
