@@ -27,12 +27,15 @@ class ReferenceIntegrator final : public Integrator {
                        const IntegratorOptions& options,
                        const std::function<void(int)>& progress = {}) const override;
 
- private:
+  // The environment as a list of (direction, L * Omega) over its texels with non-zero radiance and
+  // solid angle (exact solid angles): the quadrature this integrator and the SH projection share.
   struct Texel {
     Vec3 dir;       // world, unit
     Vec3 radiance;  // L * Omega (RGB)
   };
   static std::vector<Texel> texels_of(const EnvMap& env);
+
+ private:
   const std::vector<Texel>& level_for(int width) const;
 
   EnvMap base_;

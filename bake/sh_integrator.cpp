@@ -1,5 +1,7 @@
 #include "bake/sh_integrator.h"
 
+#include "bake/reference_integrator.h"
+
 #include "bake/lambert.h"
 
 #include <cmath>
@@ -17,20 +19,11 @@ std::array<double, 9> ShIntegrator::basis(const Vec3& d) {
 }
 
 ShIntegrator::ShIntegrator(const EnvMap& env) {
-  const Layout& l = env.layout;
-  const int ch = env.channels();
-  if (ch < 3) throw std::invalid_argument("sh: the environment needs 3 channels");
+  // Projection with exact texel solid angles: the reference integrator's (direction, L*Omega) list.
   for (auto& c : coeffs_) c = Vec3::Zero();
-  for (int r = 0; r < l.height(); ++r) {
-    const float* row = env.pixels.ptr<float>(r);
-    for (int c = 0; c < l.width(); ++c) {
-      const auto d = l.texel_direction(c, r);
-      const double omega = l.texel_solid_angle(c, r);
-      if (!d || !(omega > 0)) continue;
-      const Vec3 L = Vec3(row[c * ch], row[c * ch + 1], row[c * ch + 2]) * omega;
-      const auto y = basis(d->normalized());
-      for (int k = 0; k < 9; ++k) coeffs_[std::size_t(k)] += L * y[std::size_t(k)];
-    }
+  for (const auto& t : ReferenceIntegrator::texels_of(env)) {
+    const auto y = basis(t.dir);
+    for (int k = 0; k < 9; ++k) coeffs_[std::size_t(k)] += t.radiance * y[std::size_t(k)];
   }
 }
 
