@@ -3,6 +3,8 @@
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
+#include "core/atomic_file.h"
+
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
 #include "core/exr_io.h"
@@ -33,6 +35,7 @@ struct BakeArgs {
 int run_bake(const BakeArgs& a) {
   if (std::filesystem::path(a.output).extension() != ".exr")
     throw std::invalid_argument(a.output + ": the output must be an .exr file");
+  check_output_path(a.output, {a.env, a.brdf});
   const auto t0 = std::chrono::steady_clock::now();
   const std::optional<LayoutKind> hint =
       a.layout.empty() ? std::nullopt : std::optional<LayoutKind>(parse_layout_kind(a.layout));

@@ -28,7 +28,8 @@ struct BlendArgs {
 };
 
 int run_blend(const BlendArgs& a) {
-  check_not_same_file(a.maps, a.output);
+  check_output_path(a.output, {a.maps});
+  if (!a.preview.empty()) check_output_path(a.preview, {a.maps});
   const MapSet set = read_map_set(a.maps);
   const ViewSet views = set.view_set();
   const Vec3 view(a.view[0], a.view[1], a.view[2]), up(a.up[0], a.up[1], a.up[2]);

@@ -47,7 +47,8 @@ std::string command_line_text(const ConvertArgs& a, const Layout& dst) {
 }
 
 int run_convert(const ConvertArgs& a) {
-  check_not_same_file(a.input, a.output);
+  check_output_path(a.output, {a.input});
+  if (!a.preview.empty()) check_output_path(a.preview, {a.input});
   if (std::filesystem::path(a.output).extension() != ".exr")
     throw std::invalid_argument(a.output + ": the output must be an .exr file (use --preview for a PNG)");
   const std::optional<LayoutKind> hint =

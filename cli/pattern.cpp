@@ -2,6 +2,7 @@
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
+#include "core/atomic_file.h"
 #include "core/exr_io.h"
 #include "core/map_set.h"
 #include "core/patterns.h"
@@ -22,6 +23,7 @@ struct PatternArgs {
 };
 
 int run_pattern(const PatternArgs& a) {
+  check_output_path(a.output);
   Radiance f;
   if (a.kind == "direction") {
     f = patterns::direction_coded();

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace rsibr {
 
@@ -15,5 +16,9 @@ void write_atomically(const std::filesystem::path& target,
 // Throws std::invalid_argument when output names the same file as input (inputs are never
 // overwritten).
 void check_not_same_file(const std::filesystem::path& input, const std::filesystem::path& output);
+
+// Checks an output path before long work starts: its folder exists and it names none of the
+// inputs. Throws std::invalid_argument("<output>: <problem>").
+void check_output_path(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs = {});
 
 }  // namespace rsibr

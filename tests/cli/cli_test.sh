@@ -42,6 +42,8 @@ sum_before=$(sha256sum "$work/sky.exr")
 expect_error "output equals input" "overwrite the input" convert "$work/sky.exr" "$work/sky.exr" --to cube
 check "input unchanged" test "$sum_before" = "$(sha256sum "$work/sky.exr")"
 expect_error "output folder missing" "nofolder" convert "$work/sky.exr" "$work/nofolder/o.exr" --to cube
+expect_error "bake output folder missing (checked before baking)" "nofolder" bake --env "$work/sky.exr" --brdf "$work/sky.exr" --res 8 "$work/nofolder/b.exr"
+expect_error "bake output equals the environment" "overwrite the input" bake --env "$work/sky.exr" --brdf "$work/sky.exr" --res 8 "$work/sky.exr"
 printf 'not an image' >"$work/text.exr"
 expect_error "non-image input" "text.exr" info "$work/text.exr"
 head -c 300 "$work/sky.exr" >"$work/truncated.exr"
