@@ -45,6 +45,13 @@ class Brdf {
   // Solid-angle density with which sample(wo, .) proposes wi, over the whole sphere.
   virtual double pdf(const Vec3& wo, const Vec3& wi) const = 0;
 
+  // eval(wo, wi) and pdf(wo, wi) at once (integrators need both; classes share the work where
+  // they can). Equal to calling the two.
+  virtual Vec3 eval_pdf(const Vec3& wo, const Vec3& wi, double* pdf_out) const {
+    *pdf_out = pdf(wo, wi);
+    return eval(wo, wi);
+  }
+
   // Directional albedo: integral over the upper hemisphere of eval(wo, wi) dwi (RGB, each
   // component in [0,1]): the radiance reflected toward wo under a white furnace (L_i = 1).
   // Closed form where exact, otherwise a deterministic quadrature (accuracy stated per class).

@@ -65,6 +65,8 @@ EnvironmentDistribution::EnvironmentDistribution(const EnvMap& env) : layout_(en
   }
   prob_.resize(n);
   for (std::size_t i = 0; i < n; ++i) prob_[i] = weight[i] / total;
+  density_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) density_[i] = omega_[i] > 0 ? prob_[i] / omega_[i] : 0.0;
 
   std::vector<double> row_weight(std::size_t(h_), 0.0);
   conditional_.resize(std::size_t(h_) * (w_ + 1));
@@ -98,7 +100,7 @@ EnvironmentDistribution::Sample EnvironmentDistribution::sample(const Vec2& u) c
   Sample out;
   out.dir = Vec3(std::sin(lon) * cl, std::clamp(s, -1.0, 1.0), std::cos(lon) * cl);
   out.texel = long(r) * w_ + c;
-  out.pdf = prob_[std::size_t(out.texel)] / omega_[std::size_t(out.texel)];
+  out.pdf = density_[std::size_t(out.texel)];
   return out;
 }
 
@@ -113,8 +115,7 @@ long EnvironmentDistribution::texel_of(const Vec3& d_in) const {
 }
 
 double EnvironmentDistribution::pdf(const Vec3& dir) const {
-  const long t = texel_of(dir);
-  return prob_[std::size_t(t)] / omega_[std::size_t(t)];
+  return density_[std::size_t(texel_of(dir))];
 }
 
 }  // namespace rsibr

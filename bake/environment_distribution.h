@@ -34,6 +34,8 @@ class EnvironmentDistribution {
 
   // The texel whose cell contains dir (r * width + c).
   long texel_of(const Vec3& dir) const;
+  // Solid-angle density of sample() anywhere in that texel's cell.
+  double texel_pdf(long texel) const { return density_[std::size_t(texel)]; }
   double probability(long texel) const { return prob_[std::size_t(texel)]; }
   double solid_angle(long texel) const { return omega_[std::size_t(texel)]; }
   const Layout& layout() const { return layout_; }
@@ -41,7 +43,7 @@ class EnvironmentDistribution {
  private:
   Layout layout_;
   int w_ = 0, h_ = 0;
-  std::vector<double> prob_, omega_;
+  std::vector<double> prob_, omega_, density_;  // density = prob / omega
   std::vector<double> marginal_;     // h+1 entries, CDF over rows
   std::vector<double> conditional_;  // h rows x (w+1) entries, CDF over columns per row
 };

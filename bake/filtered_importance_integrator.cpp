@@ -21,7 +21,7 @@ cv::Mat FilteredImportanceIntegrator::radiance_map(const Brdf& brdf, const Vec3&
   std::vector<Vec2> points(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) points[std::size_t(i)] = integrator_detail::rotated_hammersley(i, n, shift);
   return integrator_detail::for_each_texel(
-      size, view, world_from_view,
+      size, view, world_from_view, options.texel_mask,
       [&](long, const Vec3&, const Mat3& frame, const Vec3& wo) {
         Vec3 sum = Vec3::Zero();
         float L[kMaxChannels];

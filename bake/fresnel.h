@@ -70,5 +70,8 @@ class ConductorFresnel final : public Fresnel {
 // The formulas themselves (cos_i: cosine of the angle of incidence, clamped to [0,1]).
 double fresnel_dielectric(double cos_i, double eta);
 double fresnel_complex(double cos_i, std::complex<double> eta);
+// The same value as fresnel_complex(cos_i, {eta, k}) in real arithmetic (no complex division or
+// complex square root: about 5x faster; what ConductorFresnel evaluates). Agreement is tested.
+double fresnel_conductor(double cos_i, double eta, double k);
 
 }  // namespace rsibr

@@ -46,6 +46,20 @@ double GgxBrdf::pdf(const Vec3& wo, const Vec3& wi) const {
   return dist_.G1(wo) * dist_.D(h) / (4.0 * wo.z());
 }
 
+Vec3 GgxBrdf::eval_pdf(const Vec3& wo, const Vec3& wi, double* pdf_out) const {
+  *pdf_out = 0;
+  if (!(wo.z() > 0)) return Vec3::Zero();
+  const Vec3 h = shading::half_vector_up(wo, wi);
+  const double oh = wo.dot(h);
+  if (!(oh > 0)) return Vec3::Zero();
+  const double d = dist_.D(h);
+  *pdf_out = dist_.G1(wo) * d / (4.0 * wo.z());
+  if (!(wi.z() > 0)) return Vec3::Zero();
+  const double g2 = dist_.G2(wo, wi);
+  if (!(g2 > 0)) return Vec3::Zero();
+  return fresnel_->eval(oh) * (d * g2 / (4.0 * wo.z()));
+}
+
 Vec3 GgxBrdf::albedo(const Vec3& wo) const {
   if (!(wo.z() > 0)) return Vec3::Zero();
   return warp::square_graded_mean(256, [&](const Vec2& u) -> Vec3 {

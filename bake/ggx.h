@@ -29,6 +29,7 @@ class GgxBrdf final : public Brdf {
   // G1(wo) D(h) / (4 cos theta_o) with h the upper-hemisphere half vector, 0 where wo.h <= 0;
   // integrates to 1 over the sphere.
   double pdf(const Vec3& wo, const Vec3& wi) const override;
+  Vec3 eval_pdf(const Vec3& wo, const Vec3& wi, double* pdf_out) const override;
   // Midpoint rule over the visible-normal square (256^2 points, graded toward the rim where the
   // tail lies: warp::square_graded_mean) of F(wo.m) G2/G1(wo) for the proposals above the
   // horizon; tests/bake/brdf_test.cpp measures its error against an independent hemisphere

@@ -34,16 +34,20 @@ std::optional<TexelFrame> texel_frame(int c, int r, int size, const Vec3& view, 
   return t;
 }
 
-cv::Mat for_each_texel(int size, const Vec3& view, const Mat3& world_from_view,
+cv::Mat for_each_texel(int size, const Vec3& view, const Mat3& world_from_view, const cv::Mat& mask,
                        const std::function<Vec3(long, const Vec3&, const Mat3&, const Vec3&)>& texel,
                        const std::function<void(int)>& progress) {
   if (size < 1) throw std::invalid_argument("radiance map size must be >= 1");
+  if (!mask.empty() && (mask.type() != CV_8UC1 || mask.rows != size || mask.cols != size))
+    throw std::invalid_argument("texel mask must be CV_8UC1 of the map's size");
   cv::Mat out(size, size, CV_32FC3, cv::Scalar::all(0));
   const Vec3 v = view.normalized();
   std::atomic<int> rows_done{0};
   parallel_for_rows(size, [&](int r) {
     float* row = out.ptr<float>(r);
+    const unsigned char* keep = mask.empty() ? nullptr : mask.ptr<unsigned char>(r);
     for (int c = 0; c < size; ++c) {
+      if (keep && !keep[c]) continue;
       const auto t = texel_frame(c, r, size, v, world_from_view);
       if (!t) continue;
       const Vec3 L = texel(long(r) * size + c, t->n, t->frame, t->wo);

@@ -44,6 +44,10 @@ struct IntegratorOptions {
   int reference_width = 0;
   // Filtered importance sampling: added to 0.5*log2(Omega_sample / Omega_texel).
   double fis_lod_bias = 1.0;
+  // Compute only the texels where this CV_8UC1 size x size mask is non-zero (others are 0); empty:
+  // every texel. For error estimates on a subset (bench/bake_tradeoff.cpp): a texel's value does not
+  // depend on the mask.
+  cv::Mat texel_mask;
 };
 
 class Integrator {
@@ -118,7 +122,8 @@ inline Vec2 rotated_hammersley(int i, int n, const Vec2& shift) {
 // Runs texel(index, n_world, frame, wo_local) -> RGB over every texel of a size x size map whose
 // centre is inside the disc and whose wo is above the local horizon; others stay 0. frame has
 // columns (t, b, n): local = frame^T world. Rows in parallel; result independent of the split.
-cv::Mat for_each_texel(int size, const Vec3& view, const Mat3& world_from_view,
+// Texels where `mask` (IntegratorOptions::texel_mask) is zero are skipped.
+cv::Mat for_each_texel(int size, const Vec3& view, const Mat3& world_from_view, const cv::Mat& mask,
                        const std::function<Vec3(long, const Vec3&, const Mat3&, const Vec3&)>& texel,
                        const std::function<void(int)>& progress);
 

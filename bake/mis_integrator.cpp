@@ -29,29 +29,28 @@ cv::Mat MisIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Ma
   if (options.samples < 1) throw std::invalid_argument("mis: samples must be >= 1");
   const int n = options.samples;
   return integrator_detail::for_each_texel(
-      size, view, world_from_view,
+      size, view, world_from_view, options.texel_mask,
       [&](long index, const Vec3&, const Mat3& frame, const Vec3& wo) {
         // Stratified: a Hammersley set per sampler, rotated by the texel's own random shifts.
         integrator_detail::TexelRng rng(options.seed, std::uint64_t(index));
         const Vec2 shift_b = rng.uniform2(), shift_e = rng.uniform2();
         Vec3 sum = Vec3::Zero();
         for (int i = 0; i < n; ++i) {
-          // BRDF sample.
+          // BRDF sample: f = weight * pdf (sample() has evaluated it already).
           const BrdfSample b = brdf.sample(wo, integrator_detail::rotated_hammersley(i, n, shift_b));
           if (b.valid) {
-            const Vec3 w = frame * b.wi;
-            const double pe = dist_.pdf(w);
-            const Vec3 f = brdf.eval(wo, b.wi);
-            sum += f.cwiseProduct(radiance_[std::size_t(dist_.texel_of(w))]) / (b.pdf + pe);
+            const long t = dist_.texel_of(frame * b.wi);
+            const double pe = dist_.texel_pdf(t);
+            sum += (b.weight * b.pdf).cwiseProduct(radiance_[std::size_t(t)]) / (b.pdf + pe);
           }
           // Environment sample.
           const EnvironmentDistribution::Sample e = dist_.sample(integrator_detail::rotated_hammersley(i, n, shift_e));
           if (e.pdf > 0) {
             const Vec3 wi = frame.transpose() * e.dir;
             if (wi.z() > 0) {
-              const Vec3 f = brdf.eval(wo, wi);
-              if (f != Vec3::Zero())
-                sum += f.cwiseProduct(radiance_[std::size_t(e.texel)]) / (brdf.pdf(wo, wi) + e.pdf);
+              double pb = 0;
+              const Vec3 f = brdf.eval_pdf(wo, wi, &pb);
+              if (f != Vec3::Zero()) sum += f.cwiseProduct(radiance_[std::size_t(e.texel)]) / (pb + e.pdf);
             }
           }
         }

@@ -46,7 +46,7 @@ cv::Mat ReferenceIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, co
                                           const std::function<void(int)>& progress) const {
   const std::vector<Texel>& texels = level_for(options.reference_width);
   return integrator_detail::for_each_texel(
-      size, view, world_from_view,
+      size, view, world_from_view, options.texel_mask,
       [&](long, const Vec3& n, const Mat3& frame, const Vec3& wo) {
         Vec3 sum = Vec3::Zero();
         for (const Texel& t : texels) {

@@ -38,14 +38,14 @@ Vec3 ShIntegrator::irradiance(const Vec3& n) const {
 }
 
 cv::Mat ShIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Mat3& world_from_view, int size,
-                                   const IntegratorOptions&, const std::function<void(int)>& progress) const {
+                                   const IntegratorOptions& options, const std::function<void(int)>& progress) const {
   const auto* lambert = dynamic_cast<const LambertBrdf*>(&brdf);
   if (!lambert)
     throw std::invalid_argument("sh: spherical harmonics irradiance supports only the lambert BRDF (got " +
                                 brdf.spec() + ")");
   const Vec3 rho = lambert->rho();
   return integrator_detail::for_each_texel(
-      size, view, world_from_view,
+      size, view, world_from_view, options.texel_mask,
       [&](long, const Vec3& n, const Mat3&, const Vec3&) { return Vec3(rho.cwiseProduct(irradiance(n)) / kPi); },
       progress);
 }

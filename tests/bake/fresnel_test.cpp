@@ -93,3 +93,28 @@ TEST(Fresnel, ReflectanceStaysInTheUnitInterval) {
 
 }  // namespace
 }  // namespace rsibr
+
+namespace rsibr {
+namespace {
+
+// The real-arithmetic conductor formula (what ConductorFresnel evaluates) equals the complex-amplitude
+// definition, including k = 0 below and beyond the critical angle, grazing and normal incidence.
+TEST(Fresnel, RealConductorFormulaEqualsComplexAmplitudes) {
+  const double etas[] = {0.05, 0.2, 0.67, 1.0, 1.5, 3.0};
+  const double ks[] = {0.0, 1e-6, 0.5, 2.45, 3.9, 10.0};
+  double worst = 0;
+  for (double eta : etas)
+    for (double k : ks)
+      for (int i = 0; i <= 2000; ++i) {
+        const double c = i / 2000.0;
+        const double ref = fresnel_complex(c, {eta, k});
+        const double got = fresnel_conductor(c, eta, k);
+        ASSERT_TRUE(std::isfinite(got));
+        worst = std::max(worst, std::abs(got - ref));
+      }
+  EXPECT_LT(worst, 1e-11);  // both forms are good to a few 1e-13 against 40-digit arithmetic
+  EXPECT_EQ(fresnel_conductor(0.0, 0.2, 3.9), 1.0);
+}
+
+}  // namespace
+}  // namespace rsibr

@@ -5,6 +5,7 @@
 #include "tests/bake/integrator_cases.h"
 
 #include "bake/integrator.h"
+#include "bake/brdf_spec.h"
 #include "bake/lambert.h"
 #include "bake/sh_integrator.h"
 #include "core/vec.h"
@@ -269,3 +270,43 @@ TEST(Integrators, DISABLED_MeasureErrorVersusSamples) {
 
 }  // namespace
 }  // namespace rsibr::test
+
+namespace rsibr {
+namespace {
+
+// The texel mask (error estimates on a subset) changes which texels are computed, never their values.
+TEST(Integrators, MaskedTexelsEqualTheFullMap) {
+  const EnvMap env = test::latlong_env(test::sunny_radiance(), 64, 8);
+  const auto glossy = parse_brdf("{type: ggx, roughness: 0.3, fresnel: {type: schlick, f0: [0.9, 0.6, 0.3]}}");
+  const auto diffuse = parse_brdf("{type: lambert, albedo: [0.5, 0.6, 0.7]}");
+  const int size = 24;
+  cv::Mat mask(size, size, CV_8UC1, cv::Scalar(0));
+  for (int i = 0; i < size * size; i += 7) mask.at<unsigned char>(i / size, i % size) = 1;
+  const Vec3 view = Vec3(0.2, 0.5, 0.8).normalized();
+  const Mat3 T = world_from_view_for(view);
+  for (const char* method : {"reference", "mis", "fis", "sh"}) {
+    const Brdf& b = std::string(method) == "sh" ? *diffuse : *glossy;
+    const auto in = make_integrator(method, env);
+    IntegratorOptions o;
+    o.samples = 8;
+    o.seed = 5;
+    const cv::Mat full = in->radiance_map(b, view, T, size, o);
+    o.texel_mask = mask;
+    const cv::Mat part = in->radiance_map(b, view, T, size, o);
+    int compared = 0;
+    for (int r = 0; r < size; ++r)
+      for (int c = 0; c < size; ++c) {
+        const cv::Vec3f p = part.at<cv::Vec3f>(r, c), f = full.at<cv::Vec3f>(r, c);
+        if (mask.at<unsigned char>(r, c)) {
+          EXPECT_EQ(p, f) << method << " " << r << "," << c;
+          compared += f != cv::Vec3f(0, 0, 0);
+        } else {
+          EXPECT_EQ(p, cv::Vec3f(0, 0, 0)) << method;
+        }
+      }
+    EXPECT_GT(compared, 40) << method;
+  }
+}
+
+}  // namespace
+}  // namespace rsibr
