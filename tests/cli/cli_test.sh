@@ -25,7 +25,7 @@ expect_error() {
 }
 no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
 
-for verb in convert info pattern blend bake; do
+for verb in convert info pattern blend bake reference; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
 done
 check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
@@ -90,6 +90,25 @@ check "bake: lambert is normal-warped" bash -c "'$rsibr' info '$work/grey.exr' |
 expect_error "bake: unknown spec key" "roughnes" bake --env "$work/sky.exr" --brdf "$work/typo.yaml" --res 16 "$work/typo.exr"
 expect_error "bake: sh needs lambert" "lambert" bake --env "$work/sky.exr" --brdf "$work/ggx.yaml" --res 16 --method sh "$work/sh.exr"
 check "bake: no output after errors" test ! -e "$work/typo.exr" -a ! -e "$work/sh.exr"
+# reference: a tiny render of an octahedron, deterministic bytes, JSON, errors before work.
+printf 'v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\nf 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n' >"$work/octa.obj"
+for i in 1 2; do
+  "$rsibr" reference --mesh "$work/octa.obj" --env "$work/sky.exr" --brdf "$work/ggx.yaml" --size 32x24 --spp 2 \
+    --bounces 2 --seed 3 -q --json "$work/ref$i.json" --preview "$work/ref$i.png" "$work/ref$i.exr"
+done
+check "reference writes an EXR and a preview" test -s "$work/ref1.exr" -a -s "$work/ref1.png"
+check "reference: same seed, same bytes" cmp -s "$work/ref1.exr" "$work/ref2.exr"
+check "reference JSON counts hits" python3 -c "import json; j=json.load(open('$work/ref1.json')); assert 0 < j['hits'] < j['samples'] == 32*24*2 and j['shadows'], j"
+check "reference EXR carries provenance" bash -c "grep -aq rsibr.worldFromCam '$work/ref1.exr' && grep -aq rsibr.intrinsics '$work/ref1.exr'"
+"$rsibr" reference --mesh "$work/octa.obj" --env "$work/sky.exr" --brdf "$work/grey.yaml" --size 16x16 --spp 1 \
+  --no-shadows --background black --turntable 2 -q "$work/turn.exr"
+check "reference --turntable numbers its frames" test -s "$work/turn.0000.exr" -a -s "$work/turn.0001.exr"
+expect_error "reference: missing mesh" "nomesh.obj" reference --mesh "$work/nomesh.obj" --env "$work/sky.exr" --brdf "$work/ggx.yaml" --size 8x8 "$work/r-missing.exr"
+expect_error "reference: bad spec" "roughnes" reference --mesh "$work/octa.obj" --env "$work/sky.exr" --brdf "$work/typo.yaml" --size 8x8 "$work/r-typo.exr"
+expect_error "reference: bad size" "8by8" reference --mesh "$work/octa.obj" --env "$work/sky.exr" --brdf "$work/ggx.yaml" --size 8by8 "$work/r-size.exr"
+expect_error "reference: output folder missing" "nofolder" reference --mesh "$work/octa.obj" --env "$work/sky.exr" --brdf "$work/ggx.yaml" "$work/nofolder/r.exr"
+expect_error "reference: output must be exr" "r.png" reference --mesh "$work/octa.obj" --env "$work/sky.exr" --brdf "$work/ggx.yaml" "$work/r.png"
+check "reference: no output after errors" test ! -e "$work/r-missing.exr" -a ! -e "$work/r-typo.exr" -a ! -e "$work/r-size.exr" -a ! -e "$work/r.png"
 check "no temporaries after success" no_temporaries "$work"
 
 echo "cli: $pass passed, $fail failed"
