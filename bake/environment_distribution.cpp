@@ -87,6 +87,20 @@ EnvironmentDistribution::Sample EnvironmentDistribution::sample(const Vec2& u) c
   const double fr = frac(u.x(), marginal_[std::size_t(r)], marginal_[std::size_t(r) + 1]);
   const double fc = frac(u.y(), cdf[c], cdf[c + 1]);
 
+  Sample out;
+  out.texel = long(r) * w_ + c;
+  out.dir = cell_direction(out.texel, Vec2(fr, fc));
+  out.pdf = density_[std::size_t(out.texel)];
+  return out;
+}
+
+Vec3 EnvironmentDistribution::cell_direction(long texel, const Vec2& f) const {
+  return latlong_cell_direction(layout_, texel, f);
+}
+
+Vec3 latlong_cell_direction(const Layout& layout, long texel, const Vec2& f) {
+  const int w_ = layout.width(), h_ = layout.height();
+  const int r = int(texel / w_), c = int(texel % w_);
   // Cell of texel (c, r), as in Layout::texel_solid_angle (lat-long, "pixel is point").
   const double dlat = kPi / (h_ - 1), dlon = 2 * kPi / (w_ - 1);
   const double lat = 0.5 * kPi - dlat * r;
@@ -94,14 +108,10 @@ EnvironmentDistribution::Sample EnvironmentDistribution::sample(const Vec2& u) c
   const double bot = std::max(-0.5 * kPi, lat - 0.5 * dlat);
   const double x0 = std::max(0.0, c - 0.5), x1 = std::min(double(w_ - 1), c + 0.5);
   // Uniform in solid angle: sin(latitude) and longitude uniform.
-  const double s = std::sin(bot) + fr * (std::sin(top) - std::sin(bot));
-  const double lon = kPi - dlon * (x0 + fc * (x1 - x0));
+  const double s = std::sin(bot) + f.x() * (std::sin(top) - std::sin(bot));
+  const double lon = kPi - dlon * (x0 + f.y() * (x1 - x0));
   const double cl = std::sqrt(std::max(0.0, 1.0 - s * s));
-  Sample out;
-  out.dir = Vec3(std::sin(lon) * cl, std::clamp(s, -1.0, 1.0), std::cos(lon) * cl);
-  out.texel = long(r) * w_ + c;
-  out.pdf = density_[std::size_t(out.texel)];
-  return out;
+  return Vec3(std::sin(lon) * cl, std::clamp(s, -1.0, 1.0), std::cos(lon) * cl);
 }
 
 long EnvironmentDistribution::texel_of(const Vec3& d_in) const {

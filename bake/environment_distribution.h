@@ -32,6 +32,10 @@ class EnvironmentDistribution {
   // Solid-angle density of sample() at dir (any non-zero vector).
   double pdf(const Vec3& dir) const;
 
+  // The point of texel's cell at fractions f in [0,1]^2 (f.x along sin(latitude) from the cell's
+  // lower edge, f.y along longitude): uniform f gives points uniform in solid angle.
+  Vec3 cell_direction(long texel, const Vec2& f) const;
+
   // The texel whose cell contains dir (r * width + c).
   long texel_of(const Vec3& dir) const;
   // Solid-angle density of sample() anywhere in that texel's cell.
@@ -47,5 +51,8 @@ class EnvironmentDistribution {
   std::vector<double> marginal_;     // h+1 entries, CDF over rows
   std::vector<double> conditional_;  // h rows x (w+1) entries, CDF over columns per row
 };
+
+// The cell geometry behind EnvironmentDistribution::cell_direction, for any lat-long layout.
+Vec3 latlong_cell_direction(const Layout& latlong, long texel, const Vec2& f);
 
 }  // namespace rsibr

@@ -1,13 +1,23 @@
 #include "bake/filtered_importance_integrator.h"
 
+#include "bake/mis_integrator.h"
+
 #include <cmath>
 #include <stdexcept>
 #include <vector>
 
 namespace rsibr {
 
-FilteredImportanceIntegrator::FilteredImportanceIntegrator(const EnvMap& env) : pyramid_(env) {
+namespace {
+EnvMap checked_latlong(const EnvMap& env) {
   if (env.channels() < 3) throw std::invalid_argument("fis: the environment needs 3 channels");
+  return as_latlong(env);
+}
+}  // namespace
+
+FilteredImportanceIntegrator::FilteredImportanceIntegrator(const EnvMap& env)
+    : split_(split_bright_texels(checked_latlong(env))), pyramid_(split_.remainder) {
+  latlong_ = split_.remainder.layout;
 }
 
 cv::Mat FilteredImportanceIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Mat3& world_from_view,
@@ -33,7 +43,7 @@ cv::Mat FilteredImportanceIntegrator::radiance_map(const Brdf& brdf, const Vec3&
           pyramid_.sample(w, lod, L);
           sum += s.weight.cwiseProduct(Vec3(L[0], L[1], L[2]));
         }
-        return Vec3(sum / n);
+        return Vec3(sum / n + bright_texel_radiance(brdf, wo, frame, split_.bright, latlong_));
       },
       progress);
 }

@@ -11,6 +11,7 @@
 // Any layout (core/mip_pyramid.h).
 #pragma once
 
+#include "bake/bright_texels.h"
 #include "bake/integrator.h"
 #include "core/mip_pyramid.h"
 
@@ -25,7 +26,9 @@ class FilteredImportanceIntegrator final : public Integrator {
                        const std::function<void(int)>& progress = {}) const override;
 
  private:
-  MipPyramid pyramid_;
+  Layout latlong_;
+  EnvironmentSplit split_;  // the sun by quadrature (bake/bright_texels.h), the rest filtered
+  MipPyramid pyramid_;      // of split_.remainder
 };
 
 }  // namespace rsibr

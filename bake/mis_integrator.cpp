@@ -13,11 +13,12 @@ EnvMap as_latlong(const EnvMap& env) {
   return resample(env, Layout(LayoutKind::LatLong, 2 * h, h));
 }
 
-MisIntegrator::MisIntegrator(const EnvMap& env) : env_(as_latlong(env)), dist_(env_) {
+MisIntegrator::MisIntegrator(const EnvMap& env)
+    : env_(as_latlong(env)), split_(split_bright_texels(env_)), dist_(split_.remainder) {
   const int ch = env_.channels();
   radiance_.resize(std::size_t(env_.layout.texel_count()));
   for (int r = 0; r < env_.layout.height(); ++r) {
-    const float* row = env_.pixels.ptr<float>(r);
+    const float* row = split_.remainder.pixels.ptr<float>(r);
     for (int c = 0; c < env_.layout.width(); ++c)
       radiance_[std::size_t(r) * env_.layout.width() + c] = Vec3(row[c * ch], row[c * ch + 1], row[c * ch + 2]);
   }
@@ -54,7 +55,7 @@ cv::Mat MisIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Ma
             }
           }
         }
-        return Vec3(sum / n);
+        return Vec3(sum / n + bright_texel_radiance(brdf, wo, frame, split_.bright, env_.layout));
       },
       progress);
 }

@@ -14,9 +14,11 @@
 // Sample points: per texel, the N-point Hammersley set with a Cranley-Patterson rotation drawn
 // from the texel's own stream (seed, texel index), one rotation per sampler: unbiased, stratified,
 // deterministic, independent of threads.
-// Non-lat-long environments are resampled to lat-long (width = 2 x height) once.
+// The brightest texels (a sun) are split off and integrated by quadrature (bake/bright_texels.h);
+// the sampler sees the rest. Non-lat-long environments are resampled to lat-long (width = 2 x height) once.
 #pragma once
 
+#include "bake/bright_texels.h"
 #include "bake/environment_distribution.h"
 #include "bake/integrator.h"
 
@@ -30,10 +32,12 @@ class MisIntegrator final : public Integrator {
                        const IntegratorOptions& options,
                        const std::function<void(int)>& progress = {}) const override;
   const EnvironmentDistribution& distribution() const { return dist_; }
+  const EnvironmentSplit& split() const { return split_; }
 
  private:
   EnvMap env_;  // lat-long
-  EnvironmentDistribution dist_;
+  EnvironmentSplit split_;
+  EnvironmentDistribution dist_;  // of split_.remainder
   std::vector<Vec3> radiance_;  // per texel, RGB
 };
 

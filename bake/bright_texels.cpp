@@ -1,0 +1,96 @@
+#include "bake/bright_texels.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+namespace rsibr {
+
+namespace {
+double luminance(const float* p) {
+  auto pos = [](float v) { return std::isfinite(v) && v > 0 ? double(v) : 0.0; };
+  return 0.2126 * pos(p[0]) + 0.7152 * pos(p[1]) + 0.0722 * pos(p[2]);
+}
+}  // namespace
+
+EnvironmentSplit split_bright_texels(const EnvMap& env, const BrightTexelOptions& options) {
+  if (env.layout.kind() != LayoutKind::LatLong) throw std::invalid_argument("bright texels: the environment must be lat-long");
+  if (env.pixels.depth() != CV_32F || env.channels() < 3)
+    throw std::invalid_argument("bright texels: the environment must be CV_32F with >= 3 channels");
+  EnvironmentSplit out;
+  out.remainder = env;
+  out.remainder.pixels = env.pixels.clone();
+  if (!(options.ratio > 0) || options.max_count <= 0) return out;
+  const int w = env.layout.width(), h = env.layout.height(), ch = env.channels();
+  struct Candidate {
+    long texel;
+    double lum, omega;
+  };
+  std::vector<Candidate> all;
+  all.reserve(std::size_t(w) * std::size_t(h));
+  double power = 0, area = 0;
+  for (int r = 0; r < h; ++r) {
+    const float* row = env.pixels.ptr<float>(r);
+    for (int c = 0; c < w; ++c) {
+      const double omega = env.layout.texel_solid_angle(c, r);
+      const double lum = luminance(row + c * ch);
+      power += lum * omega;
+      area += omega;
+      all.push_back({long(r) * w + c, lum, omega});
+    }
+  }
+  if (!(power > 0) || !std::isfinite(power)) return out;
+  const double threshold = options.ratio * power / area;
+  std::vector<Candidate> bright;
+  for (const Candidate& q : all)
+    if (q.lum >= threshold && q.omega > 0) bright.push_back(q);
+  // Brightest power first; ties by texel index (deterministic).
+  std::sort(bright.begin(), bright.end(), [](const Candidate& a, const Candidate& b) {
+    const double pa = a.lum * a.omega, pb = b.lum * b.omega;
+    return pa != pb ? pa > pb : a.texel < b.texel;
+  });
+  if (int(bright.size()) > options.max_count) bright.resize(std::size_t(options.max_count));
+  double share = 0;
+  for (const Candidate& q : bright) {
+    const int r = int(q.texel / w), c = int(q.texel % w);
+    float* p = out.remainder.pixels.ptr<float>(r) + c * ch;
+    BrightTexel b;
+    b.texel = q.texel;
+    b.radiance = Vec3(p[0], p[1], p[2]);
+    b.solid_angle = q.omega;
+    b.angular_size = std::sqrt(q.omega);
+    // Half the diagonal of the cell's latitude x longitude extent (an upper bound in angle).
+    b.radius = 0.5 * std::hypot(kPi / (h - 1), 2 * kPi / (w - 1));
+    out.bright.push_back(b);
+    for (int k = 0; k < ch; ++k) p[k] = 0.f;
+    share += q.lum * q.omega;
+  }
+  out.bright_share = share / power;
+  return out;
+}
+
+Vec3 bright_texel_radiance(const Brdf& brdf, const Vec3& wo, const Mat3& frame,
+                           const std::vector<BrightTexel>& bright, const Layout& cells) {
+  if (bright.empty()) return Vec3::Zero();
+  const Vec3 n = frame.col(2);
+  const double lobe = std::max(brdf.lobe_width(wo), 1e-6);
+  Vec3 sum = Vec3::Zero();
+  for (const BrightTexel& b : bright) {
+    // Skip cells wholly below the horizon: the centre more than the cell's radius below it.
+    const Vec3 centre = latlong_cell_direction(cells, b.texel, Vec2(0.5, 0.5));
+    if (n.dot(centre) < -std::sin(std::min(b.radius, 0.5 * kPi))) continue;
+    const int k = std::clamp(int(std::ceil(4.0 * b.angular_size / lobe)), 1, 8);
+    Vec3 cell = Vec3::Zero();
+    for (int i = 0; i < k; ++i)
+      for (int j = 0; j < k; ++j) {
+        const Vec3 w = k == 1 ? centre : latlong_cell_direction(cells, b.texel, Vec2((i + 0.5) / k, (j + 0.5) / k));
+        const Vec3 wi = frame.transpose() * w;
+        if (wi.z() > 0) cell += brdf.eval(wo, wi);
+      }
+    sum += b.radiance.cwiseProduct(cell) * (b.solid_angle / (k * k));
+  }
+  return sum;
+}
+
+}  // namespace rsibr
