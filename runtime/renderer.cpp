@@ -32,6 +32,12 @@ struct TileGrid {
   int width, height, cols, rows;
   TileGrid(int w, int h) : width(w), height(h), cols((w + kTile - 1) / kTile), rows((h + kTile - 1) / kTile) {}
   int count() const { return cols * rows; }
+  // Whether the tile's pixel area meets rect (declared below).
+  template <class Rect>
+  bool overlaps(int tile, const Rect& rect) const {
+    const int x0 = (tile % cols) * kTile, y0 = (tile / cols) * kTile;
+    return rect.overlaps(x0 - 0.5, y0 - 0.5, x0 + kTile - 0.5, y0 + kTile - 0.5);
+  }
   // The tile's pixels (x, y) in packet order: 4 x 4 blocks, each block row by row. Returns the count.
   int pixels(int tile, int* xs, int* ys) const {
     const int x0 = (tile % cols) * kTile, y0 = (tile / cols) * kTile;
@@ -55,6 +61,53 @@ int spp_side(int spp) {
   return k;
 }
 
+// The image rectangle (pixel coordinates, mrcal convention) outside which no ray can hit the mesh:
+// the bounds of the projected corners of the mesh's bounding box, grown by one pixel for the float
+// arithmetic of the rays. A box not entirely in front of the camera gives the whole plane.
+struct ImageRect {
+  double x0 = -1e300, y0 = -1e300, x1 = 1e300, y1 = 1e300;
+  bool contains(double x, double y) const { return x >= x0 && x <= x1 && y >= y0 && y <= y1; }
+  bool overlaps(double ax, double ay, double bx, double by) const { return ax <= x1 && bx >= x0 && ay <= y1 && by >= y0; }
+};
+
+ImageRect projected_bounds(const Camera& cam, const Eigen::AlignedBox3f& box) {
+  ImageRect r;
+  if (box.isEmpty()) return ImageRect{1, 1, 0, 0};  // nothing can be hit
+  const Mat3 cam_from_world = cam.world_from_cam.transpose();
+  const double scale = (box.max() - box.min()).cast<double>().norm() + (box.center().cast<double>() - cam.eye).norm();
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Vec3 p = box.corner(Eigen::AlignedBox3f::CornerType(corner)).cast<double>();
+    const Vec3 q = cam_from_world * (p - cam.eye);
+    if (!(q.z() > 1e-6 * scale)) return r;  // (partly) behind the camera: no culling
+    const double x = cam.fx * q.x() / q.z() + cam.cx, y = cam.fy * q.y() / q.z() + cam.cy;
+    x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+  }
+  return ImageRect{x0 - 1, y0 - 1, x1 + 1, y1 + 1};
+}
+
+// The samples at offset (ox, oy) of the n pixels (xs, ys): hits[i] and, for traced samples (or every
+// sample with all_dirs), dirs[i]. Samples outside `rect` are misses without a ray.
+void trace_samples(const RayScene& scene, const Camera& cam, const ImageRect& rect, int n, const int* xs, const int* ys,
+                   double ox, double oy, bool all_dirs, Vec3* dirs, RayHit* hits) {
+  int index[kTile * kTile];
+  Vec3 packed[kTile * kTile];
+  RayHit packed_hits[kTile * kTile];
+  int m = 0;
+  for (int i = 0; i < n; ++i) {
+    const double x = xs[i] + ox, y = ys[i] + oy;
+    const bool inside = rect.contains(x, y);
+    hits[i] = RayHit{};
+    if (!inside && !all_dirs) continue;
+    dirs[i] = cam.ray_direction(x, y);
+    if (!inside) continue;
+    index[m] = i;
+    packed[m++] = dirs[i];
+  }
+  scene.intersect_coherent(cam.eye, packed, m, packed_hits);
+  for (int j = 0; j < m; ++j) hits[index[j]] = packed_hits[j];
+}
+
 }  // namespace
 
 struct RenderSet {
@@ -65,6 +118,7 @@ struct RenderSet {
 
 struct Renderer::Impl {
   std::unique_ptr<RayScene> scene;
+  Eigen::AlignedBox3f bounds;
   std::vector<RenderSet> sets;
   std::unique_ptr<Warp> warp;  // paper mode; nullptr = ExactWarp
   int map_size = 0;
@@ -97,6 +151,7 @@ Renderer::Renderer(const Mesh& mesh, const std::vector<const MapSet*>& sets, con
       throw std::invalid_argument("render: warp must be exact, precomputed or tessellated, not '" + options.warp + "'");
   }
   impl_->scene = std::make_unique<RayScene>(mesh);
+  impl_->bounds = mesh.bounds();
 }
 
 Renderer::~Renderer() = default;
@@ -106,6 +161,7 @@ const RayScene& Renderer::scene() const { return *impl_->scene; }
 long long Renderer::trace_only(const Camera& camera) const {
   const TileGrid grid(camera.width, camera.height);
   const RayScene& scene = *impl_->scene;
+  const ImageRect rect = projected_bounds(camera, impl_->bounds);
   return tbb::parallel_reduce(
       tbb::blocked_range<int>(0, grid.count()), 0LL,
       [&](const tbb::blocked_range<int>& range, long long hits) {
@@ -113,9 +169,9 @@ long long Renderer::trace_only(const Camera& camera) const {
         Vec3 dirs[kTile * kTile];
         RayHit rh[kTile * kTile];
         for (int t = range.begin(); t != range.end(); ++t) {
+          if (!grid.overlaps(t, rect)) continue;
           const int n = grid.pixels(t, xs, ys);
-          for (int i = 0; i < n; ++i) dirs[i] = camera.ray_direction(xs[i], ys[i]);
-          scene.intersect_coherent(camera.eye, dirs, n, rh);
+          trace_samples(scene, camera, rect, n, xs, ys, 0, 0, false, dirs, rh);
           for (int i = 0; i < n; ++i) hits += rh[i].hit;
         }
         return hits;
@@ -156,6 +212,7 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
   const int k = impl_->spp_k;
   const double inv_spp = 1.0 / (k * k);
   const EnvMap* env = options_.environment;
+  const ImageRect rect = projected_bounds(camera, impl_->bounds);
 
   struct Counts {
     long long hits = 0, covered = 0;
@@ -171,6 +228,7 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
         int hit_count[N];
         std::vector<int> hints(nsets, -1);  // per-set triangle of the last located view (speed only)
         for (int t = range.begin(); t != range.end(); ++t) {
+          if (!env && !grid.overlaps(t, rect)) continue;  // every sample misses: stays 0
           const int n = grid.pixels(t, xs, ys);
           for (int i = 0; i < n; ++i) {
             acc[i][0] = acc[i][1] = acc[i][2] = acc[i][3] = 0;
@@ -179,8 +237,7 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
           for (int sy = 0; sy < k; ++sy)
             for (int sx = 0; sx < k; ++sx) {
               const double ox = (sx + 0.5) / k - 0.5, oy = (sy + 0.5) / k - 0.5;
-              for (int i = 0; i < n; ++i) dirs[i] = camera.ray_direction(xs[i] + ox, ys[i] + oy);
-              scene.intersect_coherent(camera.eye, dirs, n, rh);
+              trace_samples(scene, camera, rect, n, xs, ys, ox, oy, env != nullptr, dirs, rh);
               for (int i = 0; i < n; ++i) {
                 const Vec3& d = dirs[i];
                 if (!rh[i].hit) {

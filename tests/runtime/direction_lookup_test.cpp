@@ -109,7 +109,8 @@ TEST(DirectionLookup, NormalsFacingAwayTakeTheNearestRimNormal) {
 // A set covering only the upper hemisphere, queried from everywhere: finite, within the maps' range.
 TEST(DirectionLookup, FiniteAndBoundedOutsideANonSurroundingSet) {
   std::vector<Vec3> up;
-  for (const Vec3& v : ViewSet::geodesic(1).views())
+  const ViewSet all = ViewSet::geodesic(1);  // named: views() refers into it
+  for (const Vec3& v : all.views())
     if (v.y() > 0.2) up.push_back(v);
   const ViewSet views(up);
   ASSERT_FALSE(views.surrounds());

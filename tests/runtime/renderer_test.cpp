@@ -182,7 +182,8 @@ TEST(Renderer, BothModesAgreeAtTheCentrePixelOfAFarNarrowCamera) {
 // grazing normals, supersampling: every value finite, alpha in [0, 1].
 TEST(Renderer, NoNanOrInfAtSilhouettesAndOutsideANonSurroundingSet) {
   std::vector<Vec3> up;
-  for (const Vec3& v : ViewSet::geodesic(1).views())
+  const ViewSet all = ViewSet::geodesic(1);  // named: views() refers into it
+  for (const Vec3& v : all.views())
     if (v.y() > 0.3) up.push_back(v);
   const MapSet set = analytic_map_set(ViewSet(up), 32, 32, "mirror", fresnel_mirror_texel);
   Mesh mesh = sphere_mesh(24, 48);
