@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   runners["pattern"] = rsibr::cli::add_pattern(app);
   runners["blend"] = rsibr::cli::add_blend(app);
   runners["bake"] = rsibr::cli::add_bake(app);
+  runners["render"] = rsibr::cli::add_render(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

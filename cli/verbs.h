@@ -14,5 +14,6 @@ Runner add_info(CLI::App& app);
 Runner add_pattern(CLI::App& app);
 Runner add_blend(CLI::App& app);
 Runner add_bake(CLI::App& app);
+Runner add_render(CLI::App& app);
 
 }  // namespace rsibr::cli
