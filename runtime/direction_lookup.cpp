@@ -30,6 +30,11 @@ DirectionLookup::DirectionLookup(const MapSet& maps, const ViewSet& view_set, co
     s.kind = warp_kind_from_string(v.warp);
     s.view_from_world = v.world_from_view.transpose();
   }
+  const auto& views = view_set.views();
+  for (const auto& T : view_set.triangles()) {
+    const Vec3 &a = views[std::size_t(T[0])], &b = views[std::size_t(T[1])], &c = views[std::size_t(T[2])];
+    edge_norms_.push_back({a.cross(b).norm(), b.cross(c).norm(), c.cross(a).norm()});
+  }
 }
 
 ViewWeights DirectionLookup::locate(const Vec3& v, int* hint) const {
@@ -41,8 +46,8 @@ ViewWeights DirectionLookup::locate(const Vec3& v, int* hint) const {
     const Vec3 p = unit(v);
     // The triangles of a view set do not overlap, so a point this far inside one is in no other.
     constexpr double kInside = 1e-9;
-    if (det3(a, b, p) > kInside * a.cross(b).norm() && det3(b, c, p) > kInside * b.cross(c).norm() &&
-        det3(c, a, p) > kInside * c.cross(a).norm()) {
+    const auto& e = edge_norms_[std::size_t(*hint)];
+    if (det3(a, b, p) > kInside * e[0] && det3(b, c, p) > kInside * e[1] && det3(c, a, p) > kInside * e[2]) {
       ViewWeights out;
       out.count = 3;
       out.views = T;

@@ -30,6 +30,7 @@
 #include "runtime/disc_sampler.h"
 #include "runtime/warp.h"
 
+#include <array>
 #include <vector>
 
 namespace rsibr {
@@ -66,6 +67,7 @@ class DirectionLookup {
   const ViewSet& view_set_;
   BlendOptions options_;
   std::vector<Source> sources_;
+  std::vector<std::array<double, 3>> edge_norms_;  // per triangle: |a x b|, |b x c|, |c x a|
 };
 
 }  // namespace rsibr
