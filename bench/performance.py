@@ -3,8 +3,9 @@
 to the baseline measured in the same run (never as an absolute threshold).
 
 Usage: bench/performance.py [--bench build/release/rsibr_bench] [--filter REGEX] [--out FILE].
---filter runs only the matching benchmarks (Google Benchmark's --benchmark_filter); sections without
-data are left out, so write a filtered run to another --out than docs/performance.md.
+--filter runs only the matching benchmarks (Google Benchmark's --benchmark_filter): the sections it
+produces replace theirs in the existing output, the others are kept as they were (each section's
+ratios come from one run either way).
 Standard library only.
 """
 import argparse
@@ -32,6 +33,21 @@ def parts(name):
     return [p for p in name.split("/")[1:] if not p.startswith(("min_time", "iterations:")) and p != "real_time"]
 
 
+def read_sections(path):
+    """An existing performance.md -> {"## title" line: the section's lines, blank line included}."""
+    sections, current = {}, None
+    with open(path) as f:
+        for line in f.read().splitlines():
+            if line.startswith("## "):
+                current = line
+                sections[current] = [line]
+            elif line.startswith("Notes:"):
+                current = None
+            elif current:
+                sections[current].append(line)
+    return sections
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--bench", default=os.path.join(ROOT, "build/release/rsibr_bench"))
@@ -48,6 +64,8 @@ def main():
         data = json.load(f)
     os.unlink(out)
     by_name = {b["name"]: b for b in data["benchmarks"] if b.get("run_type", "iteration") == "iteration"}
+    # The same, named without the min_time/iterations/real_time suffixes (baselines are looked up here).
+    plain = {"/".join([n.split("/")[0]] + parts(n)): b for n, b in by_name.items()}
     ctx = data["context"]
     lines = [
         "# Performance",
@@ -58,15 +76,18 @@ def main():
         "Each row is a ratio to a baseline measured in the same run.",
         "",
     ]
+    previous = {}
+    if args.filter and os.path.exists(args.out):
+        previous = read_sections(args.out)
     for family, (base, what) in PAIRS.items():
+        title = f"## {TITLES.get(family, family[3:])} (baseline: {what})"
         rows = []
         for name, b in sorted(by_name.items()):
             if not name.startswith(family + "/") or "error_message" in b:
                 continue
             args_ = parts(name)
             arg = "/".join(args_)
-            ref = by_name.get(f"{base}/{args_[0]}") if args_ else None
-            ref = ref or by_name.get(base) or by_name.get(f"{base}/real_time")
+            ref = (plain.get(f"{base}/{args_[0]}") if args_ else None) or plain.get(base)
             if not ref or "error_message" in ref:
                 continue
             unit = b["time_unit"]
@@ -76,9 +97,10 @@ def main():
                 row += f" {b['fps']:.1f} |"
             rows.append(row)
         if not rows:
+            lines += previous.get(title, [])
             continue
         fps = any("fps" in b for n, b in by_name.items() if n.startswith(family + "/"))
-        lines += [f"## {TITLES.get(family, family[3:])} (baseline: {what})", "",
+        lines += [title, "",
                   "| case | label | baseline | ours | ours / baseline |" + (" frames/s |" if fps else ""),
                   "|---|---|---|---|---|" + ("---|" if fps else "")]
         lines += rows
