@@ -158,6 +158,40 @@ TEST(Renderer, MirrorSetGivesTheAnalyticReflectionPerPixelAndTheCentralOneInPape
   }
 }
 
+// The paper's approximation shades every pixel as seen from the image centre: its error against the
+// exact reflection grows with the field of view (the sphere framed alike), per-pixel mode's does not.
+TEST(Renderer, PaperModeErrorGrowsWithTheFieldOfView) {
+  const Mesh mesh = sphere_mesh();
+  const MapSet set = analytic_map_set(ViewSet::icosahedron(), 128, 128, "mirror", mirror_texel);
+  const Eigen::AlignedBox3f box(Eigen::Vector3f(-1, -1, -1), Eigen::Vector3f(1, 1, 1));
+  double paper[2], exact[2];
+  const double fovs[2] = {5, 50};
+  for (int f = 0; f < 2; ++f) {
+    const Camera cam = frame_bounds(box, Vec3(-0.2, -0.4, -1), Vec3(0, 1, 0), fovs[f], 80, 80);
+    for (RenderMode mode : {RenderMode::PerPixel, RenderMode::Paper}) {
+      const Renderer renderer(mesh, {&set}, with_mode(mode));
+      const cv::Mat img = renderer.render(cam);
+      double sum = 0;
+      int n = 0;
+      for (int r = 0; r < cam.height; ++r)
+        for (int c = 0; c < cam.width; ++c) {
+          const PixelHit p = trace(renderer, cam, c, r);
+          if (!p.hit || p.n.dot(p.v) < 0.3) continue;
+          sum += (pixel(img, c, r) - environment(reflect(p.v, p.n))).cwiseAbs().maxCoeff();
+          ++n;
+        }
+      ASSERT_GT(n, 1000);
+      (mode == RenderMode::Paper ? paper : exact)[f] = sum / n;
+    }
+  }
+  std::printf("mean error against the exact reflection, fov 5 / 50 degrees: paper %.3g / %.3g, per-pixel %.3g / %.3g\n",
+              paper[0], paper[1], exact[0], exact[1]);
+  EXPECT_GT(paper[1], 4 * paper[0]);
+  EXPECT_GT(paper[1], 10 * exact[1]);
+  EXPECT_LT(exact[1], 1e-3);
+  EXPECT_LT(exact[0], 1e-3);
+}
+
 // Far away with a tiny field of view, the centre pixel's view direction is the camera's: the modes
 // agree to float precision (odd map size: the disc centre, where n = v lands, is a texel centre).
 TEST(Renderer, BothModesAgreeAtTheCentrePixelOfAFarNarrowCamera) {
