@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   runners["blend"] = rsibr::cli::add_blend(app);
   runners["bake"] = rsibr::cli::add_bake(app);
   runners["reference"] = rsibr::cli::add_reference(app);
+  runners["render"] = rsibr::cli::add_render(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

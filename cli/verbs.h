@@ -15,5 +15,6 @@ Runner add_pattern(CLI::App& app);
 Runner add_blend(CLI::App& app);
 Runner add_bake(CLI::App& app);
 Runner add_reference(CLI::App& app);
+Runner add_render(CLI::App& app);
 
 }  // namespace rsibr::cli

@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -81,6 +82,49 @@ RayHit RayScene::intersect(const Vec3& origin, const Vec3& direction, double t_n
   out.u = rh.hit.u;
   out.v = rh.hit.v;
   return out;
+}
+
+void RayScene::intersect_coherent(const Vec3& origin, const Vec3* directions, int count, RayHit* hits, double t_near,
+                                  double t_far) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  const float far =
+      t_far >= double(std::numeric_limits<float>::max()) ? std::numeric_limits<float>::infinity() : float(t_far);
+  alignas(64) RTCRayHit16 packet;
+  alignas(64) int valid[16];
+  for (int start = 0; start < count; start += 16) {
+    const int n = std::min(16, count - start);
+    for (int i = 0; i < 16; ++i) {
+      const Vec3& d = directions[start + std::min(i, n - 1)];
+      valid[i] = i < n ? -1 : 0;
+      packet.ray.org_x[i] = float(origin.x());
+      packet.ray.org_y[i] = float(origin.y());
+      packet.ray.org_z[i] = float(origin.z());
+      packet.ray.dir_x[i] = float(d.x());
+      packet.ray.dir_y[i] = float(d.y());
+      packet.ray.dir_z[i] = float(d.z());
+      packet.ray.tnear[i] = float(t_near);
+      packet.ray.tfar[i] = far;
+      packet.ray.time[i] = 0;
+      packet.ray.mask[i] = 0xFFFFFFFFu;
+      packet.ray.id[i] = unsigned(i);
+      packet.ray.flags[i] = 0;
+      packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+      packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, impl_->scene, &context, &packet);
+    for (int i = 0; i < n; ++i) {
+      RayHit& out = hits[start + i];
+      out = RayHit{};
+      if (packet.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+      out.hit = true;
+      out.t = packet.ray.tfar[i];
+      out.triangle = packet.hit.primID[i];
+      out.u = packet.hit.u[i];
+      out.v = packet.hit.v[i];
+    }
+  }
 }
 
 bool RayScene::occluded(const Vec3& origin, const Vec3& direction, double t_near, double t_far) const {

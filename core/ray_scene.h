@@ -33,6 +33,12 @@ class RayScene {
 
   RayHit intersect(const Vec3& origin, const Vec3& direction, double t_near = 0,
                    double t_far = std::numeric_limits<double>::infinity()) const;
+  // Many rays from one origin at once (e.g. a camera's primary rays), traced as Embree packets of 16:
+  // hits[i] for directions[i] (unit), i < count, with intersect()'s contract. Order the directions so
+  // that each run of 16 is coherent (a 4 x 4 pixel block) for speed. Hits agree with intersect() up to
+  // Embree's packet arithmetic (same triangle except on shared edges, t to float precision).
+  void intersect_coherent(const Vec3& origin, const Vec3* directions, int count, RayHit* hits, double t_near = 0,
+                          double t_far = std::numeric_limits<double>::infinity()) const;
   // Whether anything is hit in [t_near, t_far] (cheaper than intersect: any hit ends the query).
   bool occluded(const Vec3& origin, const Vec3& direction, double t_near = 0,
                 double t_far = std::numeric_limits<double>::infinity()) const;

@@ -1,6 +1,7 @@
 #include "runtime/blend.h"
 
 #include "core/parallel.h"
+#include "runtime/disc_sampler.h"
 #include "core/sphere_map.h"
 
 #include <algorithm>
@@ -21,63 +22,29 @@ double rim_fade_weight(double rho, double rim_fade) {
 namespace {
 
 // One located source, ready to sample.
-struct Source {
-  const cv::Mat* rgb = nullptr;
-  const cv::Mat* confidence = nullptr;  // nullptr: none, or not used
-  int width = 0, height = 0;
+struct Source : DiscMap {
   WarpKind kind = WarpKind::Mirror;
   Mat3 source_from_dest = Mat3::Identity();
   double weight = 0;  // barycentric
 };
 
-// Bilinear sample at disc point xy. Taps whose centres lie outside the unit disc (x^2 + y^2 > 1, as in
-// core's sphere-map sampling) are dropped and the rest renormalised; tap indices are clamped to the
-// image. Returns false when no tap is valid (not expected for maps of 2 x 2 or more; the point is
-// first stepped toward the centre a few times, as core's sampler does).
-bool sample(const Source& s, Vec2 xy, double rgb[3], double* confidence) {
-  const int W = s.width, H = s.height;
-  for (int attempt = 0; attempt < 8; ++attempt) {
-    const Vec2 p = sphere_map::pixel_from_disc(xy, W, H);
-    const double fc = std::floor(p.x()), fr = std::floor(p.y());
-    const double fx = p.x() - fc, fy = p.y() - fr;
-    const int c0 = int(fc), r0 = int(fr);
-    const int cs[2] = {std::clamp(c0, 0, W - 1), std::clamp(c0 + 1, 0, W - 1)};
-    const int rs[2] = {std::clamp(r0, 0, H - 1), std::clamp(r0 + 1, 0, H - 1)};
-    const double wx[2] = {1 - fx, fx}, wy[2] = {1 - fy, fy};
-    double acc[3] = {0, 0, 0}, conf = 0, total = 0;
-    for (int j = 0; j < 2; ++j) {
-      const double y = 1.0 - (2.0 * rs[j] + 1.0) / H;
-      const float* row = s.rgb->ptr<float>(rs[j]);
-      const float* crow = s.confidence ? s.confidence->ptr<float>(rs[j]) : nullptr;
-      for (int i = 0; i < 2; ++i) {
-        const double w = wx[i] * wy[j];
-        if (!(w > 0)) continue;
-        const double x = (2.0 * cs[i] + 1.0) / W - 1.0;
-        if (x * x + y * y > 1.0) continue;
-        const float* t = row + 3 * cs[i];
-        acc[0] += w * t[0];
-        acc[1] += w * t[1];
-        acc[2] += w * t[2];
-        if (crow) conf += w * crow[cs[i]];
-        total += w;
-      }
-    }
-    if (total > 0) {
-      const double inv = 1.0 / total;
-      rgb[0] = acc[0] * inv;
-      rgb[1] = acc[1] * inv;
-      rgb[2] = acc[2] * inv;
-      // A confidence is a weight: negative or NaN counts as 0.
-      const double c = s.confidence ? conf * inv : 1.0;
-      *confidence = c > 0 ? c : 0.0;
-      return true;
-    }
-    xy *= 1.0 - 1.0 / std::max(W, H);  // every tap outside the disc: step inward
-  }
-  return false;
+bool sample(const Source& s, const Vec2& xy, double rgb[3], double* confidence) {
+  return sample_disc(s, xy, rgb, confidence);
 }
 
-void check_source(const MapSet& maps, int index) {
+}  // namespace
+
+void check_blend_inputs(const MapSet& maps, const ViewSet& view_set) {
+  if (maps.views.empty()) throw std::invalid_argument("blend: the map set is empty");
+  if (view_set.views().size() != maps.views.size())
+    throw std::invalid_argument("blend: the view set has " + std::to_string(view_set.views().size()) +
+                                " views, the map set " + std::to_string(maps.views.size()));
+  for (std::size_t i = 0; i < maps.views.size(); ++i)
+    if ((view_set.views()[i] - maps.views[i].view.normalized()).norm() > 1e-6)
+      throw std::invalid_argument("blend: view set and map set differ at view " + std::to_string(i));
+}
+
+void check_blend_source(const MapSet& maps, int index) {
   const MapView& v = maps.views[std::size_t(index)];
   const std::string who = "blend: view " + std::to_string(index) + ": ";
   if (v.rgb.empty() || v.rgb.type() != CV_32FC3) throw std::invalid_argument(who + "map must be a non-empty CV_32FC3 image");
@@ -86,17 +53,9 @@ void check_source(const MapSet& maps, int index) {
     throw std::invalid_argument(who + "confidence must be one float channel of the map's size");
 }
 
-}  // namespace
-
 BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_dir, const Vec3& up,
                   const BlendOptions& options) {
-  if (maps.views.empty()) throw std::invalid_argument("blend: the map set is empty");
-  if (view_set.views().size() != maps.views.size())
-    throw std::invalid_argument("blend: the view set has " + std::to_string(view_set.views().size()) +
-                                " views, the map set " + std::to_string(maps.views.size()));
-  for (std::size_t i = 0; i < maps.views.size(); ++i)
-    if ((view_set.views()[i] - maps.views[i].view.normalized()).norm() > 1e-6)
-      throw std::invalid_argument("blend: view set and map set differ at view " + std::to_string(i));
+  check_blend_inputs(maps, view_set);
   if (!view_dir.allFinite() || !(view_dir.norm() > 0)) throw std::invalid_argument("blend: view direction must be finite and non-zero");
   if ((options.width > 0) != (options.height > 0) || options.width < 0 || options.height < 0)
     throw std::invalid_argument("blend: give both width and height (> 0), or neither");
@@ -119,7 +78,7 @@ BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_
   Source sources[3];
   for (int k = 0; k < n; ++k) {
     const int index = located.views[std::size_t(k)];
-    check_source(maps, index);
+    check_blend_source(maps, index);
     const MapView& v = maps.views[std::size_t(index)];
     Source& s = sources[k];
     s.rgb = &v.rgb;

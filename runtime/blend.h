@@ -74,6 +74,12 @@ struct BlendResult {
 // The fade of step 3 (exposed for tests and for the tessellated-disk warp to come).
 double rim_fade_weight(double rho, double rim_fade);
 
+// The input checks blend() makes, shared with runtime/direction_lookup.h: the map set is not empty
+// and view_set has its views (throws std::invalid_argument); and view `index`'s map is a CV_32FC3 of
+// at least 2 x 2 with an empty or matching CV_32FC1 confidence.
+void check_blend_inputs(const MapSet& maps, const ViewSet& view_set);
+void check_blend_source(const MapSet& maps, int index);
+
 // Throws std::invalid_argument when view_set does not have the map set's views, when a located
 // source's map is not CV_32FC3 (or its confidence not CV_32FC1 of the same size), for a bad size, a
 // zero or non-finite view_dir, or a warp that does not support the destination size.

@@ -25,7 +25,7 @@ expect_error() {
 }
 no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
 
-for verb in convert info pattern blend bake reference; do
+for verb in convert info pattern blend bake reference render; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
 done
 check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
@@ -109,6 +109,44 @@ expect_error "reference: bad size" "8by8" reference --mesh "$work/octa.obj" --en
 expect_error "reference: output folder missing" "nofolder" reference --mesh "$work/octa.obj" --env "$work/sky.exr" --brdf "$work/ggx.yaml" "$work/nofolder/r.exr"
 expect_error "reference: output must be exr" "r.png" reference --mesh "$work/octa.obj" --env "$work/sky.exr" --brdf "$work/ggx.yaml" "$work/r.png"
 check "reference: no output after errors" test ! -e "$work/r-missing.exr" -a ! -e "$work/r-typo.exr" -a ! -e "$work/r-size.exr" -a ! -e "$work/r.png"
+# render: a tiny .obj with map sets (PNG and EXR), several sets summed, turntable numbering, errors.
+cat >"$work/cube.obj" <<'OBJ'
+v -1 -1 -1
+v 1 -1 -1
+v 1 1 -1
+v -1 1 -1
+v -1 -1 1
+v 1 -1 1
+v 1 1 1
+v -1 1 1
+f 1 4 3 2
+f 5 6 7 8
+f 1 2 6 5
+f 4 8 7 3
+f 1 5 8 4
+f 2 3 7 6
+OBJ
+"$rsibr" render --maps "$work/mirror.exr" --mesh "$work/cube.obj" --size 64x48 "$work/cube.png" --json "$work/cube.json"
+check "render writes a PNG" test -s "$work/cube.png"
+check "render JSON has hits and fps" python3 -c "import json; j=json.load(open('$work/cube.json')); assert j['hits'] > 500 and j['fps'] > 0 and j['mode'] == 'per-pixel', j"
+"$rsibr" render --maps "$work/mirror.exr" --mesh "$work/cube.obj" --size 64x48 --mode paper --size-map 33 --warp tessellated --out "$work/cube.exr"
+check "render writes an RGBA float EXR with the camera" bash -c "test -s '$work/cube.exr' && grep -aq rsibr.worldFromCam '$work/cube.exr' && grep -aq 'paper' '$work/cube.exr'"
+for i in 1 2; do "$rsibr" render --maps "$work/mirror.exr" --maps "$work/grey.exr" --mesh "$work/cube.obj" --size 40x30 --spp 4 "$work/sum$i.exr"; done
+check "render: two map sets, same bytes twice" cmp -s "$work/sum1.exr" "$work/sum2.exr"
+"$rsibr" render --maps "$work/mirror.exr" --mesh "$work/cube.obj" --size 32x24 --turntable 3 "$work/spin.png" --json "$work/spin.json"
+check "render --turntable numbers its frames" test -s "$work/spin.0000.png" -a -s "$work/spin.0001.png" -a -s "$work/spin.0002.png" -a ! -e "$work/spin.png" -a ! -e "$work/spin.0003.png"
+check "render --turntable JSON lists the frames" python3 -c "import json; j=json.load(open('$work/spin.json')); assert [f['path'][-9:] for f in j['frames']] == ['.0000.png', '.0001.png', '.0002.png'], j"
+check "turntable frames differ" bash -c "! cmp -s '$work/spin.0000.png' '$work/spin.0001.png'"
+expect_error "render: missing mesh" "missing.obj" render --maps "$work/mirror.exr" --mesh "$work/missing.obj" "$work/r1.png"
+expect_error "render: missing map set" "nomaps.exr" render --maps "$work/nomaps.exr" --mesh "$work/cube.obj" "$work/r2.png"
+printf 'v 0 0 0\nf 1 2 3\n' >"$work/bad.obj"
+expect_error "render: malformed mesh" "bad.obj" render --maps "$work/mirror.exr" --mesh "$work/bad.obj" "$work/r3.png"
+expect_error "render: not a map set" "sky.exr" render --maps "$work/sky.exr" --mesh "$work/cube.obj" "$work/r4.png"
+expect_error "render: output type" "r5.jpg" render --maps "$work/mirror.exr" --mesh "$work/cube.obj" "$work/r5.jpg"
+expect_error "render: output folder missing" "nofolder" render --maps "$work/mirror.exr" --mesh "$work/cube.obj" "$work/nofolder/r6.png"
+expect_error "render: unknown mode" "fancy" render --maps "$work/mirror.exr" --mesh "$work/cube.obj" --mode fancy "$work/r7.png"
+expect_error "render: spp not a square" "spp" render --maps "$work/mirror.exr" --mesh "$work/cube.obj" --spp 2 "$work/r8.png"
+check "render: no output after errors" bash -c "! ls '$work' | grep -q '^r[0-9]'"
 check "no temporaries after success" no_temporaries "$work"
 
 echo "cli: $pass passed, $fail failed"

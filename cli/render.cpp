@@ -1,0 +1,261 @@
+// rsibr render: draws a mesh with one or more map sets (runtime/renderer.h) from the shared camera
+// options (cli/camera_options.h); PNG through the OpenColorIO display transform, or RGBA float EXR.
+#include "cli/camera_options.h"
+#include "cli/summary.h"
+#include "cli/verbs.h"
+
+#include "core/atomic_file.h"
+#include "core/colour.h"
+#include "core/exr_io.h"
+#include "core/map_set.h"
+#include "core/mesh.h"
+#include "core/progress.h"
+#include "runtime/renderer.h"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfMatrixAttribute.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStandardAttributes.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfVecAttribute.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+namespace rsibr::cli {
+namespace {
+
+struct RenderArgs {
+  std::vector<std::string> maps;
+  std::string mesh, output, mode = "per-pixel", warp = "precomputed", env, json;
+  CameraArgs camera;
+  int map_size = 0, rings = 16, spp = 1;
+  double rim_fade = 0.4;
+  float exposure = 0.f;
+  bool quiet = false;
+};
+
+std::string extension_of(const std::string& path) {
+  std::string e = std::filesystem::path(path).extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return e;
+}
+
+std::string file_name(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
+// RGBA float32, premultiplied, with the camera and the inputs in the header. Atomic.
+void write_exr(const std::string& path, const cv::Mat& rgba, const Camera& cam,
+               const std::map<std::string, std::string>& provenance) {
+  const int W = rgba.cols, H = rgba.rows;
+  Imf::Header header(W, H);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  Imf::addChromaticities(header, Imf::Chromaticities());
+  for (const auto& [key, value] : provenance) {
+    const std::string name = "rsibr." + key;
+    if (name.size() > kMaxAttributeName) throw std::logic_error("attribute name too long: " + name);
+    header.insert(name, Imf::StringAttribute(value));
+  }
+  header.insert("rsibr.eye", Imf::V3fAttribute(Imath::V3f(float(cam.eye.x()), float(cam.eye.y()), float(cam.eye.z()))));
+  Imath::M33f m;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) m[r][c] = float(cam.world_from_cam(r, c));
+  header.insert("rsibr.worldFromCam", Imf::M33fAttribute(m));
+  header.insert("rsibr.focal", Imf::V2fAttribute(Imath::V2f(float(cam.fx), float(cam.fy))));
+  header.insert("rsibr.principal", Imf::V2fAttribute(Imath::V2f(float(cam.cx), float(cam.cy))));
+  const char* names[] = {"R", "G", "B", "A"};
+  for (const char* n : names) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
+  cv::Mat contiguous = rgba.isContinuous() ? rgba : rgba.clone();
+  char* base = reinterpret_cast<char*>(contiguous.data);
+  Imf::FrameBuffer fb;
+  for (int k = 0; k < 4; ++k)
+    fb.insert(names[k], Imf::Slice(Imf::FLOAT, base + k * sizeof(float), 4 * sizeof(float), 4 * sizeof(float) * std::size_t(W)));
+  try {
+    write_atomically(path, [&](const std::string& tmp) {
+      Imf::OutputFile out(tmp.c_str(), header);
+      out.setFrameBuffer(fb);
+      out.writePixels(H);
+    });
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+}
+
+// 8-bit RGBA PNG, straight alpha: the colour un-premultiplied, then the display transform.
+void write_png(const std::string& path, const cv::Mat& rgba, float exposure) {
+  cv::Mat straight = rgba.clone();
+  for (int r = 0; r < straight.rows; ++r) {
+    float* p = straight.ptr<float>(r);
+    for (int c = 0; c < straight.cols; ++c, p += 4)
+      if (p[3] > 0 && p[3] < 1)
+        for (int k = 0; k < 3; ++k) p[k] /= p[3];
+  }
+  const cv::Mat bgr = display_encode(straight, exposure);
+  cv::Mat bgra(bgr.rows, bgr.cols, CV_8UC4);
+  for (int r = 0; r < bgr.rows; ++r) {
+    const unsigned char* s = bgr.ptr<unsigned char>(r);
+    const float* a = rgba.ptr<float>(r);
+    unsigned char* d = bgra.ptr<unsigned char>(r);
+    for (int c = 0; c < bgr.cols; ++c) {
+      d[4 * c] = s[3 * c];
+      d[4 * c + 1] = s[3 * c + 1];
+      d[4 * c + 2] = s[3 * c + 2];
+      d[4 * c + 3] = (unsigned char)std::lround(std::clamp(a[4 * c + 3], 0.f, 1.f) * 255.f);
+    }
+  }
+  write_atomically(path, [&](const std::string& tmp) {
+    if (!cv::imwrite(tmp, bgra, {cv::IMWRITE_PNG_COMPRESSION, 3}))
+      throw std::runtime_error(path + ": cannot write the PNG image");
+  });
+}
+
+int run_render(const RenderArgs& a) {
+  const std::string ext = extension_of(a.output);
+  if (ext != ".png" && ext != ".exr") throw std::invalid_argument(a.output + ": the output must be .png or .exr");
+  if (a.mode != "paper" && a.mode != "per-pixel")
+    throw std::invalid_argument("--mode must be 'paper' or 'per-pixel', not '" + a.mode + "'");
+  const int side = int(std::lround(std::sqrt(double(a.spp))));
+  if (side * side != a.spp) throw std::invalid_argument("--spp must be a perfect square (1, 4, 9, ...), not " + std::to_string(a.spp));
+  RenderOptions options;
+  options.mode = render_mode_from_string(a.mode);
+  options.map_size = a.map_size;
+  options.warp = a.warp;
+  options.rings = a.rings;
+  options.blend.rim_fade = a.rim_fade;
+  options.spp = a.spp;
+  if (a.warp != "exact" && a.warp != "precomputed" && a.warp != "tessellated")
+    throw std::invalid_argument("--warp must be 'exact', 'precomputed' or 'tessellated', not '" + a.warp + "'");
+
+  // Every output is checked before any work.
+  std::vector<std::filesystem::path> inputs(a.maps.begin(), a.maps.end());
+  inputs.emplace_back(a.mesh);
+  if (!a.env.empty()) inputs.emplace_back(a.env);
+  const int frames = std::max(1, a.camera.turntable);
+  for (int k = 0; k < frames; ++k) check_output_path(frame_path(a.output, a.camera.turntable, k), inputs);
+  if (!a.json.empty() && a.json != "-") check_output_path(a.json, inputs);
+
+  const auto t_load = std::chrono::steady_clock::now();
+  MeshLoadReport mesh_report;
+  const Mesh mesh = load_mesh(a.mesh, &mesh_report);
+  std::vector<MapSet> sets;
+  sets.reserve(a.maps.size());
+  for (const std::string& m : a.maps) {
+    sets.push_back(read_map_set(m));
+    try {
+      validate(sets.back());
+    } catch (const std::exception& e) {
+      throw std::invalid_argument(m + ": " + e.what());
+    }
+  }
+  EnvMap env;
+  if (!a.env.empty()) {
+    env = read_environment(a.env);
+    options.environment = &env;
+  }
+  std::vector<const MapSet*> set_ptrs;
+  for (const MapSet& s : sets) set_ptrs.push_back(&s);
+  // Camera errors (bad --size etc.) before the scene is built.
+  make_camera(a.camera, mesh.bounds(), 0);
+  const Renderer renderer(mesh, set_ptrs, options);
+  const double load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_load).count();
+
+  std::map<std::string, std::string> provenance;
+  provenance["version"] = RSIBR_VERSION;
+  provenance["mode"] = to_string(options.mode);
+  std::string maps_names;
+  for (const std::string& m : a.maps) maps_names += (maps_names.empty() ? "" : " ") + file_name(m);
+  provenance["maps"] = maps_names;
+  provenance["mesh"] = file_name(a.mesh);
+  provenance["spp"] = std::to_string(a.spp);
+  if (options.mode == RenderMode::Paper) {
+    provenance["warp"] = a.warp;
+    provenance["mapSize"] = std::to_string(a.map_size > 0 ? a.map_size : sets.front().width());
+  }
+  if (!a.env.empty()) provenance["environment"] = file_name(a.env);
+
+  Progress bar("render", !a.quiet && frames > 1 && Progress::stderr_is_terminal());
+  nlohmann::json jframes = nlohmann::json::array();
+  double render_total = 0;
+  long long hits_total = 0;
+  for (int k = 0; k < frames; ++k) {
+    const Camera cam = make_camera(a.camera, mesh.bounds(), k);
+    RenderStats stats;
+    const cv::Mat image = renderer.render(cam, &stats);
+    render_total += stats.seconds;
+    hits_total += stats.hits;
+    const std::string path = frame_path(a.output, a.camera.turntable, k);
+    auto p = provenance;
+    if (a.camera.turntable > 0) p["frame"] = std::to_string(k) + "/" + std::to_string(a.camera.turntable);
+    if (ext == ".exr") write_exr(path, image, cam, p);
+    else write_png(path, image, a.exposure);
+    jframes.push_back({{"path", path},
+                       {"seconds", stats.seconds},
+                       {"seconds_blend", stats.seconds_blend},
+                       {"samples", stats.samples},
+                       {"hits", stats.hits},
+                       {"covered_pixels", stats.covered_pixels}});
+    bar.update(double(k + 1) / frames);
+  }
+  bar.done();
+
+  nlohmann::json j;
+  j["maps"] = a.maps;
+  j["mesh"] = a.mesh;
+  j["mesh_triangles"] = mesh_report.triangles;
+  j["mode"] = to_string(options.mode);
+  if (options.mode == RenderMode::Paper) {
+    j["warp"] = a.warp;
+    j["map_size"] = a.map_size > 0 ? a.map_size : sets.front().width();
+  }
+  j["spp"] = a.spp;
+  j["size"] = a.camera.size;
+  j["frames"] = jframes;
+  j["load_seconds"] = load_seconds;
+  j["render_seconds_per_frame"] = render_total / frames;
+  j["fps"] = render_total > 0 ? frames / render_total : 0.0;
+  j["hits"] = hits_total;
+  write_summary(a.json, j);
+  return 0;
+}
+
+}  // namespace
+
+Runner add_render(CLI::App& app) {
+  auto a = std::make_shared<RenderArgs>();
+  CLI::App* c = app.add_subcommand("render", "Render a mesh (.glb, .gltf, .obj) with one or more map sets");
+  c->footer(
+      "Primary rays (Embree, one per pixel centre, mrcal pixel convention; --spp for a k x k subpixel grid) find "
+      "the visible surface; its shading normal and the direction to the eye index the map sets.\n"
+      "Modes: per-pixel (default, exact: every pixel blends the located sources for its own view direction) or "
+      "paper (one destination map per frame for the camera's central direction, read by normal: error grows "
+      "with the field of view).\n"
+      "Several --maps are summed (e.g. a normal-lobe and a mirror-lobe set of one BRDF), each with its own warp.\n"
+      "Output: .exr (RGBA float32, premultiplied, camera in the header) or .png (OpenColorIO display transform, "
+      "$OCIO honoured; straight alpha). Misses are black with alpha 0 unless --env is given.\n"
+      "Example: rsibr render --maps maps.exr --mesh cache/assets/models/bunny.glb bunny.png --turntable 36");
+  c->add_option("--maps", a->maps, "Map set (.exr); repeat to sum several sets")->required()->check(CLI::ExistingFile);
+  c->add_option("--mesh", a->mesh, "Mesh (.glb, .gltf, .obj)")->required()->check(CLI::ExistingFile);
+  c->add_option("output,--out", a->output, "Output image (.png or .exr); numbered with --turntable")->required();
+  add_camera_options(c, a->camera);
+  c->add_option("--mode", a->mode, "per-pixel (exact) or paper (one destination map per frame)")->capture_default_str();
+  c->add_option("--size-map", a->map_size, "paper: destination map size (default: the first map set's)")
+      ->check(CLI::Range(2, 8192));
+  c->add_option("--warp", a->warp, "paper: exact, precomputed or tessellated warp for the destination map")
+      ->capture_default_str();
+  c->add_option("--rings", a->rings, "tessellated: rings of the disc mesh (4x as many segments)")->check(CLI::Range(1, 1024));
+  c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));
+  c->add_option("--spp", a->spp, "Samples per pixel: a perfect square (1, 4, 9, ...)")->check(CLI::Range(1, 1024));
+  c->add_option("--env", a->env, "Environment map shown where rays miss (alpha 1)")->check(CLI::ExistingFile);
+  c->add_option("--exposure", a->exposure, "PNG: exposure in stops before the display transform");
+  c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
+  c->add_flag("-q,--quiet", a->quiet, "No progress bar");
+  return [a] { return run_render(*a); };
+}
+
+}  // namespace rsibr::cli

@@ -1,0 +1,307 @@
+#include "runtime/renderer.h"
+
+#include "runtime/direction_lookup.h"
+#include "runtime/disc_sampler.h"
+#include "runtime/tessellated_warp.h"
+#include "runtime/warp.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace rsibr {
+
+RenderMode render_mode_from_string(const std::string& name) {
+  if (name == "paper") return RenderMode::Paper;
+  if (name == "per-pixel") return RenderMode::PerPixel;
+  throw std::invalid_argument("render: unknown mode '" + name + "' (expected paper or per-pixel)");
+}
+
+const char* to_string(RenderMode mode) { return mode == RenderMode::Paper ? "paper" : "per-pixel"; }
+
+namespace {
+
+// Tiles of kTile x kTile pixels, traced in 4 x 4 blocks (one Embree packet of 16 each).
+constexpr int kTile = 16;
+
+struct TileGrid {
+  int width, height, cols, rows;
+  TileGrid(int w, int h) : width(w), height(h), cols((w + kTile - 1) / kTile), rows((h + kTile - 1) / kTile) {}
+  int count() const { return cols * rows; }
+  // Whether the tile's pixel area meets rect (declared below).
+  template <class Rect>
+  bool overlaps(int tile, const Rect& rect) const {
+    const int x0 = (tile % cols) * kTile, y0 = (tile / cols) * kTile;
+    return rect.overlaps(x0 - 0.5, y0 - 0.5, x0 + kTile - 0.5, y0 + kTile - 0.5);
+  }
+  // The tile's pixels (x, y) in packet order: 4 x 4 blocks, each block row by row. Returns the count.
+  int pixels(int tile, int* xs, int* ys) const {
+    const int x0 = (tile % cols) * kTile, y0 = (tile / cols) * kTile;
+    int n = 0;
+    for (int by = 0; by < kTile; by += 4)
+      for (int bx = 0; bx < kTile; bx += 4)
+        for (int j = 0; j < 16; ++j) {
+          const int x = x0 + bx + (j & 3), y = y0 + by + (j >> 2);
+          if (x >= width || y >= height) continue;
+          xs[n] = x;
+          ys[n] = y;
+          ++n;
+        }
+    return n;
+  }
+};
+
+int spp_side(int spp) {
+  const int k = int(std::lround(std::sqrt(double(spp))));
+  if (spp < 1 || k * k != spp) throw std::invalid_argument("render: spp must be a perfect square (1, 4, 9, ...), not " + std::to_string(spp));
+  return k;
+}
+
+// The image rectangle (pixel coordinates, mrcal convention) outside which no ray can hit the mesh:
+// the bounds of the projected corners of the mesh's bounding box, grown by one pixel for the float
+// arithmetic of the rays. A box not entirely in front of the camera gives the whole plane.
+struct ImageRect {
+  double x0 = -1e300, y0 = -1e300, x1 = 1e300, y1 = 1e300;
+  bool contains(double x, double y) const { return x >= x0 && x <= x1 && y >= y0 && y <= y1; }
+  bool overlaps(double ax, double ay, double bx, double by) const { return ax <= x1 && bx >= x0 && ay <= y1 && by >= y0; }
+};
+
+ImageRect projected_bounds(const Camera& cam, const Eigen::AlignedBox3f& box) {
+  ImageRect r;
+  if (box.isEmpty()) return ImageRect{1, 1, 0, 0};  // nothing can be hit
+  const Mat3 cam_from_world = cam.world_from_cam.transpose();
+  const double scale = (box.max() - box.min()).cast<double>().norm() + (box.center().cast<double>() - cam.eye).norm();
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Vec3 p = box.corner(Eigen::AlignedBox3f::CornerType(corner)).cast<double>();
+    const Vec3 q = cam_from_world * (p - cam.eye);
+    if (!(q.z() > 1e-6 * scale)) return r;  // (partly) behind the camera: no culling
+    const double x = cam.fx * q.x() / q.z() + cam.cx, y = cam.fy * q.y() / q.z() + cam.cy;
+    x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+  }
+  return ImageRect{x0 - 1, y0 - 1, x1 + 1, y1 + 1};
+}
+
+// The samples at offset (ox, oy) of the n pixels (xs, ys): hits[i] and, for traced samples (or every
+// sample with all_dirs), dirs[i]. Samples outside `rect` are misses without a ray.
+void trace_samples(const RayScene& scene, const Camera& cam, const ImageRect& rect, int n, const int* xs, const int* ys,
+                   double ox, double oy, bool all_dirs, Vec3* dirs, RayHit* hits) {
+  int index[kTile * kTile];
+  Vec3 packed[kTile * kTile];
+  RayHit packed_hits[kTile * kTile];
+  int m = 0;
+  for (int i = 0; i < n; ++i) {
+    const double x = xs[i] + ox, y = ys[i] + oy;
+    const bool inside = rect.contains(x, y);
+    hits[i] = RayHit{};
+    if (!inside && !all_dirs) continue;
+    dirs[i] = cam.ray_direction(x, y);
+    if (!inside) continue;
+    index[m] = i;
+    packed[m++] = dirs[i];
+  }
+  scene.intersect_coherent(cam.eye, packed, m, packed_hits);
+  for (int j = 0; j < m; ++j) hits[index[j]] = packed_hits[j];
+}
+
+}  // namespace
+
+struct RenderSet {
+  const MapSet* maps = nullptr;
+  std::unique_ptr<ViewSet> views;
+  std::unique_ptr<DirectionLookup> lookup;
+};
+
+struct Renderer::Impl {
+  std::unique_ptr<RayScene> scene;
+  Eigen::AlignedBox3f bounds;
+  std::vector<RenderSet> sets;
+  std::unique_ptr<Warp> warp;  // paper mode; nullptr = ExactWarp
+  int map_size = 0;
+  int spp_k = 1;
+};
+
+Renderer::Renderer(const Mesh& mesh, const std::vector<const MapSet*>& sets, const RenderOptions& options)
+    : options_(options), impl_(std::make_unique<Impl>()) {
+  if (sets.empty()) throw std::invalid_argument("render: no map set");
+  impl_->spp_k = spp_side(options.spp);
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    if (!sets[i]) throw std::invalid_argument("render: null map set");
+    validate(*sets[i]);
+    RenderSet s;
+    s.maps = sets[i];
+    s.views = std::make_unique<ViewSet>(sets[i]->view_set());
+    s.lookup = std::make_unique<DirectionLookup>(*s.maps, *s.views, options.blend);
+    impl_->sets.push_back(std::move(s));
+  }
+  impl_->map_size = options.map_size > 0 ? options.map_size : sets.front()->width();
+  if (options.map_size < 0 || impl_->map_size < 2 || impl_->map_size > 16384)
+    throw std::invalid_argument("render: map size must be in [2, 16384]");
+  if (options.mode == RenderMode::Paper) {
+    const int n = impl_->map_size;
+    if (options.warp == "precomputed")
+      impl_->warp = std::make_unique<PrecomputedWarp>(n, n);
+    else if (options.warp == "tessellated")
+      impl_->warp = std::make_unique<TessellatedWarp>(n, n, TessellationOptions{options.rings, 4 * options.rings});
+    else if (options.warp != "exact")
+      throw std::invalid_argument("render: warp must be exact, precomputed or tessellated, not '" + options.warp + "'");
+  }
+  impl_->scene = std::make_unique<RayScene>(mesh);
+  impl_->bounds = mesh.bounds();
+}
+
+Renderer::~Renderer() = default;
+
+const RayScene& Renderer::scene() const { return *impl_->scene; }
+
+long long Renderer::trace_only(const Camera& camera) const {
+  const TileGrid grid(camera.width, camera.height);
+  const RayScene& scene = *impl_->scene;
+  const ImageRect rect = projected_bounds(camera, impl_->bounds);
+  return tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, grid.count()), 0LL,
+      [&](const tbb::blocked_range<int>& range, long long hits) {
+        int xs[kTile * kTile], ys[kTile * kTile];
+        Vec3 dirs[kTile * kTile];
+        RayHit rh[kTile * kTile];
+        for (int t = range.begin(); t != range.end(); ++t) {
+          if (!grid.overlaps(t, rect)) continue;
+          const int n = grid.pixels(t, xs, ys);
+          trace_samples(scene, camera, rect, n, xs, ys, 0, 0, false, dirs, rh);
+          for (int i = 0; i < n; ++i) hits += rh[i].hit;
+        }
+        return hits;
+      },
+      [](long long a, long long b) { return a + b; });
+}
+
+cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (camera.width < 1 || camera.height < 1) throw std::invalid_argument("render: empty image size");
+  const RayScene& scene = *impl_->scene;
+  const bool paper = options_.mode == RenderMode::Paper;
+  const std::size_t nsets = impl_->sets.size();
+
+  // Paper mode: one destination map per set for the camera's central direction.
+  struct Dest {
+    cv::Mat rgb;
+    DiscMap map;
+    Mat3 view_from_world;
+  };
+  std::vector<Dest> dests(paper ? nsets : 0);
+  if (paper) {
+    BlendOptions bo = options_.blend;
+    bo.width = bo.height = impl_->map_size;
+    bo.warp = impl_->warp.get();
+    bo.source_weights = false;
+    for (std::size_t s = 0; s < nsets; ++s) {
+      BlendResult b = blend(*impl_->sets[s].maps, *impl_->sets[s].views, camera.view_direction(), camera.up(), bo);
+      dests[s].rgb = b.rgb;
+      dests[s].map = DiscMap{&dests[s].rgb, nullptr, b.rgb.cols, b.rgb.rows};
+      dests[s].view_from_world = b.world_from_view.transpose();
+    }
+  }
+  const auto t1 = std::chrono::steady_clock::now();
+
+  cv::Mat out = cv::Mat::zeros(camera.height, camera.width, CV_32FC4);
+  const TileGrid grid(camera.width, camera.height);
+  const int k = impl_->spp_k;
+  const double inv_spp = 1.0 / (k * k);
+  const EnvMap* env = options_.environment;
+  const ImageRect rect = projected_bounds(camera, impl_->bounds);
+
+  struct Counts {
+    long long hits = 0, covered = 0;
+  };
+  const Counts counts = tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, grid.count()), Counts{},
+      [&](const tbb::blocked_range<int>& range, Counts c) {
+        constexpr int N = kTile * kTile;
+        int xs[N], ys[N];
+        Vec3 dirs[N];
+        RayHit rh[N];
+        double acc[N][4];
+        int hit_count[N];
+        std::vector<int> hints(nsets, -1);  // per-set triangle of the last located view (speed only)
+        for (int t = range.begin(); t != range.end(); ++t) {
+          if (!env && !grid.overlaps(t, rect)) continue;  // every sample misses: stays 0
+          const int n = grid.pixels(t, xs, ys);
+          for (int i = 0; i < n; ++i) {
+            acc[i][0] = acc[i][1] = acc[i][2] = acc[i][3] = 0;
+            hit_count[i] = 0;
+          }
+          for (int sy = 0; sy < k; ++sy)
+            for (int sx = 0; sx < k; ++sx) {
+              const double ox = (sx + 0.5) / k - 0.5, oy = (sy + 0.5) / k - 0.5;
+              trace_samples(scene, camera, rect, n, xs, ys, ox, oy, env != nullptr, dirs, rh);
+              for (int i = 0; i < n; ++i) {
+                const Vec3& d = dirs[i];
+                if (!rh[i].hit) {
+                  if (env) {
+                    float L[kMaxChannels] = {0, 0, 0, 0};
+                    sample_bilinear(*env, d, L);
+                    if (env->channels() == 1) L[1] = L[2] = L[0];
+                    acc[i][0] += L[0];
+                    acc[i][1] += L[1];
+                    acc[i][2] += L[2];
+                    acc[i][3] += 1;
+                  }
+                  continue;
+                }
+                ++c.hits;
+                ++hit_count[i];
+                Vec3 nrm = scene.shading_normal(rh[i]);
+                if (scene.geometric_normal(rh[i]).dot(d) > 0) nrm = -nrm;  // back face: two-sided
+                const Vec3 v = -d;
+                double L[3] = {0, 0, 0};
+                for (std::size_t s = 0; s < nsets; ++s) {
+                  if (paper) {
+                    const WarpSample ws = warp_direction(WarpKind::Normal, dests[s].view_from_world * nrm);
+                    double Ls[3], conf;
+                    if (!sample_disc(dests[s].map, ws.disc, Ls, &conf)) continue;
+                    L[0] += Ls[0];
+                    L[1] += Ls[1];
+                    L[2] += Ls[2];
+                  } else {
+                    const DirectionLookup& lookup = *impl_->sets[s].lookup;
+                    const Vec3 Ls = lookup.radiance(lookup.locate(v, &hints[s]), v, nrm);
+                    L[0] += Ls.x();
+                    L[1] += Ls.y();
+                    L[2] += Ls.z();
+                  }
+                }
+                acc[i][0] += L[0];
+                acc[i][1] += L[1];
+                acc[i][2] += L[2];
+                acc[i][3] += 1;
+              }
+            }
+          for (int i = 0; i < n; ++i) {
+            float* o = out.ptr<float>(ys[i]) + 4 * xs[i];
+            for (int ch = 0; ch < 4; ++ch) o[ch] = float(acc[i][ch] * inv_spp);
+            c.covered += hit_count[i] > 0;
+          }
+        }
+        return c;
+      },
+      [](Counts a, const Counts& b) {
+        a.hits += b.hits;
+        a.covered += b.covered;
+        return a;
+      });
+
+  if (stats) {
+    stats->samples = (long long)camera.width * camera.height * k * k;
+    stats->hits = counts.hits;
+    stats->covered_pixels = counts.covered;
+    stats->seconds_blend = std::chrono::duration<double>(t1 - t0).count();
+    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  return out;
+}
+
+}  // namespace rsibr
