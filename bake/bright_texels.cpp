@@ -67,18 +67,65 @@ EnvironmentSplit split_bright_texels(const EnvMap& env, const BrightTexelOptions
     share += q.lum * q.omega;
   }
   out.bright_share = share / power;
+
+  // Cluster levels (see the header).
+  std::vector<Vec3> centres;
+  // Texel directions as the reference quadrature uses them (Layout::texel_direction).
+  for (const BrightTexel& b : out.bright)
+    centres.push_back(env.layout.texel_direction(int(b.texel % w), int(b.texel / w))->normalized());
+  for (double degrees : {0.5, 1.0, 2.0, 4.0, 8.0, 16.0}) {
+    BrightClusterLevel level;
+    level.max_radius = degrees * kPi / 180.0;
+    const double cos_r = std::cos(level.max_radius);
+    std::vector<Vec3> seeds, sums;
+    std::vector<std::vector<std::size_t>> members;
+    for (std::size_t i = 0; i < out.bright.size(); ++i) {  // brightest first
+      std::size_t j = 0;
+      while (j < seeds.size() && !(seeds[j].dot(centres[i]) >= cos_r)) ++j;
+      if (j == seeds.size()) {
+        seeds.push_back(centres[i]);
+        members.emplace_back();
+      }
+      members[j].push_back(i);
+    }
+    for (const auto& group : members) {
+      BrightCluster cl;
+      Vec3 weighted = Vec3::Zero();
+      for (std::size_t i : group) {
+        const BrightTexel& b = out.bright[i];
+        cl.power += b.radiance * b.solid_angle;
+        const double lum = 0.2126 * b.radiance[0] + 0.7152 * b.radiance[1] + 0.0722 * b.radiance[2];
+        weighted += std::max(lum, 1e-30) * b.solid_angle * centres[i];
+      }
+      cl.dir = weighted.normalized();
+      for (std::size_t i : group) cl.radius = std::max(cl.radius, angle_between(cl.dir, centres[i]));
+      level.clusters.push_back(cl);
+    }
+    out.levels.push_back(std::move(level));
+  }
   return out;
 }
 
-Vec3 bright_texel_radiance(const Brdf& brdf, const Vec3& wo, const Mat3& frame,
-                           const std::vector<BrightTexel>& bright, const Layout& cells) {
+Vec3 bright_texel_radiance(const Brdf& brdf, const Vec3& wo, const Mat3& frame, const EnvironmentSplit& split,
+                           const Layout& cells) {
+  const std::vector<BrightTexel>& bright = split.bright;
   if (bright.empty()) return Vec3::Zero();
   const Vec3 n = frame.col(2);
   const double lobe = std::max(brdf.lobe_width(wo), 1e-6);
   Vec3 sum = Vec3::Zero();
+  const BrightClusterLevel* level = nullptr;
+  for (const BrightClusterLevel& l : split.levels)
+    if (l.max_radius <= kClusterFraction * lobe) level = &l;
+  if (level) {
+    for (const BrightCluster& cl : level->clusters) {
+      const Vec3 wi = frame.transpose() * cl.dir;
+      if (wi.z() > 0) sum += brdf.eval(wo, wi).cwiseProduct(cl.power);
+    }
+    return sum;
+  }
   for (const BrightTexel& b : bright) {
     // Skip cells wholly below the horizon: the centre more than the cell's radius below it.
-    const Vec3 centre = latlong_cell_direction(cells, b.texel, Vec2(0.5, 0.5));
+    const Vec3 centre = cells.texel_direction(int(b.texel % cells.width()), int(b.texel / cells.width()))->normalized();
     if (n.dot(centre) < -std::sin(std::min(b.radius, 0.5 * kPi))) continue;
     const int k = std::clamp(int(std::ceil(4.0 * b.angular_size / lobe)), 1, 8);
     Vec3 cell = Vec3::Zero();

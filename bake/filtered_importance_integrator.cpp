@@ -43,7 +43,7 @@ cv::Mat FilteredImportanceIntegrator::radiance_map(const Brdf& brdf, const Vec3&
           pyramid_.sample(w, lod, L);
           sum += s.weight.cwiseProduct(Vec3(L[0], L[1], L[2]));
         }
-        return Vec3(sum / n + bright_texel_radiance(brdf, wo, frame, split_.bright, latlong_));
+        return Vec3(sum / n + bright_texel_radiance(brdf, wo, frame, split_, latlong_));
       },
       progress);
 }

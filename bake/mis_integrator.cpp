@@ -55,7 +55,7 @@ cv::Mat MisIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Ma
             }
           }
         }
-        return Vec3(sum / n + bright_texel_radiance(brdf, wo, frame, split_.bright, env_.layout));
+        return Vec3(sum / n + bright_texel_radiance(brdf, wo, frame, split_, env_.layout));
       },
       progress);
 }

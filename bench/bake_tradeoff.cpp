@@ -113,7 +113,8 @@ std::vector<Config> configs(const std::string& brdf_name, bool quick) {
   return out;
 }
 
-nlohmann::json sweep(const std::vector<std::string>& envs, int size, int probes, bool quick) {
+nlohmann::json sweep(const std::vector<std::string>& envs, int size, int probes, bool quick,
+                     const std::string& only_brdf) {
   nlohmann::json rows = nlohmann::json::array();
   const Vec3 view = Vec3(0.3, 0.4, 0.866).normalized();  // a generic view (not a symmetry axis)
   const Mat3 T = world_from_view_for(view);
@@ -124,6 +125,7 @@ nlohmann::json sweep(const std::vector<std::string>& envs, int size, int probes,
     std::map<std::string, std::unique_ptr<Integrator>> integrators;
     for (const char* m : {"reference", "mis", "fis", "sh"}) integrators[m] = make_integrator(m, env);
     for (const auto& [brdf_name, spec] : brdfs()) {
+      if (!only_brdf.empty() && brdf_name != only_brdf) continue;
       const auto brdf = parse_brdf(spec);
       IntegratorOptions ref_options;
       ref_options.texel_mask = mask;
@@ -214,6 +216,8 @@ int main(int argc, char** argv) {
   std::string envs, target_env, out;
   int size = 256, probes = 1500;
   bool quick = false;
+  std::string only_brdf;
+  app.add_option("--brdf", only_brdf, "Only this BRDF of the sweep (e.g. 'ggx 0.2')");
   app.add_option("--envs", envs, "Comma-separated environments for the knob sweep");
   app.add_option("--target", target_env, "Environment for the 12-view target run");
   app.add_option("--out", out, "JSON output")->required();
@@ -226,7 +230,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> list;
     std::stringstream ss(envs);
     for (std::string e; std::getline(ss, e, ',');) list.push_back(e);
-    result["sweep"] = rsibr::sweep(list, size, probes, quick);
+    result["sweep"] = rsibr::sweep(list, size, probes, quick, only_brdf);
     result["size"] = size;
     result["probes"] = probes;
     result["threads"] = tbb::info::default_concurrency();
