@@ -85,8 +85,9 @@ struct ErrorSums {
 
 struct Config {
   std::string method;
-  std::string knob;  // "samples" or "reference_width"
+  std::string knob;  // "samples", "reference_width" or "order"
   int value;
+  double lod_bias = 0;  // fis only
 };
 
 const std::vector<std::pair<std::string, std::string>>& brdfs() {
@@ -109,6 +110,7 @@ std::vector<Config> configs(const std::string& brdf_name, bool quick) {
   for (int w : ref) out.push_back({"reference", "reference_width", w});
   for (int n : mis) out.push_back({"mis", "samples", n});
   for (int n : fis) out.push_back({"fis", "samples", n});
+  out.push_back({"fis", "samples", 32, 1.0});  // the LOD-bias knob
   if (brdf_name == "lambert") out.push_back({"sh", "order", 2});
   return out;
 }
@@ -138,13 +140,15 @@ nlohmann::json sweep(const std::vector<std::string>& envs, int size, int probes,
         o.seed = 1;
         if (c.knob == "samples") o.samples = c.value;
         if (c.knob == "reference_width") o.reference_width = c.value;
+        o.fis_lod_bias = c.lod_bias;
         t0 = Clock::now();
         const cv::Mat map = integrators[c.method]->radiance_map(*brdf, view, T, size, o);
         const double secs = seconds_since(t0);
         ErrorSums e;
         e.add(map, ref, mask);
         rows.push_back({{"env", env_name}, {"brdf", brdf_name}, {"method", c.method}, {"knob", c.knob},
-                        {"value", c.value}, {"seconds", secs}, {"rel_rms", e.relative_rms()}});
+                        {"value", c.value}, {"lod_bias", c.lod_bias}, {"seconds", secs},
+                        {"rel_rms", e.relative_rms()}});
         std::cerr << env_name << " | " << brdf_name << " | " << c.method << " " << c.knob << "=" << c.value << ": "
                   << e.relative_rms() << " in " << secs << " s\n";
       }
@@ -185,7 +189,7 @@ nlohmann::json target(const std::string& env_path, int size, int probes) {
   out["reference_seconds_extrapolated"] = ref_seconds;
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& [method, samples] : std::vector<std::pair<std::string, int>>{
-           {"mis", 16}, {"mis", 32}, {"mis", 48}, {"mis", 64}, {"mis", 128}, {"fis", 32}, {"fis", 64}}) {
+           {"fis", 16}, {"fis", 32}, {"fis", 64}, {"mis", 64}, {"mis", 256}}) {
     t0 = Clock::now();
     const auto integrator = make_integrator(method, env);  // its precomputation is part of the cost
     ErrorSums e;
