@@ -14,6 +14,14 @@ import subprocess
 import sys
 import tempfile
 
+# Debian's python3-matplotlib lives in the system interpreter; another python3 earlier on PATH
+# (pyenv) would not see it.
+try:
+    import matplotlib  # noqa: F401
+except ImportError:
+    if os.path.exists("/usr/bin/python3") and os.path.realpath(sys.executable) != os.path.realpath("/usr/bin/python3"):
+        os.execv("/usr/bin/python3", ["/usr/bin/python3"] + sys.argv)
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "bench"))
 from convert_roundtrip import replace_section  # noqa: E402
@@ -44,7 +52,7 @@ def sweep_section(data):
            f"reference quadrature over every environment texel, at {data['probes']} random disc texels; "
            f"time: the whole map, {data['threads']} threads. Machine: {machine()} (shared with other work, so "
            "times are indicative; ratios within a row set are what to compare). The reference's own time is "
-           "extrapolated from the probe texels (its cost per texel is constant). GGX uses a gold conductor "
+           "extrapolated from the probe texels (its cost per texel is constant). GGX uses a copper-like conductor "
            "Fresnel; the clear coat is the automotive paint of docs/user-guide.md.", ""]
     cheapest = []
     for brdf in BRDFS:
@@ -135,19 +143,26 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build/release"))
     ap.add_argument("--quick", action="store_true", help="fewer knob values (for a smoke run)")
     ap.add_argument("--skip-target", action="store_true")
+    ap.add_argument("--save", help="also keep the tool's JSON rows in this file")
+    ap.add_argument("--from-json", help="write the docs from saved rows instead of measuring")
     a = ap.parse_args()
     tool = os.path.join(a.build, "rsibr_bake_tradeoff")
     envs = [os.path.join(ROOT, "cache/assets/hdri", e + ".exr") for e in ENVS]
     missing = [e for e in envs if not os.path.exists(e)]
     if missing:
         sys.exit(f"bake_tradeoff.py: missing {missing[0]} (run scripts/fetch-assets.sh)")
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "rows.json")
-        cmd = [tool, "--envs", ",".join(envs), "--out", out] + (["--quick"] if a.quick else [])
-        if not a.skip_target:
-            cmd += ["--target", envs[0]]
-        subprocess.run(cmd, check=True)
-        data = json.load(open(out))
+    if a.from_json:
+        data = json.load(open(a.from_json))
+    else:
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "rows.json")
+            cmd = [tool, "--envs", ",".join(envs), "--out", out] + (["--quick"] if a.quick else [])
+            if not a.skip_target:
+                cmd += ["--target", envs[0]]
+            subprocess.run(cmd, check=True)
+            data = json.load(open(out))
+        if a.save:
+            json.dump(data, open(a.save, "w"), indent=1)
     doc = os.path.join(ROOT, "docs/tradeoffs.md")
     replace_section(doc, "Bake integrators (rsibr bake)", sweep_section(data))
     if "target" in data:

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # The main job on a built-in default, on a fresh Debian 12 machine as root: installs what rsibr
-# needs, builds it, fetches a CC0 environment (Poly Haven via @pmndrs/assets) and runs the
-# pipeline stages that exist so far on it: inspect it, convert it to every layout with PNG
-# previews, and inspect a result. Outputs go to out/default/ (or the folder given as $1).
+# needs, builds it, fetches CC0 data (a Poly Haven sky and the bunny via @pmndrs/assets) and runs
+# the pipeline stages that exist so far: inspect the sky, convert it to every layout with PNG
+# previews; bake a copper map set under it (12 views), blend a novel view, render the bunny with the
+# maps (the runtime) and with the Embree reference path tracer, side by side.
+# Outputs go to out/default/ (or the folder given as $1).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 out=${1:-out/default}
@@ -13,6 +15,7 @@ cmake --build --preset release -j "$(nproc)"
 bash scripts/fetch-assets.sh
 rsibr=build/release/rsibr
 env=cache/assets/hdri/sky.exr
+mesh=cache/assets/models/bunny.glb
 
 mkdir -p "$out"
 "$rsibr" info "$env" --json "$out/sky-info.json"
@@ -22,4 +25,18 @@ for layout in cube octahedral sphere latlong; do
     --json "$out/sky-$layout.json"
 done
 "$rsibr" info "$out/sky-octahedral.exr"
+
+# Computed maps: copper (GGX 0.2, conductor Fresnel) under the sky, the icosahedron's 12 views.
+printf '{type: ggx, roughness: 0.2, fresnel: {type: conductor, eta: [0.2, 0.92, 1.1], k: [3.9, 2.45, 2.14]}}\n' \
+  > "$out/copper.yaml"
+"$rsibr" bake --env "$env" --brdf "$out/copper.yaml" --views icosa --res 128 --method fis --samples 32 \
+  --sanitize --json "$out/copper-maps.json" "$out/copper-maps.exr"
+"$rsibr" blend "$out/copper-maps.exr" "$out/copper-novel.exr" --view 0.2 0.3 0.9 --preview "$out/copper-novel.png"
+# The bunny rendered with the maps (per-pixel mode) and by the reference path tracer without
+# shadows (the maps' contract), same camera.
+"$rsibr" render --maps "$out/copper-maps.exr" --mesh "$mesh" --size 640x360 --json "$out/bunny-render.json" \
+  "$out/bunny-render.png"
+"$rsibr" reference --mesh "$mesh" --env "$env" --brdf "$out/copper.yaml" --size 640x360 --spp 16 --no-shadows \
+  --background black --sanitize --preview "$out/bunny-reference.png" --json "$out/bunny-reference.json" \
+  "$out/bunny-reference.exr"
 echo "run-default: results in $out/ (EXR, PNG previews, JSON summaries)"
