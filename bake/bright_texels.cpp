@@ -106,6 +106,13 @@ EnvironmentSplit split_bright_texels(const EnvMap& env, const BrightTexelOptions
   return out;
 }
 
+const BrightClusterLevel* cluster_level_for(const EnvironmentSplit& split, double lobe_width) {
+  const BrightClusterLevel* level = nullptr;
+  for (const BrightClusterLevel& l : split.levels)
+    if (l.max_radius <= kClusterFraction * lobe_width) level = &l;
+  return level;
+}
+
 Vec3 bright_texel_radiance(const Brdf& brdf, const Vec3& wo, const Mat3& frame, const EnvironmentSplit& split,
                            const Layout& cells) {
   const std::vector<BrightTexel>& bright = split.bright;
@@ -113,10 +120,7 @@ Vec3 bright_texel_radiance(const Brdf& brdf, const Vec3& wo, const Mat3& frame, 
   const Vec3 n = frame.col(2);
   const double lobe = std::max(brdf.lobe_width(wo), 1e-6);
   Vec3 sum = Vec3::Zero();
-  const BrightClusterLevel* level = nullptr;
-  for (const BrightClusterLevel& l : split.levels)
-    if (l.max_radius <= kClusterFraction * lobe) level = &l;
-  if (level) {
+  if (const BrightClusterLevel* level = cluster_level_for(split, lobe)) {
     for (const BrightCluster& cl : level->clusters) {
       const Vec3 wi = frame.transpose() * cl.dir;
       if (wi.z() > 0) sum += brdf.eval(wo, wi).cwiseProduct(cl.power);

@@ -71,6 +71,10 @@ struct EnvironmentSplit {
 // env must be lat-long (bake/mis_integrator.h: as_latlong).
 EnvironmentSplit split_bright_texels(const EnvMap& latlong, const BrightTexelOptions& options = {});
 
+// The coarsest cluster level whose max_radius <= kClusterFraction * lobe_width; nullptr when the
+// lobe is narrower than the finest level allows.
+const BrightClusterLevel* cluster_level_for(const EnvironmentSplit& split, double lobe_width);
+
 // The first term of the split for one map texel: with the coarsest cluster level allowed by the
 // lobe width at wo, sum over clusters of eval(wo, frame^T dir) * power (clusters whose centroid is
 // below the horizon contribute 0); without one, sum over the bright texels of

@@ -29,12 +29,21 @@ Vec3 texel_rgb(const float* p, int channels) {
 }  // namespace
 
 ReferenceLighting::ReferenceLighting(const EnvMap& env)
-    : original_(env), latlong_(as_latlong(env)), dist_(latlong_) {
+    : original_(env),
+      latlong_(as_latlong(env)),
+      dist_(latlong_),
+      split_(split_bright_texels(latlong_)),
+      remainder_dist_(split_.remainder) {
   const int ch = latlong_.channels(), w = latlong_.layout.width();
   radiance_.resize(static_cast<std::size_t>(latlong_.layout.texel_count()));
+  remainder_radiance_.resize(radiance_.size());
   for (int r = 0; r < latlong_.layout.height(); ++r) {
     const float* row = latlong_.pixels.ptr<float>(r);
-    for (int c = 0; c < w; ++c) radiance_[std::size_t(r) * w + c] = texel_rgb(row + c * ch, ch);
+    const float* rest = split_.remainder.pixels.ptr<float>(r);
+    for (int c = 0; c < w; ++c) {
+      radiance_[std::size_t(r) * w + c] = texel_rgb(row + c * ch, ch);
+      remainder_radiance_[std::size_t(r) * w + c] = texel_rgb(rest + c * ch, ch);
+    }
   }
 }
 
@@ -105,7 +114,6 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
   const int bounces = shadows ? options.bounces : 1;
   const int spp = options.spp, K = options.light_samples, n_first = spp * K;
   const double inv_k = 1.0 / K;
-  const EnvironmentDistribution& dist = lighting.distribution();
   const int W = camera.width, H = camera.height;
 
   ReferenceImage out;
@@ -138,6 +146,29 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
           const Surface S = surface_at(scene, hit, -dir);
           const Vec3 origin = S.x + eps * S.ng;
           const bool may_continue = depth + 1 < bounces;
+          // The sun split where a cluster level fits this lobe: clusters as point lights (one
+          // shadow ray each), MIS over the remainder; otherwise MIS over the whole environment.
+          const BrightClusterLevel* level =
+              lighting.split().bright.empty() ? nullptr
+                                              : cluster_level_for(lighting.split(), brdf.lobe_width(S.wo));
+          const EnvironmentDistribution& dist = level ? lighting.remainder_distribution() : lighting.distribution();
+          auto env_radiance = [&](long texel) -> const Vec3& {
+            return level ? lighting.remainder_radiance(texel) : lighting.radiance(texel);
+          };
+          if (level) {
+            for (const BrightCluster& cl : level->clusters) {
+              const Vec3 wi = S.frame.transpose() * cl.dir;
+              if (!(wi.z() > 0)) continue;
+              const Vec3 f = brdf.eval(S.wo, wi);
+              if (f == Vec3::Zero()) continue;
+              if (shadows) {
+                if (cl.dir.dot(S.ng) <= 0) continue;
+                ++counts.shadow_rays;
+                if (scene.occluded(origin, cl.dir)) continue;
+              }
+              radiance += beta.cwiseProduct(f.cwiseProduct(cl.power));
+            }
+          }
           bool next = false;
           Vec3 next_dir, next_weight;
           RayHit next_hit;
@@ -177,7 +208,7 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
               }
               if (escapes) {
                 const Vec3 f = brdf.eval(S.wo, b.wi);
-                radiance += inv_k * beta.cwiseProduct(f.cwiseProduct(lighting.radiance(dist.texel_of(w)))) /
+                radiance += inv_k * beta.cwiseProduct(f.cwiseProduct(env_radiance(dist.texel_of(w)))) /
                             (b.pdf + dist.pdf(w));
               }
             }
@@ -198,7 +229,7 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
                     }
                   }
                   if (visible)
-                    radiance += inv_k * beta.cwiseProduct(f.cwiseProduct(lighting.radiance(e.texel))) /
+                    radiance += inv_k * beta.cwiseProduct(f.cwiseProduct(env_radiance(e.texel))) /
                                 (brdf.pdf(S.wo, wi) + e.pdf);
                 }
               }

@@ -51,6 +51,7 @@
 #pragma once
 
 #include "bake/brdf.h"
+#include "bake/bright_texels.h"
 #include "bake/environment_distribution.h"
 #include "core/camera.h"
 #include "core/env_map.h"
@@ -97,12 +98,20 @@ struct ReferenceImage {
 
 // Precomputed lighting: the environment in lat-long (other layouts resampled once, about as many
 // texels), its sampling distribution and per-texel RGB, and the original map for the background.
+// The sun split (bake/bright_texels.h): where a cluster level fits the BRDF's lobe at a hit, the
+// bright texels are that level's clusters, each a point light with one shadow ray, and MIS samples
+// the remainder (no sun noise: the dark speckles a 1e4 sun leaves at 64 spp are gone); for lobes
+// too narrow for any level, MIS samples the whole environment.
 class ReferenceLighting {
  public:
   explicit ReferenceLighting(const EnvMap& env);
   // L_i(w) as lighting sees it: the lat-long texel containing w (piecewise constant).
   const Vec3& radiance(long texel) const { return radiance_[std::size_t(texel)]; }
   const EnvironmentDistribution& distribution() const { return dist_; }
+  // The same without the bright texels, and its distribution.
+  const Vec3& remainder_radiance(long texel) const { return remainder_radiance_[std::size_t(texel)]; }
+  const EnvironmentDistribution& remainder_distribution() const { return remainder_dist_; }
+  const EnvironmentSplit& split() const { return split_; }
   // L_i(d) seen directly (bilinear in the original layout).
   Vec3 background(const Vec3& d) const;
 
@@ -110,6 +119,9 @@ class ReferenceLighting {
   EnvMap original_, latlong_;
   EnvironmentDistribution dist_;
   std::vector<Vec3> radiance_;
+  EnvironmentSplit split_;
+  EnvironmentDistribution remainder_dist_;
+  std::vector<Vec3> remainder_radiance_;
 };
 
 // Renders the image (see the contract above). Throws std::invalid_argument for bad options
