@@ -92,6 +92,10 @@ def table(doc, args, wall):
                                  f"{a['rel_rms_inner'] / b['rel_rms_inner']:.2f}x)")
     lines += [
         "",
+        "Reading: a split row and the whole-BRDF row at the split's mirror views differ only in how the binder is "
+        "stored (mirror-warped inside one set, or normal-warped in a set of its own): their difference is what the "
+        "split buys; the maps it gives to the normal part are what it costs.",
+        "",
         "The truth's own noise (the whole BRDF baked with seeds 1 and 2, relative RMS): "
         + ", ".join(f"{e} {n:.1e}" for e, n in noise.items()) + ".",
         "",
@@ -110,6 +114,7 @@ def main():
     ap.add_argument("--samples", type=int, default=128)
     ap.add_argument("--truth-samples", type=int, default=512)
     ap.add_argument("--novel", type=int, default=6)
+    ap.add_argument("--brdf", help="another BRDF spec (YAML text) than the clear coat of the section (with --no-write)")
     ap.add_argument("--docs", default=os.path.join(ROOT, "docs/tradeoffs.md"))
     ap.add_argument("--no-write", action="store_true", help="print the section instead of writing it")
     args = ap.parse_args()
@@ -124,7 +129,8 @@ def main():
     t0 = time.perf_counter()
     subprocess.run([args.tool, "--envs", ",".join(envs), "--configs", args.configs, "--res", str(args.res),
                     "--samples", str(args.samples), "--truth-samples", str(args.truth_samples),
-                    "--novel", str(args.novel), "--out", out], check=True)
+                    "--novel", str(args.novel), "--out", out, *(["--brdf", args.brdf] if args.brdf else [])],
+                   check=True)
     wall = time.perf_counter() - t0
     with open(out) as f:
         doc = json.load(f)
