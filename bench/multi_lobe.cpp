@@ -169,8 +169,10 @@ int run(int argc, char** argv) {
 
     // The truth of each part (seed 1); the whole BRDF's truth is their sum: a part samples with its
     // parent's sampler and pdf (bake/brdf_lobes.h), so with one seed the MIS estimates of the parts
-    // add up to the parent's estimate (to rounding). The whole BRDF again with seed 2: the truth's
-    // own noise, which must be well below the blend errors.
+    // add up to the parent's estimate, up to the bright-texel quadrature's order, which follows each
+    // part's own lobe width (5e-4 relative under a sun, tests/bake/brdf_lobes_test.cpp; far below
+    // the truth's noise). The whole BRDF again with seed 2: the truth's own noise (against the sum),
+    // which must be well below the blend errors.
     std::vector<cv::Mat> truth;
     std::vector<std::array<cv::Mat, 2>> truth_part;  // normal, mirror
     Sums noise;
