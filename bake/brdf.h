@@ -69,6 +69,25 @@ class Brdf {
   // The BRDF as one line of YAML (flow style) that make_brdf() parses back to the same BRDF
   // (bake/brdf_spec.h); the text of a map set's rsibr.material attribute.
   virtual std::string spec() const = 0;
+
+  // Multi-lobe split (bake/brdf_lobes.h): the BRDF as the sum of a Normal-centred and a
+  // Mirror-centred part, each baked as its own map set and warped with its own warp.
+  //   eval_lobe(Normal, wo, wi) + eval_lobe(Mirror, wo, wi) = eval(wo, wi)   (to rounding)
+  //   albedo_lobe(Normal, wo)   + albedo_lobe(Mirror, wo)   = albedo(wo)     (to rounding)
+  // Same contract as eval (cosine included, local frame, 0 below the horizon) and albedo.
+  // Defaults: the whole BRDF is its central_direction() part and the other part is empty.
+  // has_lobe(part) is false when the part is identically zero (then eval_lobe and albedo_lobe
+  // return 0 and lobe_width_of is meaningless).
+  virtual bool has_lobe(Lobe part) const { return part == central_direction(); }
+  virtual Vec3 eval_lobe(Lobe part, const Vec3& wo, const Vec3& wi) const {
+    return has_lobe(part) ? eval(wo, wi) : Vec3::Zero();
+  }
+  virtual Vec3 albedo_lobe(Lobe part, const Vec3& wo) const { return has_lobe(part) ? albedo(wo) : Vec3::Zero(); }
+  // lobe_width() of the part alone, about the part's own central direction.
+  virtual double lobe_width_of(Lobe part, const Vec3& wo) const {
+    (void)part;
+    return lobe_width(wo);
+  }
 };
 
 // The energy fraction that lobe_width() refers to.

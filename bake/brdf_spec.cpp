@@ -1,6 +1,7 @@
 #include "bake/brdf_spec.h"
 
 #include "bake/blinn_phong.h"
+#include "bake/brdf_lobes.h"
 #include "bake/clear_coat.h"
 #include "bake/ggx.h"
 #include "bake/lambert.h"
@@ -146,7 +147,15 @@ std::shared_ptr<const Fresnel> make_fresnel(const YAML::Node& spec, const std::s
 }
 
 std::unique_ptr<Brdf> make_brdf(const YAML::Node& spec, const std::string& path) {
-  const std::string type = type_of(spec, path, {"lambert", "phong", "blinn_phong", "ggx", "clearcoat"});
+  const std::string type = type_of(spec, path, {"lambert", "phong", "blinn_phong", "ggx", "clearcoat", "lobe"});
+  if (type == "lobe") {
+    MapSpec m(spec, path, {"type", "part", "of"});
+    const std::string part = m.string("part");
+    if (part != "normal" && part != "mirror") fail(m.at("part"), "expected normal or mirror, got '" + part + "'");
+    std::shared_ptr<const Brdf> parent = make_brdf(m.get("of"), m.at("of"));
+    if (!parent->has_lobe(lobe_from_string(part))) fail(m.at("part"), "the BRDF in 'of' has no " + part + " lobe");
+    return std::make_unique<BrdfLobe>(std::move(parent), lobe_from_string(part));
+  }
   if (type == "lambert") {
     MapSpec m(spec, path, {"type", "albedo"});
     return std::make_unique<LambertBrdf>(unit_rgb(m, "albedo"));

@@ -9,6 +9,9 @@
 //   {type: clearcoat,   coat: {ior: n, roughness: a},                         n > 1
 //                       flakes: {coverage: c, roughness: a, fresnel: F},      c in [0,1]
 //                       base: {albedo: [r, g, b]}}
+//   {type: lobe,        part: normal|mirror, of: B}                          one part of the BRDF B
+//                                                                          (bake/brdf_lobes.h); B
+//                                                                          must have that part
 //   F = {type: none} | {type: schlick, f0: [r, g, b]} | {type: dielectric, ior: n}      n > 0
 //     | {type: conductor, eta: [r, g, b], k: [r, g, b]}                                 eta > 0, k >= 0
 //

@@ -58,6 +58,16 @@ class ClearCoatBrdf final : public Brdf {
   double lobe_width(const Vec3& wo) const override;
   std::string spec() const override;
 
+  // Multi-lobe split (bake/brdf_lobes.h):
+  //   Mirror part = f_coat + T(wo) T(wi) c f_flake          (centred on the mirror direction)
+  //   Normal part = T(wo) T(wi) (1 - c) rho / pi            (the binder, centred on n)
+  // times cos theta_i, as eval. The Normal part exists when (1 - c) rho is not zero. albedo() is
+  // the sum of the two parts' albedos; each part's width is lobe_width()'s rule over its own terms.
+  bool has_lobe(Lobe part) const override;
+  Vec3 eval_lobe(Lobe part, const Vec3& wo, const Vec3& wi) const override;
+  Vec3 albedo_lobe(Lobe part, const Vec3& wo) const override;
+  double lobe_width_of(Lobe part, const Vec3& wo) const override;
+
   const ClearCoatParams& params() const { return p_; }
   // Lobe selection probabilities at wo: coat, flakes, binder (sum to 1).
   std::array<double, 3> lobe_probabilities(const Vec3& wo) const;

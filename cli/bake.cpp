@@ -5,6 +5,7 @@
 
 #include "core/atomic_file.h"
 
+#include "bake/brdf_lobes.h"
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
 #include "core/exr_io.h"
@@ -24,7 +25,7 @@ namespace rsibr::cli {
 namespace {
 
 struct BakeArgs {
-  std::string env, brdf, views = "icosa", method = "mis", layout, json, output;
+  std::string env, brdf, views = "icosa", method = "mis", layout, json, output, lobe = "all";
   int res = 128;
   int samples = 64;
   int reference_width = 0;
@@ -52,7 +53,14 @@ int run_bake(const BakeArgs& a) {
         if (!std::isfinite(row[i]) || row[i] < 0) row[i] = 0.f;
     }
   }
-  const std::unique_ptr<Brdf> brdf = load_brdf(a.brdf);
+  // --lobe: the whole BRDF, or one part of it (bake/brdf_lobes.h) with its own central direction.
+  std::shared_ptr<const Brdf> brdf = load_brdf(a.brdf);
+  if (a.lobe != "all") {
+    const Lobe part = lobe_from_string(a.lobe);
+    if (!brdf->has_lobe(part))
+      throw std::invalid_argument(a.brdf + ": --lobe " + a.lobe + ": the BRDF has no " + a.lobe + " lobe");
+    brdf = std::make_shared<BrdfLobe>(brdf, part);
+  }
   const ViewSet views = ViewSet::named(a.views);
   const auto integrator = make_integrator(a.method, env);
   IntegratorOptions options;
@@ -104,6 +112,7 @@ int run_bake(const BakeArgs& a) {
   j["environment_size"] = {env.layout.width(), env.layout.height()};
   j["material"] = brdf->spec();
   j["warp"] = warp;
+  j["lobe"] = a.lobe;
   j["method"] = a.method;
   j["samples"] = a.samples;
   j["seed"] = a.seed;
@@ -122,12 +131,19 @@ Runner add_bake(CLI::App& app) {
   CLI::App* c = app.add_subcommand("bake", "Compute a map set: a BRDF lit by an environment, one sphere map per view");
   c->footer("Methods: reference (quadrature over every environment texel; exact, slow), mis (Monte Carlo, BRDF and "
             "environment sampling combined), fis (filtered importance sampling over a MIP pyramid), sh (spherical "
-            "harmonics order 2, lambert only). The same inputs and --seed give the same bytes.");
+            "harmonics order 2, lambert only). The same inputs and --seed give the same bytes.\n"
+            "Multi-lobe maps: --lobe normal and --lobe mirror bake the two parts of a BRDF (clear coat: the binder; "
+            "the coat and flakes) as two sets, each warped with its own warp; the runtime sums them "
+            "(rsibr render --maps normal.exr --maps mirror.exr).");
   c->add_option("output", a->output, "Output map set (.exr)")->required();
   c->add_option("--env", a->env, "Environment map (EXR or .hdr)")->required();
   c->add_option("--brdf", a->brdf, "BRDF spec (YAML)")->required();
   c->add_option("--views", a->views, "View set: icosa, 42, 162, 642 or a file of 'x y z' lines");
   c->add_option("--res", a->res, "Sphere-map size (square)")->check(CLI::Range(1, 8192));
+  c->add_option("--lobe", a->lobe,
+                "all (the whole BRDF), or normal / mirror: only that part of it (multi-lobe maps: bake each part "
+                "and render with --maps once per part); the warp follows the part")
+      ->check(CLI::IsMember({"all", "normal", "mirror"}));
   c->add_option("--method", a->method, "reference, mis, fis or sh")
       ->check(CLI::IsMember({"reference", "mis", "fis", "sh"}));
   c->add_option("--samples", a->samples, "mis, fis: samples per texel")->check(CLI::Range(1, 1 << 20));

@@ -90,6 +90,22 @@ check "bake: lambert is normal-warped" bash -c "'$rsibr' info '$work/grey.exr' |
 expect_error "bake: unknown spec key" "roughnes" bake --env "$work/sky.exr" --brdf "$work/typo.yaml" --res 16 "$work/typo.exr"
 expect_error "bake: sh needs lambert" "lambert" bake --env "$work/sky.exr" --brdf "$work/ggx.yaml" --res 16 --method sh "$work/sh.exr"
 check "bake: no output after errors" test ! -e "$work/typo.exr" -a ! -e "$work/sh.exr"
+# bake --lobe: each part of a clear coat is its own set, warped from the part's central direction.
+check "bake --help mentions --lobe" bash -c "'$rsibr' bake --help | grep -q -- --lobe"
+printf '%s\n' '{type: clearcoat, coat: {ior: 1.5, roughness: 0.05}, flakes: {coverage: 0.3, roughness: 0.3, fresnel: {type: schlick, f0: [0.9, 0.7, 0.4]}}, base: {albedo: [0.5, 0.05, 0.03]}}' >"$work/paint.yaml"
+lobe_attr() {  # lobe_attr FILE KEY: the first part's rsibr attribute from info --json
+  "$rsibr" info "$1" --json - 2>/dev/null | python3 -c "import json,sys; print(json.load(sys.stdin)['parts'][0]['$2'])"
+}
+for lobe in all normal mirror; do
+  "$rsibr" bake --env "$work/sky.exr" --brdf "$work/paint.yaml" --lobe $lobe --views icosa --res 8 --samples 4 -q "$work/paint_$lobe.exr"
+done
+check "bake --lobe all: mirror warp, the whole BRDF" test "$(lobe_attr "$work/paint_all.exr" warp)" = mirror -a "$(lobe_attr "$work/paint_all.exr" material | cut -c1-16)" = "{type: clearcoat"
+check "bake --lobe normal: normal warp" test "$(lobe_attr "$work/paint_normal.exr" warp)" = normal
+check "bake --lobe mirror: mirror warp" test "$(lobe_attr "$work/paint_mirror.exr" warp)" = mirror
+check "bake --lobe normal: material is the part's spec" bash -c "'$rsibr' info '$work/paint_normal.exr' --json - 2>/dev/null | grep -q '{type: lobe, part: normal, of: {type: clearcoat'"
+expect_error "bake --lobe of a missing part" "no normal lobe" bake --env "$work/sky.exr" --brdf "$work/ggx.yaml" --lobe normal --res 8 "$work/ggx_normal.exr"
+expect_error "bake --lobe with a bad name" "lobe" bake --env "$work/sky.exr" --brdf "$work/paint.yaml" --lobe diffuse --res 8 "$work/bad_lobe.exr"
+check "bake --lobe: no output after errors" test ! -e "$work/ggx_normal.exr" -a ! -e "$work/bad_lobe.exr"
 # reference: a tiny render of an octahedron, deterministic bytes, JSON, errors before work.
 printf 'v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\nf 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n' >"$work/octa.obj"
 for i in 1 2; do
