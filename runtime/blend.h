@@ -61,6 +61,11 @@ struct BlendOptions {
   const Warp* warp = nullptr;
   // Also return each located source's per-texel weight a_i (BlendResult::source_weight).
   bool source_weights = false;
+  // The reference path: per texel in double through Warp::warp_row and sample_disc. The default
+  // (fast) path computes the same definition in float32, fusing warp (exact or precomputed warps:
+  // recomputed in the row loop), fade, sampling and normalisation per row; it agrees with the
+  // reference path to ~1e-6 in colour and weight (tests/runtime/blend_test.cpp measures it).
+  bool reference = false;
 };
 
 struct BlendResult {
