@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -67,10 +68,11 @@ void prepare(const Source& s, FastSource& f) {
   f.offset_x = 0.5 * (s.width - 1);
   f.scale_y = 0.5 * s.height;
   f.offset_y = 0.5 * (s.height - 1);
-  // A footprint's taps lie within one texel of the point in x and in y: within a disc-unit distance
-  // 2 sqrt(1/W^2 + 1/H^2) of it. Points inside radius 1 - that (less a margin for rounding)
-  // have every tap inside the disc and in the image. Offsets must fit an int (else no interior).
-  const double reach = 2.0 * std::sqrt(1.0 / (double(s.width) * s.width) + 1.0 / (double(s.height) * s.height));
+  // A footprint's taps lie within one texel of the point in x and in y, and the gather loop also
+  // reads the first channel of the texel right of the footprint (4-wide loads): within a disc-unit
+  // distance sqrt((4/W)^2 + (2/H)^2). Points inside radius 1 - that (less a margin for rounding)
+  // have all of these inside the disc and in the image. Offsets must fit an int (else no interior).
+  const double reach = std::sqrt(16.0 / (double(s.width) * s.width) + 4.0 / (double(s.height) * s.height));
   const double radius = 1.0 - reach - 1e-4;
   const bool fits = double(s.rgb->step1()) * s.height < 2e9 &&
                     (!s.confidence || double(s.confidence->step1()) * s.height < 2e9);
@@ -97,6 +99,14 @@ void prepare(const Source& s, FastSource& f) {
   }
 }
 
+// Four floats (GCC/Clang vector extension): one bilinear tap's RGB in one load.
+typedef float v4f __attribute__((vector_size(16)));
+inline v4f load4(const float* p) {
+  v4f v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
 // Per-tile-row scratch of the fast path, structure of arrays (one allocation per task).
 struct Scratch {
   std::vector<double> doubles;
@@ -104,15 +114,16 @@ struct Scratch {
   std::vector<int> ints;
   std::vector<WarpSample> samples;
   double *dir[2][3], *disc_x[3], *disc_y[3], *rim[3];
-  float *a[3], *fx[3], *fy[3];
+  float *a[3], *fx[3], *fy[3], *acc[4];
   int *offset[3], *conf_offset[3], *interior[3];
   explicit Scratch(int width)
-      : doubles(std::size_t(15) * std::size_t(width)), floats(std::size_t(9) * std::size_t(width)),
+      : doubles(std::size_t(15) * std::size_t(width)), floats(std::size_t(13) * std::size_t(width)),
         ints(std::size_t(9) * std::size_t(width)) {
     double* p = doubles.data();
     float* q = floats.data();
     for (auto& d : dir)
       for (auto& c : d) c = p, p += width;
+    acc[3] = q, q += width;
     for (int k = 0; k < 3; ++k) {
       disc_x[k] = p, p += width;
       disc_y[k] = p, p += width;
@@ -120,6 +131,7 @@ struct Scratch {
       a[k] = q, q += width;
       fx[k] = q, q += width;
       fy[k] = q, q += width;
+      acc[k] = q, q += width;
       offset[k] = ints.data() + std::size_t(3 * k) * std::size_t(width);
       conf_offset[k] = offset[k] + width;
       interior[k] = conf_offset[k] + width;
@@ -398,21 +410,21 @@ BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_
             __builtin_prefetch(t + fast[k].rgb_step);
           }
         }
-      float acc0 = 0, acc1 = 0, acc2 = 0, total = 0;
+      v4f acc = {0.0f, 0.0f, 0.0f, 0.0f};
+      float total = 0;
       for (int j = 0; j < m; ++j) {
         const int k = active[j];
         float a = s.a[k][i];
         if (!(a > 0.0f)) continue;
         const FastSource& f = fast[k];
-        float L[3];
+        v4f L;
         if (s.interior[k][i]) {
           const float fx = s.fx[k][i], fy = s.fy[k][i];
           const float w00 = (1.0f - fx) * (1.0f - fy), w01 = fx * (1.0f - fy), w10 = (1.0f - fx) * fy, w11 = fx * fy;
           const float* t0 = f.rgb + s.offset[k][i];
           const float* t1 = t0 + f.rgb_step;
-          L[0] = w00 * t0[0] + w01 * t0[3] + w10 * t1[0] + w11 * t1[3];
-          L[1] = w00 * t0[1] + w01 * t0[4] + w10 * t1[1] + w11 * t1[4];
-          L[2] = w00 * t0[2] + w01 * t0[5] + w10 * t1[2] + w11 * t1[5];
+          // Four lanes: RGB and the next texel's R (unused; in the image, see FastSource::interior2).
+          L = w00 * load4(t0) + w01 * load4(t0 + 3) + w10 * load4(t1) + w11 * load4(t1 + 3);
           if (any_confidence && f.confidence) {
             const float* k0 = f.confidence + s.conf_offset[k][i];
             const float* k1 = k0 + f.confidence_step;
@@ -421,30 +433,40 @@ BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_
             a *= conf > 0.0f ? conf : 0.0f;  // negative or NaN counts as 0
           }
         } else {
-          float conf;
-          if (!sample_rim(f, sources[k], s.disc_x[k][i], s.disc_y[k][i], L, &conf)) continue;
+          float conf, Lr[3];
+          if (!sample_rim(f, sources[k], s.disc_x[k][i], s.disc_y[k][i], Lr, &conf)) continue;
           a *= conf;
+          L = v4f{Lr[0], Lr[1], Lr[2], 0.0f};
         }
         if (!(a > 0.0f)) continue;
-        acc0 += a * L[0];
-        acc1 += a * L[1];
-        acc2 += a * L[2];
+        acc += a * L;
         total += a;
         if (sw[k]) sw[k][i] = a;
       }
-      float* o = out + 3 * i;
-      if (total > 0.0f) {
-        const float inv = 1.0f / total;
-        o[0] = acc0 * inv;
-        o[1] = acc1 * inv;
-        o[2] = acc2 * inv;
-        out_w[i] = total;
-      } else {
-        o[0] = o[1] = o[2] = 0.0f;
-        fallback(sources, n, W, H, r, c0 + i, o);
-        out_w[i] = 0.0f;
-      }
+      s.acc[0][i] = acc[0];
+      s.acc[1][i] = acc[1];
+      s.acc[2][i] = acc[2];
+      s.acc[3][i] = total;
     }
+    // Normalisation (vectorised), then the fallback where nothing was accumulated.
+    bool any_empty = false;
+    for (int i = 0; i < span; ++i) {
+      const float total = s.acc[3][i];
+      const float inv = 1.0f / (total > 0.0f ? total : 1.0f);
+      out[3 * i] = s.acc[0][i] * inv;
+      out[3 * i + 1] = s.acc[1][i] * inv;
+      out[3 * i + 2] = s.acc[2][i] * inv;
+      out_w[i] = total;
+      any_empty |= !(total > 0.0f);
+    }
+    if (any_empty)
+      for (int i = 0; i < span; ++i)
+        if (!(s.acc[3][i] > 0.0f)) {
+          float* o = out + 3 * i;
+          o[0] = o[1] = o[2] = 0.0f;
+          fallback(sources, n, W, H, r, c0 + i, o);
+          out_w[i] = 0.0f;
+        }
   };
   // Tiles of kTileRows x kTileCols destination texels: a tile's footprint in each source is compact
   // (tens of KiB for three sources), so the bilinear taps hit the cache and the TLB; a whole

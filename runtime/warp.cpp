@@ -76,19 +76,14 @@ void central_directions_row(WarpKind kind, int width, int height, int row, int c
   const int n = c_end - c_begin;
   for (int i = 0; i < n; ++i) {
     const double x = (2.0 * (c_begin + i) + 1.0) / width - 1.0;
-    const double rho2 = x * x + y * y;
-    // Outside the disc (texels the caller did not clip): the rim, as g_normal.
-    const bool outside = rho2 >= 1.0;
-    const double s = 1.0 / std::sqrt(outside ? rho2 : 1.0);
-    const double z = std::sqrt(outside ? 0.0 : 1.0 - rho2);
-    const double nx = outside ? x * s : x, ny = outside ? y * s : y;
+    const double z = std::sqrt(std::max(0.0, 1.0 - (x * x + y * y)));  // g_normal inside the disc
     if (kind == WarpKind::Mirror) {
-      out_x[i] = 2 * nx * z;
-      out_y[i] = 2 * ny * z;
+      out_x[i] = 2 * x * z;
+      out_y[i] = 2 * y * z;
       out_z[i] = 2 * z * z - 1.0;
     } else {
-      out_x[i] = nx;
-      out_y[i] = ny;
+      out_x[i] = x;
+      out_y[i] = y;
       out_z[i] = z;
     }
   }

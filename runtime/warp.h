@@ -58,8 +58,8 @@ std::pair<int, int> disc_span(int row, int width, int height);
 // Structure-of-arrays forms of the exact warp, for fused row loops (runtime/blend.cpp) that the
 // compiler vectorises (no branches, no calls per texel).
 //   central_directions_row: the central directions of `kind` (the destination's own frame) of the
-//     destination texels (c, row), c in [c_begin, c_end): out_x/y/z[c - c_begin]. Texel centres outside
-//     the disc are clamped to the rim, as g_normal does.
+//     destination texels (c, row), c in [c_begin, c_end): out_x/y/z[c - c_begin], the same arithmetic
+//     as g_normal / g_mirror. The texel centres must lie inside the disc (within disc_span).
 //   warp_directions: warp_direction for the n unit directions (x, y, z) rotated by m (row-major 3x3,
 //     the source_from_dest rotation): the source disc point (disc_x, disc_y) and rim value. The
 //     rotated direction is taken as unit (no renormalisation: the input is unit and m a rotation);
