@@ -140,7 +140,8 @@ struct Scratch {
 };
 
 // a = weight * fade(rim) (rim_fade_weight's formula), rounded to float.
-void fade_row(int n, double weight, double rim_fade, const double* __restrict rim, float* __restrict a) {
+// Vectorised, also for AVX2 (as warp_directions, runtime/warp.cpp: no FMA, the same bits).
+__attribute__((target_clones("avx2", "default"))) void fade_row(int n, double weight, double rim_fade, const double* __restrict rim, float* __restrict a) {
   if (!(rim_fade > 0)) {
     for (int i = 0; i < n; ++i) a[i] = float(weight);
     return;
@@ -156,7 +157,7 @@ void fade_row(int n, double weight, double rim_fade, const double* __restrict ri
 // The bilinear footprint of each disc point (vectorised): the offset of its top-left tap in floats
 // (rgb; the confidence offset follows from it), the fractions, and whether it lies in the interior
 // (all four taps valid: the gather loop needs no further test).
-void footprints_row(const FastSource& f, int n, const double* __restrict disc_x, const double* __restrict disc_y,
+__attribute__((target_clones("avx2", "default"))) void footprints_row(const FastSource& f, int n, const double* __restrict disc_x, const double* __restrict disc_y,
                     float* __restrict fx, float* __restrict fy, int* __restrict offset, int* __restrict conf_offset,
                     int* __restrict interior) {
   for (int i = 0; i < n; ++i) {
