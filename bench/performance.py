@@ -93,8 +93,11 @@ def main():
             if not ref or "error_message" in ref:
                 continue
             unit = b["time_unit"]
+            ratio = b['real_time'] / ref['real_time']
             row = (f"| {arg} | {b.get('label', '')} | {ref['real_time']:.3g} {unit} | "
-                   f"{b['real_time']:.3g} {unit} | {b['real_time'] / ref['real_time']:.1f}x |")
+                   f"{b['real_time']:.3g} {unit} | {ratio:.2f}x |" if ratio < 1 else
+                   f"| {arg} | {b.get('label', '')} | {ref['real_time']:.3g} {unit} | "
+                   f"{b['real_time']:.3g} {unit} | {ratio:.1f}x |")
             if "fps" in b:
                 row += f" {b['fps']:.1f} |"
             rows.append(row)
@@ -107,6 +110,8 @@ def main():
                   "|---|---|---|---|---|" + ("---|" if fps else "")]
         lines += rows
         lines.append("")
+        if ctx.get("load_avg"):  # the machine may be shared: timings scale with it, ratios less so
+            lines += ["Load average (1, 5, 15 min) when measured: " + ", ".join(f"{x:.2f}" for x in ctx["load_avg"]) + ".", ""]
     lines += [
         "Notes: rsibr's resampler does more than the baseline: area-weighted footprints (no aliasing when",
         "shrinking) and extra taps where a sun holds energy, so its cost buys accuracy (docs/tradeoffs.md).",

@@ -157,22 +157,40 @@ __attribute__((target_clones("avx2", "default"))) void fade_row(int n, double we
 // The bilinear footprint of each disc point (vectorised): the offset of its top-left tap in floats
 // (rgb; the confidence offset follows from it), the fractions, and whether it lies in the interior
 // (all four taps valid: the gather loop needs no further test).
-__attribute__((target_clones("avx2", "default"))) void footprints_row(const FastSource& f, int n, const double* __restrict disc_x, const double* __restrict disc_y,
-                    float* __restrict fx, float* __restrict fy, int* __restrict offset, int* __restrict conf_offset,
-                    int* __restrict interior) {
+__attribute__((target_clones("avx2", "default"))) void footprints_row(
+    const FastSource& f, int n, const double* __restrict disc_x, const double* __restrict disc_y, float* __restrict fx,
+    float* __restrict fy, int* __restrict offset, int* __restrict conf_offset, int* __restrict interior) {
+  // Locals: the int stores below could otherwise alias f's members, which would then be reloaded.
+  const double interior2 = f.interior2, scale_x = f.scale_x, offset_x = f.offset_x, scale_y = f.scale_y,
+               offset_y = f.offset_y;
+  const int rgb_step = f.rgb_step, confidence_step = f.confidence_step;
   for (int i = 0; i < n; ++i) {
     const double x = disc_x[i], y = disc_y[i];
-    const bool in = x * x + y * y <= f.interior2;
+    const bool in = x * x + y * y <= interior2;
     // Outside the interior the values are unused (the exact test and sample_disc decide there);
     // zero keeps the conversions in range.
-    const double px = in ? x * f.scale_x + f.offset_x : 0.0;
-    const double py = in ? f.offset_y - y * f.scale_y : 0.0;
+    const double px = in ? x * scale_x + offset_x : 0.0;
+    const double py = in ? offset_y - y * scale_y : 0.0;
     const int c0 = int(px), r0 = int(py);  // px, py >= 0 in the interior: truncation is floor
     fx[i] = float(px - c0);
     fy[i] = float(py - r0);
-    offset[i] = r0 * f.rgb_step + 3 * c0;
-    conf_offset[i] = r0 * f.confidence_step + c0;
+    offset[i] = r0 * rgb_step + 3 * c0;
+    conf_offset[i] = r0 * confidence_step + c0;
     interior[i] = in;
+  }
+}
+
+// out = acc / total (RGB interleaved), weight = total; where total is 0, 0 and 0 (the caller's
+// fallback then decides).
+void normalise_row(int n, const float* __restrict r, const float* __restrict g, const float* __restrict b,
+                   const float* __restrict total, float* __restrict out, float* __restrict weight) {
+  for (int i = 0; i < n; ++i) {
+    const float t = total[i];
+    const float inv = t > 0.0f ? 1.0f / t : 0.0f;
+    out[3 * i] = r[i] * inv;
+    out[3 * i + 1] = g[i] * inv;
+    out[3 * i + 2] = b[i] * inv;
+    weight[i] = t > 0.0f ? t : 0.0f;
   }
 }
 
@@ -451,16 +469,10 @@ BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_
       s.acc[3][i] = total;
     }
     // Normalisation (vectorised), then the fallback where nothing was accumulated.
-    bool any_empty = false;
-    for (int i = 0; i < span; ++i) {
-      const float total = s.acc[3][i];
-      const float inv = 1.0f / (total > 0.0f ? total : 1.0f);
-      out[3 * i] = s.acc[0][i] * inv;
-      out[3 * i + 1] = s.acc[1][i] * inv;
-      out[3 * i + 2] = s.acc[2][i] * inv;
-      out_w[i] = total;
-      any_empty |= !(total > 0.0f);
-    }
+    normalise_row(span, s.acc[0], s.acc[1], s.acc[2], s.acc[3], out, out_w);
+    int empty = 0;
+    for (int i = 0; i < span; ++i) empty += !(s.acc[3][i] > 0.0f);
+    const bool any_empty = empty > 0;
     if (any_empty)
       for (int i = 0; i < span; ++i)
         if (!(s.acc[3][i] > 0.0f)) {
