@@ -418,17 +418,15 @@ BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_
     if (options.source_weights)
       for (int k = 0; k < 3; ++k) sw[k] = result.source_weight[std::size_t(k)].ptr<float>(r) + c0;
     // The gathers are latency-bound (the source rows a tile needs are seldom in cache yet): the taps
-    // kPrefetch texels ahead are requested early. Prefetching the interior's offsets is always safe.
+    // kPrefetch texels ahead are requested early (a prefetch never faults).
     constexpr int kPrefetch = 12;
     for (int i = 0; i < span; ++i) {
       if (i + kPrefetch < span)
         for (int j = 0; j < m; ++j) {
           const int k = active[j];
-          if (s.interior[k][i + kPrefetch]) {
-            const float* t = fast[k].rgb + s.offset[k][i + kPrefetch];
-            __builtin_prefetch(t);
-            __builtin_prefetch(t + fast[k].rgb_step);
-          }
+          const float* t = fast[k].rgb + s.offset[k][i + kPrefetch];  // offset 0 outside the interior
+          __builtin_prefetch(t);
+          __builtin_prefetch(t + fast[k].rgb_step);
         }
       v4f acc = {0.0f, 0.0f, 0.0f, 0.0f};
       float total = 0;
