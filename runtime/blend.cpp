@@ -14,6 +14,14 @@
 #include <string>
 #include <vector>
 
+// Vectorised row loops are also built for AVX2 and chosen at load time (x86-64 GCC/Clang; no FMA,
+// so both builds give the same bits).
+#if defined(__x86_64__) && defined(__GNUC__)
+#define RSIBR_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define RSIBR_AVX2_CLONES
+#endif
+
 namespace rsibr {
 
 double rim_fade_weight(double rho, double rim_fade) {
@@ -141,7 +149,8 @@ struct Scratch {
 
 // a = weight * fade(rim) (rim_fade_weight's formula), rounded to float.
 // Vectorised, also for AVX2 (as warp_directions, runtime/warp.cpp: no FMA, the same bits).
-__attribute__((target_clones("avx2", "default"))) void fade_row(int n, double weight, double rim_fade, const double* __restrict rim, float* __restrict a) {
+RSIBR_AVX2_CLONES void fade_row(int n, double weight, double rim_fade, const double* __restrict rim,
+                                float* __restrict a) {
   if (!(rim_fade > 0)) {
     for (int i = 0; i < n; ++i) a[i] = float(weight);
     return;
@@ -157,7 +166,7 @@ __attribute__((target_clones("avx2", "default"))) void fade_row(int n, double we
 // The bilinear footprint of each disc point (vectorised): the offset of its top-left tap in floats
 // (rgb; the confidence offset follows from it), the fractions, and whether it lies in the interior
 // (all four taps valid: the gather loop needs no further test).
-__attribute__((target_clones("avx2", "default"))) void footprints_row(
+RSIBR_AVX2_CLONES void footprints_row(
     const FastSource& f, int n, const double* __restrict disc_x, const double* __restrict disc_y, float* __restrict fx,
     float* __restrict fy, int* __restrict offset, int* __restrict conf_offset, int* __restrict interior) {
   // Locals: the int stores below could otherwise alias f's members, which would then be reloaded.
@@ -390,7 +399,8 @@ BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_
     const int span = c1 - c0;
     if (fused)
       for (int kind = 0; kind < 2; ++kind)
-        if (kinds[kind]) central_directions_row(WarpKind(kind), W, H, r, c0, c1, s.dir[kind][0], s.dir[kind][1], s.dir[kind][2]);
+        if (kinds[kind])
+          central_directions_row(WarpKind(kind), W, H, r, c0, c1, s.dir[kind][0], s.dir[kind][1], s.dir[kind][2]);
     int active[3], m = 0;
     for (int k = 0; k < n; ++k) {
       const Source& src = sources[k];

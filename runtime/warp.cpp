@@ -6,6 +6,14 @@
 #include <cmath>
 #include <stdexcept>
 
+// Vectorised row loops are also built for AVX2 and chosen at load time (x86-64 GCC/Clang; no FMA,
+// so both builds give the same bits).
+#if defined(__x86_64__) && defined(__GNUC__)
+#define RSIBR_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define RSIBR_AVX2_CLONES
+#endif
+
 namespace rsibr {
 
 WarpKind warp_kind_from_string(const std::string& name) {
@@ -70,8 +78,9 @@ std::pair<int, int> disc_span(int row, int width, int height) {
   return {c0, c1};
 }
 
-__attribute__((target_clones("avx2", "default"))) void central_directions_row(
-    WarpKind kind, int width, int height, int row, int c_begin, int c_end, double* __restrict out_x, double* __restrict out_y, double* __restrict out_z) {
+RSIBR_AVX2_CLONES void central_directions_row(
+    WarpKind kind, int width, int height, int row, int c_begin, int c_end, double* __restrict out_x,
+    double* __restrict out_y, double* __restrict out_z) {
   const double y = 1.0 - (2.0 * row + 1.0) / height;
   const int n = c_end - c_begin;
   for (int i = 0; i < n; ++i) {
@@ -92,9 +101,9 @@ __attribute__((target_clones("avx2", "default"))) void central_directions_row(
 // Branch-free forms of mirror_inverse / normal_inverse (selects, not jumps, so the loops vectorise).
 // Also built for AVX2 (4 doubles a vector; chosen at load time where the CPU has it). No FMA: the
 // results are the same to the bit on either path.
-__attribute__((target_clones("avx2", "default"))) void warp_directions(WarpKind kind, const double m[9], int n, const double* __restrict x, const double* __restrict y,
-                     const double* __restrict z, double* __restrict disc_x, double* __restrict disc_y,
-                     double* __restrict rim) {
+RSIBR_AVX2_CLONES void warp_directions(WarpKind kind, const double m[9], int n, const double* __restrict x,
+                                       const double* __restrict y, const double* __restrict z,
+                                       double* __restrict disc_x, double* __restrict disc_y, double* __restrict rim) {
   const double m0 = m[0], m1 = m[1], m2 = m[2], m3 = m[3], m4 = m[4], m5 = m[5], m6 = m[6], m7 = m[7], m8 = m[8];
   if (kind == WarpKind::Mirror) {
     for (int i = 0; i < n; ++i) {
