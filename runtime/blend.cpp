@@ -380,9 +380,9 @@ BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_
     return result;
   }
 
-  // The fast path (contract: BlendOptions::reference): structure of arrays, one fused pass per tile row (warp
-  // and fade in double, footprints, float taps and sums, normalisation), bands of rows in parallel.
-  // Per texel the arithmetic does not depend on the tiling or the threads.
+  // The fast path (contract: BlendOptions::reference): structure of arrays, one fused pass per tile
+  // row (warp and fade in double, footprints, float taps and sums, normalisation), bands of rows in
+  // parallel. Per texel the arithmetic does not depend on the tiling or the threads.
   FastSource fast[3];
   bool kinds[2] = {false, false};
   for (int k = 0; k < n; ++k) {
