@@ -55,6 +55,22 @@ WarpSample warp_direction(WarpKind kind, const Vec3& dir_in_source);
 // empty (first == second) when none.
 std::pair<int, int> disc_span(int row, int width, int height);
 
+// Structure-of-arrays forms of the exact warp, for fused row loops (runtime/blend.cpp) that the
+// compiler vectorises (no branches, no calls per texel).
+//   central_directions_row: the central directions of `kind` (the destination's own frame) of the
+//     destination texels (c, row), c in [c_begin, c_end): out_x/y/z[c - c_begin], the same arithmetic
+//     as g_normal / g_mirror. The texel centres must lie inside the disc (within disc_span).
+//   warp_directions: warp_direction for the n unit directions (x, y, z) rotated by m (row-major 3x3,
+//     the source_from_dest rotation): the source disc point (disc_x, disc_y) and rim value. The
+//     rotated direction is taken as unit (no renormalisation: the input is unit and m a rotation);
+//     r = -z exactly (mirror) and a normal straight behind give (0, -1) with rim 0, as warp_direction
+//     does. Agrees with warp_direction to ~1e-15 (conditioned by 1/rim near the singularity;
+//     tests/runtime/warp_test.cpp).
+void central_directions_row(WarpKind kind, int width, int height, int row, int c_begin, int c_end, double* out_x,
+                            double* out_y, double* out_z);
+void warp_directions(WarpKind kind, const double m[9], int n, const double* x, const double* y, const double* z,
+                     double* disc_x, double* disc_y, double* rim);
+
 // The interface of the warp implementations (a speed/accuracy knob). Implementations are immutable
 // after construction and safe to call from many threads at once.
 class Warp {
@@ -63,6 +79,9 @@ class Warp {
   virtual const char* name() const = 0;
   // Whether warp_row may be called for a width x height destination.
   virtual bool supports(int width, int height) const { return width > 0 && height > 0; }
+  // True when warp_row is ExactWarp's map (the same arithmetic): a caller may then compute the warp
+  // itself, fused with its own per-texel work (runtime/blend.cpp does, in float32).
+  virtual bool exact() const { return false; }
   // For destination texels (c, row), c in [c_begin, c_end), of a width x height destination map,
   // writes out[c - c_begin] = where that texel's central direction of the given kind lands in a
   // source whose frame relates to the destination's by source_from_dest = T_s^T T_d (a rotation).
@@ -74,6 +93,7 @@ class Warp {
 class ExactWarp final : public Warp {
  public:
   const char* name() const override { return "exact"; }
+  bool exact() const override { return true; }
   void warp_row(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
                 WarpSample* out) const override;
 };
@@ -87,6 +107,7 @@ class PrecomputedWarp final : public Warp {
  public:
   PrecomputedWarp(int width, int height);
   const char* name() const override { return "precomputed"; }
+  bool exact() const override { return true; }
   int width() const { return width_; }
   int height() const { return height_; }
   bool supports(int width, int height) const override { return width == width_ && height == height_; }

@@ -134,3 +134,45 @@ TEST(Warp, UnknownWarpNameIsAnError) {
 
 }  // namespace
 }  // namespace rsibr
+
+namespace rsibr {
+namespace {
+
+// The structure-of-arrays row warp against warp_direction: the same map up to rounding (the disc
+// point relative to its conditioning, ~1/rim near the singularity).
+TEST(Warp, RowWarpAgreesWithWarpDirection) {
+  std::mt19937 rng(5);
+  for (auto [W, H] : {std::pair{64, 64}, std::pair{129, 129}, std::pair{40, 24}}) {
+    double worst_disc = 0, worst_rim = 0, worst_dir = 0;
+    for (int trial = 0; trial < 10; ++trial) {
+      const Mat3 M = random_frame(rng).transpose() * random_frame(rng);
+      double m[9];
+      for (int i = 0; i < 9; ++i) m[i] = M(i / 3, i % 3);
+      for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal})
+        for (int r = 0; r < H; ++r) {
+          const auto [c0, c1] = disc_span(r, W, H);
+          const int n = c1 - c0;
+          const std::size_t count = std::size_t(n);
+          std::vector<double> x(count), y(count), z(count), dx(count), dy(count), rim(count);
+          central_directions_row(kind, W, H, r, c0, c1, x.data(), y.data(), z.data());
+          warp_directions(kind, m, n, x.data(), y.data(), z.data(), dx.data(), dy.data(), rim.data());
+          for (int i = 0; i < n; ++i) {
+            const Vec3 dir = central_direction(kind, sphere_map::disc_from_pixel(Vec2(c0 + i, r), W, H));
+            worst_dir = std::max(worst_dir, (dir - Vec3(x[std::size_t(i)], y[std::size_t(i)], z[std::size_t(i)])).norm());
+            const WarpSample s = warp_direction(kind, M * dir);
+            worst_rim = std::max(worst_rim, std::abs(s.rim - rim[std::size_t(i)]));
+            // Conditioning: d disc / d direction ~ 1 / (2 rim) (mirror), 1 / |n_xy| (normal behind).
+            const double cond = std::max(kind == WarpKind::Normal && s.rim < 0 ? (M * dir).head<2>().norm() : std::abs(s.rim), 1e-3);
+            worst_disc = std::max(worst_disc, cond * (s.disc - Vec2(dx[std::size_t(i)], dy[std::size_t(i)])).norm());
+          }
+        }
+    }
+    std::printf("[ row warp %dx%d ] direction %.2e, rim %.2e, disc x rim %.2e\n", W, H, worst_dir, worst_rim, worst_disc);
+    EXPECT_LE(worst_dir, 1e-14);
+    EXPECT_LE(worst_rim, 1e-14);
+    EXPECT_LE(worst_disc, 1e-14);
+  }
+}
+
+}  // namespace
+}  // namespace rsibr
