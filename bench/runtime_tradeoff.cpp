@@ -22,6 +22,8 @@
 //   rel_rms = sqrt(sum_texels,rgb (blend - direct)^2 / sum_texels,rgb direct^2)   (pooled over the views)
 //   worst   = max_texel |blend - direct|_2 (RGB) / sqrt(sum_texels |direct|_2^2 / n_texels)
 //             (the worst texel in units of the map's RMS radiance; same normalisation as rel_rms)
+// and the same two over the texels at disc radius <= 0.9 only ("inner": away from the rim, where the
+// mirror direction approaches -v and every source is faded).
 // Time per frame: median of --reps passes over the novel views (one blend per view per pass, so the
 // tessellated warp's per-frame vertex cache never serves a repeated frame).
 // Floor: blend() at a source view against a direct bake there (0 for a deterministic bake).
@@ -356,6 +358,10 @@ nlohmann::json run_novel(const std::string& env_path, int env_width, const std::
   for (const SetSpec& spec : sets) {
     const int size = spec.size;
     const cv::Mat disc = disc_mask(size);
+    cv::Mat interior(size, size, CV_8UC1, cv::Scalar(0));  // disc radius <= 0.9 (away from the rim)
+    for (int r = 0; r < size; ++r)
+      for (int c = 0; c < size; ++c)
+        interior.at<unsigned char>(r, c) = sphere_map::disc_from_pixel(Vec2(c, r), size, size).norm() <= 0.9;
     std::vector<cv::Mat> directs;
     for (int i = 0; i < novel; ++i)
       directs.push_back(baker.direct(brdf_name, *brdf, novel_dirs[std::size_t(i)], i, size, 2));
@@ -375,7 +381,7 @@ nlohmann::json run_novel(const std::string& env_path, int env_width, const std::
     for (const WarpChoice& w : warps) {
       BlendOptions o;
       o.warp = w.warp.get();
-      ErrorSums e;
+      ErrorSums e, inner;
       std::vector<double> times;
       for (int rep = 0; rep < reps; ++rep)
         for (int i = 0; i < novel; ++i) {
@@ -390,11 +396,12 @@ nlohmann::json run_novel(const std::string& env_path, int env_width, const std::
             for (int c = 0; c < size; ++c)
               if (!(b.weight.at<float>(r, c) > 0)) mask.at<unsigned char>(r, c) = 0;
           e.add(b.rgb, directs[std::size_t(i)], mask);
+          inner.add(b.rgb, directs[std::size_t(i)], mask & interior);
         }
       const double t = median(times);
       rows.push_back({{"env", baker.env_name}, {"brdf", brdf_name}, {"size", size}, {"views", spec.views},
                       {"warp", w.name}, {"rings", w.rings}, {"rel_rms", e.relative_rms()}, {"worst", e.worst()},
-                      {"seconds", t}});
+                      {"rel_rms_inner", inner.relative_rms()}, {"worst_inner", inner.worst()}, {"seconds", t}});
       std::cerr << brdf_name << " | " << size << " | " << spec.views << " | " << w.name
                 << (w.rings ? std::to_string(w.rings) : "") << ": rel " << e.relative_rms() << " worst " << e.worst()
                 << " " << t * 1e3 << " ms\n";
