@@ -112,6 +112,41 @@ inline double radical_inverse_2(std::uint32_t i) {
   return double(i) * 0x1.0p-32;
 }
 
+// A random permutation of [0, n) keyed by `key`, evaluated one index at a time (no table): a keyed
+// invertible hash on the next power of two, cycle-walked until it lands below n (after Kensler
+// 2013, "Correlated Multi-Jittered Sampling"). Used to decorrelate sample dimensions that share a
+// stratified index (a pixel's sub-position and its light samples).
+inline std::uint32_t permute_index(std::uint32_t i, std::uint32_t n, std::uint32_t key) {
+  if (n <= 1) return 0;
+  std::uint32_t w = n - 1;
+  w |= w >> 1;
+  w |= w >> 2;
+  w |= w >> 4;
+  w |= w >> 8;
+  w |= w >> 16;
+  do {
+    i ^= key;
+    i *= 0xe170893du;
+    i ^= key >> 16;
+    i ^= (i & w) >> 4;
+    i ^= key >> 8;
+    i *= 0x0929eb3fu;
+    i ^= key >> 23;
+    i ^= (i & w) >> 1;
+    i *= 1u | key >> 27;
+    i *= 0x6935fa69u;
+    i ^= (i & w) >> 11;
+    i *= 0x74dcb303u;
+    i ^= (i & w) >> 2;
+    i *= 0x9e501cc3u;
+    i ^= (i & w) >> 2;
+    i *= 0xc860a3dfu;
+    i &= w;
+    i ^= i >> 5;
+  } while (i >= n);
+  return (i + key) % n;
+}
+
 // Point i of the n-point Hammersley set ((i + 1/2)/n, radical_inverse_2(i)) shifted by `shift`
 // modulo 1 (a Cranley-Patterson rotation: each point stays uniform on [0,1)^2, the set stays
 // stratified).

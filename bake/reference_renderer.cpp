@@ -129,6 +129,10 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
     for (int c = 0; c < W; ++c) {
       integrator_detail::TexelRng rng(options.seed, std::uint64_t(r) * std::uint64_t(W) + std::uint64_t(c));
       const Vec2 shift_pixel = rng.uniform2(), shift_b = rng.uniform2(), shift_e = rng.uniform2();
+      // The light samples of sub-pixel sample s use a per-pixel random permutation of the index:
+      // with the same index in both, the light sample would be a function of the sub-pixel
+      // position and the pixel would converge to a seed-dependent value.
+      const auto key_b = std::uint32_t(rng.uniform() * 4294967296.0), key_e = std::uint32_t(rng.uniform() * 4294967296.0);
       Vec3 pixel = Vec3::Zero();
       int covered = 0;
       for (int s = 0; s < spp; ++s) {
@@ -177,8 +181,11 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
             // draw from the pixel's stream (only reached with shadows and bounces > 1).
             Vec2 ub, ue;
             if (depth == 0) {
-              ub = integrator_detail::rotated_hammersley(s * K + k, n_first, shift_b);
-              ue = integrator_detail::rotated_hammersley(s * K + k, n_first, shift_e);
+              const auto index = std::uint32_t(s * K + k), count = std::uint32_t(n_first);
+              ub = integrator_detail::rotated_hammersley(
+                  int(integrator_detail::permute_index(index, count, key_b)), n_first, shift_b);
+              ue = integrator_detail::rotated_hammersley(
+                  int(integrator_detail::permute_index(index, count, key_e)), n_first, shift_e);
             } else {
               ub = rng.uniform2();
               ue = rng.uniform2();
