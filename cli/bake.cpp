@@ -1,5 +1,6 @@
 // rsibr bake: a computed map set, the lighting integral of a BRDF against an environment, one
 // sphere map per view (bake/integrator.h for what a texel holds).
+#include "cli/render_image.h"
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
@@ -38,21 +39,7 @@ int run_bake(const BakeArgs& a) {
     throw std::invalid_argument(a.output + ": the output must be an .exr file");
   check_output_path(a.output, {a.env, a.brdf});
   const auto t0 = std::chrono::steady_clock::now();
-  const std::optional<LayoutKind> hint =
-      a.layout.empty() ? std::nullopt : std::optional<LayoutKind>(parse_layout_kind(a.layout));
-  EnvReadReport report;
-  EnvMap env = read_environment(a.env, hint, &report);
-  if ((report.nan_values || report.inf_values) && !a.sanitize)
-    throw std::runtime_error(a.env + ": " + std::to_string(report.nan_values) + " NaN and " +
-                             std::to_string(report.inf_values) + " Inf values; pass --sanitize to zero them");
-  if (a.sanitize) {
-    const int ch = env.channels();
-    for (int r = 0; r < env.pixels.rows; ++r) {
-      float* row = env.pixels.ptr<float>(r);
-      for (int i = 0; i < env.pixels.cols * ch; ++i)
-        if (!std::isfinite(row[i]) || row[i] < 0) row[i] = 0.f;
-    }
-  }
+  const EnvMap env = read_environment_input(a.env, a.layout, a.sanitize);
   // --lobe: the whole BRDF, or one part of it (bake/brdf_lobes.h) with its own central direction.
   std::shared_ptr<const Brdf> brdf = load_brdf(a.brdf);
   if (a.lobe != "all") {

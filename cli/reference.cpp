@@ -1,6 +1,7 @@
 // rsibr reference: the ground-truth render of a mesh with a BRDF under an environment, seen by a
 // perspective camera (bake/reference_renderer.h for what a pixel holds).
 #include "cli/camera_options.h"
+#include "cli/render_image.h"
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
@@ -44,58 +45,19 @@ struct ReferenceArgs {
   float preview_exposure = 0.f;
 };
 
-Imath::M33f m33(const Mat3& m) {
-  Imath::M33f out;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) out[r][c] = float(m(r, c));  // m[row][col], as rsibr.worldFromView
-  return out;
-}
-
-// RGBA float32, ZIP, Rec.709 chromaticities and the provenance of the render; atomic.
+// RGBA float32 (RGB radiance, A coverage) with the render's provenance.
 void write_render(const std::string& path, const ReferenceImage& im, const Camera& cam,
                   const std::map<std::string, std::string>& strings, const ReferenceOptions& o) {
-  const int W = im.rgb.cols, H = im.rgb.rows;
-  Imf::Header header(W, H);
-  header.compression() = Imf::ZIP_COMPRESSION;
-  Imf::addChromaticities(header, Imf::Chromaticities());
-  auto name = [&](const std::string& key) {
-    const std::string n = "rsibr." + key;
-    if (n.size() > kMaxAttributeName) throw std::logic_error("attribute name '" + n + "' is too long");
-    return n;
-  };
-  for (const auto& [key, value] : strings) header.insert(name(key), Imf::StringAttribute(value));
-  header.insert(name("eye"), Imf::V3fAttribute(Imath::V3f(float(cam.eye.x()), float(cam.eye.y()), float(cam.eye.z()))));
-  header.insert(name("worldFromCam"), Imf::M33fAttribute(m33(cam.world_from_cam)));
-  Mat3 K;
-  K << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1;
-  header.insert(name("intrinsics"), Imf::M33fAttribute(m33(K)));
-  header.insert(name("spp"), Imf::IntAttribute(o.spp));
-  header.insert(name("lightSamples"), Imf::IntAttribute(o.light_samples));
-  header.insert(name("seed"), Imf::StringAttribute(std::to_string(o.seed)));
-  header.insert(name("shadows"), Imf::IntAttribute(o.shadows ? 1 : 0));
-  header.insert(name("bounces"), Imf::IntAttribute(o.shadows ? o.bounces : 1));
-  header.insert(name("background"), Imf::StringAttribute(to_string(o.background)));
-
-  cv::Mat rgba(H, W, CV_32FC4);
+  cv::Mat rgba(im.rgb.rows, im.rgb.cols, CV_32FC4);
   const int from_to[] = {0, 0, 1, 1, 2, 2, 3, 3};
   const cv::Mat sources[] = {im.rgb, im.alpha};
   cv::mixChannels(sources, 2, &rgba, 1, from_to, 4);
-  const char* names[] = {"R", "G", "B", "A"};
-  Imf::FrameBuffer fb;
-  for (int k = 0; k < 4; ++k) {
-    header.channels().insert(names[k], Imf::Channel(Imf::FLOAT));
-    fb.insert(names[k], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(rgba.ptr<float>()) + k * sizeof(float),
-                                   4 * sizeof(float), 4 * sizeof(float) * std::size_t(W)));
-  }
-  try {
-    write_atomically(path, [&](const std::string& tmp) {
-      Imf::OutputFile out(tmp.c_str(), header);
-      out.setFrameBuffer(fb);
-      out.writePixels(H);
-    });
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
+  std::map<std::string, std::string> all = strings;
+  all["seed"] = std::to_string(o.seed);
+  all["background"] = to_string(o.background);
+  write_render_exr(path, rgba, cam, all,
+                   {{"spp", o.spp}, {"lightSamples", o.light_samples}, {"shadows", o.shadows ? 1 : 0},
+                    {"bounces", o.shadows ? o.bounces : 1}});
 }
 
 int run_reference(const ReferenceArgs& a) {
@@ -121,21 +83,7 @@ int run_reference(const ReferenceArgs& a) {
   // Validate the camera options before the slower environment and scene set-up.
   const Camera first = make_camera(a.camera, mesh.bounds(), 0);
   const std::unique_ptr<Brdf> brdf = load_brdf(a.brdf);
-  const std::optional<LayoutKind> hint =
-      a.layout.empty() ? std::nullopt : std::optional<LayoutKind>(parse_layout_kind(a.layout));
-  EnvReadReport env_report;
-  EnvMap env = read_environment(a.env, hint, &env_report);
-  if ((env_report.nan_values || env_report.inf_values) && !a.sanitize)
-    throw std::runtime_error(a.env + ": " + std::to_string(env_report.nan_values) + " NaN and " +
-                             std::to_string(env_report.inf_values) + " Inf values; pass --sanitize to zero them");
-  if (a.sanitize) {
-    const int ch = env.channels();
-    for (int r = 0; r < env.pixels.rows; ++r) {
-      float* row = env.pixels.ptr<float>(r);
-      for (int i = 0; i < env.pixels.cols * ch; ++i)
-        if (!std::isfinite(row[i]) || row[i] < 0) row[i] = 0.f;
-    }
-  }
+  const EnvMap env = read_environment_input(a.env, a.layout, a.sanitize);
   const ReferenceLighting lighting(env);
   const auto t1 = std::chrono::steady_clock::now();
   const RayScene scene(mesh);

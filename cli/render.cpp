@@ -1,6 +1,7 @@
 // rsibr render: draws a mesh with one or more map sets (runtime/renderer.h) from the shared camera
 // options (cli/camera_options.h); PNG through the OpenColorIO display transform, or RGBA float EXR.
 #include "cli/camera_options.h"
+#include "cli/render_image.h"
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
@@ -49,43 +50,6 @@ std::string extension_of(const std::string& path) {
 }
 
 std::string file_name(const std::string& path) { return std::filesystem::path(path).filename().string(); }
-
-// RGBA float32, premultiplied, with the camera and the inputs in the header. Atomic.
-void write_exr(const std::string& path, const cv::Mat& rgba, const Camera& cam,
-               const std::map<std::string, std::string>& provenance) {
-  const int W = rgba.cols, H = rgba.rows;
-  Imf::Header header(W, H);
-  header.compression() = Imf::ZIP_COMPRESSION;
-  Imf::addChromaticities(header, Imf::Chromaticities());
-  for (const auto& [key, value] : provenance) {
-    const std::string name = "rsibr." + key;
-    if (name.size() > kMaxAttributeName) throw std::logic_error("attribute name too long: " + name);
-    header.insert(name, Imf::StringAttribute(value));
-  }
-  header.insert("rsibr.eye", Imf::V3fAttribute(Imath::V3f(float(cam.eye.x()), float(cam.eye.y()), float(cam.eye.z()))));
-  Imath::M33f m;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) m[r][c] = float(cam.world_from_cam(r, c));
-  header.insert("rsibr.worldFromCam", Imf::M33fAttribute(m));
-  header.insert("rsibr.focal", Imf::V2fAttribute(Imath::V2f(float(cam.fx), float(cam.fy))));
-  header.insert("rsibr.principal", Imf::V2fAttribute(Imath::V2f(float(cam.cx), float(cam.cy))));
-  const char* names[] = {"R", "G", "B", "A"};
-  for (const char* n : names) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
-  cv::Mat contiguous = rgba.isContinuous() ? rgba : rgba.clone();
-  char* base = reinterpret_cast<char*>(contiguous.data);
-  Imf::FrameBuffer fb;
-  for (int k = 0; k < 4; ++k)
-    fb.insert(names[k], Imf::Slice(Imf::FLOAT, base + k * sizeof(float), 4 * sizeof(float), 4 * sizeof(float) * std::size_t(W)));
-  try {
-    write_atomically(path, [&](const std::string& tmp) {
-      Imf::OutputFile out(tmp.c_str(), header);
-      out.setFrameBuffer(fb);
-      out.writePixels(H);
-    });
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
-}
 
 // 8-bit RGBA PNG, straight alpha: the colour un-premultiplied, then the display transform.
 void write_png(const std::string& path, const cv::Mat& rgba, float exposure) {
@@ -192,7 +156,7 @@ int run_render(const RenderArgs& a) {
     const std::string path = frame_path(a.output, a.camera.turntable, k);
     auto p = provenance;
     if (a.camera.turntable > 0) p["frame"] = std::to_string(k) + "/" + std::to_string(a.camera.turntable);
-    if (ext == ".exr") write_exr(path, image, cam, p);
+    if (ext == ".exr") write_render_exr(path, image, cam, p);
     else write_png(path, image, a.exposure);
     jframes.push_back({{"path", path},
                        {"seconds", stats.seconds},
