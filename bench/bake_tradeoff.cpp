@@ -10,6 +10,7 @@
 //   rsibr_bake_tradeoff --target ENV.exr --out target.json            (12 views, GGX 0.2 + Fresnel)
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
+#include "bench/measure.h"
 #include "core/exr_io.h"
 #include "core/resample.h"
 #include "core/sphere_map.h"
@@ -30,35 +31,9 @@
 namespace rsibr {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+using namespace rsibr::bench;
 
-EnvMap load_sanitized(const std::string& path) {
-  EnvMap env = read_environment(path);
-  const int ch = env.channels();
-  for (int r = 0; r < env.pixels.rows; ++r) {
-    float* row = env.pixels.ptr<float>(r);
-    for (int i = 0; i < env.pixels.cols * ch; ++i)
-      if (!std::isfinite(row[i]) || row[i] < 0) row[i] = 0.f;  // DWAB ringing (docs/conventions.md)
-  }
-  return env;
-}
 
-// `count` distinct random texels whose centres lie inside the disc, fixed by the seed.
-cv::Mat probe_mask(int size, int count, std::uint32_t seed) {
-  cv::Mat mask(size, size, CV_8UC1, cv::Scalar(0));
-  std::mt19937 rng(seed);
-  std::uniform_int_distribution<int> pick(0, size - 1);
-  int placed = 0;
-  while (placed < count) {
-    const int c = pick(rng), r = pick(rng);
-    if (!(sphere_map::disc_from_pixel(Vec2(c, r), size, size).squaredNorm() < 0.98)) continue;
-    if (mask.at<unsigned char>(r, c)) continue;
-    mask.at<unsigned char>(r, c) = 1;
-    ++placed;
-  }
-  return mask;
-}
 
 double disc_texel_count(int size) {
   int n = 0;
@@ -67,21 +42,6 @@ double disc_texel_count(int size) {
   return n;
 }
 
-struct ErrorSums {
-  double num = 0, den = 0;
-  void add(const cv::Mat& a, const cv::Mat& ref, const cv::Mat& mask) {
-    for (int r = 0; r < a.rows; ++r)
-      for (int c = 0; c < a.cols; ++c) {
-        if (!mask.at<unsigned char>(r, c)) continue;
-        for (int k = 0; k < 3; ++k) {
-          const double x = a.at<cv::Vec3f>(r, c)[k], y = ref.at<cv::Vec3f>(r, c)[k];
-          num += (x - y) * (x - y);
-          den += y * y;
-        }
-      }
-  }
-  double relative_rms() const { return den > 0 ? std::sqrt(num / den) : 0.0; }
-};
 
 struct Config {
   std::string method;

@@ -16,6 +16,7 @@
 #include "bake/brdf_lobes.h"
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
+#include "bench/measure.h"
 #include "core/exr_io.h"
 #include "core/map_set.h"
 #include "core/sphere_map.h"
@@ -40,23 +41,12 @@
 namespace rsibr {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+using namespace rsibr::bench;
 
 const char* kClearCoat =
     "{type: clearcoat, coat: {ior: 1.5, roughness: 0.05}, flakes: {coverage: 0.3, roughness: 0.3, fresnel: {type: "
     "conductor, eta: [1.66, 0.88, 0.52], k: [9.22, 6.27, 4.84]}}, base: {albedo: [0.5, 0.05, 0.03]}}";
 
-EnvMap load_sanitized(const std::string& path) {  // as rsibr bake --sanitize
-  EnvMap env = read_environment(path);
-  const int ch = env.channels();
-  for (int r = 0; r < env.pixels.rows; ++r) {
-    float* row = env.pixels.ptr<float>(r);
-    for (int i = 0; i < env.pixels.cols * ch; ++i)
-      if (!std::isfinite(row[i]) || row[i] < 0) row[i] = 0.f;
-  }
-  return env;
-}
 
 // N points of the Fibonacci sphere: z = 1 - (2i+1)/N, azimuth i * golden angle.
 std::vector<Vec3> fibonacci(int n) {
@@ -80,21 +70,6 @@ struct Baked {
   double seconds = 0;
 };
 
-struct Sums {
-  double num = 0, den = 0;
-  void add(const cv::Mat& a, const cv::Mat& ref, const cv::Mat& mask) {
-    for (int r = 0; r < a.rows; ++r)
-      for (int c = 0; c < a.cols; ++c) {
-        if (!mask.at<unsigned char>(r, c)) continue;
-        for (int k = 0; k < 3; ++k) {
-          const double x = a.at<cv::Vec3f>(r, c)[k], y = ref.at<cv::Vec3f>(r, c)[k];
-          num += (x - y) * (x - y);
-          den += y * y;
-        }
-      }
-  }
-  double rel() const { return den > 0 ? std::sqrt(num / den) : 0.0; }
-};
 
 // Texels whose centre lies inside the disc of the given radius (1: the whole disc).
 cv::Mat disc_mask(int size, double radius = 1.0) {
@@ -175,7 +150,7 @@ int run(int argc, char** argv) {
     // which must be well below the blend errors.
     std::vector<cv::Mat> truth;
     std::vector<std::array<cv::Mat, 2>> truth_part;  // normal, mirror
-    Sums noise;
+    ErrorSums noise;
     auto t0 = Clock::now();
     for (const Vec3& v : novel_views) {
       truth_part.push_back({bake(*normal_part, v, truth_samples, 1), bake(*mirror_part, v, truth_samples, 1)});
@@ -184,7 +159,7 @@ int run(int argc, char** argv) {
     }
     const double truth_seconds = seconds_since(t0) / 3;
     std::printf("%s: truth %d views x %d^2, %d samples: %.1f s, noise (seed 1 vs 2) %.2e\n", env_name.c_str(), novel,
-                res, truth_samples, truth_seconds, noise.rel());
+                res, truth_samples, truth_seconds, noise.relative_rms());
     std::fflush(stdout);
 
     std::map<std::string, Baked> cache;  // "<lobe>:<set>"
@@ -223,7 +198,7 @@ int run(int argc, char** argv) {
         maps += int(s->set.views.size());
         bake_seconds += s->seconds;
       }
-      Sums err, err_inner;
+      ErrorSums err, err_inner;
       double err_part[2] = {0, 0};  // split: each part's squared error against its own truth
       double worst = 0, blend_seconds = 0;
       for (std::size_t k = 0; k < novel_views.size(); ++k) {
@@ -239,15 +214,15 @@ int run(int argc, char** argv) {
         blend_seconds += seconds_since(t);
         if (sets.size() == 2)
           for (int p = 0; p < 2; ++p) {
-            Sums s;
+            ErrorSums s;
             s.add(blended[std::size_t(p)], truth_part[k][std::size_t(p)], mask);
             err_part[p] += s.num;
           }
-        Sums one;
+        ErrorSums one;
         one.add(sum, truth[k], mask);
         err.add(sum, truth[k], mask);
         err_inner.add(sum, truth[k], mask & inner);
-        worst = std::max(worst, one.rel());
+        worst = std::max(worst, one.relative_rms());
       }
       std::string sizes;
       for (const Baked* s : sets) sizes += (sizes.empty() ? "" : " + ") + std::to_string(s->set.views.size());
@@ -257,14 +232,14 @@ int run(int argc, char** argv) {
                                   err.den > 0 ? std::sqrt(err_part[1] / err.den) : 0.0};
       std::printf("  %-12s %-8s maps %3d: rel RMS %.4f (inner %.4f, worst view %.4f; normal part %.4f, mirror part %.4f), "
                   "bake %.1f s, blend %.2f ms/view\n",
-                  cfg.c_str(), sets.size() == 1 ? "single" : "split", maps, err.rel(), err_inner.rel(), worst, part_rel[0], part_rel[1],
+                  cfg.c_str(), sets.size() == 1 ? "single" : "split", maps, err.relative_rms(), err_inner.relative_rms(), worst, part_rel[0], part_rel[1],
                   bake_seconds, 1e3 * blend_seconds / double(novel_views.size()));
       std::fflush(stdout);
       rows.push_back({{"env", env_name}, {"config", cfg}, {"kind", sets.size() == 1 ? "single" : "split"},
-                      {"sets", sizes}, {"maps", maps}, {"rel_rms", err.rel()}, {"rel_rms_inner", err_inner.rel()}, {"worst_view", worst},
+                      {"sets", sizes}, {"maps", maps}, {"rel_rms", err.relative_rms()}, {"rel_rms_inner", err_inner.relative_rms()}, {"worst_view", worst},
                       {"normal_part_rel_rms", part_rel[0]}, {"mirror_part_rel_rms", part_rel[1]},
                       {"bake_s", bake_seconds}, {"blend_ms", 1e3 * blend_seconds / double(novel_views.size())},
-                      {"truth_noise", noise.rel()}, {"res", res}, {"samples", samples},
+                      {"truth_noise", noise.relative_rms()}, {"res", res}, {"samples", samples},
                       {"truth_samples", truth_samples}, {"novel", novel}});
     }
   }

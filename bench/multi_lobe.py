@@ -22,23 +22,9 @@ import tempfile
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "bench"))
+from convert_roundtrip import replace_section  # noqa: E402
 TITLE = "Multi-lobe maps (clear coat)"
-
-
-def replace_section(path, title, body):
-    """Replaces (or appends) the section '## title' of a markdown file (as bench/convert_roundtrip.py)."""
-    text = open(path).read() if os.path.exists(path) else "# Trade-offs: error against time for every knob\n"
-    start = text.find(f"## {title}\n")
-    section = f"## {title}\n\n{body}\n"
-    if start < 0:
-        text = text.rstrip("\n") + "\n\n" + section
-    else:
-        end = text.find("\n## ", start + 1)
-        text = text[:start] + section + (text[end + 1:] if end >= 0 else "")
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        f.write(text)
-    os.replace(tmp, path)
 
 
 def machine():
