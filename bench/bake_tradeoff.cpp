@@ -65,7 +65,7 @@ const std::vector<std::pair<std::string, std::string>>& brdfs() {
 std::vector<Config> configs(const std::string& brdf_name, bool quick) {
   std::vector<Config> out;
   const std::vector<int> mis = quick ? std::vector<int>{4, 16, 64} : std::vector<int>{4, 16, 64, 256};
-  const std::vector<int> fis = quick ? std::vector<int>{8, 32} : std::vector<int>{8, 32, 128};
+  const std::vector<int> fis = quick ? std::vector<int>{8, 32} : std::vector<int>{8, 32, 128, 512};
   const std::vector<int> ref = quick ? std::vector<int>{32, 64} : std::vector<int>{32, 64, 128};
   for (int w : ref) out.push_back({"reference", "reference_width", w});
   for (int n : mis) out.push_back({"mis", "samples", n});
@@ -76,7 +76,7 @@ std::vector<Config> configs(const std::string& brdf_name, bool quick) {
 }
 
 nlohmann::json sweep(const std::vector<std::string>& envs, int size, int probes, bool quick,
-                     const std::string& only_brdf) {
+                     const std::string& only_brdf, const std::string& only_config) {
   nlohmann::json rows = nlohmann::json::array();
   const Vec3 view = Vec3(0.3, 0.4, 0.866).normalized();  // a generic view (not a symmetry axis)
   const Mat3 T = world_from_view_for(view);
@@ -96,6 +96,7 @@ nlohmann::json sweep(const std::vector<std::string>& envs, int size, int probes,
       const double ref_probe_seconds = seconds_since(t0);
       const double disc_texels = disc_texel_count(size);
       for (const Config& c : configs(brdf_name, quick)) {
+        if (!only_config.empty() && only_config != c.method + ":" + std::to_string(c.value)) continue;
         IntegratorOptions o;
         o.seed = 1;
         if (c.knob == "samples") o.samples = c.value;
@@ -182,6 +183,8 @@ int main(int argc, char** argv) {
   bool quick = false;
   std::string only_brdf;
   app.add_option("--brdf", only_brdf, "Only this BRDF of the sweep (e.g. 'ggx 0.2')");
+  std::string only_config;
+  app.add_option("--config", only_config, "Only this configuration of the sweep (method:value, e.g. fis:512)");
   app.add_option("--envs", envs, "Comma-separated environments for the knob sweep");
   app.add_option("--target", target_env, "Environment for the 12-view target run");
   app.add_option("--out", out, "JSON output")->required();
@@ -194,7 +197,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> list;
     std::stringstream ss(envs);
     for (std::string e; std::getline(ss, e, ',');) list.push_back(e);
-    result["sweep"] = rsibr::sweep(list, size, probes, quick, only_brdf);
+    result["sweep"] = rsibr::sweep(list, size, probes, quick, only_brdf, only_config);
     result["size"] = size;
     result["probes"] = probes;
     result["threads"] = tbb::info::default_concurrency();

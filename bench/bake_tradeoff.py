@@ -32,7 +32,7 @@ BRDFS = ["lambert", "ggx 0.05", "ggx 0.2", "ggx 0.5", "clear coat"]
 
 def machine():
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
-    return f"{platform.machine()}, {os.cpu_count()} cores, load average {load:.1f} at the start"
+    return f"{platform.machine()}, {os.cpu_count()} cores, load average {load:.1f} when this section was written"
 
 
 def label(r):
@@ -53,7 +53,9 @@ def sweep_section(data):
            f"time: the whole map, {data['threads']} threads. Machine: {machine()} (shared with other work, so "
            "times are indicative; ratios within a row set are what to compare). The reference's own time is "
            "extrapolated from the probe texels (its cost per texel is constant). GGX uses a copper-like conductor "
-           "Fresnel; the clear coat is the automotive paint of docs/user-guide.md.", ""]
+           "Fresnel; the clear coat is the automotive paint of docs/user-guide.md."
+           + (" Rows marked * were measured in a separate, less loaded run (`--config`), so their times "
+              "read low against the others." if any(r.get("separate_run") for r in rows) else ""), ""]
     cheapest = []
     for brdf in BRDFS:
         out += [f"### {brdf}", "", "| method | " + " | ".join(f"{e} error | {e} s" for e in ENVS) + " |",
@@ -67,7 +69,8 @@ def sweep_section(data):
             for e in ENVS:
                 m = [r for r in rows if r["brdf"] == brdf and r["env"] == e and label(r) == lab]
                 cells.append(f"{m[0]['rel_rms']:.2e} | {m[0]['seconds']:.2f}" if m else "- | -")
-            out.append(f"| {lab} | " + " | ".join(cells) + " |")
+            star = "*" if any(r.get("separate_run") for r in rows if r["brdf"] == brdf and label(r) == lab) else ""
+            out.append(f"| {lab}{star} | " + " | ".join(cells) + " |")
         # Cheapest configuration whose worst error over the environments is <= 1%.
         best = None
         for lab in labels:
