@@ -104,7 +104,7 @@ void trace_samples(const RayScene& scene, const Camera& cam, const ImageRect& re
     index[m] = i;
     packed[m++] = dirs[i];
   }
-  scene.intersect_coherent(cam.eye, packed, m, packed_hits);
+  if (m > 0) scene.intersect_coherent(cam.eye, packed, m, packed_hits);
   for (int j = 0; j < m; ++j) hits[index[j]] = packed_hits[j];
 }
 
