@@ -52,7 +52,8 @@ def sweep_section(data):
            f"reference quadrature over every environment texel, at {data['probes']} random disc texels; "
            f"time: the whole map, {data['threads']} threads. Machine: {machine()} (shared with other work, so "
            "times are indicative; ratios within a row set are what to compare). The reference's own time is "
-           "extrapolated from the probe texels (its cost per texel is constant). GGX uses a copper-like conductor "
+           "extrapolated from the probe texels (its cost per texel is constant); the first reduced-width row "
+           "also pays for building the MIP pyramid. GGX uses a copper-like conductor "
            "Fresnel; the clear coat is the automotive paint of docs/user-guide.md."
            + (" Rows marked * were measured in a separate, less loaded run (`--config`), so their times "
               "read low against the others." if any(r.get("separate_run") for r in rows) else ""), ""]
