@@ -6,6 +6,7 @@
 #include "bake/ggx.h"
 #include "bake/lambert.h"
 #include "bake/phong.h"
+#include "core/yaml_spec.h"
 
 #include <algorithm>
 #include <cmath>
@@ -19,110 +20,26 @@ namespace rsibr {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& path, const std::string& what) {
-  throw std::invalid_argument(path + ": " + what);
-}
+using MapSpec = YamlMap;
 
-std::string join(const std::vector<std::string>& v) {
-  std::string s;
-  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
-  return s;
-}
-
-// A mapping node with its key path; checks keys against the allowed set up front.
-class MapSpec {
- public:
-  MapSpec(const YAML::Node& node, std::string path, const std::vector<std::string>& allowed)
-      : node_(node), path_(std::move(path)) {
-    if (!node_ || !node_.IsMap()) fail(path_, "expected a mapping");
-    for (const auto& kv : node_) {
-      if (!kv.first.IsScalar()) fail(path_, "keys must be strings");
-      const std::string key = kv.first.as<std::string>();
-      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
-        fail(at(key), "unknown key (expected one of: " + join(allowed) + ")");
-    }
-  }
-
-  std::string at(const std::string& key) const { return path_ + "." + key; }
-
-  YAML::Node get(const std::string& key) const {
-    const YAML::Node v = node_[key];
-    if (!v || v.IsNull()) fail(at(key), "missing");
-    return v;
-  }
-
-  std::string string(const std::string& key) const {
-    const YAML::Node v = get(key);
-    if (!v.IsScalar()) fail(at(key), "expected a string");
-    return v.as<std::string>();
-  }
-
-  double number(const std::string& key) const { return as_number(get(key), at(key)); }
-
-  Vec3 rgb(const std::string& key) const {
-    const YAML::Node v = get(key);
-    if (!v.IsSequence() || v.size() != 3) fail(at(key), "expected a sequence of 3 numbers");
-    Vec3 c;
-    for (std::size_t i = 0; i < 3; ++i) c[int(i)] = as_number(v[i], at(key) + "[" + std::to_string(i) + "]");
-    return c;
-  }
-
-  static double as_number(const YAML::Node& v, const std::string& path) {
-    if (!v.IsScalar()) fail(path, "expected a number");
-    double x;
-    try {
-      x = v.as<double>();
-    } catch (const YAML::Exception&) {
-      fail(path, "expected a number, got '" + v.as<std::string>() + "'");
-    }
-    if (!std::isfinite(x)) fail(path, "must be finite");
-    return x;
-  }
-
- private:
-  YAML::Node node_;
-  std::string path_;
-};
-
-std::string fmt(double x) {
-  std::ostringstream s;
-  s << x;
-  return s.str();
-}
-
-double in_range(double x, const std::string& path, double lo, bool lo_open, double hi, bool hi_open) {
-  const bool ok = (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi);
-  if (!ok) {
-    const std::string range = std::string(lo_open ? "(" : "[") + fmt(lo) + "," +
-                              (std::isinf(hi) ? "inf" : fmt(hi)) + (hi_open ? ")" : "]");
-    fail(path, "must be in " + range + ", got " + fmt(x));
-  }
-  return x;
-}
+[[noreturn]] void fail(const std::string& path, const std::string& what) { spec_fail(path, what); }
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-double roughness(const MapSpec& m) { return in_range(m.number("roughness"), m.at("roughness"), 0, true, 1, false); }
-double positive(const MapSpec& m, const std::string& key) {
-  return in_range(m.number(key), m.at(key), 0, true, kInf, true);
+double in_range(double x, const std::string& path, double lo, bool lo_open, double hi, bool hi_open) {
+  return spec_in_range(x, path, lo, lo_open, hi, hi_open);
 }
+double roughness(const MapSpec& m) { return m.number_in("roughness", 0, true, 1, false); }
+double positive(const MapSpec& m, const std::string& key) { return m.positive(key); }
 Vec3 rgb_in(const MapSpec& m, const std::string& key, double lo, bool lo_open, double hi, bool hi_open) {
-  const Vec3 c = m.rgb(key);
+  const Vec3 c = m.vec3(key);
   for (int i = 0; i < 3; ++i) in_range(c[i], m.at(key) + "[" + std::to_string(i) + "]", lo, lo_open, hi, hi_open);
   return c;
 }
 Vec3 unit_rgb(const MapSpec& m, const std::string& key) { return rgb_in(m, key, 0, false, 1, false); }
 
-// The "type" of a mapping, read before its other keys are checked.
 std::string type_of(const YAML::Node& node, const std::string& path, const std::vector<std::string>& types) {
-  if (!node || !node.IsMap()) fail(path, "expected a mapping");
-  const YAML::Node t = node["type"];
-  if (!t || t.IsNull()) fail(path + ".type", "missing");
-  if (!t.IsScalar()) fail(path + ".type", "expected a string");
-  const std::string type = t.as<std::string>();
-  if (std::find(types.begin(), types.end(), type) == types.end())
-    fail(path + ".type", "unknown type '" + type + "' (expected one of: " + join(types) + ")");
-  return type;
+  return spec_type(node, path, types);
 }
 
 }  // namespace
