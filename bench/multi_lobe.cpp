@@ -14,9 +14,11 @@
 //
 //   rsibr_multi_lobe --envs a.exr,b.exr --configs fib24,fib6+fib18,fib18 --out rows.json
 #include "bake/brdf_lobes.h"
+#include "bake/albedo_table.h"
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
 #include "bench/measure.h"
+#include "core/albedo_normalisation.h"
 #include "core/exr_io.h"
 #include "core/map_set.h"
 #include "core/sphere_map.h"
@@ -66,6 +68,7 @@ std::vector<Vec3> views_of(const std::string& name) {
 
 struct Baked {
   MapSet set;
+  std::vector<float> albedo;  // albedo-normalised maps: the table (core/albedo_normalisation.h)
   ViewSet views;
   double seconds = 0;
 };
@@ -114,7 +117,7 @@ int run(int argc, char** argv) {
   // Novel views: random, away from the poles (up hint) and >= 3 degrees from every view of every set.
   std::vector<Vec3> all_views;
   for (const std::string& cfg : configs) {
-    std::stringstream ss(cfg);
+    std::stringstream ss(cfg.rfind("n:", 0) == 0 ? cfg.substr(2) : cfg);
     std::string name;
     while (std::getline(ss, name, '+'))
       for (const Vec3& v : views_of(name)) all_views.push_back(v);
@@ -163,13 +166,14 @@ int run(int argc, char** argv) {
     std::fflush(stdout);
 
     std::map<std::string, Baked> cache;  // "<lobe>:<set>"
-    const auto baked = [&](const std::string& lobe, const std::string& name) -> const Baked& {
-      const std::string key = lobe + ":" + name;
+    const auto baked = [&](const std::string& lobe, const std::string& name, bool normalised) -> const Baked& {
+      const std::string key = lobe + ":" + name + (normalised ? ":n" : "");
       auto it = cache.find(key);
       if (it != cache.end()) return it->second;
       const Brdf& b = lobe == "all" ? *brdf : lobe == "normal" ? *normal_part : *mirror_part;
-      Baked out{{}, ViewSet(views_of(name)), 0};
+      Baked out{{}, {}, ViewSet(views_of(name)), 0};
       const auto t = Clock::now();
+      if (normalised) out.albedo = albedo_table(b);
       for (const Vec3& v : out.views.views()) {
         MapView mv;
         mv.view = v;
@@ -177,20 +181,27 @@ int run(int argc, char** argv) {
         mv.warp = to_string(b.central_direction());
         mv.material = b.spec();
         mv.rgb = bake(b, v, samples, 7);
+        if (normalised) {
+          normalise_by_albedo(mv.rgb, out.albedo);
+          mv.albedo = out.albedo;  // blend() multiplies it back at the destination
+        }
         out.set.views.push_back(std::move(mv));
       }
       out.seconds = seconds_since(t);
       return cache.emplace(key, std::move(out)).first->second;
     };
 
-    for (const std::string& cfg : configs) {
+    for (const std::string& cfg_text : configs) {
+      // "n:" = albedo-normalised maps (every set of the configuration).
+      const bool normalised = cfg_text.rfind("n:", 0) == 0;
+      const std::string cfg = normalised ? cfg_text.substr(2) : cfg_text;
       const auto plus = cfg.find('+');
       std::vector<const Baked*> sets;
       if (plus == std::string::npos) {
-        sets.push_back(&baked("all", cfg));
+        sets.push_back(&baked("all", cfg, normalised));
       } else {
-        sets.push_back(&baked("normal", cfg.substr(0, plus)));
-        sets.push_back(&baked("mirror", cfg.substr(plus + 1)));
+        sets.push_back(&baked("normal", cfg.substr(0, plus), normalised));
+        sets.push_back(&baked("mirror", cfg.substr(plus + 1), normalised));
       }
       int maps = 0;
       double bake_seconds = 0;
@@ -232,10 +243,10 @@ int run(int argc, char** argv) {
                                   err.den > 0 ? std::sqrt(err_part[1] / err.den) : 0.0};
       std::printf("  %-12s %-8s maps %3d: rel RMS %.4f (inner %.4f, worst view %.4f; normal part %.4f, mirror part %.4f), "
                   "bake %.1f s, blend %.2f ms/view\n",
-                  cfg.c_str(), sets.size() == 1 ? "single" : "split", maps, err.relative_rms(), err_inner.relative_rms(), worst, part_rel[0], part_rel[1],
+                  cfg_text.c_str(), sets.size() == 1 ? "single" : "split", maps, err.relative_rms(), err_inner.relative_rms(), worst, part_rel[0], part_rel[1],
                   bake_seconds, 1e3 * blend_seconds / double(novel_views.size()));
       std::fflush(stdout);
-      rows.push_back({{"env", env_name}, {"config", cfg}, {"kind", sets.size() == 1 ? "single" : "split"},
+      rows.push_back({{"env", env_name}, {"config", cfg_text}, {"normalised", normalised}, {"kind", sets.size() == 1 ? "single" : "split"},
                       {"sets", sizes}, {"maps", maps}, {"rel_rms", err.relative_rms()}, {"rel_rms_inner", err_inner.relative_rms()}, {"worst_view", worst},
                       {"normal_part_rel_rms", part_rel[0]}, {"mirror_part_rel_rms", part_rel[1]},
                       {"bake_s", bake_seconds}, {"blend_ms", 1e3 * blend_seconds / double(novel_views.size())},

@@ -6,7 +6,9 @@
 
 #include "core/atomic_file.h"
 
+#include "bake/albedo_table.h"
 #include "bake/brdf_lobes.h"
+#include "core/albedo_normalisation.h"
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
 #include "core/exr_io.h"
@@ -26,7 +28,7 @@ namespace rsibr::cli {
 namespace {
 
 struct BakeArgs {
-  std::string env, brdf, views = "icosa", method = "mis", layout, json, output, lobe = "all";
+  std::string env, brdf, views = "icosa", method = "mis", layout, json, output, lobe = "all", normalise = "none";
   int res = 128;
   int samples = 64;
   int reference_width = 0;
@@ -56,6 +58,8 @@ int run_bake(const BakeArgs& a) {
   options.reference_width = a.reference_width;
   const auto t1 = std::chrono::steady_clock::now();
 
+  // --normalise albedo: texels hold L / A(n.v), the runtime multiplies A back (core/albedo_normalisation.h).
+  const std::vector<float> albedo = a.normalise == "albedo" ? albedo_table(*brdf) : std::vector<float>{};
   const std::string warp = brdf->central_direction() == Lobe::Normal ? "normal" : "mirror";
   const bool stochastic = a.method == "mis" || a.method == "fis";
   Progress bar("bake", !a.quiet && Progress::stderr_is_terminal());
@@ -80,6 +84,10 @@ int run_bake(const BakeArgs& a) {
     mv.rgb = integrator->radiance_map(*brdf, v, mv.world_from_view, a.res, options,
                                       [&](int done) { bar.update((before + done) / total_rows); });
     rows_before += a.res;
+    if (!albedo.empty()) {
+      normalise_by_albedo(mv.rgb, albedo);
+      mv.albedo = albedo;
+    }
     set.views.push_back(std::move(mv));
   }
   bar.done();
@@ -100,6 +108,7 @@ int run_bake(const BakeArgs& a) {
   j["material"] = brdf->spec();
   j["warp"] = warp;
   j["lobe"] = a.lobe;
+  j["normalise"] = a.normalise;
   j["method"] = a.method;
   j["samples"] = a.samples;
   j["seed"] = a.seed;
@@ -121,7 +130,10 @@ Runner add_bake(CLI::App& app) {
             "harmonics order 2, lambert only). The same inputs and --seed give the same bytes.\n"
             "Multi-lobe maps: --lobe normal and --lobe mirror bake the two parts of a BRDF (clear coat: the binder; "
             "the coat and flakes) as two sets, each warped with its own warp; the runtime sums them "
-            "(rsibr render --maps normal.exr --maps mirror.exr).");
+            "(rsibr render --maps normal.exr --maps mirror.exr).\n"
+            "--normalise albedo stores each texel divided by the BRDF's directional albedo at its n.v (a table in the "
+            "file); the runtime multiplies it back at the destination view, so a view dependence through Fresnel "
+            "factors is not warped (the clear coat's normal part becomes exactly view independent).");
   c->add_option("output", a->output, "Output map set (.exr)")->required();
   c->add_option("--env", a->env, "Environment map (EXR or .hdr)")->required();
   c->add_option("--brdf", a->brdf, "BRDF spec (YAML)")->required();
@@ -131,6 +143,8 @@ Runner add_bake(CLI::App& app) {
                 "all (the whole BRDF), or normal / mirror: only that part of it (multi-lobe maps: bake each part "
                 "and render with --maps once per part); the warp follows the part")
       ->check(CLI::IsMember({"all", "normal", "mirror"}));
+  c->add_option("--normalise", a->normalise, "none, or albedo: albedo-normalised maps (see below)")
+      ->check(CLI::IsMember({"none", "albedo"}));
   c->add_option("--method", a->method, "reference, mis, fis or sh")
       ->check(CLI::IsMember({"reference", "mis", "fis", "sh"}));
   c->add_option("--samples", a->samples, "mis, fis: samples per texel")->check(CLI::Range(1, 1 << 20));

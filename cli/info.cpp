@@ -154,13 +154,16 @@ int info_map_set(const InfoArgs& a) {
     jv["source"] = v.source;
     jv["material"] = v.material;
     jv["confidence"] = !v.confidence.empty();
+    jv["albedo_normalised"] = !v.albedo.empty();
+    if (!v.albedo.empty()) jv["albedo_table"] = v.albedo;
     jv["values"] = channel_stats(v.rgb);
     jv["attributes"] = v.attributes;
     std::ostringstream line;
     line << std::fixed << std::setprecision(4) << "  view." << std::setw(3) << std::setfill('0') << i
          << std::setfill(' ') << "  v=(" << v.view.x() << ", " << v.view.y() << ", " << v.view.z() << ")  up=("
          << v.world_from_view(0, 1) << ", " << v.world_from_view(1, 1) << ", " << v.world_from_view(2, 1) << ")  " << v.warp
-         << "  " << v.source << (v.confidence.empty() ? "" : "  +confidence");
+         << "  " << v.source << (v.confidence.empty() ? "" : "  +confidence")
+         << (v.albedo.empty() ? "" : "  albedo-normalised");
     const std::string first_line = v.material.substr(0, v.material.find('\n'));
     if (!first_line.empty()) line << "  material: " << first_line;
     text << line.str() << "\n";

@@ -1,11 +1,13 @@
 #include "core/map_set.h"
 
+#include "core/albedo_normalisation.h"
 #include "core/atomic_file.h"
 #include "core/colour.h"
 #include "core/exr_io.h"
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfChromaticitiesAttribute.h>
+#include <OpenEXR/ImfFloatVectorAttribute.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputPart.h>
@@ -30,7 +32,7 @@ std::string part_name(std::size_t i) {
   return buf;
 }
 
-const std::vector<std::string> kReserved = {"view", "worldFromView", "warp", "source", "material"};
+const std::vector<std::string> kReserved = {"view", "worldFromView", "warp", "source", "material", "albedo"};
 
 }  // namespace
 
@@ -59,6 +61,15 @@ void validate(const MapSet& set) {
     if (v.warp != "mirror" && v.warp != "normal") throw std::invalid_argument(who + "warp must be 'mirror' or 'normal'");
     if (v.source != "computed" && v.source != "captured")
       throw std::invalid_argument(who + "source must be 'computed' or 'captured'");
+    if (v.albedo != set.views.front().albedo)
+      throw std::invalid_argument(who + "albedo table differs from view.000's (a set shares one BRDF)");
+    if (!v.albedo.empty()) {
+      try {
+        check_albedo_table(v.albedo);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(who + e.what());
+      }
+    }
     for (const auto& [key, value] : v.attributes) {
       for (const std::string& r : kReserved)
         if (key == r) throw std::invalid_argument(who + "attribute '" + key + "' is reserved");
@@ -91,6 +102,7 @@ void write_map_set(const std::string& path, const MapSet& set) {
     h.insert("rsibr.warp", Imf::StringAttribute(v.warp));
     h.insert("rsibr.source", Imf::StringAttribute(v.source));
     h.insert("rsibr.material", Imf::StringAttribute(v.material));
+    if (!v.albedo.empty()) h.insert("rsibr.albedo", Imf::FloatVectorAttribute(v.albedo));
     for (const auto& [key, value] : v.attributes) h.insert("rsibr." + key, Imf::StringAttribute(value));
     for (const char* c : {"R", "G", "B"}) h.channels().insert(c, Imf::Channel(Imf::FLOAT));
     if (!v.confidence.empty()) h.channels().insert("confidence", Imf::Channel(Imf::FLOAT));
@@ -153,6 +165,7 @@ MapSet read_map_set(const std::string& path) {
       v.warp = warp->value();
       v.source = source->value();
       if (const auto* m = h.findTypedAttribute<Imf::StringAttribute>("rsibr.material")) v.material = m->value();
+      if (const auto* a = h.findTypedAttribute<Imf::FloatVectorAttribute>("rsibr.albedo")) v.albedo = a->value();
       for (auto it = h.begin(); it != h.end(); ++it) {
         const std::string name = it.name();
         if (name.rfind("rsibr.", 0) != 0) continue;

@@ -6,6 +6,8 @@
 //   rsibr.warp           "mirror" | "normal"   which central direction the runtime warps
 //   rsibr.source         "computed" | "captured"
 //   rsibr.material       the BRDF spec as text
+//   rsibr.albedo         optional FloatVector: the maps are albedo-normalised (texels hold L / A(n.v));
+//                        A's table as core/albedo_normalisation.h lays it out; the same for every view
 //   rsibr.<key>          provenance strings (MapView::attributes)
 //   chromaticities       Rec.709 / D65 (the working space)
 // Channels R, G, B (float32), plus "confidence" for captured maps. Texel p of view v holds the
@@ -29,6 +31,9 @@ struct MapView {
   std::string warp = "mirror";        // "mirror" | "normal"
   std::string source = "computed";    // "computed" | "captured"
   std::string material;
+  // Empty, or the albedo table of albedo-normalised maps (core/albedo_normalisation.h): rgb then holds
+  // L / A(n.v) and the runtime (runtime/blend.h, direction_lookup.h) multiplies A back at the destination.
+  std::vector<float> albedo;
   std::map<std::string, std::string> attributes;  // provenance, written as rsibr.<key>
   cv::Mat rgb;                        // CV_32FC3, RGB order, sphere-map layout (square or not)
   cv::Mat confidence;                 // empty, or CV_32FC1 of the same size

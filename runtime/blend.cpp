@@ -1,5 +1,7 @@
 #include "runtime/blend.h"
 
+#include "core/albedo_normalisation.h"
+
 #include "core/parallel.h"
 #include "core/sphere_map.h"
 #include "runtime/disc_sampler.h"
@@ -329,9 +331,9 @@ void check_blend_source(const MapSet& maps, int index) {
     throw std::invalid_argument(who + "confidence must be one float channel of the map's size");
 }
 
-BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_dir, const Vec3& up,
-                  const BlendOptions& options) {
-  check_blend_inputs(maps, view_set);
+// The blend of the stored texels (albedo-normalised ones still normalised; blend() scales them).
+static BlendResult blend_stored(const MapSet& maps, const ViewSet& view_set, const Vec3& view_dir, const Vec3& up,
+                                const BlendOptions& options) {
   if (!view_dir.allFinite() || !(view_dir.norm() > 0)) throw std::invalid_argument("blend: view direction must be finite and non-zero");
   if ((options.width > 0) != (options.height > 0) || options.width < 0 || options.height < 0)
     throw std::invalid_argument("blend: give both width and height (> 0), or neither");
@@ -519,6 +521,16 @@ BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_
           }
       },
       tbb::simple_partitioner());
+  return result;
+}
+
+BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_dir, const Vec3& up,
+                  const BlendOptions& options) {
+  check_blend_inputs(maps, view_set);
+  BlendResult result = blend_stored(maps, view_set, view_dir, up, options);
+  // Albedo-normalised sets: the destination texel p has n.d = g_normal(p).z in d's own frame.
+  const std::vector<float>& albedo = maps.views.front().albedo;
+  if (!albedo.empty()) denormalise_by_albedo(result.rgb, albedo);
   return result;
 }
 

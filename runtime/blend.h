@@ -35,6 +35,10 @@
 //      ViewWeights order, zero-weight located views included) at its clamped disc point, and weight(p)
 //      is 0. Texels outside the destination disc are 0 with weight 0. No NaN or Inf is produced for
 //      finite maps.
+//   6. Albedo-normalised sets (MapView::albedo, core/albedo_normalisation.h): steps 1-5 blend the stored
+//      L / A values; out(p) is then multiplied by A(z_p), z_p = n . d = g_normal(p).z, so every source
+//      contributes L_i(p_i) A(n.d) / A(n_i.v_i): the outgoing-angle factor is re-evaluated at the
+//      destination instead of being warped. A set reproduces each source at its own view either way.
 #pragma once
 
 #include "core/map_set.h"

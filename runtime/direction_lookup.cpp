@@ -1,5 +1,7 @@
 #include "runtime/direction_lookup.h"
 
+#include "core/albedo_normalisation.h"
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -74,6 +76,9 @@ Vec3 DirectionLookup::radiance(const ViewWeights& located, const Vec3& v, const 
     nv = 0;
   }
   const Vec3 r = 2.0 * nv * n - v;
+  // Albedo-normalised sets: the blend of stored texels times A(n.v) (core/albedo_normalisation.h).
+  const std::vector<float>& albedo = maps_.views.front().albedo;
+  const Vec3 A = albedo.empty() ? Vec3(1, 1, 1) : albedo_at(albedo, float(nv));
 
   // 2-4.
   double acc[3] = {0, 0, 0}, total = 0;
@@ -97,7 +102,7 @@ Vec3 DirectionLookup::radiance(const ViewWeights& located, const Vec3& v, const 
   if (total > 0) {
     if (weight) *weight = total;
     const double inv = 1.0 / total;
-    return Vec3(acc[0] * inv, acc[1] * inv, acc[2] * inv);
+    return Vec3(acc[0] * inv, acc[1] * inv, acc[2] * inv).cwiseProduct(A);
   }
   // 5. Fallback: the least-faded located source, weight 0.
   if (weight) *weight = 0;
@@ -106,7 +111,7 @@ Vec3 DirectionLookup::radiance(const ViewWeights& located, const Vec3& v, const 
     if (best < 0 || samples[k].rim > samples[best].rim) best = k;
   double L[3], conf;
   if (best >= 0 && sample_disc(sources_[std::size_t(located.views[std::size_t(best)])], samples[best].disc, L, &conf))
-    return Vec3(L[0], L[1], L[2]);
+    return Vec3(L[0], L[1], L[2]).cwiseProduct(A);
   return Vec3::Zero();
 }
 

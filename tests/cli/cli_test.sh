@@ -106,6 +106,12 @@ check "bake --lobe normal: material is the part's spec" bash -c "'$rsibr' info '
 expect_error "bake --lobe of a missing part" "no normal lobe" bake --env "$work/sky.exr" --brdf "$work/ggx.yaml" --lobe normal --res 8 "$work/ggx_normal.exr"
 expect_error "bake --lobe with a bad name" "lobe" bake --env "$work/sky.exr" --brdf "$work/paint.yaml" --lobe diffuse --res 8 "$work/bad_lobe.exr"
 check "bake --lobe: no output after errors" test ! -e "$work/ggx_normal.exr" -a ! -e "$work/bad_lobe.exr"
+# bake --normalise albedo: the table travels in the file, info says so, the blend scales it back.
+"$rsibr" bake --env "$work/sky.exr" --brdf "$work/paint.yaml" --lobe normal --normalise albedo --views icosa --res 8 --samples 4 -q "$work/paint_normal_n.exr"
+check "bake --normalise albedo: info says albedo-normalised" bash -c "'$rsibr' info '$work/paint_normal_n.exr' | grep -q albedo-normalised"
+check "bake --normalise albedo: the JSON carries the table" bash -c "'$rsibr' info '$work/paint_normal_n.exr' --json - 2>/dev/null | grep -q albedo_table"
+expect_error "bake --normalise with a bad value" "normalise" bake --env "$work/sky.exr" --brdf "$work/paint.yaml" --normalise fresnel --res 8 "$work/bad_norm.exr"
+check "bake --normalise: no output after an error" test ! -e "$work/bad_norm.exr"
 # reference: a tiny render of an octahedron, deterministic bytes, JSON, errors before work.
 printf 'v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\nf 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n' >"$work/octa.obj"
 for i in 1 2; do

@@ -302,3 +302,35 @@ TEST(MapSet, PartsAreNamedInOrder) {
 
 }  // namespace
 }  // namespace rsibr
+
+namespace rsibr {
+namespace {
+
+TEST(MapSet, AlbedoTableRoundTripsAndMustBeSharedAndValid) {
+  TempDir dir;
+  MapSet set = make_set(3, 9);
+  std::vector<float> table;
+  for (int k = 0; k < 16; ++k)
+    for (int c = 0; c < 3; ++c) table.push_back(0.04f + 0.9f * float(k) / 15.0f * float(c + 1) / 3.0f);
+  for (MapView& v : set.views) v.albedo = table;
+  const std::string path = dir.file("maps.exr");
+  write_map_set(path, set);
+  const MapSet back = read_map_set(path);
+  for (const MapView& v : back.views) EXPECT_EQ(v.albedo, table);
+
+  MapSet differs = set;
+  differs.views[4].albedo[7] += 0.01f;
+  EXPECT_THROW(validate(differs), std::invalid_argument);
+  MapSet negative = set;
+  for (MapView& v : negative.views) v.albedo[0] = -1.0f;
+  EXPECT_THROW(validate(negative), std::invalid_argument);
+  MapSet short_table = set;
+  for (MapView& v : short_table.views) v.albedo.resize(3);
+  EXPECT_THROW(validate(short_table), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(dir.file("bad.exr")));
+  EXPECT_THROW(write_map_set(dir.file("bad.exr"), differs), std::runtime_error);
+  EXPECT_FALSE(fs::exists(dir.file("bad.exr")));
+}
+
+}  // namespace
+}  // namespace rsibr

@@ -1,6 +1,7 @@
 #include "runtime/direction_lookup.h"
 
 #include "analytic_map_set.h"
+#include "core/albedo_normalisation.h"
 #include "core/sphere_map.h"
 
 #include <gtest/gtest.h>
@@ -41,6 +42,33 @@ TEST(DirectionLookup, LookupEqualsBlendAtTheDestinationView) {
       EXPECT_GT(checked, 700);
     }
   }
+}
+
+// Albedo-normalised sets: both scale by A(n.v) (blend per destination texel, the lookup per call).
+TEST(DirectionLookup, LookupEqualsBlendForAlbedoNormalisedMaps) {
+  const ViewSet views = ViewSet::icosahedron();
+  MapSet set = analytic_map_set(views, 24, 24, "mirror", fresnel_mirror_texel);
+  std::vector<float> table;
+  for (int k = 0; k < 8; ++k) table.insert(table.end(), {0.1f + 0.1f * float(k), 1.0f - 0.1f * float(k), 0.5f});
+  for (MapView& v : set.views) v.albedo = table;
+  const DirectionLookup lookup(set, views);
+  const Vec3 d = Vec3(-0.3, 0.5, 0.6).normalized();
+  const BlendResult b = blend(set, views, d, Vec3(0, 1, 0));
+  MapSet plain = set;
+  for (MapView& v : plain.views) v.albedo.clear();
+  const BlendResult p = blend(plain, views, d, Vec3(0, 1, 0));
+  for (int r = 0; r < 24; ++r)
+    for (int c = 0; c < 24; ++c) {
+      const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), 24, 24);
+      if (xy.squaredNorm() > 1.0) continue;
+      const Vec3 A = albedo_at(table, float(sphere_map::g_normal(xy).z()));
+      const Vec3 L = lookup.radiance(d, b.world_from_view * sphere_map::g_normal(xy));
+      for (int k = 0; k < 3; ++k) {
+        const double o = b.rgb.at<cv::Vec3f>(r, c)[k];
+        ASSERT_NEAR(o, A[k] * p.rgb.at<cv::Vec3f>(r, c)[k], 1e-6 * std::max(1.0, std::abs(o)));
+        ASSERT_NEAR(L[k], o, 1e-5 * std::max(1.0, std::abs(o))) << "texel " << c << "," << r;
+      }
+    }
 }
 
 // Same with confidence channels (captured maps): the confidence multiplies the weights identically.
