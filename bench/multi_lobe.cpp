@@ -50,19 +50,7 @@ const char* kClearCoat =
     "conductor, eta: [1.66, 0.88, 0.52], k: [9.22, 6.27, 4.84]}}, base: {albedo: [0.5, 0.05, 0.03]}}";
 
 
-// N points of the Fibonacci sphere: z = 1 - (2i+1)/N, azimuth i * golden angle.
-std::vector<Vec3> fibonacci(int n) {
-  std::vector<Vec3> v;
-  const double golden = kPi * (3.0 - std::sqrt(5.0));
-  for (int i = 0; i < n; ++i) {
-    const double z = 1.0 - (2.0 * i + 1.0) / n, s = std::sqrt(std::max(0.0, 1.0 - z * z));
-    v.emplace_back(s * std::cos(golden * i), s * std::sin(golden * i), z);
-  }
-  return v;
-}
-
 std::vector<Vec3> views_of(const std::string& name) {
-  if (name.rfind("fib", 0) == 0) return fibonacci(std::stoi(name.substr(3)));
   return ViewSet::named(name).views();
 }
 

@@ -137,7 +137,7 @@ Runner add_bake(CLI::App& app) {
   c->add_option("output", a->output, "Output map set (.exr)")->required();
   c->add_option("--env", a->env, "Environment map (EXR or .hdr)")->required();
   c->add_option("--brdf", a->brdf, "BRDF spec (YAML)")->required();
-  c->add_option("--views", a->views, "View set: icosa, 42, 162, 642 or a file of 'x y z' lines");
+  c->add_option("--views", a->views, "View set: tetra, octa, icosa, 42, 162, 642, fibN or a file of 'x y z' lines");
   c->add_option("--res", a->res, "Sphere-map size (square)")->check(CLI::Range(1, 8192));
   c->add_option("--lobe", a->lobe,
                 "all (the whole BRDF), or normal / mirror: only that part of it (multi-lobe maps: bake each part "

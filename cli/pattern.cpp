@@ -108,7 +108,7 @@ Runner add_pattern(CLI::App& app) {
   c->add_option("--checker", a->checker_deg, "checker: square size in degrees")->check(CLI::Range(0.01, 180.0));
   c->add_option("--map-set", a->views,
                 "Write instead a map set of a perfect mirror (no Fresnel) lit by the pattern, one sphere map per view "
-                "of this view set (icosa, 42, 162, 642 or a file of 'x y z' lines)");
+                "of this view set (tetra, octa, icosa, 42, 162, 642, fibN or a file of 'x y z' lines)");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   return [a] { return run_pattern(*a); };
 }

@@ -254,13 +254,38 @@ ViewSet ViewSet::geodesic(int k) {
   return set;
 }
 
+ViewSet ViewSet::tetrahedron() {
+  return ViewSet({Vec3(1, 1, 1).normalized(), Vec3(1, -1, -1).normalized(), Vec3(-1, 1, -1).normalized(),
+                  Vec3(-1, -1, 1).normalized()});
+}
+
+ViewSet ViewSet::octahedron() {
+  return ViewSet({Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0), Vec3(0, 0, 1), Vec3(0, 0, -1)});
+}
+
+ViewSet ViewSet::fibonacci(int n) {
+  if (n < 4) throw std::invalid_argument("fibonacci view set: need at least 4 views, got " + std::to_string(n));
+  std::vector<Vec3> v;
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / n, s = std::sqrt(std::max(0.0, 1.0 - z * z));
+    v.emplace_back(s * std::cos(golden * i), s * std::sin(golden * i), z);
+  }
+  return ViewSet(v);
+}
+
 ViewSet ViewSet::named(const std::string& name) {
+  if (name == "tetra" || name == "tetrahedron") return tetrahedron();
+  if (name == "octa" || name == "octahedron") return octahedron();
+  if (name.size() > 3 && name.rfind("fib", 0) == 0 &&
+      name.find_first_not_of("0123456789", 3) == std::string::npos && name.size() < 9)
+    return fibonacci(std::stoi(name.substr(3)));
   if (name == "icosa" || name == "icosahedron" || name == "12") return icosahedron();
   if (name == "42") return geodesic(1);
   if (name == "162") return geodesic(2);
   if (name == "642") return geodesic(3);
   std::ifstream in(name);
-  if (!in) throw std::invalid_argument(name + ": not a view set name (icosa, 42, 162, 642) nor a readable file");
+  if (!in) throw std::invalid_argument(name + ": not a view set name (tetra, octa, icosa, 42, 162, 642, fibN) nor a readable file");
   std::vector<Vec3> views;
   std::string line;
   int lineno = 0;

@@ -60,7 +60,15 @@ class ViewSet {
   static ViewSet icosahedron();
   // Geodesic subdivision of the icosahedron: k = 0, 1, 2, 3 give 12, 42, 162, 642 views.
   static ViewSet geodesic(int k);
-  // "icosa" / "12" / "42" / "162" / "642", or a text file with one "x y z" per line ('#' comments).
+  // The 4 vertices of a regular tetrahedron ((+-1, +-1, +-1) with an even number of minus signs): the
+  // fewest views that surround the sphere (for view-independent maps, e.g. albedo-normalised ones).
+  static ViewSet tetrahedron();
+  // The 6 axis directions.
+  static ViewSet octahedron();
+  // n >= 4 points of the Fibonacci sphere: z_i = 1 - (2i+1)/n, azimuth i * pi (3 - sqrt 5) about +Z.
+  static ViewSet fibonacci(int n);
+  // "tetra" / "octa" / "icosa" / "12" / "42" / "162" / "642" / "fibN" (N >= 4), or a text file with one
+  // "x y z" per line ('#' comments).
   static ViewSet named(const std::string& name);
 
   const std::vector<Vec3>& views() const { return views_; }

@@ -1044,6 +1044,23 @@ TEST(ViewSet, NamedSetsParse) {
   EXPECT_EQ(ViewSet::named("642").views().size(), 642u);
   EXPECT_EQ(ViewSet::named("42").triangles(), ViewSet::geodesic(1).triangles());
   EXPECT_THROW(ViewSet::named("43"), std::invalid_argument);
+  // The small sets and the Fibonacci sphere: counts, unit views, and each surrounds the sphere.
+  for (const auto& [name, count] : {std::pair{"tetra", 4}, std::pair{"octa", 6}, std::pair{"fib4", 4},
+                                    std::pair{"fib7", 7}, std::pair{"fib24", 24}, std::pair{"fib500", 500}}) {
+    const ViewSet v = ViewSet::named(name);
+    EXPECT_EQ(int(v.views().size()), count) << name;
+    EXPECT_TRUE(v.surrounds()) << name;
+    EXPECT_EQ(int(v.triangles().size()), 2 * count - 4) << name << ": a closed hull has 2V - 4 triangles";
+    for (const Vec3& d : v.views()) EXPECT_NEAR(d.norm(), 1.0, 1e-15) << name;
+  }
+  // The tetrahedron is regular: every pair of views is acos(-1/3) apart.
+  const ViewSet tetra = ViewSet::tetrahedron();
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j)
+      EXPECT_NEAR(tetra.views()[std::size_t(i)].dot(tetra.views()[std::size_t(j)]), -1.0 / 3.0, 1e-15);
+  EXPECT_THROW(ViewSet::named("fib3"), std::invalid_argument);
+  EXPECT_THROW(ViewSet::named("fib"), std::invalid_argument);
+  EXPECT_THROW(ViewSet::named("fibx"), std::invalid_argument);
   EXPECT_THROW(ViewSet::named("/nonexistent/rsibr/views.txt"), std::invalid_argument);
 
   const auto good = temp_file("good.txt",
