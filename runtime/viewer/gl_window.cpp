@@ -1,0 +1,48 @@
+#include "runtime/viewer/gl_window.h"
+
+#include <epoxy/gl.h>
+// After epoxy: GLFW must not include the system GL header.
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include <stdexcept>
+
+namespace rsibr::viewer {
+namespace {
+std::string last_glfw_error() {
+  const char* description = nullptr;
+  const int code = glfwGetError(&description);
+  return code == GLFW_NO_ERROR ? std::string("unknown error") : std::string(description ? description : "?");
+}
+}  // namespace
+
+GlWindow::GlWindow(int width, int height, const std::string& title, bool visible) {
+  if (!glfwInit())
+    throw std::runtime_error("cannot open a window (" + last_glfw_error() +
+                             "); the viewer needs a display (run under `xvfb-run -a` without one)");
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_VISIBLE, visible ? GLFW_TRUE : GLFW_FALSE);
+  window_ = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+  if (!window_) {
+    const std::string why = last_glfw_error();
+    glfwTerminate();
+    throw std::runtime_error("cannot create an OpenGL 3.3 core window (" + why + ")");
+  }
+  glfwMakeContextCurrent(window_);
+}
+
+GlWindow::~GlWindow() {
+  if (window_) glfwDestroyWindow(window_);
+  glfwTerminate();
+}
+
+std::string GlWindow::renderer() const {
+  const auto* r = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const auto* v = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+  return std::string(r ? r : "?") + ", " + (v ? v : "?");
+}
+
+}  // namespace rsibr::viewer
