@@ -5,10 +5,29 @@
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
+#include <dlfcn.h>
+#include <link.h>
+
+#include <cstring>
 #include <stdexcept>
 
 namespace rsibr::viewer {
 namespace {
+// Keeps the OpenGL driver modules (Mesa's .../dri/*_dri.so, libGLX_mesa) loaded until the process
+// exits. Mesa unloads them when the display closes, and leak reports of the allocations they make
+// and never free would then show "<unknown module>" frames that no suppression can name. Pinned,
+// LeakSanitizer names them and runtime/viewer/lsan.supp suppresses exactly those modules.
+void pin_gl_driver_modules() {
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, size_t, void*) {
+        const char* name = info->dlpi_name;
+        if (name && (std::strstr(name, "_dri.so") || std::strstr(name, "libGLX_mesa")))
+          dlopen(name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);  // a reference never dropped
+        return 0;
+      },
+      nullptr);
+}
+
 std::string last_glfw_error() {
   const char* description = nullptr;
   const int code = glfwGetError(&description);
@@ -32,6 +51,7 @@ GlWindow::GlWindow(int width, int height, const std::string& title, bool visible
     throw std::runtime_error("cannot create an OpenGL 3.3 core window (" + why + ")");
   }
   glfwMakeContextCurrent(window_);
+  pin_gl_driver_modules();
 }
 
 GlWindow::~GlWindow() {
