@@ -13,6 +13,9 @@
 
 namespace rsibr::viewer {
 namespace {
+// Windows alive (GLFW is initialised with the first and terminated with the last).
+int g_windows = 0;
+
 // Keeps the OpenGL driver modules (Mesa's .../dri/*_dri.so, libGLX_mesa) loaded until the process
 // exits. Mesa unloads them when the display closes, and leak reports of the allocations they make
 // and never free would then show "<unknown module>" frames that no suppression can name. Pinned,
@@ -36,7 +39,7 @@ std::string last_glfw_error() {
 }  // namespace
 
 GlWindow::GlWindow(int width, int height, const std::string& title, bool visible) {
-  if (!glfwInit())
+  if (g_windows == 0 && !glfwInit())
     throw std::runtime_error("cannot open a window (" + last_glfw_error() +
                              "); the viewer needs a display (run under `xvfb-run -a` without one)");
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
@@ -47,17 +50,20 @@ GlWindow::GlWindow(int width, int height, const std::string& title, bool visible
   window_ = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
   if (!window_) {
     const std::string why = last_glfw_error();
-    glfwTerminate();
+    if (g_windows == 0) glfwTerminate();
     throw std::runtime_error("cannot create an OpenGL 3.3 core window (" + why + ")");
   }
+  ++g_windows;
   glfwMakeContextCurrent(window_);
   pin_gl_driver_modules();
 }
 
 GlWindow::~GlWindow() {
-  if (window_) glfwDestroyWindow(window_);
-  glfwTerminate();
+  glfwDestroyWindow(window_);
+  if (--g_windows == 0) glfwTerminate();
 }
+
+void GlWindow::make_current() const { glfwMakeContextCurrent(window_); }
 
 std::string GlWindow::renderer() const {
   const auto* r = reinterpret_cast<const char*>(glGetString(GL_RENDERER));

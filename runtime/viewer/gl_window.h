@@ -1,6 +1,7 @@
 // A GLFW window with an OpenGL 3.3 core context (function pointers through libepoxy), for the viewer
 // and for its scripted and test modes (a hidden window: the frame is drawn into an offscreen
-// framebuffer, so its size need not match the window's). One window per process at a time.
+// framebuffer, so its size need not match the window's). Several may exist (GLFW is initialised
+// with the first and terminated with the last); the newest is current. Main thread only.
 #pragma once
 
 #include <string>
@@ -19,6 +20,7 @@ class GlWindow {
   GlWindow& operator=(const GlWindow&) = delete;
 
   GLFWwindow* handle() const { return window_; }
+  void make_current() const;
   // GL_RENDERER and GL_VERSION, e.g. "llvmpipe (LLVM 15.0.6, 256 bits), 4.5 (Core Profile) Mesa 22.3.6".
   std::string renderer() const;
 

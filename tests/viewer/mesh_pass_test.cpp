@@ -15,7 +15,6 @@
 #include "runtime/viewer/gl_frame.h"
 #include "runtime/viewer/gl_map_set.h"
 #include "runtime/viewer/gl_mesh.h"
-#include "runtime/viewer/gl_window.h"
 #include "runtime/viewer/mesh_pass.h"
 
 #include "bake/test_meshes.h"
@@ -23,6 +22,8 @@
 #include "runtime/analytic_map_set.h"
 #include "runtime/direction_lookup.h"
 #include "runtime/renderer.h"
+
+#include "viewer/gl_test_context.h"
 
 #include <gtest/gtest.h>
 
@@ -36,15 +37,10 @@ namespace {
 using viewer::GlFrame;
 using viewer::GlMapSet;
 using viewer::GlMesh;
-using viewer::GlWindow;
 using viewer::MeshPass;
 using viewer::MeshPassOptions;
 
-// One hidden window for the whole suite (GLFW allows one init per process at a time).
-GlWindow& window() {
-  static GlWindow w(64, 64, "rsibr viewer tests", false);
-  return w;
-}
+void window() { testing::gl_test_context(); }
 
 struct Agreement {
   long coverage_mismatch = 0, both = 0, within_tight = 0;
