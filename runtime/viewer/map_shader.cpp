@@ -20,7 +20,7 @@ void main() {
 }
 )GLSL";
 
-const char* const kMeshFragmentShader = R"GLSL(#version 330 core
+const char* const kMeshFragmentShader = R"GLSL(
 in vec3 vNormal;
 out vec4 fragColor;
 
@@ -28,7 +28,6 @@ uniform mat3 uWorldFromCam;
 uniform vec4 uIntrinsics;   // fx, fy, cx, cy
 uniform vec2 uSize;         // W, H of the whole frame
 uniform vec2 uOrigin;       // window position of this camera's pixel (0, 0) corner
-uniform int uMode;          // 0: per pixel, 1: paper (destination map)
 uniform int uShowWeight;    // 1: output sum_i a_i as grey
 uniform float uRimFade;
 
@@ -44,45 +43,45 @@ uniform sampler2D uDest;         // paper: RGBA32F destination map, A = weight
 uniform ivec2 uDestSize;
 uniform mat3 uDestViewFromWorld; // T_d^T
 
-// runtime/disc_sampler.h
-vec4 tap_map(int layer, ivec2 c) { return texelFetch(uMaps, ivec3(c, layer), 0); }
-vec4 tap_dest(ivec2 c) { return texelFetch(uDest, c, 0); }
-// Returns (rgb, confidence) in .rgb/.a and success in ok.
-vec4 sample_disc(int layer, vec2 xy, ivec2 size, out bool ok) {
-  float W = float(size.x), H = float(size.y);
-  for (int attempt = 0; attempt < 8; ++attempt) {
-    vec2 p = vec2(0.5 * ((xy.x + 1.0) * W - 1.0), 0.5 * ((1.0 - xy.y) * H - 1.0));
-    vec2 f0 = floor(p);
-    vec2 f = p - f0;
-    ivec2 c0 = ivec2(f0);
-    ivec2 lo = clamp(c0, ivec2(0), size - 1), hi = clamp(c0 + 1, ivec2(0), size - 1);
-    vec4 acc = vec4(0.0);
-    float total = 0.0;
-    for (int j = 0; j < 2; ++j) {
-      int r = j == 0 ? lo.y : hi.y;
-      float y = 1.0 - (2.0 * float(r) + 1.0) / H;
-      float wy = j == 0 ? 1.0 - f.y : f.y;
-      for (int i = 0; i < 2; ++i) {
-        int c = i == 0 ? lo.x : hi.x;
-        float w = (i == 0 ? 1.0 - f.x : f.x) * wy;
-        if (!(w > 0.0)) continue;
-        float x = (2.0 * float(c) + 1.0) / W - 1.0;
-        if (x * x + y * y > 1.0) continue;
-        acc += w * (layer >= 0 ? tap_map(layer, ivec2(c, r)) : tap_dest(ivec2(c, r)));
-        total += w;
-      }
-    }
-    if (total > 0.0) {
-      ok = true;
-      vec4 s = acc / total;
-      s.a = s.a > 0.0 ? s.a : 0.0;
-      return s;
-    }
-    xy *= 1.0 - 1.0 / float(max(size.x, size.y));
+// runtime/disc_sampler.h; returns (rgb, confidence) in .rgb/.a and success in ok. FETCH(c) reads
+// texel c of the sampled map (one function per map kind: no per-tap branch).
+#define SAMPLE_DISC(NAME, FETCH)                                                                  \
+  vec4 NAME(int layer, vec2 xy, ivec2 size, out bool ok) {                                        \
+    float W = float(size.x), H = float(size.y);                                                   \
+    for (int attempt = 0; attempt < 8; ++attempt) {                                               \
+      vec2 p = vec2(0.5 * ((xy.x + 1.0) * W - 1.0), 0.5 * ((1.0 - xy.y) * H - 1.0));              \
+      vec2 f0 = floor(p);                                                                         \
+      vec2 f = p - f0;                                                                            \
+      ivec2 c0 = ivec2(f0);                                                                       \
+      ivec2 lo = clamp(c0, ivec2(0), size - 1), hi = clamp(c0 + 1, ivec2(0), size - 1);           \
+      vec4 acc = vec4(0.0);                                                                       \
+      float total = 0.0;                                                                          \
+      for (int j = 0; j < 2; ++j) {                                                               \
+        int r = j == 0 ? lo.y : hi.y;                                                             \
+        float y = 1.0 - (2.0 * float(r) + 1.0) / H;                                               \
+        float wy = j == 0 ? 1.0 - f.y : f.y;                                                      \
+        for (int i = 0; i < 2; ++i) {                                                             \
+          int c = i == 0 ? lo.x : hi.x;                                                           \
+          float w = (i == 0 ? 1.0 - f.x : f.x) * wy;                                              \
+          float x = (2.0 * float(c) + 1.0) / W - 1.0;                                             \
+          if (!(w > 0.0) || x * x + y * y > 1.0) continue;                                        \
+          acc += w * FETCH;                                                                       \
+          total += w;                                                                             \
+        }                                                                                         \
+      }                                                                                           \
+      if (total > 0.0) {                                                                          \
+        ok = true;                                                                                \
+        vec4 s = acc / total;                                                                     \
+        s.a = s.a > 0.0 ? s.a : 0.0;                                                              \
+        return s;                                                                                 \
+      }                                                                                           \
+      xy *= 1.0 - 1.0 / float(max(size.x, size.y));                                               \
+    }                                                                                             \
+    ok = false;                                                                                   \
+    return vec4(0.0);                                                                             \
   }
-  ok = false;
-  return vec4(0.0);
-}
+SAMPLE_DISC(sample_disc, texelFetch(uMaps, ivec3(c, r, layer), 0))
+SAMPLE_DISC(sample_dest, texelFetch(uDest, ivec2(c, r), 0))
 
 // runtime/warp.cpp warp_direction: (disc.x, disc.y, rim).
 vec3 warp_direction(int kind, vec3 d) {
@@ -191,15 +190,14 @@ void main() {
   vec3 v = -d;
   vec3 n = normalize(vNormal);
   if (!gl_FrontFacing) n = -n;
-  vec4 L;
-  if (uMode == 0) {
-    L = lookup(v, n);
-  } else {
-    vec3 s = warp_direction(1, uDestViewFromWorld * n);
-    bool ok;
-    L = sample_disc(-1, s.xy, uDestSize, ok);
-    if (!ok) L = vec4(0.0);
-  }
+#if RSIBR_PAPER
+  vec3 s = warp_direction(1, uDestViewFromWorld * n);
+  bool ok;
+  vec4 L = sample_dest(0, s.xy, uDestSize, ok);
+  if (!ok) L = vec4(0.0);
+#else
+  vec4 L = lookup(v, n);
+#endif
   fragColor = uShowWeight != 0 ? vec4(vec3(L.a), 1.0) : vec4(L.rgb, 1.0);
 }
 )GLSL";

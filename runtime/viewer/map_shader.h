@@ -35,6 +35,8 @@
 namespace rsibr::viewer {
 
 extern const char* const kMeshVertexShader;
+// Without its "#version" line: compiled twice, after "#version 330 core\n#define RSIBR_PAPER 0" (per
+// pixel) and "... 1" (paper), so that each program holds one path only.
 extern const char* const kMeshFragmentShader;
 
 }  // namespace rsibr::viewer

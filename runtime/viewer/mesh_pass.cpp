@@ -4,16 +4,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace rsibr::viewer {
 
-MeshPass::MeshPass() : program_("mesh pass", kMeshVertexShader, kMeshFragmentShader) {
-  program_.use();
-  program_.set("uMaps", 0);
-  program_.set("uViewData", 1);
-  program_.set("uTriangles", 2);
-  program_.set("uEdgeNorms", 3);
-  program_.set("uDest", 4);
+MeshPass::MeshPass()
+    : per_pixel_("mesh pass (per pixel)", kMeshVertexShader,
+                 std::string("#version 330 core\n#define RSIBR_PAPER 0\n") + kMeshFragmentShader),
+      paper_("mesh pass (paper)", kMeshVertexShader,
+             std::string("#version 330 core\n#define RSIBR_PAPER 1\n") + kMeshFragmentShader) {
+  for (const GlProgram* p : {&per_pixel_, &paper_}) {
+    p->use();
+    p->set("uMaps", 0);
+    p->set("uViewData", 1);
+    p->set("uTriangles", 2);
+    p->set("uEdgeNorms", 3);
+    p->set("uDest", 4);
+  }
   glUseProgram(0);
 }
 
@@ -37,6 +44,7 @@ void MeshPass::draw(const Camera& camera, const Eigen::AlignedBox3f& bounds, con
   glDisable(GL_CULL_FACE);  // two-sided, as the renderer
   glDisable(GL_BLEND);
   glFrontFace(GL_CCW);
+  const GlProgram& program_ = paper ? paper_ : per_pixel_;
   program_.use();
   program_.set("uCamFromWorld", Mat3(camera.world_from_cam.transpose()));
   program_.set("uWorldFromCam", camera.world_from_cam);
@@ -46,7 +54,6 @@ void MeshPass::draw(const Camera& camera, const Eigen::AlignedBox3f& bounds, con
   program_.set("uSize", Vec2(camera.width, camera.height));
   program_.set("uOrigin", Vec2(x0, y0));
   program_.set("uDepth", Vec2(A, B));
-  program_.set("uMode", paper ? 1 : 0);
   program_.set("uShowWeight", options.show_weight ? 1 : 0);
   program_.set("uRimFade", float(set.blend_options().rim_fade));
   glUniform2i(glGetUniformLocation(program_.id(), "uMapSize"), set.maps().width(), set.maps().height());

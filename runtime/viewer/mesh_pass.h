@@ -29,7 +29,7 @@ class MeshPass {
             const MeshPassOptions& options, int x0 = 0, int y0 = 0) const;
 
  private:
-  GlProgram program_;
+  GlProgram per_pixel_, paper_;
 };
 
 }  // namespace rsibr::viewer
