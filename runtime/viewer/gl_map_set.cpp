@@ -2,7 +2,10 @@
 
 #include "runtime/tessellated_warp.h"
 
+#include <algorithm>
 #include <chrono>
+#include <map>
+#include <utility>
 #include <stdexcept>
 #include <vector>
 
@@ -35,7 +38,7 @@ GlMapSet::GlMapSet(const MapSet& maps, const BlendOptions& blend, const std::str
     throw std::invalid_argument("viewer: unknown warp '" + warp + "' (exact, precomputed or tessellated)");
   }
   const int W = maps.width(), H = maps.height(), N = int(maps.views.size());
-  glGenTextures(5, textures_);
+  glGenTextures(6, textures_);
 
   // 0: the maps, RGB + confidence.
   std::vector<float> texels(std::size_t(W) * H * 4 * N);
@@ -74,21 +77,47 @@ GlMapSet::GlMapSet(const MapSet& maps, const BlendOptions& blend, const std::str
   glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, N, 4, 0, GL_RGBA, GL_FLOAT, data.data());
   nearest(GL_TEXTURE_2D);
 
-  // 2, 3: triangles and their edge norms |a x b|, |b x c|, |c x a| (the margin's denominators).
+  // 2, 3: triangles and their edge planes (unit a x b, b x c, c x a: the margin of locate).
   const auto& tris = view_set_.triangles();
   const auto& views = view_set_.views();
+  const int T = int(tris.size());
   std::vector<int> idx;
-  std::vector<float> norms;
-  for (const auto& T : tris) {
-    const Vec3 &a = views[std::size_t(T[0])], &b = views[std::size_t(T[1])], &c = views[std::size_t(T[2])];
-    idx.insert(idx.end(), {T[0], T[1], T[2], 0});
-    norms.insert(norms.end(), {float(a.cross(b).norm()), float(b.cross(c).norm()), float(c.cross(a).norm()), 0.f});
+  std::vector<float> planes(std::size_t(T) * 3 * 4, 0.f);
+  for (int t = 0; t < T; ++t) {
+    const auto& tri = tris[std::size_t(t)];
+    idx.insert(idx.end(), {tri[0], tri[1], tri[2], 0});
+    for (int e = 0; e < 3; ++e) {
+      const Vec3 n = views[std::size_t(tri[std::size_t(e)])].cross(views[std::size_t(tri[std::size_t((e + 1) % 3)])]).normalized();
+      for (int k = 0; k < 3; ++k) planes[(std::size_t(e) * T + t) * 4 + k] = float(n[k]);
+    }
   }
   glBindTexture(GL_TEXTURE_2D, textures_[2]);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32I, GLsizei(tris.size()), 1, 0, GL_RGBA_INTEGER, GL_INT, idx.data());
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32I, T, 1, 0, GL_RGBA_INTEGER, GL_INT, idx.data());
   nearest(GL_TEXTURE_2D);
   glBindTexture(GL_TEXTURE_2D, textures_[3]);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, GLsizei(tris.size()), 1, 0, GL_RGBA, GL_FLOAT, norms.data());
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, T, 3, 0, GL_RGBA, GL_FLOAT, planes.data());
+  nearest(GL_TEXTURE_2D);
+
+  // 5: the boundary arcs of a set that does not surround the sphere: the triangle edges no other
+  // triangle shares (core/view_set.h's covered-region boundary), with their triangle.
+  std::vector<int> arcs;
+  if (!view_set_.surrounds()) {
+    std::map<std::pair<int, int>, int> edges;  // undirected edge -> count
+    for (const auto& tri : tris)
+      for (int e = 0; e < 3; ++e) {
+        const int a = tri[std::size_t(e)], b = tri[std::size_t((e + 1) % 3)];
+        ++edges[{std::min(a, b), std::max(a, b)}];
+      }
+    for (int t = 0; t < T; ++t)
+      for (int e = 0; e < 3; ++e) {
+        const int a = tris[std::size_t(t)][std::size_t(e)], b = tris[std::size_t(t)][std::size_t((e + 1) % 3)];
+        if (edges[{std::min(a, b), std::max(a, b)}] == 1) arcs.insert(arcs.end(), {a, b, t, 0});
+      }
+  }
+  arc_count_ = int(arcs.size() / 4);
+  if (arcs.empty()) arcs.assign(4, 0);
+  glBindTexture(GL_TEXTURE_2D, textures_[5]);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32I, std::max(arc_count_, 1), 1, 0, GL_RGBA_INTEGER, GL_INT, arcs.data());
   nearest(GL_TEXTURE_2D);
 
   // 4: the destination map (paper mode), allocated here, filled per frame.
@@ -98,7 +127,7 @@ GlMapSet::GlMapSet(const MapSet& maps, const BlendOptions& blend, const std::str
   glBindTexture(GL_TEXTURE_2D, 0);
 }
 
-GlMapSet::~GlMapSet() { glDeleteTextures(5, textures_); }
+GlMapSet::~GlMapSet() { glDeleteTextures(6, textures_); }
 
 const BlendResult& GlMapSet::update_destination(const Vec3& view, const Vec3& up) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -120,8 +149,9 @@ const BlendResult& GlMapSet::update_destination(const Vec3& view, const Vec3& up
 }
 
 void GlMapSet::bind_textures() const {
-  const GLenum targets[5] = {GL_TEXTURE_2D_ARRAY, GL_TEXTURE_2D, GL_TEXTURE_2D, GL_TEXTURE_2D, GL_TEXTURE_2D};
-  for (int i = 0; i < 5; ++i) {
+  const GLenum targets[6] = {GL_TEXTURE_2D_ARRAY, GL_TEXTURE_2D, GL_TEXTURE_2D,
+                             GL_TEXTURE_2D,       GL_TEXTURE_2D, GL_TEXTURE_2D};
+  for (int i = 0; i < 6; ++i) {
     glActiveTexture(GLenum(GL_TEXTURE0 + i));
     glBindTexture(targets[i], textures_[i]);
   }

@@ -1,6 +1,7 @@
 // A map set on the GPU for the viewer's mesh pass (runtime/viewer/map_shader.h): every view's map
 // in one RGBA32F texture array (RGB, A = confidence, 1 without one or when confidence is off), the
-// view frames and warps, the view-set triangulation (core/view_set.h) and its edge norms. Also the
+// view frames and warps, the view-set triangulation (core/view_set.h), its edge planes and, for a
+// set that does not surround the sphere, the boundary arcs of the covered region. Also the
 // CPU engine of paper mode: one destination map per frame (runtime/blend.h) with the chosen warp.
 #pragma once
 
@@ -39,10 +40,11 @@ class GlMapSet {
   const BlendResult& destination() const { return destination_; }
   double last_blend_seconds() const { return blend_seconds_; }
 
-  // Binds the textures to units 0..4 (maps, view data, triangles, edge norms, destination).
+  // Binds the textures to units 0..5 (maps, view data, triangles, edge planes, destination, arcs).
   void bind_textures() const;
   GLuint destination_texture() const { return textures_[4]; }
   int triangle_count() const { return int(view_set_.triangles().size()); }
+  int arc_count() const { return arc_count_; }  // boundary arcs (0 when the set surrounds)
 
  private:
   const MapSet& maps_;
@@ -53,7 +55,8 @@ class GlMapSet {
   std::unique_ptr<Warp> warp_;
   BlendResult destination_;
   double blend_seconds_ = 0;
-  GLuint textures_[5] = {0, 0, 0, 0, 0};
+  int arc_count_ = 0;
+  GLuint textures_[6] = {0, 0, 0, 0, 0, 0};
 };
 
 }  // namespace rsibr::viewer

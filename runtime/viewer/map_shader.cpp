@@ -35,8 +35,10 @@ uniform sampler2DArray uMaps;    // RGBA32F per view: RGB, A = confidence (1 wit
 uniform ivec2 uMapSize;
 uniform sampler2D uViewData;     // RGBA32F, width = views; rows 0..2: rows of view_from_world, row 0 .w = kind
 uniform isampler2D uTriangles;   // RGBA32I, width = triangles: the three view indices
-uniform sampler2D uEdgeNorms;    // RGBA32F, width = triangles: |a x b|, |b x c|, |c x a|
+uniform sampler2D uEdgePlanes;   // RGBA32F, width = triangles, rows 0..2: unit a x b, b x c, c x a
 uniform int uTriangleCount;
+uniform isampler2D uArcs;        // RGBA32I, width = boundary arcs: views a, b and their triangle
+uniform int uArcCount;           // 0 when the set surrounds the sphere
 uniform int uHint;               // triangle of the camera's central direction (tried first)
 
 uniform sampler2D uDest;         // paper: RGBA32F destination map, A = weight
@@ -113,11 +115,11 @@ float rim_fade_weight(float rho) {
 }
 
 vec3 view_of(int i) { return texelFetch(uViewData, ivec2(i, 3), 0).xyz; }
+// Signed sine of p's angular distance from the triangle's nearest edge circle (positive inside):
+// core/view_set.cpp locate's score, min_k det(a_k, a_k+1, p) / |a_k x a_k+1|.
 float margin(int t, vec3 p) {
-  ivec3 T = texelFetch(uTriangles, ivec2(t, 0), 0).xyz;
-  vec3 a = view_of(T.x), b = view_of(T.y), c = view_of(T.z);
-  vec3 e = texelFetch(uEdgeNorms, ivec2(t, 0), 0).xyz;
-  return min(min(dot(p, cross(a, b)) / e.x, dot(p, cross(b, c)) / e.y), dot(p, cross(c, a)) / e.z);
+  return min(min(dot(p, texelFetch(uEdgePlanes, ivec2(t, 0), 0).xyz), dot(p, texelFetch(uEdgePlanes, ivec2(t, 1), 0).xyz)),
+             dot(p, texelFetch(uEdgePlanes, ivec2(t, 2), 0).xyz));
 }
 // core/view_set.cpp triangle_weights (gnomonic)
 vec3 triangle_weights(vec3 p, vec3 a, vec3 b, vec3 c) {
@@ -142,17 +144,36 @@ vec4 lookup(vec3 v, vec3 n) {
     nv = 0.0;
   }
   vec3 r = 2.0 * nv * n - v;
-  // Locate: the hinted triangle when v lies clearly inside it, else the largest margin.
+  // Locate (core/view_set.cpp): the hinted triangle when v lies clearly inside it, else the one
+  // with the largest margin; outside every triangle of a set that does not surround the sphere, the
+  // nearest point q of the nearest boundary arc, with the weights its triangle gives there.
   int best = uHint;
-  if (!(best >= 0 && margin(best, v) > 1e-5)) {
-    float best_margin = -1e30;
+  float best_margin = best >= 0 ? margin(best, v) : -1e30;
+  if (!(best_margin > 1e-5)) {
+    best_margin = -1e30;
     for (int t = 0; t < uTriangleCount; ++t) {
       float m = margin(t, v);
       if (m > best_margin) { best_margin = m; best = t; }
     }
   }
+  vec3 p = v;
+  if (best_margin < -1e-6 && uArcCount > 0) {
+    float best_cos = -2.0;
+    for (int i = 0; i < uArcCount; ++i) {
+      ivec3 arc = texelFetch(uArcs, ivec2(i, 0), 0).xyz;
+      vec3 a = view_of(arc.x), b = view_of(arc.y);
+      vec3 nab = normalize(cross(a, b));
+      vec3 q = v - dot(v, nab) * nab;
+      float ql = length(q);
+      vec3 qn = ql > 0.0 ? q / ql : a;
+      bool on = ql > 1e-7 && dot(a, cross(qn, nab)) >= 0.0 && dot(qn, cross(b, nab)) >= 0.0;
+      if (!on) qn = dot(a, v) >= dot(b, v) ? a : b;
+      float c = dot(v, qn);
+      if (c > best_cos) { best_cos = c; best = arc.z; p = qn; }
+    }
+  }
   ivec3 T = texelFetch(uTriangles, ivec2(best, 0), 0).xyz;
-  vec3 w = triangle_weights(v, view_of(T.x), view_of(T.y), view_of(T.z));
+  vec3 w = triangle_weights(p, view_of(T.x), view_of(T.y), view_of(T.z));
   vec3 acc = vec3(0.0);
   float total = 0.0;
   vec3 s[3];

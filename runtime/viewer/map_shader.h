@@ -14,7 +14,9 @@
 //                                                          interpolated position: the same ray)
 //   n = normalise(interpolated vertex normal), flipped on back faces
 //   per-pixel mode: runtime/direction_lookup.h, steps 0-5: n clamped to v's hemisphere,
-//     r = 2 (n.v) n - v; v located in the view set (spherical triangle with the largest margin,
+//     r = 2 (n.v) n - v; v located in the view set (core/view_set.cpp: the spherical triangle with
+//     the largest margin; outside a non-surrounding set, the nearest point of the nearest boundary
+//     arc with its triangle's weights there,
 //     gnomonic weights det(p,b-p,c-p) : det(a,p-a,c-a) : det(a,b-a,p-a) clamped at 0 and normalised,
 //     core/view_set.cpp triangle_weights); per source warp_direction (runtime/warp.cpp: half vector
 //     with the 1 + r_z cancellation avoided, or the normal with its rim clamp), rim_fade_weight
@@ -26,10 +28,8 @@
 // Output: RGB radiance, alpha 1 (the renderer's alpha for a covered pixel at 1 sample per pixel); or,
 // with uShowWeight, the total weight sum_i a_i as grey (the singularity fades made visible).
 // Differences from the CPU path (stated in tests/viewer/gl_renderer_test.cpp with the tolerance):
-// float32 arithmetic; ties exactly on a triangle edge (both sides give the same gnomonic weights);
-// for a view set that does not surround the sphere, a direction outside every triangle takes the
-// clamped weights of the triangle with the largest (negative) margin instead of the CPU's projection
-// onto the covered region's boundary; the measure-zero n = -v case takes another rim normal.
+// float32 arithmetic; ties exactly on a triangle edge or equidistant boundary arcs (both sides give
+// the same weights there); the measure-zero n = -v case takes another rim normal.
 #pragma once
 
 namespace rsibr::viewer {

@@ -18,8 +18,9 @@ MeshPass::MeshPass()
     p->set("uMaps", 0);
     p->set("uViewData", 1);
     p->set("uTriangles", 2);
-    p->set("uEdgeNorms", 3);
+    p->set("uEdgePlanes", 3);
     p->set("uDest", 4);
+    p->set("uArcs", 5);
   }
   glUseProgram(0);
 }
@@ -59,6 +60,7 @@ void MeshPass::draw(const Camera& camera, const Eigen::AlignedBox3f& bounds, con
   glUniform2i(glGetUniformLocation(program_.id(), "uMapSize"), set.maps().width(), set.maps().height());
   glUniform2i(glGetUniformLocation(program_.id(), "uDestSize"), set.map_size(), set.map_size());
   program_.set("uTriangleCount", set.triangle_count());
+  program_.set("uArcCount", set.arc_count());
   program_.set("uHint", set.view_set().locate(camera.view_direction()).triangle);
   if (paper) program_.set("uDestViewFromWorld", Mat3(set.destination().world_from_view.transpose()));
   set.bind_textures();

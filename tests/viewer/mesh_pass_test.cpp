@@ -142,6 +142,29 @@ TEST(MeshPass, PaperModeMatchesTheCpuRenderer) {
   }
 }
 
+// A captured set need not surround the sphere: views only around +Z (within 70 degrees). Seen from
+// the side, many pixels' view directions fall outside every triangle, where locate projects them onto
+// the covered region's boundary; the shader must do the same.
+TEST(MeshPass, PerPixelShaderMatchesOutsideANonSurroundingSet) {
+  std::vector<Vec3> views;
+  const ViewSet all = ViewSet::geodesic(1);
+  for (const Vec3& v : all.views())
+    if (v.z() > std::cos(70.0 * 3.14159265358979 / 180.0)) views.push_back(v);
+  const ViewSet partial(views);
+  ASSERT_FALSE(partial.surrounds());
+  const Mesh mesh = scene_mesh();
+  const MapSet maps = testing::analytic_map_set(partial, 64, 64, "mirror", testing::fresnel_mirror_texel);
+  const Camera cam = look_at(Vec3(3.5, 0.8, 1.0), Vec3(0, 0, 0), Vec3(0, 1, 0), 60, 256, 192);
+  long outside = 0;
+  for (int r = 0; r < cam.height; r += 4)
+    for (int c = 0; c < cam.width; c += 4) outside += !partial.locate(-cam.ray_direction(c, r)).inside;
+  EXPECT_GT(outside, 500) << "the camera must see view directions outside the set";
+  RenderOptions ro;
+  const cv::Mat cpu = Renderer(mesh, {&maps}, ro).render(cam);
+  const cv::Mat gpu = gpu_frame(cam, mesh, maps, ro, {RenderMode::PerPixel, false});
+  expect_agreement(compare(gpu, cpu), cam.width * cam.height, "non-surrounding");
+}
+
 // The per-pixel and paper modes differ where v_px departs from the central view (the paper
 // mode's field-of-view error, runtime/renderer.h): the shader must show that difference, not
 // hide it (a shader that ignored v_px would match paper mode instead).
