@@ -37,6 +37,7 @@ struct ViewArgs {
   bool weights = false, benchmark = false, quiet = false;
 };
 
+#if RSIBR_HAVE_VIEWER
 std::string file_name(const std::string& path) { return std::filesystem::path(path).filename().string(); }
 
 MapSet load_maps(const std::string& path) {
@@ -48,6 +49,7 @@ MapSet load_maps(const std::string& path) {
   }
   return set;
 }
+#endif
 
 int run_view(const ViewArgs& a) {
   if (a.mode != "paper" && a.mode != "per-pixel")

@@ -31,6 +31,8 @@ class GlMapSet {
   const MapSet& maps() const { return maps_; }
   const ViewSet& view_set() const { return view_set_; }
   const BlendOptions& blend_options() const { return blend_; }
+  // The singularity fade's width (a uniform of the shader, an option of the CPU blend).
+  void set_rim_fade(double rim_fade) { blend_.rim_fade = rim_fade; }
   const std::string& warp_name() const { return warp_name_; }
   int map_size() const { return map_size_; }
 

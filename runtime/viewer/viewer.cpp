@@ -70,12 +70,10 @@ struct Stage {
       half.width = camera.width / 2;
       half.cx = camera.cx - 0.5 * (camera.width - half.width);
       pass.draw(half, bounds, mesh, *sets[0], mo, 0, 0);
-      seconds_blend += sets[0]->last_blend_seconds();
       Camera right = half;
       right.width = camera.width - half.width;
       right.cx = camera.cx - 0.5 * (camera.width - right.width);
       pass.draw(right, bounds, mesh, *sets[1], mo, half.width, 0);
-      seconds_blend += sets[1]->last_blend_seconds();
     } else {
       const int split = std::clamp(int(std::lround(settings.wipe * camera.width)), 0, camera.width);
       glEnable(GL_SCISSOR_TEST);
@@ -84,9 +82,9 @@ struct Stage {
       glScissor(split, 0, camera.width - split, camera.height);
       pass.draw(camera, bounds, mesh, *sets[1], mo);
       glDisable(GL_SCISSOR_TEST);
-      seconds_blend += sets[1]->last_blend_seconds();
     }
-    if (settings.mode == RenderMode::Paper) seconds_blend += sets[0]->last_blend_seconds();
+    if (settings.mode == RenderMode::Paper)
+      for (const auto& set : sets) seconds_blend += set->last_blend_seconds();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
   }
   void present(int window_width, int window_height) const {
@@ -311,7 +309,7 @@ int run_interactive(const ViewerScene& scene, const ViewerSettings& initial) {
     float fade = float(s.blend.rim_fade);
     if (ImGui::SliderFloat("rim fade", &fade, 0.f, 1.f, "%.2f")) {
       s.blend.rim_fade = fade;
-      rebuild = true;
+      for (auto& set : stage.sets) set->set_rim_fade(fade);
     }
     ImGui::SliderFloat("exposure", &s.exposure, -10.f, 10.f, "%.1f stops");
     int view_index = int(std::find(views.begin(), views.end(), stage.display->view()) - views.begin());
@@ -348,6 +346,10 @@ int run_interactive(const ViewerScene& scene, const ViewerSettings& initial) {
                 1e3 * stage.seconds_blend);
     ImGui::Text("%dx%d, %s", fw, fh, renderer.c_str());
     ImGui::End();
+    if (stage.sets.size() > 1 && s.compare == Compare::Wipe) {  // the wipe's edge
+      const float x = s.wipe * io.DisplaySize.x;  // window coordinates
+      ImGui::GetBackgroundDrawList()->AddLine(ImVec2(x, 0), ImVec2(x, io.DisplaySize.y), IM_COL32(255, 255, 255, 160));
+    }
     ImGui::Render();
     glViewport(0, 0, fw, fh);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
