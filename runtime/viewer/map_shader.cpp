@@ -154,6 +154,7 @@ vec4 lookup(vec3 v, vec3 n) {
     for (int t = 0; t < uTriangleCount; ++t) {
       float m = margin(t, v);
       if (m > best_margin) { best_margin = m; best = t; }
+      if (m > 1e-5) break;  // clearly inside: triangles do not overlap, no other can hold v
     }
   }
   vec3 p = v;
