@@ -278,14 +278,16 @@ int run_interactive(const ViewerScene& scene, const ViewerSettings& initial) {
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
     ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(400, 0), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowBgAlpha(0.85f);
     ImGui::Begin("rsibr view");
     ImGui::TextWrapped("%s", kViewerKeys);
     ImGui::Separator();
     for (std::size_t i = 0; i < stage.sets.size(); ++i) {
       const GlMapSet& set = *stage.sets[i];
-      ImGui::Text("%s %s", stage.sets.size() > 1 ? (i == 0 ? "[left]" : "[right]") : "maps:",
-                  i < scene.names.size() ? scene.names[i].c_str() : "?");
+      const std::string header = std::string(stage.sets.size() > 1 ? (i == 0 ? "left: " : "right: ") : "maps: ") +
+                                 (i < scene.names.size() ? scene.names[i] : "?");
+      if (!ImGui::CollapsingHeader(header.c_str(), i == 0 ? ImGuiTreeNodeFlags_DefaultOpen : 0)) continue;
       ImGui::Text("  %s", describe(set.maps()).c_str());
       const std::string& material = set.maps().views.front().material;
       if (!material.empty()) ImGui::TextWrapped("  material: %s", material.c_str());
