@@ -11,17 +11,20 @@ uniform vec4 uIntrinsics;  // fx, fy, cx, cy (pixels, mrcal convention)
 uniform vec2 uSize;        // W, H
 uniform vec2 uDepth;       // A, B of clip.z = A q.z + B
 out vec3 vNormal;
+out vec3 vWorld;
 void main() {
   vec3 q = uCamFromWorld * (aPosition - uEye);
   gl_Position = vec4((2.0 * uIntrinsics.x / uSize.x) * q.x + (2.0 * (uIntrinsics.z + 0.5) / uSize.x - 1.0) * q.z,
                      -(2.0 * uIntrinsics.y / uSize.y) * q.y + (1.0 - 2.0 * (uIntrinsics.w + 0.5) / uSize.y) * q.z,
                      uDepth.x * q.z + uDepth.y, q.z);
   vNormal = aNormal;
+  vWorld = aPosition;
 }
 )GLSL";
 
 const char* const kMeshFragmentShader = R"GLSL(
 in vec3 vNormal;
+in vec3 vWorld;
 out vec4 fragColor;
 
 uniform mat3 uWorldFromCam;
@@ -210,8 +213,17 @@ void main() {
   vec3 d = normalize(uWorldFromCam * vec3((px.x - uIntrinsics.z) / uIntrinsics.x,
                                           (px.y - uIntrinsics.w) / uIntrinsics.y, 1.0));
   vec3 v = -d;
-  vec3 n = normalize(vNormal);
-  if (!gl_FrontFacing) n = -n;
+  // The interpolated vertex normal, flipped on back faces; where it cancels, the triangle's own
+  // normal facing the eye (core/ray_scene.h shading_normal's fallback, then the renderer's flip).
+  float nl = length(vNormal);
+  vec3 n;
+  if (nl > 1e-12) {
+    n = vNormal / nl;
+    if (!gl_FrontFacing) n = -n;
+  } else {
+    n = normalize(cross(dFdx(vWorld), dFdy(vWorld)));
+    if (!(dot(n, v) >= 0.0)) n = -n;
+  }
 #if RSIBR_PAPER
   vec3 s = warp_direction(1, uDestViewFromWorld * n);
   bool ok;
