@@ -112,6 +112,11 @@ def main():
         lines.append("")
         if ctx.get("load_avg"):  # the machine may be shared: timings scale with it, ratios less so
             lines += ["Load average (1, 5, 15 min) when measured: " + ", ".join(f"{x:.2f}" for x in ctx["load_avg"]) + ".", ""]
+    # Sections other scripts write (bench/viewer_fps.py: "## Viewer") are kept as they were.
+    if os.path.exists(args.out):
+        for title, section in read_sections(args.out).items():
+            if title.startswith("## Viewer"):
+                lines += section
     lines += [
         "Notes: rsibr's resampler does more than the baseline: area-weighted footprints (no aliasing when",
         "shrinking) and extra taps where a sun holds energy, so its cost buys accuracy (docs/tradeoffs.md).",

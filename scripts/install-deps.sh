@@ -15,6 +15,8 @@ packages=(
   # bake / capture / calib / hdr
   libqhull-dev
   libembree-dev libceres-dev libmrcal-dev libmrgingham-dev mrgingham mrcal libexiv2-dev
+  # viewer (runtime/viewer; optional at build time) and its CI test under Xvfb (Mesa llvmpipe)
+  libglfw3-dev libimgui-dev libepoxy-dev xvfb xauth libgl1-mesa-dri
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   # real-data fetch (npm registry) and docs plots

@@ -25,7 +25,7 @@ expect_error() {
 }
 no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
 
-for verb in convert info pattern blend bake reference render; do
+for verb in convert info pattern blend bake reference render view; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
 done
 check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
@@ -170,6 +170,40 @@ expect_error "render: unknown mode" "fancy" render --maps "$work/mirror.exr" --m
 expect_error "render: spp not a square" "spp" render --maps "$work/mirror.exr" --mesh "$work/cube.obj" --spp 2 "$work/r8.png"
 check "render: no output after errors" bash -c "! ls '$work' | grep -q '^r[0-9]'"
 check "no temporaries after success" no_temporaries "$work"
+
+# view: scripted mode under Xvfb (Mesa's software OpenGL) against rsibr render of the same frames:
+# the same 8-bit PNG encoding, so colours agree within 2 levels (float32 shader against the double
+# CPU engine: ~1e-5 relative, tests/viewer/mesh_pass_test.cpp) except on at most 0.5% of the pixels
+# (silhouette pixels whose centre lies within rounding of an edge). Without the viewer built, the
+# verb must say so.
+view_help=$("$rsibr" view --help)
+if ! grep -q "Keys:" <<<"$view_help"; then
+  expect_error "view: built without the viewer" "without the viewer" view --maps "$work/mirror.exr" --mesh "$work/cube.obj"
+elif ! command -v xvfb-run >/dev/null; then
+  echo "FAILED: view: xvfb-run not found (scripts/install-deps.sh installs xvfb)"; fail=$((fail + 1))
+else
+  compare_png="$(dirname "${BASH_SOURCE[0]}")/../viewer/compare_png.py"
+  for mode in per-pixel paper; do
+    xvfb-run -a "$rsibr" view --maps "$work/mirror.exr" --mesh "$work/cube.obj" --size 128x96 --from 1,0.6,0.8 \
+      --mode "$mode" --orbit 2 --screenshot "$work/view-$mode.png" --exr "$work/view-$mode.exr" --json "$work/view-$mode.json"
+    "$rsibr" render --maps "$work/mirror.exr" --mesh "$work/cube.obj" --size 128x96 --from 1,0.6,0.8 --mode "$mode" \
+      --turntable 2 "$work/render-$mode.png"
+    for k in 0000 0001; do
+      check "view $mode frame $k matches rsibr render" python3 "$compare_png" "$work/view-$mode.$k.png" "$work/render-$mode.$k.png" 2 0.005
+    done
+    check "view $mode writes EXR frames with the camera" bash -c "grep -aq rsibr.worldFromCam '$work/view-$mode.0001.exr'"
+    check "view $mode JSON lists the frames and a frame rate" python3 -c "import json; j=json.load(open('$work/view-$mode.json')); assert len(j['frames']) == 2 and j['fps'] > 0 and j['gl_renderer'], j"
+  done
+  xvfb-run -a "$rsibr" view --maps "$work/mirror.exr" --maps2 "$work/grey.exr" --mesh "$work/cube.obj" --size 64x48 \
+    --compare side --orbit 1 --screenshot "$work/view-side.png"
+  check "view: two sets side by side (numbered like render --turntable 1)" test -s "$work/view-side.0000.png"
+  expect_error "view: --screenshot needs --orbit" "orbit" view --maps "$work/mirror.exr" --mesh "$work/cube.obj" --screenshot "$work/v1.png"
+  expect_error "view: screenshot type" "v2.jpg" view --maps "$work/mirror.exr" --mesh "$work/cube.obj" --orbit 1 --screenshot "$work/v2.jpg"
+  expect_error "view: output folder missing" "nofolder" view --maps "$work/mirror.exr" --mesh "$work/cube.obj" --orbit 1 --screenshot "$work/nofolder/v3.png"
+  expect_error "view: not a map set" "sky.exr" view --maps "$work/sky.exr" --mesh "$work/cube.obj" --orbit 1
+  expect_error "view: unknown mode" "fancy" view --maps "$work/mirror.exr" --mesh "$work/cube.obj" --mode fancy --orbit 1
+  check "view: no output after errors" bash -c "! ls '$work' | grep -q '^v[0-9]'"
+fi
 
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
