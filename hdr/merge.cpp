@@ -3,12 +3,19 @@
 #include "core/parallel.h"
 #include "hdr/response_recovery.h"
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 namespace rsibr {
 
+// Implementation: rows in parallel; within a row, structure of arrays so that the loops over
+// pixels vectorise. Per bracket j, channel c and code z the tables hold
+//   Lt = X(z) / e_j              (the bracket's radiance estimate)
+//   Bt = (read + quant(z)) / e_j^2 (the signal-independent part of var(L_j))
+// and var(L_j) = shot * L / e_j + Bt for a radiance L (the pilot, or L_j itself in pass 1).
 MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, const NoiseModel& noise,
                            const MergeOptions& o) {
   if (curve.max_code != b.max_code)
@@ -20,90 +27,147 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
   const int sat = o.saturation_code > 0 ? o.saturation_code : default_saturation_code(b.max_code);
   std::array<std::vector<float>, 3> tx, tq;
   curve.tables(tx, tq);
-  float inv_e[kMax], e[kMax];
-  for (int j = 0; j < P; ++j) e[j] = float(b.exposures[std::size_t(j)]), inv_e[j] = float(1.0 / b.exposures[std::size_t(j)]);
-  float shot[3], read[3];
-  for (int c = 0; c < 3; ++c) shot[c] = float(noise.shot[std::size_t(c)]), read[c] = float(noise.read[std::size_t(c)]);
+  const std::size_t codes = std::size_t(b.max_code) + 1;
+  // Tables indexed [(j * 3 + c) * codes + z].
+  std::vector<float> Lt(std::size_t(P) * 3 * codes), Bt(Lt.size());
+  float shot_e[kMax][3];
+  for (int j = 0; j < P; ++j)
+    for (int c = 0; c < 3; ++c) {
+      const double e = b.exposures[std::size_t(j)];
+      shot_e[j][c] = float(noise.shot[std::size_t(c)] / e);
+      for (std::size_t z = 0; z < codes; ++z) {
+        Lt[(std::size_t(j) * 3 + std::size_t(c)) * codes + z] = float(tx[std::size_t(c)][z] / e);
+        Bt[(std::size_t(j) * 3 + std::size_t(c)) * codes + z] =
+            float((noise.read[std::size_t(c)] + tq[std::size_t(c)][z]) / (e * e));
+      }
+    }
   const float eps2 = float(o.model_error * o.model_error);
+  const float ghost_sigmas = float(o.ghost_sigmas);
+  const bool pilot = o.pilot_pass;
   const int H = b.rows(), W = b.cols();
   MergedImage m;
   m.radiance.create(H, W, CV_32FC3);
   m.variance.create(H, W, CV_32FC3);
   m.flags.create(H, W, CV_8UC1);
   std::vector<long> counts(std::size_t(H) * 3, 0);
+  // Per-thread scratch rows.
+  struct Scratch {
+    std::vector<float> mask, L, B, sw, swl, num, chi2, n;
+  };
+  tbb::enumerable_thread_specific<Scratch> scratch([&] {
+    Scratch s;
+    s.mask.resize(std::size_t(P) * W);
+    s.L.resize(std::size_t(P) * W);
+    s.B.resize(std::size_t(P) * W);
+    s.sw.resize(std::size_t(W));
+    s.swl.resize(std::size_t(W));
+    s.num.resize(std::size_t(W));
+    s.chi2.resize(std::size_t(W));
+    s.n.resize(std::size_t(W));
+    return s;
+  });
   parallel_for_rows(H, [&](int r) {
+    Scratch& s = scratch.local();
     const std::uint16_t* row[kMax];
     for (int j = 0; j < P; ++j) row[j] = b.codes[std::size_t(j)].ptr<std::uint16_t>(r);
     float* out = m.radiance.ptr<float>(r);
     float* var = m.variance.ptr<float>(r);
     unsigned char* flag = m.flags.ptr<unsigned char>(r);
-    for (int x = 0; x < W; ++x) {
-      // Brackets usable for this pixel: no channel saturated.
-      int used[kMax];
-      int n = 0;
+    // Usable brackets: no channel saturated.
+    std::fill(s.n.begin(), s.n.end(), 0.f);
+    std::fill(s.chi2.begin(), s.chi2.end(), 0.f);
+    for (int j = 0; j < P; ++j) {
+      float* mk = &s.mask[std::size_t(j) * W];
+      const std::uint16_t* z = row[j];
+      for (int x = 0; x < W; ++x) {
+        const bool ok = z[3 * x] < sat && z[3 * x + 1] < sat && z[3 * x + 2] < sat;
+        mk[x] = ok ? 1.f : 0.f;
+        s.n[std::size_t(x)] += mk[x];
+      }
+    }
+    for (int c = 0; c < 3; ++c) {
+      float* sw = s.sw.data();
+      float* swl = s.swl.data();
+      std::fill(s.sw.begin(), s.sw.end(), 0.f);
+      std::fill(s.swl.begin(), s.swl.end(), 0.f);
+      // Gather the bracket estimates and pass 1: weights from the measured signal.
       for (int j = 0; j < P; ++j) {
-        const std::uint16_t* z = row[j] + 3 * x;
-        if (z[0] < sat && z[1] < sat && z[2] < sat) used[n++] = j;
+        const float* lt = &Lt[(std::size_t(j) * 3 + std::size_t(c)) * codes];
+        const float* bt = &Bt[(std::size_t(j) * 3 + std::size_t(c)) * codes];
+        float* L = &s.L[std::size_t(j) * W];
+        float* B = &s.B[std::size_t(j) * W];
+        const std::uint16_t* z = row[j] + c;
+        for (int x = 0; x < W; ++x) {
+          L[x] = lt[z[3 * x]];
+          B[x] = bt[z[3 * x]];
+        }
+        const float* mk = &s.mask[std::size_t(j) * W];
+        const float se = shot_e[j][c];
+        for (int x = 0; x < W; ++x) {
+          const float w = mk[x] / (se * std::max(L[x], 0.f) + B[x]);
+          sw[x] += w;
+          swl[x] += w * L[x];
+        }
       }
+      if (pilot) {
+        // Pass 2: weights from the pilot radiance (swl becomes the pilot; sw and num are rebuilt).
+        float* num = s.num.data();
+        for (int x = 0; x < W; ++x) {
+          swl[x] = sw[x] > 0.f ? std::max(swl[x] / sw[x], 0.f) : 0.f;
+          sw[x] = 0.f;
+          num[x] = 0.f;
+        }
+        for (int j = 0; j < P; ++j) {
+          const float* L = &s.L[std::size_t(j) * W];
+          const float* B = &s.B[std::size_t(j) * W];
+          const float* mk = &s.mask[std::size_t(j) * W];
+          const float se = shot_e[j][c];
+          for (int x = 0; x < W; ++x) {
+            const float w = mk[x] / (se * swl[x] + B[x]);
+            sw[x] += w;
+            num[x] += w * L[x];
+          }
+        }
+        for (int x = 0; x < W; ++x) swl[x] = num[x];
+      }
+      for (int x = 0; x < W; ++x) {
+        out[3 * x + c] = sw[x] > 0.f ? swl[x] / sw[x] : 0.f;
+        var[3 * x + c] = sw[x] > 0.f ? 1.f / sw[x] : 0.f;
+      }
+      // The merged channel, contiguous, for the ghost loop.
+      float* Lm = s.num.data();
+      for (int x = 0; x < W; ++x) Lm[x] = out[3 * x + c];
+      // Ghost statistic: chi2 += (L_j - L)^2 / (var(L_j) + (model_error L)^2) over usable brackets.
+      for (int j = 0; j < P; ++j) {
+        const float* L = &s.L[std::size_t(j) * W];
+        const float* B = &s.B[std::size_t(j) * W];
+        const float* mk = &s.mask[std::size_t(j) * W];
+        const float se = shot_e[j][c];
+        float* chi2 = s.chi2.data();
+        for (int x = 0; x < W; ++x) {
+          const float l = std::max(Lm[x], 0.f);
+          const float d = L[x] - Lm[x];
+          chi2[x] += mk[x] * d * d / (se * l + B[x] + eps2 * l * l);
+        }
+      }
+    }
+    for (int x = 0; x < W; ++x) {
       unsigned char f = 0;
-      {
-        const std::uint16_t* z = row[P - 1] + 3 * x;
-        if (z[0] == 0 && z[1] == 0 && z[2] == 0) f |= kBlack;
-      }
-      if (n == 0) {
+      const std::uint16_t* zl = row[P - 1] + 3 * x;
+      if (zl[0] == 0 && zl[1] == 0 && zl[2] == 0) f |= kBlack;
+      const float n = s.n[std::size_t(x)];
+      if (n == 0.f) {
         // Saturated in every bracket: the shortest bracket's value, a lower bound.
         f |= kClipped;
         const std::uint16_t* z = row[0] + 3 * x;
         for (int c = 0; c < 3; ++c) {
-          const float X = tx[std::size_t(c)][z[c]];
-          out[3 * x + c] = X * inv_e[0];
-          var[3 * x + c] = (shot[c] * X + read[c] + tq[std::size_t(c)][z[c]]) * inv_e[0] * inv_e[0];
+          const std::size_t t = std::size_t(c) * codes + z[c];  // bracket 0
+          out[3 * x + c] = Lt[t];
+          var[3 * x + c] = shot_e[0][c] * Lt[t] + Bt[t];
         }
-        flag[x] = f;
-        continue;
-      }
-      float chi2 = 0;
-      for (int c = 0; c < 3; ++c) {
-        const float* xt = tx[std::size_t(c)].data();
-        const float* qt = tq[std::size_t(c)].data();
-        float Xs[kMax], base[kMax];
-        // Pass 1: weights from the measured signal.
-        float sw = 0, swl = 0;
-        for (int k = 0; k < n; ++k) {
-          const int j = used[k];
-          const int z = row[j][3 * x + c];
-          Xs[k] = xt[z];
-          base[k] = read[c] + qt[z];
-          const float w = e[j] * e[j] / (shot[c] * Xs[k] + base[k]);
-          sw += w, swl += w * Xs[k] * inv_e[j];
-        }
-        float L = swl / sw;
-        if (o.pilot_pass) {
-          // Pass 2: weights from the pilot radiance.
-          const float Lp = std::max(L, 0.f);
-          sw = 0, swl = 0;
-          for (int k = 0; k < n; ++k) {
-            const int j = used[k];
-            const float w = e[j] * e[j] / (shot[c] * Lp * e[j] + base[k]);
-            sw += w, swl += w * Xs[k] * inv_e[j];
-          }
-          L = swl / sw;
-        }
-        out[3 * x + c] = L;
-        var[3 * x + c] = 1.f / sw;
-        if (n > 1) {
-          const float Lp = std::max(L, 0.f);
-          for (int k = 0; k < n; ++k) {
-            const int j = used[k];
-            const float d = Xs[k] * inv_e[j] - L;
-            const float v = (shot[c] * Lp * e[j] + base[k]) * inv_e[j] * inv_e[j] + eps2 * Lp * Lp;
-            chi2 += d * d / v;
-          }
-        }
-      }
-      if (n > 1) {
-        const float dof = 3.f * float(n - 1);
-        if (chi2 > dof + float(o.ghost_sigmas) * std::sqrt(2.f * dof)) f |= kGhost;
+      } else if (n > 1.f) {
+        const float dof = 3.f * (n - 1.f);
+        if (s.chi2[std::size_t(x)] > dof + ghost_sigmas * std::sqrt(2.f * dof)) f |= kGhost;
       }
       flag[x] = f;
     }
