@@ -9,7 +9,48 @@
 #include <cmath>
 #include <stdexcept>
 
+// Row kernels are also built for AVX2 and chosen at load time (x86-64 GCC; no FMA, so both builds
+// give the same bits).
+#if defined(__x86_64__) && defined(__GNUC__)
+#define RSIBR_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define RSIBR_AVX2_CLONES
+#endif
+
 namespace rsibr {
+namespace {
+
+// L[x] = lt[z[3x]], B[x] = bt[z[3x]] (one channel of an interleaved RGB row of codes).
+RSIBR_AVX2_CLONES void gather_row(const std::uint16_t* __restrict z, const float* __restrict lt,
+                                  const float* __restrict bt, float* __restrict L, float* __restrict B, int W) {
+  for (int x = 0; x < W; ++x) {
+    const int code = z[3 * x];
+    L[x] = lt[code];
+    B[x] = bt[code];
+  }
+}
+
+// w = mask / (se * Lw + B); sw += w; num += w * L.
+RSIBR_AVX2_CLONES void accumulate_row(const float* __restrict mk, const float* __restrict L, const float* __restrict B,
+                                      const float* __restrict Lw, float se, float* __restrict sw, float* __restrict num, int W) {
+  for (int x = 0; x < W; ++x) {
+    const float w = mk[x] / (se * Lw[x] + B[x]);
+    sw[x] += w;
+    num[x] += w * L[x];
+  }
+}
+
+// chi2 += mask (L - Lm)^2 / (se * Lm+ + B + eps2 Lm+^2), Lm+ = max(Lm, 0).
+RSIBR_AVX2_CLONES void chi2_row(const float* __restrict mk, const float* __restrict L, const float* __restrict B,
+                                const float* __restrict Lm, float se, float eps2, float* __restrict chi2, int W) {
+  for (int x = 0; x < W; ++x) {
+    const float l = std::max(Lm[x], 0.f);
+    const float d = L[x] - Lm[x];
+    chi2[x] += mk[x] * d * d / (se * l + B[x] + eps2 * l * l);
+  }
+}
+
+}  // namespace
 
 // Implementation: rows in parallel; within a row, structure of arrays so that the loops over
 // pixels vectorise. Per bracket j, channel c and code z the tables hold
@@ -90,24 +131,13 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
       float* swl = s.swl.data();
       std::fill(s.sw.begin(), s.sw.end(), 0.f);
       std::fill(s.swl.begin(), s.swl.end(), 0.f);
-      // Gather the bracket estimates and pass 1: weights from the measured signal.
+      // Gather the bracket estimates and pass 1: weights from the measured signal (L_j itself).
       for (int j = 0; j < P; ++j) {
-        const float* lt = &Lt[(std::size_t(j) * 3 + std::size_t(c)) * codes];
-        const float* bt = &Bt[(std::size_t(j) * 3 + std::size_t(c)) * codes];
         float* L = &s.L[std::size_t(j) * W];
         float* B = &s.B[std::size_t(j) * W];
-        const std::uint16_t* z = row[j] + c;
-        for (int x = 0; x < W; ++x) {
-          L[x] = lt[z[3 * x]];
-          B[x] = bt[z[3 * x]];
-        }
-        const float* mk = &s.mask[std::size_t(j) * W];
-        const float se = shot_e[j][c];
-        for (int x = 0; x < W; ++x) {
-          const float w = mk[x] / (se * std::max(L[x], 0.f) + B[x]);
-          sw[x] += w;
-          swl[x] += w * L[x];
-        }
+        gather_row(row[j] + c, &Lt[(std::size_t(j) * 3 + std::size_t(c)) * codes],
+                   &Bt[(std::size_t(j) * 3 + std::size_t(c)) * codes], L, B, W);
+        accumulate_row(&s.mask[std::size_t(j) * W], L, B, L, shot_e[j][c], sw, swl, W);
       }
       if (pilot) {
         // Pass 2: weights from the pilot radiance (swl becomes the pilot; sw and num are rebuilt).
@@ -117,39 +147,21 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
           sw[x] = 0.f;
           num[x] = 0.f;
         }
-        for (int j = 0; j < P; ++j) {
-          const float* L = &s.L[std::size_t(j) * W];
-          const float* B = &s.B[std::size_t(j) * W];
-          const float* mk = &s.mask[std::size_t(j) * W];
-          const float se = shot_e[j][c];
-          for (int x = 0; x < W; ++x) {
-            const float w = mk[x] / (se * swl[x] + B[x]);
-            sw[x] += w;
-            num[x] += w * L[x];
-          }
-        }
-        for (int x = 0; x < W; ++x) swl[x] = num[x];
+        for (int j = 0; j < P; ++j)
+          accumulate_row(&s.mask[std::size_t(j) * W], &s.L[std::size_t(j) * W], &s.B[std::size_t(j) * W], swl,
+                         shot_e[j][c], sw, num, W);
+        std::copy(num, num + W, swl);
       }
+      float* Lm = s.num.data();  // the merged channel, contiguous, for the ghost test
       for (int x = 0; x < W; ++x) {
-        out[3 * x + c] = sw[x] > 0.f ? swl[x] / sw[x] : 0.f;
+        Lm[x] = sw[x] > 0.f ? swl[x] / sw[x] : 0.f;
+        out[3 * x + c] = Lm[x];
         var[3 * x + c] = sw[x] > 0.f ? 1.f / sw[x] : 0.f;
       }
-      // The merged channel, contiguous, for the ghost loop.
-      float* Lm = s.num.data();
-      for (int x = 0; x < W; ++x) Lm[x] = out[3 * x + c];
       // Ghost statistic: chi2 += (L_j - L)^2 / (var(L_j) + (model_error L)^2) over usable brackets.
-      for (int j = 0; j < P; ++j) {
-        const float* L = &s.L[std::size_t(j) * W];
-        const float* B = &s.B[std::size_t(j) * W];
-        const float* mk = &s.mask[std::size_t(j) * W];
-        const float se = shot_e[j][c];
-        float* chi2 = s.chi2.data();
-        for (int x = 0; x < W; ++x) {
-          const float l = std::max(Lm[x], 0.f);
-          const float d = L[x] - Lm[x];
-          chi2[x] += mk[x] * d * d / (se * l + B[x] + eps2 * l * l);
-        }
-      }
+      for (int j = 0; j < P; ++j)
+        chi2_row(&s.mask[std::size_t(j) * W], &s.L[std::size_t(j) * W], &s.B[std::size_t(j) * W], Lm, shot_e[j][c],
+                 eps2, s.chi2.data(), W);
     }
     for (int x = 0; x < W; ++x) {
       unsigned char f = 0;
