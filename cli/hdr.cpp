@@ -239,7 +239,6 @@ int run_hdr(const HdrArgs& a) {
         cv::transform(m.variance, m.variance, sq);
       }
       const auto t2 = std::chrono::steady_clock::now();
-      std::vector<std::string> names;
       std::string files;
       for (const std::string& f : b.files) files += (files.empty() ? "" : ";") + relative_name(f, set.folder);
       std::vector<double> times;

@@ -199,10 +199,14 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
 }
 
 cv::Mat merge_hat_weighted(const BracketSet& b, const ResponseCurve& curve, int saturation_code) {
+  // Debevec & Malik 1997, eq. 6: ln L = sum_j w(z_j) (ln X(z_j) - ln e_j) / sum_j w(z_j) with the hat
+  // w(z) = min(z, max_code - z) (zero at both ends), per channel, saturated codes left out.
   const int sat = saturation_code > 0 ? saturation_code : default_saturation_code(b.max_code);
   std::array<std::vector<float>, 3> tx, tq;
   curve.tables(tx, tq);
   const int P = int(b.size()), H = b.rows(), W = b.cols();
+  std::vector<float> log_e(std::size_t(P), 0.f);
+  for (int j = 0; j < P; ++j) log_e[std::size_t(j)] = float(std::log(b.exposures[std::size_t(j)]));
   cv::Mat out(H, W, CV_32FC3);
   parallel_for_rows(H, [&](int r) {
     float* o = out.ptr<float>(r);
@@ -211,12 +215,15 @@ cv::Mat merge_hat_weighted(const BracketSet& b, const ResponseCurve& curve, int 
         float sw = 0, swl = 0;
         for (int j = 0; j < P; ++j) {
           const int z = b.codes[std::size_t(j)].ptr<std::uint16_t>(r)[3 * x + c];
-          if (z >= sat) continue;
-          const float w = float(std::min(z, b.max_code - z)) + 1e-3f;
-          sw += w, swl += w * tx[std::size_t(c)][std::size_t(z)] / float(b.exposures[std::size_t(j)]);
+          const float X = tx[std::size_t(c)][std::size_t(z)];
+          if (z >= sat || !(X > 0)) continue;
+          const float w = float(std::min(z, b.max_code - z));
+          sw += w, swl += w * (std::log(X) - log_e[std::size_t(j)]);
         }
-        // Saturated everywhere: the shortest bracket's value (as the merge does).
-        o[3 * x + c] = sw > 0 ? swl / sw : tx[std::size_t(c)][b.codes[0].ptr<std::uint16_t>(r)[3 * x + c]] / float(b.exposures[0]);
+        // No weight anywhere: saturated (the shortest bracket's value, as the merge) or black (0).
+        const int z0 = b.codes[0].ptr<std::uint16_t>(r)[3 * x + c];
+        o[3 * x + c] = sw > 0 ? std::exp(swl / sw)
+                              : (z0 >= sat ? tx[std::size_t(c)][std::size_t(z0)] / float(b.exposures[0]) : 0.f);
       }
   });
   return out;

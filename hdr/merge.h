@@ -50,8 +50,8 @@ struct MergedImage {
 MergedImage merge_brackets(const BracketSet& brackets, const ResponseCurve& curve, const NoiseModel& noise,
                            const MergeOptions& options = {});
 
-// Debevec & Malik's hat-weighted average, w(z) = min(z, max_code - z) (saturated codes excluded per
-// channel), in linear space with the same curve: the comparison baseline for the merge.
+// Debevec & Malik's hat-weighted average of ln X(z_j) - ln e_j (their eq. 6), w(z) = min(z, max_code - z),
+// saturated codes excluded per channel, with the same curve: the comparison baseline for the merge.
 cv::Mat merge_hat_weighted(const BracketSet& brackets, const ResponseCurve& curve, int saturation_code = -1);
 
 }  // namespace rsibr

@@ -4,12 +4,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 namespace rsibr {
 
 NoiseModel estimate_noise(const BracketSet& b, const ResponseCurve& curve, int saturation_code) {
   NoiseModel out;
+  if (curve.max_code != b.max_code)
+    throw std::invalid_argument("estimate_noise: the response curve's code range differs from the brackets'");
   if (b.size() < 2) return out;
   std::array<std::vector<float>, 3> tx, tq;
   curve.tables(tx, tq);

@@ -28,6 +28,7 @@ struct NoiseModel {
 // Pairs are selected on the longer bracket (selecting on the noisy shorter one truncates its
 // noise), and the shorter one must be four read-noise sigmas clear of the black clip.
 // Needs at least two brackets; with fewer usable pairs than 100 returns the default model.
+// Throws std::invalid_argument when the curve's max_code differs from the brackets'.
 NoiseModel estimate_noise(const BracketSet& brackets, const ResponseCurve& curve, int saturation_code);
 
 }  // namespace rsibr
