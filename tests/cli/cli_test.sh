@@ -224,6 +224,11 @@ expect_error "hdr: all-black brackets" "too few usable pixels" hdr "$work/black"
 "$rsibr" hdr "$work/black" --out "$work/hdr4" --model identity --json "$work/hdr4.json" -q
 check "hdr: all-black with the identity model is flagged black, not NaN" python3 -c "
 import json; v = json.load(open('$work/hdr4.json'))['views'][0]; assert v['black_pixels'] == 64 and v['radiance_max'] == 0, v"
+"$rsibr" hdr "$work/shoot" --out "$work/hdr6" --input-colorspace lin_p3d65 --response "$work/hdr/response.json" --json "$work/hdr6.json" -q
+check "hdr: P3 input converted to the working space (the bluish darkest pixel gets more saturated, the space is named)" bash -c "grep -aq lin_p3d65 '$work/hdr6/north.exr' && python3 -c \"
+import json; a = json.load(open('$work/hdr.json'))['views'][0]; b = json.load(open('$work/hdr6.json'))['views'][0]
+assert b['radiance_min'] < a['radiance_min'] * 0.9999, (a['radiance_min'], b['radiance_min'])\""
+expect_error "hdr: unknown input colour space" "nospace" hdr "$work/shoot" --out "$work/hdr3" --input-colorspace nospace
 check "hdr: no output after errors" test ! -e "$work/hdr3"
 check "hdr: no staging folders left" bash -c "! ls -A '$work/hdr' '$work/hdr2' '$work/hdr4' | grep -q rsibr-hdr"
 

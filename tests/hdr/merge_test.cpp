@@ -167,8 +167,21 @@ TEST(Merge, ABracketSaturatedInAnyChannelIsExcludedSoHueIsKept) {
   const cv::Vec3f v = m.radiance.at<cv::Vec3f>(4, 4);
   EXPECT_NEAR(v[0] / v[1], 40.0 / 12.0, 0.02 * 40.0 / 12.0);
   EXPECT_NEAR(v[0], 40.0, 0.02 * 40.0);
-  // The baseline that excludes per channel keeps fewer red samples but still mixes brackets:
-  // it is the comparison, not the contract; only require it to be finite.
+  // Green's variance is that of the brackets where no channel saturates: the bracket where only
+  // red saturates is not used for green either.
+  const NoiseModel nm;
+  const double q = 1.0 / (12.0 * 255 * 255), sat_X = 254.0 / 255.0;
+  double info_all = 0, info_kept = 0;
+  int kept = 0, green_unsaturated = 0;
+  for (double ej : e) {
+    const double G = v[1];
+    const double w = ej * ej / (nm.shot[1] * G * ej + nm.read[1] + q);
+    if (12.0 * ej < sat_X) info_all += w, ++green_unsaturated;
+    if (40.0 * ej < sat_X) info_kept += w, ++kept;
+  }
+  ASSERT_LT(kept, green_unsaturated);  // the scene does what the test needs
+  EXPECT_NEAR(m.variance.at<cv::Vec3f>(4, 4)[1], 1.0 / info_kept, 1e-3 / info_kept);
+  EXPECT_GT(1.0 / info_kept, 1.5 / info_all);
   EXPECT_TRUE(all_finite(merge_hat_weighted(b, ResponseCurve::identity(255))));
 }
 
