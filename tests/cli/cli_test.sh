@@ -229,6 +229,30 @@ check "hdr: P3 input converted to the working space (the bluish darkest pixel ge
 import json; a = json.load(open('$work/hdr.json'))['views'][0]; b = json.load(open('$work/hdr6.json'))['views'][0]
 assert b['radiance_min'] < a['radiance_min'] * 0.9999, (a['radiance_min'], b['radiance_min'])\""
 expect_error "hdr: unknown input colour space" "nospace" hdr "$work/shoot" --out "$work/hdr3" --input-colorspace nospace
+# 16-bit linear photos (PNG, bit depth 16): the identity model is chosen, radiance in known units.
+mkdir -p "$work/lin/v"
+python3 - "$work/lin" <<'PY'
+import os, random, struct, sys, zlib
+root, rng, W, H = sys.argv[1], random.Random(2), 64, 32
+def png16(path, pixel):
+    raw = b"".join(b"\x00" + b"".join(struct.pack(">HHH", *pixel(x, y)) for x in range(W)) for y in range(H))
+    chunk = lambda t, d: struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
+    open(path, "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", W, H, 16, 2, 0, 0, 0))
+                           + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+lines = ["rsibr_photoset: 1", "views:", "  - name: v", "    brackets:"]
+for j, t in enumerate([0.01, 0.04, 0.16, 0.64]):
+    def pixel(x, y, t=t):
+        L = 10 ** (-1 + 3 * x / W)
+        return [int(round(65535 * min(1.0, max(0.0, L * t + 2e-4 * rng.gauss(0, 1))))) for _ in range(3)]
+    png16(os.path.join(root, "v", "%d.png" % j), pixel)
+    lines.append("      - {file: v/%d.png, exposure_s: %r}" % (j, t))
+open(os.path.join(root, "photoset.yaml"), "w").write("\n".join(lines) + "\n")
+PY
+"$rsibr" hdr "$work/lin" --out "$work/lin-out" --json "$work/lin.json" -q
+check "hdr: 16-bit linear photos choose the identity model; the brightest column (L = 89.8) comes back" python3 -c "
+import json; j = json.load(open('$work/lin.json')); v = j['views'][0]
+assert j['response']['model'] == 'identity' and v['bit_depth'] == 16, j['response']['model']
+assert 80 < v['radiance_max'] < 101, v['radiance_max']"
 check "hdr: no output after errors" test ! -e "$work/hdr3"
 check "hdr: no staging folders left" bash -c "! ls -A '$work/hdr' '$work/hdr2' '$work/hdr4' | grep -q rsibr-hdr"
 
