@@ -37,7 +37,7 @@ struct HdrArgs {
   std::vector<std::string> views;
   int samples = 3000;
   double smoothness = 100.0, ghost_sigmas = 6.0;
-  bool align = false, quiet = false, no_preview = false;
+  bool align = false, deghost = false, quiet = false, no_preview = false;
   std::optional<float> preview_exposure;
 };
 
@@ -230,6 +230,7 @@ int run_hdr(const HdrArgs& a) {
       const auto t1 = std::chrono::steady_clock::now();
       MergeOptions mo;
       mo.ghost_sigmas = a.ghost_sigmas;
+      mo.deghost = a.deghost;
       MergedImage m = merge_brackets(b, curve, noise, mo);
       if (to_working) {
         convert_colour_space(m.radiance, a.input_colour_space, working);
@@ -260,6 +261,7 @@ int run_hdr(const HdrArgs& a) {
           {"colourSpace", working},
           {"inputColourSpace", a.input_colour_space.empty() ? working : a.input_colour_space},
           {"alignment", a.align ? "MTB shifts " + shift_text : "none"},
+          {"ghosts", a.deghost ? "flagged; longest usable bracket alone" : "flagged; merged as usual"},
           {"flags", "clipped: lower bound (saturated in every bracket); black: nothing recorded; ghost: brackets disagree"}};
       write_merged_exr((stage / (v.name + ".exr")).string(), m, attrs);
       staged.push_back({stage / (v.name + ".exr"), out_dir / (v.name + ".exr")});
@@ -337,6 +339,7 @@ Runner add_hdr(CLI::App& app) {
   c->add_option("--smoothness", a->smoothness, "Debevec's smoothness weight lambda")->check(CLI::Range(0.0, 1e6));
   c->add_option("--noise", a->noise, "Given noise model SHOT,READ: var(X) = SHOT*X + READ, X normalised to saturation");
   c->add_flag("--align", a->align, "Align brackets by small shifts (OpenCV median threshold bitmaps)");
+  c->add_flag("--deghost", a->deghost, "Ghost pixels take the longest usable bracket alone instead of a blend");
   c->add_option("--ghost-sigmas", a->ghost_sigmas, "Ghost threshold in standard deviations of chi-square")->check(CLI::Range(0.0, 1e6));
   c->add_option("--input-colorspace", a->input_colour_space,
                 "OpenColorIO colour space of the linearised camera RGB (default: the working space; $OCIO honoured)");

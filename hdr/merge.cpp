@@ -179,7 +179,20 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
         }
       } else if (n > 1.f) {
         const float dof = 3.f * (n - 1.f);
-        if (s.chi2[std::size_t(x)] > dof + ghost_sigmas * std::sqrt(2.f * dof)) f |= kGhost;
+        if (s.chi2[std::size_t(x)] > dof + ghost_sigmas * std::sqrt(2.f * dof)) {
+          f |= kGhost;
+          if (o.deghost) {
+            // One bracket instead of a blend of two scenes: the longest usable one (best SNR).
+            int j = P - 1;
+            while (s.mask[std::size_t(j) * W + std::size_t(x)] == 0.f) --j;
+            const std::uint16_t* z = row[j] + 3 * x;
+            for (int c = 0; c < 3; ++c) {
+              const std::size_t t = (std::size_t(j) * 3 + std::size_t(c)) * codes + z[c];
+              out[3 * x + c] = Lt[t];
+              var[3 * x + c] = shot_e[j][c] * Lt[t] + Bt[t];
+            }
+          }
+        }
       }
       flag[x] = f;
     }

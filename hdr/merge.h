@@ -16,7 +16,8 @@
 // is flagged `black` (radiance below what the set can detect; the value is the merge of zeros).
 // Ghosts: with L the merge, chi2 = sum_{j,c} (L_j - L)^2 / (var(L_j) + (model_error * L)^2) over the
 // used brackets has about 3(n-1) degrees of freedom for a static scene; a pixel is flagged
-// `ghost` when chi2 > dof + ghost_sigmas * sqrt(2 dof).
+// `ghost` when chi2 > dof + ghost_sigmas * sqrt(2 dof). With `deghost`, a ghost pixel's value is the
+// longest usable bracket's alone (one consistent scene instead of a blend of two; noisier).
 // Output radiance is X / e: the signal normalised to saturation per unit relative exposure,
 // i.e. L_scene * k / X_sat in the capture convention X = L * e * k (camera gain k).
 #pragma once
@@ -36,6 +37,7 @@ struct MergeOptions {
   bool pilot_pass = true;      // false: weights from the measured X_j (biased; for comparisons)
   double model_error = 0.03;   // relative error allowed for the curve in the ghost test
   double ghost_sigmas = 6.0;
+  bool deghost = false;        // ghost pixels take the longest usable bracket alone (value and variance)
 };
 
 struct MergedImage {

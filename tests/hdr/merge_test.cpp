@@ -291,6 +291,25 @@ TEST(Merge, GhostsAreFlaggedWhereTheSceneMovedAndRarelyElsewhere) {
     }
   ASSERT_GT(used_in_block, 100);
   EXPECT_GT(flagged_in_block, int(0.95 * used_in_block));
+  // Deghosting: flagged pixels hold one bracket's scene (within 4.5 sigma of its variance channel),
+  // not a blend of the two.
+  MergeOptions o;
+  o.deghost = true;
+  const MergedImage d = merge_brackets(make_brackets(imgs, e), ResponseCurve::identity(65535), true_noise(cam), o);
+  int blended = 0, checked = 0, blended_plain = 0;
+  for (int r = 24; r < 40; ++r)
+    for (int x = 24; x < 40; ++x) {
+      if (!(d.flags.at<unsigned char>(r, x) & kGhost)) continue;
+      ++checked;
+      const double v = d.radiance.at<cv::Vec3f>(r, x)[1], a = L.at<cv::Vec3d>(r, x)[1], b = moved.at<cv::Vec3d>(r, x)[1];
+      const double sigma = std::sqrt(d.variance.at<cv::Vec3f>(r, x)[1]);
+      if (std::abs(v - a) > 4.5 * sigma && std::abs(v - b) > 4.5 * sigma) ++blended;
+      const double p = m.radiance.at<cv::Vec3f>(r, x)[1];  // the plain merge, same tolerance
+      if (std::abs(p - a) > 4.5 * sigma && std::abs(p - b) > 4.5 * sigma) ++blended_plain;
+    }
+  ASSERT_GT(checked, 100);
+  EXPECT_EQ(blended, 0);
+  EXPECT_GT(blended_plain, checked / 2);  // the check can tell a blend
 }
 
 TEST(Merge, BeatsHatWeightingByThreeDecibelsInTheDarkestDecade) {
