@@ -144,6 +144,7 @@ int run_hdr(const HdrArgs& a) {
       for (const fs::path& in : inputs) check_not_same_file(in, target);
     }
   for (const fs::path& in : inputs) check_not_same_file(in, response_out);
+  if (!a.json.empty() && a.json != "-") check_output_path(a.json, inputs);
 
   // Everything goes to a staging folder inside the output folder and is renamed into place only
   // when every view has merged: a failure leaves no partial output.

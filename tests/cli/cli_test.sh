@@ -211,6 +211,7 @@ expect_error "hdr: output parent missing" "nofolder" hdr "$work/shoot" --out "$w
 expect_error "hdr: unknown model" "fancy" hdr "$work/shoot" --out "$work/hdr3" --model fancy
 expect_error "hdr: malformed noise" "noise" hdr "$work/shoot" --out "$work/hdr3" --noise 1e-4
 expect_error "hdr: unknown view" "south" hdr "$work/shoot" --out "$work/hdr3" --view south
+expect_error "hdr: JSON folder missing (checked before merging)" "nofolder" hdr "$work/shoot" --out "$work/hdr3" --json "$work/nofolder/s.json"
 printf '{"rsibr_response": 1, "model": "x", "max_code": 255, "knots": [[0,1],[0,1]]}' >"$work/bad-response.json"
 expect_error "hdr: malformed response file" "bad-response.json" hdr "$work/shoot" --out "$work/hdr3" --response "$work/bad-response.json"
 mkdir -p "$work/black/v"
