@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   runners["reference"] = rsibr::cli::add_reference(app);
   runners["render"] = rsibr::cli::add_render(app);
   runners["view"] = rsibr::cli::add_view(app);
+  runners["hdr"] = rsibr::cli::add_hdr(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

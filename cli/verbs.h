@@ -17,5 +17,6 @@ Runner add_bake(CLI::App& app);
 Runner add_reference(CLI::App& app);
 Runner add_render(CLI::App& app);
 Runner add_view(CLI::App& app);
+Runner add_hdr(CLI::App& app);
 
 }  // namespace rsibr::cli

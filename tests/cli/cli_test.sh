@@ -25,7 +25,7 @@ expect_error() {
 }
 no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
 
-for verb in convert info pattern blend bake reference render view; do
+for verb in convert info pattern blend bake reference render view hdr; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
 done
 check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
@@ -204,6 +204,97 @@ else
   expect_error "view: unknown mode" "fancy" view --maps "$work/mirror.exr" --mesh "$work/cube.obj" --mode fancy --orbit 1
   check "view: no output after errors" bash -c "! ls '$work' | grep -q '^v[0-9]'"
 fi
+# hdr: a synthetic 8-bit bracket set (gamma 2.2 camera, a radiance ramp with a clipped sun), written
+# by a standard-library PNG writer.
+mkdir -p "$work/shoot/north"
+python3 - "$work/shoot" <<'PY'
+import math, os, random, struct, sys, zlib
+root = sys.argv[1]
+def png(path, w, h, pixel):
+    raw = b"".join(b"\x00" + bytes(v for x in range(w) for v in pixel(x, y)) for y in range(h))
+    chunk = lambda t, d: struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+                + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+rng = random.Random(1)
+W, H = 96, 64
+radiance = [[(10 ** (-3 + 4 * (x + 0.5) / W)) * (1e4 if (x - 80) ** 2 + (y - 12) ** 2 < 16 else 1) for x in range(W)] for y in range(H)]
+times = [1 / 256, 1 / 64, 1 / 16, 1 / 4, 1.0]
+lines = ["rsibr_photoset: 1", "views:", "  - name: north", "    brackets:"]
+for j, t in enumerate(times):
+    def pixel(x, y, t=t):
+        out = []
+        for c, tint in enumerate((0.9, 1.0, 1.1)):
+            X = min(1.0, max(0.0, radiance[y][x] * tint * t * (1 + 0.01 * rng.gauss(0, 1))))
+            out.append(int(round(255 * X ** (1 / 2.2))))
+        return out
+    png(os.path.join(root, "north", "%d.png" % j), W, H, pixel)
+    lines.append("      - {file: north/%d.png, exposure_s: %r}" % (j, t))
+open(os.path.join(root, "photoset.yaml"), "w").write("\n".join(lines) + "\n")
+PY
+"$rsibr" hdr "$work/shoot" --out "$work/hdr" --json "$work/hdr.json" -q
+check "hdr writes EXR, PNG and the response" test -s "$work/hdr/north.exr" -a -s "$work/hdr/north.png" -a -s "$work/hdr/response.json"
+check "hdr JSON: model chosen by held-out error, sun clipped, no ghosts" python3 -c "
+import json; j = json.load(open('$work/hdr.json')); v = j['views'][0]
+assert j['response']['model'] in ('gamma', 'polynomial'), j['response']['model']
+assert len(j['response']['candidates']) >= 5 and len(j['response']['curve']) == 65
+assert 20 < v['clipped_pixels'] < 80 and v['ghost_fraction'] < 0.01, v"
+check "hdr EXR carries channels and provenance" bash -c "'$rsibr' info '$work/hdr/north.exr' >/dev/null 2>&1; grep -aq variance.R '$work/hdr/north.exr' && grep -aq rsibr.responseModel '$work/hdr/north.exr' && grep -aq 'north/0.png' '$work/hdr/north.exr'"
+"$rsibr" hdr "$work/shoot" --out "$work/hdr5" -q
+check "hdr: same photos, same bytes" cmp -s "$work/hdr/north.exr" "$work/hdr5/north.exr"
+"$rsibr" hdr "$work/shoot" --out "$work/hdr2" --response "$work/hdr/response.json" -q
+check "hdr: a reused response is named in the header" grep -aq "hdr/response.json" "$work/hdr2/north.exr"
+check "hdr: reusing a response writes none" test ! -e "$work/hdr2/response.json"
+expect_error "hdr: missing photo set" "nothere" hdr "$work/nothere" --out "$work/hdr3"
+expect_error "hdr: output parent missing" "nofolder" hdr "$work/shoot" --out "$work/nofolder/sub"
+expect_error "hdr: unknown model" "fancy" hdr "$work/shoot" --out "$work/hdr3" --model fancy
+expect_error "hdr: malformed noise" "noise" hdr "$work/shoot" --out "$work/hdr3" --noise 1e-4
+expect_error "hdr: unknown view" "south" hdr "$work/shoot" --out "$work/hdr3" --view south
+expect_error "hdr: JSON folder missing (checked before merging)" "nofolder" hdr "$work/shoot" --out "$work/hdr3" --json "$work/nofolder/s.json"
+printf '{"rsibr_response": 1, "model": "x", "max_code": 255, "knots": [[0,1],[0,1]]}' >"$work/bad-response.json"
+expect_error "hdr: malformed response file" "bad-response.json" hdr "$work/shoot" --out "$work/hdr3" --response "$work/bad-response.json"
+mkdir -p "$work/black/v"
+cp "$work/shoot/photoset.yaml" "$work/black/photoset.yaml"; sed -i 's#north/#v/#; s#name: north#name: v#' "$work/black/photoset.yaml"
+python3 -c "
+import struct, zlib
+raw = b''.join(b'\x00' + bytes(3 * 8) for _ in range(8))
+ch = lambda t, d: struct.pack('>I', len(d)) + t + d + struct.pack('>I', zlib.crc32(t + d) & 0xffffffff)
+for j in range(5): open('$work/black/v/%d.png' % j, 'wb').write(b'\x89PNG\r\n\x1a\n' + ch(b'IHDR', struct.pack('>IIBBBBB', 8, 8, 8, 2, 0, 0, 0)) + ch(b'IDAT', zlib.compress(raw)) + ch(b'IEND', b''))"
+expect_error "hdr: all-black brackets" "too few usable pixels" hdr "$work/black" --out "$work/hdr3"
+"$rsibr" hdr "$work/black" --out "$work/hdr4" --model identity --json "$work/hdr4.json" -q
+check "hdr: all-black with the identity model is flagged black, not NaN" python3 -c "
+import json; v = json.load(open('$work/hdr4.json'))['views'][0]; assert v['black_pixels'] == 64 and v['radiance_max'] == 0, v"
+"$rsibr" hdr "$work/shoot" --out "$work/hdr6" --input-colorspace lin_p3d65 --response "$work/hdr/response.json" --json "$work/hdr6.json" -q
+check "hdr: P3 input converted to the working space (the bluish darkest pixel gets more saturated, the space is named)" bash -c "grep -aq lin_p3d65 '$work/hdr6/north.exr' && python3 -c \"
+import json; a = json.load(open('$work/hdr.json'))['views'][0]; b = json.load(open('$work/hdr6.json'))['views'][0]
+assert b['radiance_min'] < a['radiance_min'] * 0.9999, (a['radiance_min'], b['radiance_min'])\""
+expect_error "hdr: unknown input colour space" "nospace" hdr "$work/shoot" --out "$work/hdr3" --input-colorspace nospace
+# 16-bit linear photos (PNG, bit depth 16): the identity model is chosen, radiance in known units.
+mkdir -p "$work/lin/v"
+python3 - "$work/lin" <<'PY'
+import os, random, struct, sys, zlib
+root, rng, W, H = sys.argv[1], random.Random(2), 64, 32
+def png16(path, pixel):
+    raw = b"".join(b"\x00" + b"".join(struct.pack(">HHH", *pixel(x, y)) for x in range(W)) for y in range(H))
+    chunk = lambda t, d: struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
+    open(path, "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", W, H, 16, 2, 0, 0, 0))
+                           + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+lines = ["rsibr_photoset: 1", "views:", "  - name: v", "    brackets:"]
+for j, t in enumerate([0.01, 0.04, 0.16, 0.64]):
+    def pixel(x, y, t=t):
+        L = 10 ** (-1 + 3 * x / W)
+        return [int(round(65535 * min(1.0, max(0.0, L * t + 2e-4 * rng.gauss(0, 1))))) for _ in range(3)]
+    png16(os.path.join(root, "v", "%d.png" % j), pixel)
+    lines.append("      - {file: v/%d.png, exposure_s: %r}" % (j, t))
+open(os.path.join(root, "photoset.yaml"), "w").write("\n".join(lines) + "\n")
+PY
+"$rsibr" hdr "$work/lin" --out "$work/lin-out" --json "$work/lin.json" -q
+check "hdr: 16-bit linear photos choose the identity model; the brightest column (L = 89.8) comes back" python3 -c "
+import json; j = json.load(open('$work/lin.json')); v = j['views'][0]
+assert j['response']['model'] == 'identity' and v['bit_depth'] == 16, j['response']['model']
+assert 80 < v['radiance_max'] < 101, v['radiance_max']"
+check "hdr: no output after errors" test ! -e "$work/hdr3"
+check "hdr: no staging folders left" bash -c "! ls -A '$work/hdr' '$work/hdr2' '$work/hdr4' | grep -q rsibr-hdr"
 
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

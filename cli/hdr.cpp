@@ -1,0 +1,354 @@
+// rsibr hdr: merge each view's exposure brackets into radiance (hdr/): exposures from
+// photoset.yaml or EXIF, a response curve recovered (model chosen by held-out error) or reused,
+// a shot + read noise model, the inverse-variance merge with variance, clipped, black and ghost
+// channels, conversion to the working colour space, EXR + PNG preview per view.
+#include "cli/summary.h"
+#include "cli/verbs.h"
+
+#include "capture/photo_set.h"
+#include "core/atomic_file.h"
+#include "core/colour.h"
+#include "core/progress.h"
+#include "hdr/alignment.h"
+#include "hdr/bracket_set.h"
+#include "hdr/merge.h"
+#include "hdr/merged_exr.h"
+#include "hdr/noise_model.h"
+#include "hdr/response_recovery.h"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+namespace rsibr::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct HdrArgs {
+  std::string photoset, out, response, model = "auto", noise, input_colour_space, json;
+  std::vector<std::string> views;
+  int samples = 3000;
+  double smoothness = 100.0, ghost_sigmas = 6.0;
+  bool align = false, deghost = false, quiet = false, no_preview = false;
+  std::optional<float> preview_exposure;
+};
+
+std::string join(const std::vector<double>& v) {
+  std::ostringstream s;
+  s.precision(9);
+  for (std::size_t i = 0; i < v.size(); ++i) s << (i ? " " : "") << v[i];
+  return s.str();
+}
+
+NoiseModel parse_noise(const std::string& text) {
+  NoiseModel n;
+  double shot = 0, read = 0;
+  char comma = 0;
+  std::istringstream in(text);
+  if (!(in >> shot >> comma >> read) || comma != ',' || !(in >> std::ws).eof() || !(shot >= 0) || !(read > 0) ||
+      !std::isfinite(shot) || !std::isfinite(read))
+    throw std::invalid_argument("--noise '" + text + "': expected SHOT,READ with SHOT >= 0 and READ > 0 (variance = SHOT * X + READ)");
+  n.shot = {shot, shot, shot};
+  n.read = {read, read, read};
+  n.source = "given";
+  return n;
+}
+
+std::string describe(const NoiseModel& n) {
+  std::ostringstream s;
+  s.precision(4);
+  s << "var(X) = shot*X + read + quantisation (" << n.source << "); shot " << n.shot[0] << " " << n.shot[1] << " "
+    << n.shot[2] << "; read " << n.read[0] << " " << n.read[1] << " " << n.read[2];
+  return s.str();
+}
+
+// The matrix of a linear OCIO conversion, from its action on the unit colours.
+cv::Matx33f conversion_matrix(const std::string& from, const std::string& to) {
+  cv::Mat basis(1, 3, CV_32FC3);
+  basis.at<cv::Vec3f>(0, 0) = {1, 0, 0};
+  basis.at<cv::Vec3f>(0, 1) = {0, 1, 0};
+  basis.at<cv::Vec3f>(0, 2) = {0, 0, 1};
+  convert_colour_space(basis, from, to);
+  cv::Matx33f m;
+  for (int col = 0; col < 3; ++col)
+    for (int row = 0; row < 3; ++row) m(row, col) = basis.at<cv::Vec3f>(0, col)[row];
+  return m;
+}
+
+// Preview exposure: the median luminance of unclipped pixels maps to 0.18.
+float auto_exposure(const MergedImage& m) {
+  std::vector<float> lum;
+  for (int r = 0; r < m.radiance.rows; r += 4)
+    for (int x = 0; x < m.radiance.cols; x += 4) {
+      if (m.flags.at<unsigned char>(r, x) & kClipped) continue;
+      const cv::Vec3f v = m.radiance.at<cv::Vec3f>(r, x);
+      lum.push_back(0.2126f * v[0] + 0.7152f * v[1] + 0.0722f * v[2]);
+    }
+  if (lum.empty()) return 0.f;
+  std::nth_element(lum.begin(), lum.begin() + long(lum.size() / 2), lum.end());
+  const float median = lum[lum.size() / 2];
+  return median > 0 ? std::log2(0.18f / median) : 0.f;
+}
+
+std::string relative_name(const fs::path& file, const fs::path& folder) {
+  const fs::path rel = file.lexically_relative(folder);
+  return rel.empty() || *rel.begin() == ".." ? file.string() : rel.string();
+}
+
+int run_hdr(const HdrArgs& a) {
+  const auto t_start = std::chrono::steady_clock::now();
+  const PhotoSet set = load_photo_set(a.photoset);
+  std::vector<const PhotoView*> views;
+  if (a.views.empty())
+    for (const PhotoView& v : set.views) views.push_back(&v);
+  for (const std::string& name : a.views) {
+    const auto it = std::find_if(set.views.begin(), set.views.end(), [&](const PhotoView& v) { return v.name == name; });
+    if (it == set.views.end()) throw std::invalid_argument(a.photoset + ": no view named '" + name + "'");
+    views.push_back(&*it);
+  }
+  std::optional<NoiseModel> given_noise;
+  if (!a.noise.empty()) given_noise = parse_noise(a.noise);
+  std::optional<ResponseCurve> given_curve;
+  if (!a.response.empty()) given_curve = load_response(a.response);
+  if (a.model != "auto" && a.model != "identity" && a.model != "gamma" && a.model != "polynomial" &&
+      a.model != "robertson" && a.model != "debevec")
+    throw std::invalid_argument("--model '" + a.model + "': expected auto, identity, gamma, polynomial, robertson or debevec");
+  const std::string working = working_space();
+  std::optional<cv::Matx33f> to_working;
+  if (!a.input_colour_space.empty() && a.input_colour_space != working)
+    to_working = conversion_matrix(a.input_colour_space, working);
+
+  // Outputs: the folder may be new (its parent must exist); no output may name an input.
+  const fs::path out_dir = fs::absolute(a.out);
+  if (!fs::is_directory(out_dir)) {
+    if (!fs::is_directory(out_dir.parent_path()))
+      throw std::invalid_argument(a.out + ": neither it nor its parent folder exists");
+  }
+  std::vector<fs::path> inputs;
+  for (const PhotoView& v : set.views)
+    for (const BracketPhoto& b : v.brackets) inputs.push_back(b.file);
+  if (!a.response.empty()) inputs.push_back(a.response);
+  std::vector<std::pair<fs::path, fs::path>> staged;  // (temporary, final)
+  const fs::path response_out = out_dir / "response.json";
+  for (const PhotoView* v : views)
+    for (const char* ext : {".exr", ".png"}) {
+      const fs::path target = out_dir / (v->name + ext);
+      for (const fs::path& in : inputs) check_not_same_file(in, target);
+    }
+  for (const fs::path& in : inputs) check_not_same_file(in, response_out);
+  if (!a.json.empty() && a.json != "-") check_output_path(a.json, inputs);
+
+  // Everything goes to a staging folder inside the output folder and is renamed into place only
+  // when every view has merged: a failure leaves no partial output.
+  const bool created_out = !fs::is_directory(out_dir);
+  if (created_out) fs::create_directory(out_dir);
+  const fs::path stage = out_dir / (".rsibr-hdr.tmp" + std::to_string(::getpid()));
+  fs::create_directory(stage);
+  nlohmann::json summary;
+  try {
+    Progress bar("hdr", !a.quiet && Progress::stderr_is_terminal());
+    // The response: reused, or recovered once per photo set (one camera) from the view with the
+    // most brackets.
+    RecoveryOptions ro;
+    ro.model = a.model;
+    ro.samples = a.samples;
+    ro.smoothness = a.smoothness;
+    ResponseCurve curve;
+    nlohmann::json response_json;
+    if (given_curve) {
+      curve = *given_curve;
+      response_json = {{"model", curve.model}, {"source", a.response}};
+    } else {
+      const PhotoView* richest = views.front();
+      for (const PhotoView* v : views)
+        if (v->brackets.size() > richest->brackets.size()) richest = v;
+      BracketSet b = load_brackets(*richest);
+      if (a.align) align_brackets(b);
+      ResponseRecovery rec;
+      if (a.model == "identity") {  // linear input: nothing to fit (and no samples needed)
+        rec.curve = ResponseCurve::identity(b.max_code);
+      } else {
+        try {
+          rec = recover_response(b, ro);
+        } catch (const std::runtime_error& e) {
+          throw std::runtime_error("view " + richest->name + ": " + e.what());
+        }
+      }
+      curve = rec.curve;
+      nlohmann::json cands = nlohmann::json::array();
+      for (const auto& c : rec.candidates)
+        cands.push_back({{"model", c.model}, {"complexity", c.complexity},
+                         {"held_out_error", std::isfinite(c.held_out_error) ? nlohmann::json(c.held_out_error) : nlohmann::json("rejected")},
+                         {"parameters", c.parameters}});
+      response_json = {{"model", curve.model}, {"parameters", curve.parameters}, {"recovered_from", richest->name},
+                       {"candidates", cands}, {"train_samples", rec.train_samples}, {"held_out_samples", rec.held_out_samples},
+                       {"file", response_out.string()}};
+      save_response(stage / "response.json", curve,
+                    {{"camera", set.camera_name}, {"recovered_from", richest->name}, {"candidates", cands}});
+      staged.push_back({stage / "response.json", response_out});
+    }
+    // A plot-friendly curve: 65 points per channel.
+    nlohmann::json plot = nlohmann::json::array();
+    for (int k = 0; k <= 64; ++k) {
+      const double z = double(k) * curve.max_code / 64;
+      plot.push_back({{"code", z}, {"X", {curve.linear(0, z), curve.linear(1, z), curve.linear(2, z)}}});
+    }
+    response_json["curve"] = plot;
+    response_json["max_code"] = curve.max_code;
+    summary["response"] = response_json;
+
+    std::string response_model = curve.model;
+    for (const auto& c : response_json.value("candidates", nlohmann::json::array()))
+      if (c["model"] == curve.model && c["held_out_error"].is_number()) {
+        std::ostringstream s;
+        s.precision(3);
+        s << curve.model << " (held-out code error " << c["held_out_error"].get<double>() << ")";
+        response_model = s.str();
+        break;
+      }
+
+    nlohmann::json view_list = nlohmann::json::array();
+    for (std::size_t vi = 0; vi < views.size(); ++vi) {
+      const PhotoView& v = *views[vi];
+      const auto t0 = std::chrono::steady_clock::now();
+      BracketSet b = load_brackets(v);
+      if (b.max_code != curve.max_code)
+        throw std::runtime_error("view " + v.name + ": " + std::to_string(b.max_code == 255 ? 8 : 16) +
+                                 "-bit photos, but the response curve is for " +
+                                 std::to_string(curve.max_code == 255 ? 8 : 16) + "-bit input");
+      std::vector<cv::Point> shifts(b.size(), cv::Point(0, 0));
+      if (a.align) shifts = align_brackets(b);
+      const int sat = default_saturation_code(b.max_code);
+      const NoiseModel noise = given_noise ? *given_noise : estimate_noise(b, curve, sat);
+      const auto t1 = std::chrono::steady_clock::now();
+      MergeOptions mo;
+      mo.ghost_sigmas = a.ghost_sigmas;
+      mo.deghost = a.deghost;
+      MergedImage m = merge_brackets(b, curve, noise, mo);
+      if (to_working) {
+        convert_colour_space(m.radiance, a.input_colour_space, working);
+        // Variances through the squared matrix (channel covariances are not kept).
+        cv::Matx33f sq;
+        for (int i = 0; i < 9; ++i) sq.val[i] = (*to_working).val[i] * (*to_working).val[i];
+        cv::transform(m.variance, m.variance, sq);
+      }
+      const auto t2 = std::chrono::steady_clock::now();
+      std::string files;
+      for (const std::string& f : b.files) files += (files.empty() ? "" : ";") + relative_name(f, set.folder);
+      std::vector<double> times;
+      std::string sources;
+      for (const auto& md : b.metadata) times.push_back(md.exposure_s), sources += (sources.empty() ? "" : " ") + md.source;
+      std::string shift_text;
+      for (const auto& s : shifts) shift_text += (shift_text.empty() ? "" : " ") + std::to_string(s.x) + "," + std::to_string(s.y);
+      const std::map<std::string, std::string> attrs = {
+          {"version", RSIBR_VERSION},
+          {"view", v.name},
+          {"files", files},
+          {"exposures", join(b.exposures)},
+          {"exposureTimes", join(times)},
+          {"exposureSource", sources},
+          {"responseModel", response_model},
+          {"responseFile", given_curve ? a.response : std::string("response.json (next to this file)")},
+          {"noiseModel", describe(noise)},
+          {"radianceUnit", "X/e: signal over saturation per relative exposure t*iso/100/N^2"},
+          {"colourSpace", working},
+          {"inputColourSpace", a.input_colour_space.empty() ? working : a.input_colour_space},
+          {"alignment", a.align ? "MTB shifts " + shift_text : "none"},
+          {"ghosts", a.deghost ? "flagged; longest usable bracket alone" : "flagged; merged as usual"},
+          {"flags", "clipped: lower bound (saturated in every bracket); black: nothing recorded; ghost: brackets disagree"}};
+      write_merged_exr((stage / (v.name + ".exr")).string(), m, attrs);
+      staged.push_back({stage / (v.name + ".exr"), out_dir / (v.name + ".exr")});
+      const float stops = a.preview_exposure ? *a.preview_exposure : auto_exposure(m);
+      if (!a.no_preview) {
+        const cv::Mat png = display_encode(m.radiance, stops);
+        const fs::path p = stage / (v.name + ".png");
+        if (!cv::imwrite(p.string(), png)) throw std::runtime_error(p.string() + ": cannot write the preview");
+        staged.push_back({p, out_dir / (v.name + ".png")});
+      }
+      const auto t3 = std::chrono::steady_clock::now();
+      auto secs = [](auto d) { return std::chrono::duration<double>(d).count(); };
+      const double pixels = double(m.radiance.total());
+      double lo = 0, hi = 0;
+      cv::minMaxLoc(m.radiance.reshape(1), &lo, &hi);
+      nlohmann::json vj = {
+          {"name", v.name}, {"width", b.cols()}, {"height", b.rows()}, {"bit_depth", b.max_code == 255 ? 8 : 16},
+          {"files", b.files}, {"exposures", b.exposures}, {"exposure_s", times}, {"exposure_source", sources},
+          {"noise", {{"source", noise.source}, {"shot", noise.shot}, {"read", noise.read}}},
+          {"clipped_pixels", m.clipped}, {"clipped_fraction", m.clipped / pixels},
+          {"black_pixels", m.black}, {"ghost_pixels", m.ghost}, {"ghost_fraction", m.ghost / pixels},
+          {"radiance_min", lo}, {"radiance_max", hi}, {"preview_exposure_stops", stops},
+          {"exr", (out_dir / (v.name + ".exr")).string()},
+          {"seconds", {{"load", secs(t1 - t0)}, {"merge", secs(t2 - t1)}, {"write", secs(t3 - t2)}}}};
+      if (a.align) {
+        nlohmann::json sj = nlohmann::json::array();
+        for (const auto& s : shifts) sj.push_back({s.x, s.y});
+        vj["alignment_shifts"] = sj;
+      }
+      view_list.push_back(vj);
+      bar.update(double(vi + 1) / double(views.size()));
+      if (!a.quiet)
+        std::cerr << "rsibr hdr: " << v.name << ": " << b.size() << " brackets, " << b.cols() << "x" << b.rows()
+                  << ", clipped " << m.clipped << ", ghost " << m.ghost << " pixels, merge " << secs(t2 - t1) << " s\n";
+    }
+    bar.done();
+    summary["views"] = view_list;
+    summary["photoset"] = set.folder.string();
+    summary["output"] = out_dir.string();
+    summary["colour_space"] = working;
+    summary["radiance_unit"] = "X/e: linear signal normalised to saturation, per unit relative exposure t*iso/100/N^2";
+    summary["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    for (const auto& [tmp, target] : staged) fs::rename(tmp, target);
+    fs::remove_all(stage);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(stage, ec);
+    if (created_out) fs::remove(out_dir, ec);
+    throw;
+  }
+  if (!a.quiet) std::cerr << "rsibr hdr: response model " << summary["response"]["model"].get<std::string>() << "\n";
+  write_summary(a.json, summary);
+  return 0;
+}
+
+}  // namespace
+
+Runner add_hdr(CLI::App& app) {
+  auto a = std::make_shared<HdrArgs>();
+  CLI::App* c = app.add_subcommand("hdr", "Merge each view's exposure brackets into radiance (EXR with variance and flags)");
+  c->footer(
+      "For every view of the photo set: exposures from photoset.yaml (EXIF fills what it leaves out), the camera "
+      "response (recovered once per photo set and written to OUT/response.json, or reused with --response), a "
+      "shot + read noise model (estimated from the brackets, or --noise), and the inverse-variance merge. A bracket "
+      "saturated in any channel is left out for that pixel; pixels saturated in every bracket are flagged 'clipped' "
+      "and hold a lower bound. OUT/<view>.exr has R,G,B, variance.R/G/B, clipped, black, ghost; OUT/<view>.png is a "
+      "preview. Radiance unit: X/e, the signal over its saturation value per relative exposure t*iso/100/N^2.\n"
+      "Example: rsibr hdr shoot/photoset.yaml --out shoot/hdr --json shoot/hdr.json");
+  c->add_option("photoset", a->photoset, "photoset.yaml or the folder holding it")->required();
+  c->add_option("--out", a->out, "Output folder (created if missing; its parent must exist)")->required();
+  c->add_option("--view", a->views, "Merge only this view (repeatable; default: all)");
+  c->add_option("--response", a->response, "Reuse this response curve file (from an earlier run, same camera)");
+  c->add_option("--model", a->model, "Response model: auto (held-out error), identity, gamma, polynomial, robertson, debevec");
+  c->add_option("--samples", a->samples, "Pixels sampled for response recovery")->check(CLI::Range(100, 100000));
+  c->add_option("--smoothness", a->smoothness, "Debevec's smoothness weight lambda")->check(CLI::Range(0.0, 1e6));
+  c->add_option("--noise", a->noise, "Given noise model SHOT,READ: var(X) = SHOT*X + READ, X normalised to saturation");
+  c->add_flag("--align", a->align, "Align brackets by small shifts (OpenCV median threshold bitmaps)");
+  c->add_flag("--deghost", a->deghost, "Ghost pixels take the longest usable bracket alone instead of a blend");
+  c->add_option("--ghost-sigmas", a->ghost_sigmas, "Ghost threshold in standard deviations of chi-square")->check(CLI::Range(0.0, 1e6));
+  c->add_option("--input-colorspace", a->input_colour_space,
+                "OpenColorIO colour space of the linearised camera RGB (default: the working space; $OCIO honoured)");
+  c->add_option("--preview-exposure", a->preview_exposure, "Preview exposure in stops (default: median grey at 0.18)");
+  c->add_flag("--no-preview", a->no_preview, "Do not write PNG previews");
+  c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
+  c->add_flag("-q,--quiet", a->quiet, "No progress bar or report lines");
+  return [a] { return run_hdr(*a); };
+}
+
+}  // namespace rsibr::cli
