@@ -112,10 +112,12 @@ def main():
         lines.append("")
         if ctx.get("load_avg"):  # the machine may be shared: timings scale with it, ratios less so
             lines += ["Load average (1, 5, 15 min) when measured: " + ", ".join(f"{x:.2f}" for x in ctx["load_avg"]) + ".", ""]
-    # Sections other scripts write (bench/viewer_fps.py: "## Viewer") are kept as they were.
+    # Sections other scripts write (bench/viewer_fps.py: "## Viewer", bench/hdr_merge.py: "## HDR merge", ...)
+    # are kept as they were: every section whose title is none of this script's families.
+    ours = tuple(f"## {TITLES.get(family, family[3:])} (" for family in PAIRS)
     if os.path.exists(args.out):
         for title, section in read_sections(args.out).items():
-            if title.startswith("## Viewer"):
+            if not title.startswith(ours):
                 lines += section
     lines += [
         "Notes: rsibr's resampler does more than the baseline: area-weighted footprints (no aliasing when",
