@@ -129,6 +129,7 @@ std::vector<std::pair<int, int>> match_views(const MapSet& a, const MapSet& b, c
 Comparison compare_pairs(std::vector<PairComparison> pairs, const CompareOptions& o) {
   if (pairs.empty()) throw std::invalid_argument(o.name_a + ": nothing to compare");
   double sum_b = 0, sum_a = 0, weight = 0, peak = 0;
+  std::vector<std::pair<float, float>> levels;  // (B's channel mean, weight) per weighted texel
   for (const PairComparison& p : pairs) {
     const WeightedImages& im = p.images;
     if (im.a.size() != im.b.size())
@@ -149,6 +150,7 @@ Comparison compare_pairs(std::vector<PairComparison> pairs, const CompareOptions
       for (int x = 0; x < im.a.cols; ++x) {
         if (!(pw[x] > 0)) continue;
         weight += pw[x];
+        levels.emplace_back(std::max(0.f, (pb[3 * x] + pb[3 * x + 1] + pb[3 * x + 2]) / 3), pw[x]);
         for (int c = 0; c < 3; ++c) {
           sum_a += pw[x] * std::max(0.f, pa[3 * x + c]);
           sum_b += pw[x] * std::max(0.f, pb[3 * x + c]);
@@ -162,8 +164,17 @@ Comparison compare_pairs(std::vector<PairComparison> pairs, const CompareOptions
   if (!(o.log_epsilon_fraction > 0)) throw std::invalid_argument("the log epsilon fraction must be positive");
 
   Comparison out;
-  const double mean = std::max(sum_b, sum_a) / (3 * weight);
-  out.settings.log_epsilon = o.log_epsilon_fraction * (mean > 0 ? mean : 1.0);
+  // eps scales with B's typical level: its weighted median (a sun does not move it), else B's
+  // mean, else A's, else 1.
+  std::sort(levels.begin(), levels.end());
+  double median = 0, run = 0;
+  for (const auto& [level, w] : levels)
+    if ((run += w) >= 0.5 * weight) {
+      median = level;
+      break;
+    }
+  const double level = median > 0 ? median : sum_b > 0 ? sum_b / (3 * weight) : sum_a > 0 ? sum_a / (3 * weight) : 1.0;
+  out.settings.log_epsilon = o.log_epsilon_fraction * level;
   if (o.psnr_peak > 0) {
     out.settings.psnr_peak = o.psnr_peak;
   } else {

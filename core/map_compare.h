@@ -23,7 +23,8 @@ namespace rsibr {
 
 struct CompareOptions {
   std::string name_a = "A", name_b = "B";  // how errors name the inputs (file paths in the CLI)
-  // eps of the log error = this fraction of B's weighted mean over all pairs and channels.
+  // eps of the log error = this fraction of B's level: the weighted median over all pairs' texels
+  // of B's channel mean (robust to a sun); B's weighted mean where that median is 0, else A's, else 1.
   double log_epsilon_fraction = 1e-2;
   double psnr_peak = 0;            // > 0: this peak; 0: B's largest weighted value (the HDR peak)
   double view_tolerance_deg = 0.5;

@@ -124,6 +124,18 @@ TEST(MapCompare, MismatchedInputsAreErrorsThatNameTheInput) {
   expect_error(negative, a, "confidence");
 }
 
+TEST(MapCompare, LogEpsilonFollowsTheReferencesMedianNotASun) {
+  const MapSet a = normal_set(16);
+  MapSet sunny = normal_set(16);
+  for (MapView& v : sunny.views) v.rgb.at<cv::Vec3f>(8, 8) *= 1e6f;  // one texel per view
+  CompareOptions o;
+  o.fit = false;
+  const Comparison plain = compare_map_sets(a, a, o), sun = compare_map_sets(a, sunny, o);
+  EXPECT_NEAR(sun.settings.log_epsilon / plain.settings.log_epsilon, 1.0, 0.02);
+  EXPECT_GT(sun.settings.psnr_peak, 1e5);  // the PSNR's peak is the largest value, stated
+  EXPECT_GT(plain.settings.log_epsilon, 0.0);
+}
+
 TEST(MapCompare, EnvironmentsAreWeightedBySolidAngle) {
   EnvMap a = EnvMap::zeros(Layout::with_size(LayoutKind::LatLong, 32));
   a.pixels.setTo(cv::Scalar(1, 1, 1));
