@@ -22,13 +22,7 @@ class LogGainCost final : public ceres::SizedCostFunction<3, 3> {
  public:
   LogGainCost(const Texel& t, double eps) : t_(t), eps_(eps) {}
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const double* theta = parameters[0];
-    for (int c = 0; c < 3; ++c) {
-      const double ga = std::exp(theta[c]) * t_.a[std::size_t(c)];
-      residuals[c] = std::log(ga + eps_) - std::log(t_.b[std::size_t(c)] + eps_);
-      if (jacobians && jacobians[0])
-        for (int k = 0; k < 3; ++k) jacobians[0][3 * c + k] = k == c ? ga / (ga + eps_) : 0.0;
-    }
+    log_gain_residuals(parameters[0], t_.a.data(), t_.b.data(), eps_, residuals, jacobians ? jacobians[0] : nullptr);
     return true;
   }
 
@@ -50,6 +44,16 @@ double weighted_median(std::vector<std::pair<double, double>> values) {  // (val
 }
 
 }  // namespace
+
+void log_gain_residuals(const double theta[3], const double a[3], const double b[3], double eps, double residuals[3],
+                        double* jacobian) {
+  for (int c = 0; c < 3; ++c) {
+    const double ga = std::exp(theta[c]) * std::max(0.0, a[c]);
+    residuals[c] = std::log(ga + eps) - std::log(std::max(0.0, b[c]) + eps);
+    if (jacobian)
+      for (int k = 0; k < 3; ++k) jacobian[3 * c + k] = k == c ? ga / (ga + eps) : 0.0;
+  }
+}
 
 GainFit fit_gains(const std::vector<WeightedImages>& images, const GainFitOptions& options) {
   if (!(options.log_epsilon > 0) || !(options.loss_scale > 0))

@@ -46,6 +46,12 @@ struct GainFit {
 // Throws std::invalid_argument when no texel has weight. Single-threaded: same input, same bytes.
 GainFit fit_gains(const std::vector<WeightedImages>& images, const GainFitOptions& options);
 
+// One texel's residuals and their Jacobian (d residual_c / d theta_k, row-major 3x3; diagonal),
+// the cost the fit hands to Ceres: residual_c = ln(exp(theta_c) a'_c + eps) - ln(b'_c + eps).
+// jacobian may be null.
+void log_gain_residuals(const double theta[3], const double a[3], const double b[3], double eps, double residuals[3],
+                        double* jacobian);
+
 // Returns a copy of rgb (CV_32FC3) with channel c multiplied by gains[c].
 cv::Mat apply_gains(const cv::Mat& rgb, const std::array<double, 3>& gains);
 

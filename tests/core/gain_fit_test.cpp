@@ -19,6 +19,29 @@ cv::Mat reference_image(int n) {
   return b;
 }
 
+// The analytic Jacobian against central differences (separate from the value checks below).
+TEST(GainFit, ResidualJacobianMatchesFiniteDifferences) {
+  const double a[3] = {0.3, 2.5, 0.0}, b[3] = {0.7, 1.0, 0.2};
+  for (const double eps : {1e-3, 0.5})
+    for (const double t0 : {-2.0, 0.0, 1.5}) {
+      const double theta[3] = {t0, 0.3 - t0, 0.1};
+      double r[3], jac[9];
+      log_gain_residuals(theta, a, b, eps, r, jac);
+      const double h = 1e-6;
+      for (int k = 0; k < 3; ++k) {
+        double tp[3] = {theta[0], theta[1], theta[2]}, tm[3] = {theta[0], theta[1], theta[2]};
+        tp[k] += h;
+        tm[k] -= h;
+        double rp[3], rm[3];
+        log_gain_residuals(tp, a, b, eps, rp, nullptr);
+        log_gain_residuals(tm, a, b, eps, rm, nullptr);
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(jac[3 * c + k], (rp[c] - rm[c]) / (2 * h), 1e-8) << c << k;
+      }
+      EXPECT_NEAR(r[0], std::log(std::exp(t0) * 0.3 + eps) - std::log(0.7 + eps), 1e-15);
+      EXPECT_TRUE(std::isfinite(r[2]));  // a = 0: the residual is finite through eps
+    }
+}
+
 TEST(GainFit, RecoversAKnownGainExactlyOnNoiselessData) {
   const std::array<double, 3> truth{1.7, 0.6, 2.9};
   const cv::Mat b = reference_image(32);
