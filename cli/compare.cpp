@@ -94,7 +94,8 @@ int run_compare(const CompareArgs& a) {
   std::vector<cv::Mat> calibrated, errors, weights;
   for (const PairComparison& p : c.pairs) {
     calibrated.push_back(c.fit ? apply_gains(p.images.a, c.fit->gains) : p.images.a);
-    errors.push_back(log_error_image(calibrated.back(), p.images.b, p.images.weight, c.settings.log_epsilon));
+    errors.push_back(log_error_image(p.images.a, p.images.b, p.images.weight, c.settings.log_epsilon,
+                                     c.fit ? c.fit->gains : std::array<double, 3>{1, 1, 1}));
     weights.push_back(p.images.weight);
   }
   const double heat_max = a.heat_max > 0 ? a.heat_max : heat_scale_max(errors, weights);

@@ -23,7 +23,8 @@ class LogGainCost final : public ceres::SizedCostFunction<3, 3> {
   LogGainCost(const Texel& t, double eps) : t_(t), eps_(eps) {}
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     log_gain_residuals(parameters[0], t_.a.data(), t_.b.data(), eps_, residuals, jacobians ? jacobians[0] : nullptr);
-    return true;
+    // A step that overflows is refused (Ceres then shortens it), never propagated.
+    return std::isfinite(residuals[0]) && std::isfinite(residuals[1]) && std::isfinite(residuals[2]);
   }
 
  private:
@@ -88,14 +89,21 @@ GainFit fit_gains(const std::vector<WeightedImages>& images, const GainFitOption
   const double mean_weight = weight_sum / double(texels.size());
   const double eps = options.log_epsilon;
 
-  std::array<double, 3> theta{};
+  std::array<double, 3> theta{}, start{};
   for (int c = 0; c < 3; ++c) {
+    // Texels where both are positive give the ratio without eps, which matters when A is many
+    // stops off B (eps, from B's level, would swamp A); otherwise the eps form.
     std::vector<std::pair<double, double>> ratios;
     ratios.reserve(texels.size());
     for (const Texel& t : texels)
-      ratios.emplace_back(std::log((t.b[std::size_t(c)] + eps) / (t.a[std::size_t(c)] + eps)), t.weight);
+      if (t.a[std::size_t(c)] > 0 && t.b[std::size_t(c)] > 0)
+        ratios.emplace_back(std::log(t.b[std::size_t(c)] / t.a[std::size_t(c)]), t.weight);
+    if (ratios.empty())
+      for (const Texel& t : texels)
+        ratios.emplace_back(std::log((t.b[std::size_t(c)] + eps) / (t.a[std::size_t(c)] + eps)), t.weight);
     theta[std::size_t(c)] = weighted_median(std::move(ratios));
   }
+  start = theta;
 
   ceres::CauchyLoss cauchy(options.loss_scale);
   ceres::Problem problem;
@@ -116,13 +124,16 @@ GainFit fit_gains(const std::vector<WeightedImages>& images, const GainFitOption
   ceres::Solve(so, &problem, &summary);
 
   GainFit fit;
+  bool finite = true;
+  for (double t : theta) finite = finite && std::isfinite(t) && std::isfinite(std::exp(t)) && std::exp(t) > 0;
+  if (!finite) theta = start;  // the robust start is always finite
   for (int c = 0; c < 3; ++c) fit.gains[std::size_t(c)] = std::exp(theta[std::size_t(c)]);
   const double y = 0.2126 * fit.gains[0] + 0.7152 * fit.gains[1] + 0.0722 * fit.gains[2];
   fit.exposure_stops = std::log2(y);
   for (int c = 0; c < 3; ++c) fit.chroma[std::size_t(c)] = fit.gains[std::size_t(c)] / y;
   fit.texels_used = long(texels.size());
   fit.iterations = int(summary.iterations.size());
-  fit.converged = summary.termination_type == ceres::CONVERGENCE;
+  fit.converged = finite && summary.termination_type == ceres::CONVERGENCE;
   fit.initial_cost = summary.initial_cost;
   fit.final_cost = summary.final_cost;
   return fit;

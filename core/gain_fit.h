@@ -8,7 +8,8 @@
 // The log residual weighs a dark and a bright texel alike (HDR); eps is the log error's
 // (core/image_error.h). On noiseless data (b = g* a) every residual vanishes at g = g*, so the fit
 // recovers g* to the solver's tolerance. theta starts at each channel's weighted median of
-// ln((b'+eps)/(a'+eps)), which is already robust; the loss then refines it.
+// ln(b/a) over texels where both are positive (robust already, and right even when A is many
+// stops off B, where eps would flatten the cost); the loss then refines it.
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -30,13 +30,14 @@ void check_inputs(const cv::Mat& a, const cv::Mat& b, const cv::Mat& weight) {
     throw std::invalid_argument("error metrics: images and weight differ in size");
 }
 
-double log2_ratio(float a, float b, double eps) {
-  return std::log2((std::max(0.0, double(a)) + eps) / (std::max(0.0, double(b)) + eps));
+double log2_ratio(double a, double b, double eps) {
+  return std::log2((std::max(0.0, a) + eps) / (std::max(0.0, b) + eps));
 }
 
 }  // namespace
 
-ErrorSums error_sums(const cv::Mat& a, const cv::Mat& b, const cv::Mat& weight, const ErrorSettings& s) {
+ErrorSums error_sums(const cv::Mat& a, const cv::Mat& b, const cv::Mat& weight, const ErrorSettings& s,
+                     const std::array<double, 3>& g) {
   check_inputs(a, b, weight);
   std::vector<ErrorSums> rows(std::size_t(a.rows));
   parallel_for_rows(a.rows, [&](int r) {
@@ -50,8 +51,8 @@ ErrorSums error_sums(const cv::Mat& a, const cv::Mat& b, const cv::Mat& weight, 
       row.weight += w;
       ++row.texels;
       for (int c = 0; c < 3; ++c) {
-        const double av = pa[3 * x + c], bv = pb[3 * x + c];
-        const double l = log2_ratio(pa[3 * x + c], pb[3 * x + c], s.log_epsilon);
+        const double av = g[std::size_t(c)] * pa[3 * x + c], bv = pb[3 * x + c];
+        const double l = log2_ratio(av, bv, s.log_epsilon);
         row.squared_error += w * (av - bv) * (av - bv);
         row.squared_reference += w * bv * bv;
         row.squared_log += w * l * l;
@@ -87,7 +88,8 @@ ErrorMetrics error_metrics(const ErrorSums& s, const ErrorSettings& settings) {
   return m;
 }
 
-cv::Mat log_error_image(const cv::Mat& a, const cv::Mat& b, const cv::Mat& weight, double eps) {
+cv::Mat log_error_image(const cv::Mat& a, const cv::Mat& b, const cv::Mat& weight, double eps,
+                        const std::array<double, 3>& g) {
   check_inputs(a, b, weight);
   cv::Mat out(a.size(), CV_32FC1, cv::Scalar(0));
   parallel_for_rows(a.rows, [&](int r) {
@@ -99,7 +101,7 @@ cv::Mat log_error_image(const cv::Mat& a, const cv::Mat& b, const cv::Mat& weigh
       if (!(pw[x] > 0)) continue;
       double sum = 0;
       for (int c = 0; c < 3; ++c) {
-        const double l = log2_ratio(pa[3 * x + c], pb[3 * x + c], eps);
+        const double l = log2_ratio(g[std::size_t(c)] * pa[3 * x + c], pb[3 * x + c], eps);
         sum += l * l;
       }
       po[x] = float(std::sqrt(sum / 3));

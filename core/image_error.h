@@ -53,15 +53,18 @@ struct ErrorMetrics {
 
 // a, b: CV_32FC3 of one size; weight: CV_32FC1 of that size, finite and >= 0. The caller checks
 // that a and b are finite where weight > 0 (map_compare does). Rows are summed in parallel and
-// reduced in row order, so the result does not depend on the thread count.
-ErrorSums error_sums(const cv::Mat& a, const cv::Mat& b, const cv::Mat& weight, const ErrorSettings& settings);
+// reduced in row order, so the result does not depend on the thread count. gains_a multiply A's
+// channels first, in double precision (a fitted gain times a float near its maximum stays finite).
+ErrorSums error_sums(const cv::Mat& a, const cv::Mat& b, const cv::Mat& weight, const ErrorSettings& settings,
+                     const std::array<double, 3>& gains_a = {1, 1, 1});
 
 // Throws std::invalid_argument when no texel has weight, or when the reference is zero over the
 // weighted texels but A is not (the relative error has no scale); identical zeros give 0.
 ErrorMetrics error_metrics(const ErrorSums& sums, const ErrorSettings& settings);
 
 // The heat-map quantity per texel: sqrt( sum_c log2((a' + eps)/(b' + eps))^2 / 3 ), in stops,
-// as CV_32FC1; 0 where weight is 0.
-cv::Mat log_error_image(const cv::Mat& a, const cv::Mat& b, const cv::Mat& weight, double log_epsilon);
+// as CV_32FC1; 0 where weight is 0; A's channels times gains_a first.
+cv::Mat log_error_image(const cv::Mat& a, const cv::Mat& b, const cv::Mat& weight, double log_epsilon,
+                        const std::array<double, 3>& gains_a = {1, 1, 1});
 
 }  // namespace rsibr

@@ -206,7 +206,7 @@ Comparison compare_pairs(std::vector<PairComparison> pairs, const CompareOptions
       p.after = p.before;
       continue;
     }
-    const ErrorSums s = error_sums(apply_gains(p.images.a, out.fit->gains), p.images.b, p.images.weight, out.settings);
+    const ErrorSums s = error_sums(p.images.a, p.images.b, p.images.weight, out.settings, out.fit->gains);
     p.after = error_metrics(s, out.settings);
     after.merge(s);
   }

@@ -136,6 +136,29 @@ TEST(MapCompare, LogEpsilonFollowsTheReferencesMedianNotASun) {
   EXPECT_GT(plain.settings.log_epsilon, 0.0);
 }
 
+// Float extremes (the largest float, denormals, zeros, a huge gain) give finite metrics and gains.
+TEST(MapCompare, ExtremeValuesGiveFiniteMetrics) {
+  MapSet a = normal_set(8), b = normal_set(8);
+  for (MapView& v : a.views) {
+    v.rgb.at<cv::Vec3f>(3, 3) = cv::Vec3f(3.4e38f, 1e-44f, 0.f);
+    v.rgb.at<cv::Vec3f>(4, 4) = cv::Vec3f(0, 0, 0);
+    v.rgb *= 1e-30;  // A is 2^-100 times darker: the fitted gain is huge
+    v.rgb.at<cv::Vec3f>(3, 4) = cv::Vec3f(3.4e38f, 3.4e38f, 3.4e38f);
+  }
+  for (MapView& v : b.views) v.rgb.at<cv::Vec3f>(5, 5) = cv::Vec3f(3.4e38f, 0.f, 1e-44f);
+  const Comparison c = compare_map_sets(a, b, CompareOptions{});
+  for (const ErrorMetrics* m : {&c.before, &c.after, &c.pairs[2].before, &c.pairs[2].after}) {
+    EXPECT_TRUE(std::isfinite(m->relative_rms));
+    EXPECT_TRUE(std::isfinite(m->log_rms_stops));
+    EXPECT_TRUE(std::isfinite(m->psnr_db));
+    EXPECT_TRUE(std::isfinite(m->mse));
+  }
+  for (double g : c.fit->gains) {
+    EXPECT_TRUE(std::isfinite(g));
+    EXPECT_NEAR(std::log10(g), 30, 0.1);  // the outlier texels do not move it
+  }
+}
+
 TEST(MapCompare, EnvironmentsAreWeightedBySolidAngle) {
   EnvMap a = EnvMap::zeros(Layout::with_size(LayoutKind::LatLong, 32));
   a.pixels.setTo(cv::Scalar(1, 1, 1));
