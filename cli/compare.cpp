@@ -225,7 +225,7 @@ Runner add_compare(CLI::App& app) {
       "log2((a+eps)/(b+eps)), eps = --log-eps x B's weighted median level; PSNR against B's largest weighted value "
       "(or --psnr-peak), capped at 144.5 dB (float32). Each is reported before and after a global gain fit "
       "g_c a_c ~ b_c (Ceres, Cauchy loss) that separates exposure and white balance from errors of shape.\n"
-      "--out DIR gets view.NNN.png (A x gains | B | heat map of the log2 error after the fit, with a scale "
+      "--out DIR gets view.NNN.png or environment.png (A x gains | B | heat map of the log2 error after the fit, with a scale "
       "bar) and contact.png, all or nothing. Exit status: 0 done, 3 when --fail-above is exceeded, other "
       "non-zero values on errors.\n"
       "Example: rsibr compare captured.exr computed.exr --out cmp --json cmp.json");

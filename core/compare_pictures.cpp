@@ -34,9 +34,17 @@ int text_width(const std::string& text) {
   return cv::getTextSize(text, kFont, kFontScale, 1, &base).width;
 }
 
-cv::Mat magnify(const cv::Mat& img, int factor) {
-  if (factor <= 1) return img;
+// Magnifies by an integer factor (nearest texel: texels stay visible), or shrinks by area
+// averaging so that the longer side is at most max_side.
+cv::Mat fit_panel(const cv::Mat& img, int factor, int max_side) {
   cv::Mat out;
+  if (std::max(img.cols, img.rows) > max_side) {
+    const double s = double(max_side) / std::max(img.cols, img.rows);
+    cv::resize(img, out, cv::Size(std::max(1, int(img.cols * s)), std::max(1, int(img.rows * s))), 0, 0,
+               cv::INTER_AREA);
+    return out;
+  }
+  if (factor <= 1) return img;
   cv::resize(img, out, cv::Size(img.cols * factor, img.rows * factor), 0, 0, cv::INTER_NEAREST);
   return out;
 }
@@ -97,12 +105,12 @@ double heat_scale_max(const std::vector<cv::Mat>& errors, const std::vector<cv::
   return 10 * decade;
 }
 
-cv::Mat side_by_side(const SideBySideInput& in, int min_panel) {
+cv::Mat side_by_side(const SideBySideInput& in, int min_panel, int max_panel) {
   const int w = in.a_rgb.cols, h = in.a_rgb.rows;
   const int factor = std::max(1, (min_panel + std::max(w, h) - 1) / std::max(w, h));
-  const cv::Mat a = magnify(display_encode(in.a_rgb, in.exposure_stops), factor);
-  const cv::Mat b = magnify(display_encode(in.b_rgb, in.exposure_stops), factor);
-  const cv::Mat heat = magnify(heat_map_bgr(in.error, in.weight, in.heat_max), factor);
+  const cv::Mat a = fit_panel(display_encode(in.a_rgb, in.exposure_stops), factor, max_panel);
+  const cv::Mat b = fit_panel(display_encode(in.b_rgb, in.exposure_stops), factor, max_panel);
+  const cv::Mat heat = fit_panel(heat_map_bgr(in.error, in.weight, in.heat_max), factor, max_panel);
   const int pw = a.cols, ph = a.rows;
   const int bar_h = 12, ticks_h = 18;
   const int width = 3 * pw + 4 * kGap;

@@ -38,8 +38,9 @@ struct SideBySideInput {
 };
 
 // [title] / A | B | heat / colour bar with ticks 0, max/2, max under the heat map. Small maps are
-// magnified (nearest texel) to at least min_panel pixels a side.
-cv::Mat side_by_side(const SideBySideInput& in, int min_panel = 192);
+// magnified (nearest texel) to at least min_panel pixels a side; large ones shrunk (area
+// average) to at most max_panel.
+cv::Mat side_by_side(const SideBySideInput& in, int min_panel = 192, int max_panel = 768);
 
 // The panels in a grid (ceil(sqrt(n)) columns), each scaled to the width of the widest thumbnail
 // (thumb_width pixels), on a dark background.

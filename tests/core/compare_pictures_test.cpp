@@ -61,6 +61,12 @@ TEST(ComparePictures, SideBySideHasThreePanelsAndAScaleBar) {
   EXPECT_EQ(centre, colour_bar_bgr(256, 1).at<cv::Vec3b>(0, 128));
   const cv::Mat sheet = contact_sheet({out, out, out}, 100);
   EXPECT_EQ(sheet.cols, 2 * (100 + gap) + gap);
+  // A large map is shrunk to the panel limit.
+  in.a_rgb = cv::Mat(40, 80, CV_32FC3, cv::Scalar(0.18, 0.18, 0.18));
+  in.b_rgb = in.a_rgb.clone();
+  in.error = cv::Mat(40, 80, CV_32FC1, cv::Scalar(0.25));
+  in.weight = cv::Mat(40, 80, CV_32FC1, cv::Scalar(1));
+  EXPECT_EQ(side_by_side(in, 8, 20).cols, 3 * 20 + 4 * gap);
 }
 
 TEST(ComparePictures, AutoExposurePutsTheMeanAtMidGrey) {
