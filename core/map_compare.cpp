@@ -129,7 +129,7 @@ std::vector<std::pair<int, int>> match_views(const MapSet& a, const MapSet& b, c
 Comparison compare_pairs(std::vector<PairComparison> pairs, const CompareOptions& o) {
   if (pairs.empty()) throw std::invalid_argument(o.name_a + ": nothing to compare");
   double sum_b = 0, sum_a = 0, weight = 0, peak = 0;
-  std::vector<std::pair<float, float>> levels;  // (B's channel mean, weight) per weighted texel
+  std::vector<std::pair<double, double>> levels;  // (B's channel mean, weight) per weighted texel
   for (const PairComparison& p : pairs) {
     const WeightedImages& im = p.images;
     if (im.a.size() != im.b.size())
@@ -149,11 +149,12 @@ Comparison compare_pairs(std::vector<PairComparison> pairs, const CompareOptions
       const float* pw = im.weight.ptr<float>(r);
       for (int x = 0; x < im.a.cols; ++x) {
         if (!(pw[x] > 0)) continue;
-        weight += pw[x];
-        levels.emplace_back(std::max(0.f, (pb[3 * x] + pb[3 * x + 1] + pb[3 * x + 2]) / 3), pw[x]);
+        const double w = pw[x];  // double: a weight > 1 times a float near its maximum stays finite
+        weight += w;
+        levels.emplace_back(std::max(0.0, (double(pb[3 * x]) + pb[3 * x + 1] + pb[3 * x + 2]) / 3), w);
         for (int c = 0; c < 3; ++c) {
-          sum_a += pw[x] * std::max(0.f, pa[3 * x + c]);
-          sum_b += pw[x] * std::max(0.f, pb[3 * x + c]);
+          sum_a += w * std::max(0.0, double(pa[3 * x + c]));
+          sum_b += w * std::max(0.0, double(pb[3 * x + c]));
         }
       }
     }
@@ -189,7 +190,7 @@ Comparison compare_pairs(std::vector<PairComparison> pairs, const CompareOptions
     try {
       p.before = error_metrics(s, out.settings);
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(o.name_b + ": " + p.name + ": " + e.what());
+      throw std::invalid_argument(o.name_a + " against " + o.name_b + ": " + p.name + ": " + e.what());
     }
     before.merge(s);
   }

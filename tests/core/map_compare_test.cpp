@@ -145,7 +145,12 @@ TEST(MapCompare, ExtremeValuesGiveFiniteMetrics) {
     v.rgb *= 1e-30;  // A is 2^-100 times darker: the fitted gain is huge
     v.rgb.at<cv::Vec3f>(3, 4) = cv::Vec3f(3.4e38f, 3.4e38f, 3.4e38f);
   }
-  for (MapView& v : b.views) v.rgb.at<cv::Vec3f>(5, 5) = cv::Vec3f(3.4e38f, 0.f, 1e-44f);
+  for (MapView& v : b.views) {
+    v.rgb.at<cv::Vec3f>(5, 5) = cv::Vec3f(3.4e38f, 0.f, 1e-44f);
+    v.rgb.at<cv::Vec3f>(2, 5) = cv::Vec3f(3.4e38f, 3.4e38f, 3.4e38f);  // a float sum would overflow
+    v.confidence = cv::Mat(8, 8, CV_32FC1, cv::Scalar(1));
+    v.confidence.at<float>(2, 5) = 3.f;  // and so would weight times value in float
+  }
   const Comparison c = compare_map_sets(a, b, CompareOptions{});
   for (const ErrorMetrics* m : {&c.before, &c.after, &c.pairs[2].before, &c.pairs[2].after}) {
     EXPECT_TRUE(std::isfinite(m->relative_rms));
@@ -156,6 +161,25 @@ TEST(MapCompare, ExtremeValuesGiveFiniteMetrics) {
   for (double g : c.fit->gains) {
     EXPECT_TRUE(std::isfinite(g));
     EXPECT_NEAR(std::log10(g), 30, 0.1);  // the outlier texels do not move it
+  }
+}
+
+// B black but for a few texels at the float maximum (its median is 0, so eps comes from its mean,
+// which must be summed in double): finite metrics.
+TEST(MapCompare, AMostlyBlackReferenceWithHugeTexelsGivesFiniteMetrics) {
+  MapSet a = normal_set(8), b = normal_set(8);
+  for (MapView& v : b.views) {
+    v.rgb.setTo(cv::Scalar(0, 0, 0));
+    v.rgb.at<cv::Vec3f>(3, 3) = cv::Vec3f(3.4e38f, 3.4e38f, 3.4e38f);
+    v.confidence = cv::Mat(8, 8, CV_32FC1, cv::Scalar(1));
+    v.confidence.at<float>(3, 3) = 4.f;
+  }
+  const Comparison c = compare_map_sets(a, b, CompareOptions{});
+  EXPECT_TRUE(std::isfinite(c.settings.log_epsilon) && c.settings.log_epsilon > 0);
+  for (const ErrorMetrics* m : {&c.before, &c.after}) {
+    EXPECT_TRUE(std::isfinite(m->relative_rms));
+    EXPECT_TRUE(std::isfinite(m->log_rms_stops));
+    EXPECT_TRUE(std::isfinite(m->psnr_db));
   }
 }
 
