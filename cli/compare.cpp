@@ -156,6 +156,8 @@ int run_compare(const CompareArgs& a) {
       jv["b_part"] = p.index_b;
       jv["view"] = {p.view.x(), p.view.y(), p.view.z()};
       jv["angle_deg"] = p.angle_deg;
+      jv["frame_angle_deg"] = p.frame_angle_deg;
+      jv["b_resampled_to_a_frame"] = p.b_resampled;
     }
     if (!a.out.empty()) {
       SideBySideInput in;
@@ -218,7 +220,8 @@ Runner add_compare(CLI::App& app) {
   CLI::App* c = app.add_subcommand("compare", "Compare two map sets (captured vs computed) or two environments");
   c->footer(
       "B is the reference. Map sets: views are paired by direction (every view of the smaller set needs a view "
-      "of the other within --view-tolerance, in the same frame); texels count inside the sphere-map disc, "
+      "of the other within --view-tolerance; where the frames differ, e.g. a captured view's roll, B is resampled "
+      "into A's frame); texels count inside the sphere-map disc, "
       "weighted by each map's confidence channel. Environments: same layout and size; sphere layouts weigh the "
       "disc, others solid angle.\n"
       "Metrics per view and overall: relative RMS sqrt(sum w|a-b|^2 / sum w|b|^2); log RMS in stops of "

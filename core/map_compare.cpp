@@ -2,6 +2,8 @@
 
 #include "core/sphere_map.h"
 
+#include <opencv2/imgproc.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
@@ -110,17 +112,6 @@ std::vector<std::pair<int, int>> match_views(const MapSet& a, const MapSet& b, c
       throw std::invalid_argument(small_name + ": " + part_name(int(i)) + " and " + part_name(used[std::size_t(best)]) +
                                   " both match " + large_name + "'s " + part_name(best) + "; the sets do not match");
     used[std::size_t(best)] = int(i);
-    // Same frame about the view: the angle between the x axes (a rotated map would compare texels
-    // of different normals).
-    const Vec3 xs = v.world_from_view.col(0), xl = large.views[std::size_t(best)].world_from_view.col(0);
-    const double twist = angle_between(xs, xl);
-    if (twist > tol + std::max(0.0, best_angle)) {
-      std::ostringstream s;
-      s << std::setprecision(3) << small_name << ": " << part_name(int(i)) << " is rotated by " << twist * 180 / kPi
-        << " degrees about its view against " << large_name << "'s " << part_name(best)
-        << " (world_from_view differs); the maps are not comparable texel by texel";
-      throw std::invalid_argument(s.str());
-    }
     pairs.emplace_back(a_smaller ? int(i) : best, a_smaller ? best : int(i));
   }
   return pairs;
@@ -216,6 +207,36 @@ Comparison compare_pairs(std::vector<PairComparison> pairs, const CompareOptions
   return out;
 }
 
+Reframed reframe(const MapView& view, const Mat3& world_from_view) {
+  const int w = view.rgb.cols, h = view.rgb.rows;
+  // Texel p of the target frame has normal n = world_from_view g_normal(p); in the source frame
+  // n_s = source_from_world n, found at the disc point (n_s.x, n_s.y) when n_s.z >= 0.
+  const Mat3 source_from_target = view.world_from_view.transpose() * world_from_view;
+  cv::Mat map_x(h, w, CV_32FC1), map_y(h, w, CV_32FC1);
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c) {
+      const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), w, h);
+      Vec2 src(-10, -10);  // outside the image: constant border
+      if (xy.squaredNorm() < 1.0) {
+        const Vec3 n = source_from_target * sphere_map::g_normal(xy);
+        if (n.z() >= 0) src = sphere_map::pixel_from_disc(Vec2(n.x(), n.y()), w, h);
+      }
+      map_x.at<float>(r, c) = float(src.x());
+      map_y.at<float>(r, c) = float(src.y());
+    }
+  Reframed out;
+  cv::remap(view.rgb, out.rgb, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0, 0, 0));
+  if (!view.confidence.empty())
+    cv::remap(view.confidence, out.confidence, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+  // Valid where every bilinear tap lies on a texel of the source's disc.
+  cv::Mat covered;
+  cv::remap(sphere_map_weight(w, h), covered, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+  out.valid = cv::Mat(h, w, CV_32FC1);
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c) out.valid.at<float>(r, c) = covered.at<float>(r, c) > 0.9999f ? 1.f : 0.f;
+  return out;
+}
+
 Comparison compare_map_sets(const MapSet& a, const MapSet& b, const CompareOptions& o) {
   if (a.views.empty() || b.views.empty()) throw std::invalid_argument(o.name_a + ": a map set without views");
   if (a.width() != b.width() || a.height() != b.height())
@@ -238,7 +259,19 @@ Comparison compare_map_sets(const MapSet& a, const MapSet& b, const CompareOptio
     p.angle_deg = angle_between(va.view, vb.view) * 180 / kPi;
     if (!va.confidence.empty()) check_confidence(va.confidence, o.name_a + ": " + part_name(i) + " confidence");
     if (!vb.confidence.empty()) check_confidence(vb.confidence, o.name_b + ": " + part_name(j) + " confidence");
-    p.images = {va.rgb, vb.rgb, sphere_map_weight(va.rgb.cols, va.rgb.rows, va.confidence, vb.confidence)};
+    // Frames that differ (a captured view's roll about its axis, or the small tilt of views paired
+    // within the tolerance): B is resampled into A's frame; otherwise texels are compared as stored.
+    const Mat3 b_from_a = vb.world_from_view.transpose() * va.world_from_view;
+    p.frame_angle_deg = Eigen::AngleAxisd(b_from_a).angle() * 180 / kPi;
+    if ((vb.world_from_view - va.world_from_view).cwiseAbs().maxCoeff() > 1e-6) {
+      const Reframed rb = reframe(vb, va.world_from_view);
+      p.b_resampled = true;
+      cv::Mat weight = sphere_map_weight(va.rgb.cols, va.rgb.rows, va.confidence, rb.confidence);
+      cv::multiply(weight, rb.valid, weight);
+      p.images = {va.rgb, rb.rgb, weight};
+    } else {
+      p.images = {va.rgb, vb.rgb, sphere_map_weight(va.rgb.cols, va.rgb.rows, va.confidence, vb.confidence)};
+    }
     pairs.push_back(std::move(p));
   }
   return compare_pairs(std::move(pairs), o);

@@ -2,8 +2,9 @@
 // any two), a map set and a one-view map set, or two environments. B is the reference.
 //
 // Views are paired by direction: every view of the smaller set must have a view of the other set
-// within the tolerance (and the same frame about it: the maps are not rotated against each
-// other); the pairs are compared. Texel weights: sphere maps count the texels whose centres lie
+// within the tolerance; the pairs are compared. Where a pair's frames differ (a captured view's
+// roll about its axis, the small tilt allowed by the tolerance), B is resampled into A's frame
+// (bilinear; texels whose taps leave B's disc get no weight). Texel weights: sphere maps count the texels whose centres lie
 // inside the unit disc (image-plane area, as the camera sees the ball), times the confidence of
 // each map that has one (captured maps); environments in other layouts weigh texels by solid
 // angle. Metrics (core/image_error.h) per pair and pooled over all pairs, before and after the
@@ -37,7 +38,9 @@ struct PairComparison {
   int index_a = 0, index_b = 0;
   Vec3 view = Vec3::Zero();  // A's view direction (zero for an environment)
   double angle_deg = 0;      // between A's and B's view directions
-  WeightedImages images;     // A as read, B, the weights
+  double frame_angle_deg = 0;  // rotation between A's and B's frames (roll and tilt)
+  bool b_resampled = false;    // B was resampled into A's frame
+  WeightedImages images;     // A as read, B (in A's frame), the weights
   ErrorMetrics before, after;
 };
 
@@ -56,8 +59,17 @@ cv::Mat sphere_map_weight(int width, int height, const cv::Mat& confidence_a = {
 cv::Mat solid_angle_weight(const Layout& layout);
 
 // Pairs (index in a, index in b) of matching views, in the smaller set's order. Throws
-// std::invalid_argument("<name>: view.NNN ... ") when a view has no partner or the frames differ.
+// std::invalid_argument("<name>: view.NNN ... ") when a view has no partner within the tolerance
+// or two views share one.
 std::vector<std::pair<int, int>> match_views(const MapSet& a, const MapSet& b, const CompareOptions& options);
+
+// A view's map (and confidence) resampled into another frame about nearly the same view:
+// texel p gets the source's value at the normal world_from_view * g_normal(p), bilinearly; valid
+// is 1 where all taps lie on source texels inside the disc, 0 elsewhere (CV_32FC1).
+struct Reframed {
+  cv::Mat rgb, confidence, valid;
+};
+Reframed reframe(const MapView& view, const Mat3& world_from_view);
 
 // Compares prepared pairs. Throws std::invalid_argument naming the input and the pair for
 // mismatched sizes, non-finite pixels or invalid weights where weight > 0, and no weight at all.
