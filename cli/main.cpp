@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   runners["render"] = rsibr::cli::add_render(app);
   runners["view"] = rsibr::cli::add_view(app);
   runners["hdr"] = rsibr::cli::add_hdr(app);
+  runners["compare"] = rsibr::cli::add_compare(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -18,5 +18,6 @@ Runner add_reference(CLI::App& app);
 Runner add_render(CLI::App& app);
 Runner add_view(CLI::App& app);
 Runner add_hdr(CLI::App& app);
+Runner add_compare(CLI::App& app);
 
 }  // namespace rsibr::cli

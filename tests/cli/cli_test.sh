@@ -25,7 +25,7 @@ expect_error() {
 }
 no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
 
-for verb in convert info pattern blend bake reference render view hdr; do
+for verb in convert info pattern blend bake reference render view hdr compare; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
 done
 check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
@@ -295,6 +295,35 @@ assert j['response']['model'] == 'identity' and v['bit_depth'] == 16, j['respons
 assert 80 < v['radiance_max'] < 101, v['radiance_max']"
 check "hdr: no output after errors" test ! -e "$work/hdr3"
 check "hdr: no staging folders left" bash -c "! ls -A '$work/hdr' '$work/hdr2' '$work/hdr4' | grep -q rsibr-hdr"
+# compare: metrics, the gain fit, pictures, errors (map sets and environments).
+printf 'type: lambert\nalbedo: [0.36, 0.18, 0.09]\n' >"$work/tinted.yaml"
+"$rsibr" bake --env "$work/sky.exr" --brdf "$work/tinted.yaml" --views icosa --res 16 --method sh -q "$work/tinted.exr"
+"$rsibr" compare "$work/grey.exr" "$work/grey.exr" -q --json "$work/cmp-same.json"
+check "compare: identical sets give zero error and the capped PSNR" python3 -c "import json; j=json.load(open('$work/cmp-same.json')); o=j['overall']; assert o['before']['relative_rms'] == 0 and o['before']['log_rms_stops'] == 0 and o['before']['psnr_capped'] and 144 < o['before']['psnr_db'] < 145 and len(j['views']) == 12, o"
+"$rsibr" compare "$work/tinted.exr" "$work/grey.exr" -q --json "$work/cmp-tint.json" --out "$work/cmp"
+check "compare: the fit recovers the albedo ratio as gains" python3 -c "import json; j=json.load(open('$work/cmp-tint.json')); g=j['fit']['gains']; assert all(abs(a/b-1) < 1e-4 for a,b in zip(g,[0.5,1,2])) and j['overall']['before']['log_rms_stops'] > 0.5 and j['overall']['after']['log_rms_stops'] < 1e-4, j['fit']"
+check "compare --out: a picture per view and a contact sheet" bash -c "test \$(ls '$work/cmp' | grep -c '^view\.0[0-9][0-9]\.png$') -eq 12 -a -s '$work/cmp/contact.png'"
+check "compare --out: the JSON names the pictures and the heat scale" python3 -c "import json,os; j=json.load(open('$work/cmp-tint.json')); assert all(os.path.exists(v['picture']) for v in j['views']) and j['heat_map']['colormap'] == 'viridis' and j['heat_map']['max'] > 0, j['heat_map']"
+"$rsibr" compare "$work/tinted.exr" "$work/grey.exr" -q --json "$work/cmp-tint2.json" --out "$work/cmp2"
+check "compare: same inputs, same bytes" bash -c "cmp -s '$work/cmp/contact.png' '$work/cmp2/contact.png' && cmp -s '$work/cmp/view.007.png' '$work/cmp2/view.007.png' && diff <(sed 's/cmp2/cmp/' '$work/cmp-tint2.json') '$work/cmp-tint.json' >/dev/null"
+check "compare --json - is pure JSON" bash -c "'$rsibr' compare '$work/grey.exr' '$work/tinted.exr' --json - 2>/dev/null | python3 -m json.tool >/dev/null"
+"$rsibr" compare "$work/tinted.exr" "$work/grey.exr" -q --no-fit --fail-above 0.1 2>"$work/fail-above.err"
+check "compare --fail-above: exit status 3 and one line" test $? -eq 3 -a "$(wc -l <"$work/fail-above.err")" -eq 1
+"$rsibr" compare "$work/novel.exr" "$work/novel.exr" -q --json "$work/cmp-novel.json"
+check "compare: a one-view set with confidence" python3 -c "import json; j=json.load(open('$work/cmp-novel.json')); assert len(j['views']) == 1 and j['overall']['after']['relative_rms'] == 0, j"
+"$rsibr" compare "$work/sky.exr" "$work/sky.exr" -q --json "$work/env-cmp.json"
+check "compare: two environments" python3 -c "import json; j=json.load(open('$work/env-cmp.json')); assert j['kind'] == 'environment' and j['overall']['before']['relative_rms'] == 0, j"
+"$rsibr" bake --env "$work/sky.exr" --brdf "$work/grey.yaml" --views octa --res 16 --method sh -q "$work/grey-octa.exr"
+expect_error "compare: sizes differ" "sizes must match" compare "$work/grey.exr" "$work/mirror.exr" --out "$work/cmp-e1"
+expect_error "compare: views differ" "has no view in" compare "$work/grey-octa.exr" "$work/grey.exr" --out "$work/cmp-e2"
+expect_error "compare: a one-view set off the other's views" "novel.exr: view.000" compare "$work/novel.exr" "$work/mirror.exr" --out "$work/cmp-e3"
+expect_error "compare: map set against an environment" "sky.exr" compare "$work/sky.exr" "$work/grey.exr" --out "$work/cmp-e4"
+expect_error "compare: environment layouts differ" "layout" compare "$work/sky.exr" "$work/octahedral.exr" --out "$work/cmp-e5"
+expect_error "compare: output folder's parent missing" "nofolder" compare "$work/grey.exr" "$work/grey.exr" --out "$work/nofolder/cmp"
+expect_error "compare: --out names an input" "not a folder" compare "$work/grey.exr" "$work/tinted.exr" --out "$work/grey.exr"
+expect_error "compare: missing input" "missing.exr" compare "$work/grey.exr" "$work/missing.exr"
+check "compare: no output after errors" bash -c "! ls -A '$work' | grep -q -e '^cmp-e' -e '^\.cmp'"
+check "compare: no temporaries" no_temporaries "$work"
 
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -1,0 +1,260 @@
+// rsibr compare: two map sets (captured against computed, or any two), or two environments;
+// metrics per view and overall before and after a global exposure / white-balance fit, heat maps
+// and side-by-side pictures.
+#include "cli/summary.h"
+#include "cli/verbs.h"
+
+#include "core/atomic_file.h"
+#include "core/atomic_folder.h"
+#include "core/compare_pictures.h"
+#include "core/exr_io.h"
+#include "core/map_compare.h"
+#include "core/progress.h"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+namespace rsibr::cli {
+namespace {
+
+struct CompareArgs {
+  std::string a, b, out, json, layout;
+  bool no_fit = false, quiet = false;
+  double log_eps = 1e-2, psnr_peak = 0, view_tolerance = 0.5, loss_scale = 0.1, heat_max = 0, fail_above = 0;
+  float exposure = NAN;
+  long fit_texels = 1 << 17;
+};
+
+nlohmann::json metrics_json(const ErrorMetrics& m) {
+  return {{"relative_rms", m.relative_rms}, {"log_rms_stops", m.log_rms_stops}, {"psnr_db", m.psnr_db},
+          {"psnr_capped", m.psnr_capped},   {"mse", m.mse},                     {"mean_a", m.mean_a},
+          {"mean_b", m.mean_b}};
+}
+
+std::string direction_text(const Vec3& v) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(3) << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
+  return s.str();
+}
+
+std::string metrics_text(const ErrorMetrics& m) {
+  std::ostringstream s;
+  s << std::setprecision(4) << "rel RMS " << std::setw(10) << m.relative_rms << "  log RMS " << std::setw(10)
+    << m.log_rms_stops << " stops  PSNR " << std::setprecision(4) << std::setw(7) << m.psnr_db << " dB"
+    << (m.psnr_capped ? " (cap)" : "");
+  return s.str();
+}
+
+std::vector<unsigned char> encode_png(const cv::Mat& bgr, const std::string& name) {
+  std::vector<unsigned char> bytes;
+  if (!cv::imencode(".png", bgr, bytes)) throw std::runtime_error(name + ": cannot encode the PNG");
+  return bytes;
+}
+
+int run_compare(const CompareArgs& a) {
+  namespace fs = std::filesystem;
+  if (!a.out.empty()) check_output_folder(a.out, {a.a, a.b});
+  if (!a.json.empty() && a.json != "-") check_output_path(a.json, {a.a, a.b});
+
+  CompareOptions o;
+  o.name_a = a.a;
+  o.name_b = a.b;
+  o.log_epsilon_fraction = a.log_eps;
+  o.psnr_peak = a.psnr_peak;
+  o.view_tolerance_deg = a.view_tolerance;
+  o.fit = !a.no_fit;
+  o.fit_options.loss_scale = a.loss_scale;
+  o.fit_options.max_texels = a.fit_texels;
+
+  const bool set_a = is_map_set_file(a.a), set_b = is_map_set_file(a.b);
+  if (set_a != set_b)
+    throw std::invalid_argument((set_a ? a.b : a.a) + ": is an environment but " + (set_a ? a.a : a.b) +
+                                " is a map set; compare a map set with a map set, an environment with an environment");
+  Comparison c;
+  std::string kind;
+  if (set_a) {
+    kind = "map set";
+    c = compare_map_sets(read_map_set(a.a), read_map_set(a.b), o);
+  } else {
+    kind = "environment";
+    const std::optional<LayoutKind> hint =
+        a.layout.empty() ? std::nullopt : std::optional<LayoutKind>(parse_layout_kind(a.layout));
+    EnvReadReport ra, rb;
+    const EnvMap ea = read_environment(a.a, hint, &ra), eb = read_environment(a.b, hint, &rb);
+    c = compare_environments(ea, eb, o);
+  }
+
+  // Heat maps of the error after the fit (the errors of shape), one scale for every view.
+  std::vector<cv::Mat> calibrated, errors, weights;
+  for (const PairComparison& p : c.pairs) {
+    calibrated.push_back(c.fit ? apply_gains(p.images.a, c.fit->gains) : p.images.a);
+    errors.push_back(log_error_image(p.images.a, p.images.b, p.images.weight, c.settings.log_epsilon,
+                                     c.fit ? c.fit->gains : std::array<double, 3>{1, 1, 1}));
+    weights.push_back(p.images.weight);
+  }
+  const double heat_max = a.heat_max > 0 ? a.heat_max : heat_scale_max(errors, weights);
+  const float exposure =
+      std::isfinite(a.exposure) ? a.exposure : auto_exposure(c.before.mean_b[0], c.before.mean_b[1], c.before.mean_b[2]);
+
+  nlohmann::json j;
+  j["a"] = a.a;
+  j["b"] = a.b;
+  j["kind"] = kind;
+  j["settings"] = {{"log_epsilon", c.settings.log_epsilon},
+                   {"log_epsilon_fraction_of_median_b", a.log_eps},
+                   {"psnr_peak", c.settings.psnr_peak},
+                   {"psnr_peak_source", a.psnr_peak > 0 ? "--psnr-peak" : "largest weighted value of B"},
+                   {"psnr_cap_db", kPsnrCapDb},
+                   {"view_tolerance_deg", a.view_tolerance},
+                   {"weights", kind == "map set" ? "texel centre inside the disc x confidence of A and B"
+                                                 : "sphere layout: disc; other layouts: texel solid angle"}};
+  j["overall"] = {{"before", metrics_json(c.before)}, {"after", metrics_json(c.after)},
+                  {"texels", c.before.texels}, {"weight", c.before.weight}};
+  if (c.fit) {
+    j["fit"] = {{"gains", c.fit->gains},
+                {"exposure_stops", c.fit->exposure_stops},
+                {"chroma", c.fit->chroma},
+                {"model", "g_c a_c ~ b_c; residual ln(g a' + eps) - ln(b' + eps); Cauchy loss"},
+                {"loss_scale", a.loss_scale},
+                {"texels_used", c.fit->texels_used},
+                {"iterations", c.fit->iterations},
+                {"converged", c.fit->converged},
+                {"initial_cost", c.fit->initial_cost},
+                {"final_cost", c.fit->final_cost}};
+  } else {
+    j["fit"] = nullptr;
+  }
+  j["heat_map"] = {{"quantity", std::string("sqrt(mean over R,G,B of log2((a' + eps)/(b' + eps))^2), A ") +
+                                    (c.fit ? "after the fit" : "as read")},
+                   {"unit", "stops"},
+                   {"colormap", "viridis"},
+                   {"min", 0.0},
+                   {"max", heat_max},
+                   {"ticks", {0.0, 0.5 * heat_max, heat_max}},
+                   {"no_weight_colour_rgb", {kNoWeightColour[2], kNoWeightColour[1], kNoWeightColour[0]}},
+                   {"display_exposure_stops", exposure}};
+
+  FolderContents files;
+  std::vector<cv::Mat> panels;
+  nlohmann::json views = nlohmann::json::array();
+  auto bar = std::make_shared<Progress>("compare", !a.quiet && Progress::stderr_is_terminal());
+  for (std::size_t i = 0; i < c.pairs.size(); ++i) {
+    const PairComparison& p = c.pairs[i];
+    nlohmann::json jv = {{"name", p.name},
+                         {"texels", p.before.texels},
+                         {"weight", p.before.weight},
+                         {"before", metrics_json(p.before)},
+                         {"after", metrics_json(p.after)}};
+    if (kind == "map set") {
+      jv["a_part"] = p.index_a;
+      jv["b_part"] = p.index_b;
+      jv["view"] = {p.view.x(), p.view.y(), p.view.z()};
+      jv["angle_deg"] = p.angle_deg;
+      jv["frame_angle_deg"] = p.frame_angle_deg;
+      jv["b_resampled_to_a_frame"] = p.b_resampled;
+    }
+    if (!a.out.empty()) {
+      SideBySideInput in;
+      in.a_rgb = calibrated[i];
+      in.b_rgb = p.images.b;
+      in.error = errors[i];
+      in.weight = p.images.weight;
+      in.exposure_stops = exposure;
+      in.heat_max = heat_max;
+      in.title = p.name + (kind == "map set" ? "  view " + direction_text(p.view) : "") + "   log RMS " +
+                 std::to_string(p.after.log_rms_stops).substr(0, 6) + " stops";
+      in.a_label = c.fit ? "A x fitted gains" : "A";
+      in.heat_label = "log2 error";
+      const cv::Mat panel = side_by_side(in);
+      const std::string name = p.name + ".png";
+      files[name] = encode_png(panel, (fs::path(a.out) / name).string());
+      jv["picture"] = (fs::path(a.out) / name).string();
+      panels.push_back(panel);
+    }
+    views.push_back(jv);
+    bar->update(double(i + 1) / double(c.pairs.size()));
+  }
+  bar->done();
+  j["views"] = views;
+  if (!a.out.empty()) {
+    files["contact.png"] = encode_png(contact_sheet(panels), (fs::path(a.out) / "contact.png").string());
+    j["contact_sheet"] = (fs::path(a.out) / "contact.png").string();
+    write_folder_atomically(a.out, files);
+  }
+
+  std::ostream& text = a.json == "-" ? std::cerr : std::cout;
+  if (!a.quiet) {
+    text << "rsibr compare: " << c.pairs.size() << (kind == "map set" ? " views" : " environment") << ", eps "
+         << c.settings.log_epsilon << ", PSNR peak " << c.settings.psnr_peak << "\n";
+    for (const PairComparison& p : c.pairs) {
+      const std::string head = "  " + p.name + (kind == "map set" ? " " + direction_text(p.view) : "");
+      text << head << "  before: " << metrics_text(p.before) << "\n"
+           << std::string(head.size(), ' ') << "  after:  " << metrics_text(p.after) << "\n";
+    }
+    text << "  overall  before: " << metrics_text(c.before) << "\n  overall  after:  " << metrics_text(c.after) << "\n";
+    if (c.fit)
+      text << "  fitted gains (A -> B) " << c.fit->gains[0] << " " << c.fit->gains[1] << " " << c.fit->gains[2]
+           << ": exposure " << c.fit->exposure_stops << " stops, chroma " << c.fit->chroma[0] << " "
+           << c.fit->chroma[1] << " " << c.fit->chroma[2] << (c.fit->converged ? "" : " (not converged)") << "\n";
+    if (!a.out.empty()) text << "  pictures in " << a.out << " (heat scale 0.." << heat_max << " stops)\n";
+  }
+  write_summary(a.json, j);
+  if (a.fail_above > 0 && c.after.log_rms_stops > a.fail_above) {
+    std::cerr << "rsibr compare: " << a.a << ": log RMS error after the fit " << c.after.log_rms_stops
+              << " stops exceeds --fail-above " << a.fail_above << "\n";
+    return 3;
+  }
+  return 0;
+}
+
+}  // namespace
+
+Runner add_compare(CLI::App& app) {
+  auto a = std::make_shared<CompareArgs>();
+  CLI::App* c = app.add_subcommand("compare", "Compare two map sets (captured vs computed) or two environments");
+  c->footer(
+      "B is the reference. Map sets: views are paired by direction (every view of the smaller set needs a view "
+      "of the other within --view-tolerance; where the frames differ, e.g. a captured view's roll, B is resampled "
+      "into A's frame); texels count inside the sphere-map disc, "
+      "weighted by each map's confidence channel. Environments: same layout and size; sphere layouts weigh the "
+      "disc, others solid angle.\n"
+      "Metrics per view and overall: relative RMS sqrt(sum w|a-b|^2 / sum w|b|^2); log RMS in stops of "
+      "log2((a+eps)/(b+eps)), eps = --log-eps x B's weighted median level; PSNR against B's largest weighted value "
+      "(or --psnr-peak), capped at 144.5 dB (float32). Each is reported before and after a global gain fit "
+      "g_c a_c ~ b_c (Ceres, Cauchy loss) that separates exposure and white balance from errors of shape.\n"
+      "--out DIR gets view.NNN.png or environment.png (A x gains | B | heat map of the log2 error after the fit, with a scale "
+      "bar) and contact.png, all or nothing. Exit status: 0 done, 3 when --fail-above is exceeded, other "
+      "non-zero values on errors.\n"
+      "Example: rsibr compare captured.exr computed.exr --out cmp --json cmp.json");
+  c->add_option("a", a->a, "Map set or environment A (e.g. captured)")->required()->check(CLI::ExistingFile);
+  c->add_option("b", a->b, "Map set or environment B, the reference (e.g. computed)")->required()->check(CLI::ExistingFile);
+  c->add_option("--out", a->out, "Folder for the pictures (created if missing; its parent must exist)");
+  c->add_option("--json", a->json, "Write the metrics as JSON to FILE ('-' for stdout)");
+  c->add_flag("--no-fit", a->no_fit, "Skip the exposure / white-balance fit (after = before)");
+  c->add_option("--log-eps", a->log_eps, "eps of the log error as a fraction of B's weighted median (default 0.01)")
+      ->check(CLI::Range(1e-9, 1e3));
+  c->add_option("--psnr-peak", a->psnr_peak, "Peak of the PSNR (default: B's largest weighted value)")
+      ->check(CLI::PositiveNumber);
+  c->add_option("--view-tolerance", a->view_tolerance, "Largest angle in degrees between paired views (default 0.5)")
+      ->check(CLI::Range(0.0, 90.0));
+  c->add_option("--loss-scale", a->loss_scale, "Cauchy loss scale of the fit in ln units (default 0.1, about 10 %)")
+      ->check(CLI::Range(1e-6, 1e6));
+  c->add_option("--fit-texels", a->fit_texels, "At most this many texels enter the fit (every n-th; 0: all)")
+      ->check(CLI::Range(0L, 1L << 30));
+  c->add_option("--heat-max", a->heat_max, "Top of the heat-map scale in stops (default: the 99th percentile)")
+      ->check(CLI::PositiveNumber);
+  c->add_option("--exposure", a->exposure, "Display exposure of A and B in stops (default: B's mean at 0.18)");
+  c->add_option("--layout", a->layout, "Layout of environments whose header and shape do not tell");
+  c->add_option("--fail-above", a->fail_above, "Exit with status 3 when the overall log RMS after the fit exceeds this (stops)")
+      ->check(CLI::PositiveNumber);
+  c->add_flag("-q,--quiet", a->quiet, "No progress bar or report");
+  return [a] { return run_compare(*a); };
+}
+
+}  // namespace rsibr::cli

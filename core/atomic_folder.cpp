@@ -1,0 +1,72 @@
+#include "core/atomic_folder.h"
+
+#include <unistd.h>
+
+#include <fstream>
+#include <stdexcept>
+
+namespace rsibr {
+namespace {
+
+// Absolute, normal, without a trailing separator ("out/" -> "/.../out").
+std::filesystem::path normal_folder(const std::filesystem::path& folder) {
+  std::filesystem::path p = std::filesystem::absolute(folder).lexically_normal();
+  if (p.filename().empty() && p.has_parent_path()) p = p.parent_path();
+  return p;
+}
+
+}  // namespace
+
+void check_output_folder(const std::filesystem::path& folder, const std::vector<std::filesystem::path>& inputs) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (folder.empty()) throw std::invalid_argument("the output folder name is empty");
+  const fs::path parent = normal_folder(folder).parent_path();
+  if ( !fs::is_directory(parent, ec))
+    throw std::invalid_argument(folder.string() + ": the folder " + parent.string() + " does not exist");
+  if (fs::exists(folder, ec) && !fs::is_directory(folder, ec))
+    throw std::invalid_argument(folder.string() + ": exists and is not a folder");
+  for (const auto& input : inputs)
+    if (fs::exists(folder, ec) && fs::equivalent(input, folder, ec))
+      throw std::invalid_argument(folder.string() + ": output would overwrite the input");
+}
+
+void write_folder_atomically(const std::filesystem::path& folder, const FolderContents& files) {
+  namespace fs = std::filesystem;
+  check_output_folder(folder);
+  for (const auto& [name, bytes] : files)
+    if (name.empty() || fs::path(name).has_parent_path() || name == "." || name == "..")
+      throw std::invalid_argument(folder.string() + ": bad file name " + name);
+  const fs::path target = normal_folder(folder);
+  std::string staging_name = ".";
+  staging_name += target.filename().string();
+  staging_name += ".tmp";
+  staging_name += std::to_string(::getpid());
+  const fs::path staging = target.parent_path() / staging_name;
+  std::error_code ec;
+  const bool existed = fs::exists(target, ec);
+  try {
+    fs::remove_all(staging, ec);
+    fs::create_directory(staging);
+    for (const auto& [name, bytes] : files) {
+      std::ofstream out(staging / name, std::ios::binary);
+      out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+      out.close();
+      if (!out) throw std::runtime_error((target / name).string() + ": cannot write");
+    }
+    if (!existed) {
+      fs::rename(staging, target);
+    } else {
+      for (const auto& [name, bytes] : files) fs::rename(staging / name, target / name);
+      fs::remove(staging);
+    }
+  } catch (const fs::filesystem_error& e) {
+    fs::remove_all(staging, ec);
+    throw std::runtime_error(folder.string() + ": " + e.code().message());
+  } catch (...) {
+    fs::remove_all(staging, ec);
+    throw;
+  }
+}
+
+}  // namespace rsibr
