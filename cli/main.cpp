@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   runners["bake"] = rsibr::cli::add_bake(app);
   runners["reference"] = rsibr::cli::add_reference(app);
   runners["render"] = rsibr::cli::add_render(app);
+  runners["synth"] = rsibr::cli::add_synth(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -16,5 +16,6 @@ Runner add_blend(CLI::App& app);
 Runner add_bake(CLI::App& app);
 Runner add_reference(CLI::App& app);
 Runner add_render(CLI::App& app);
+Runner add_synth(CLI::App& app);
 
 }  // namespace rsibr::cli

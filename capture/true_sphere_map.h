@@ -1,0 +1,20 @@
+// The true sphere map of one ball seen from one camera (the truth that extraction is tested
+// against), in the view frame of DESIGN.md: v = unit vector from the ball centre toward the camera
+// centre, world_from_view = world_from_view_for(v) (core/vec.h). Texel p (centre inside the disc):
+//   chrome   F(n.v) * L_env(2 (n.v) n - v),  n = world_from_view * g_normal(p)   (a perfect mirror
+//            with the ball's Fresnel; the environment sampled bilinearly as the renderer does)
+//   grey     the Lambert map of bake/'s reference integrator (exact quadrature over the environment's
+//            MIP level at most 256 texels wide): albedo * E(n) / pi
+// Texels outside the disc are 0. The camera body, photographer and stand are NOT in these maps
+// (the photos show them; extraction must remove them).
+#pragma once
+
+#include "capture/synth_scene.h"
+#include "core/env_map.h"
+#include "core/map_set.h"
+
+namespace rsibr {
+
+MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const EnvMap& env, int size);
+
+}  // namespace rsibr
