@@ -51,6 +51,9 @@ SynthBall parse_ball(const YAML::Node& node, const std::string& path) {
   const YamlMap m(node, path, {"name", "kind", "diameter_m", "centre", "fresnel", "albedo"});
   SynthBall b;
   b.name = m.string("name");
+  // Names become file names (truth/maps/<name>.exr).
+  if (b.name.empty() || b.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") != std::string::npos)
+    spec_fail(m.at("name"), "use letters, digits, '_' and '-' only");
   b.kind = m.choice("kind", {"chrome", "grey"});
   if (m.has("diameter_m")) b.diameter_m = m.positive("diameter_m");
   if (m.has("centre")) b.centre = m.vec3("centre");
