@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
@@ -113,8 +114,18 @@ EnvMap synth_environment(const SynthScene& scene) {
       cv::cvtColor(env.pixels, rgb, cv::COLOR_RGBA2RGB);
       env.pixels = rgb;
     }
-    if (!cv::checkRange(env.pixels, true, nullptr, 0, 3.4e38))
-      throw std::invalid_argument(e.file->string() + ": the environment has NaN, Inf or negative values");
+    long bad = 0;
+    for (int y = 0; y < env.pixels.rows; ++y) {
+      float* p = env.pixels.ptr<float>(y);
+      for (int i = 0; i < env.pixels.cols * env.channels(); ++i)
+        if (!(std::isfinite(p[i]) && p[i] >= 0)) {
+          ++bad;
+          p[i] = 0;
+        }
+    }
+    if (bad && !e.sanitize)
+      throw std::invalid_argument(e.file->string() + ": " + std::to_string(bad) +
+                                  " NaN, Inf or negative values (set environment.sanitize: true to zero them)");
   } else {
     env = render_pattern(patterns::sun_and_sky(e.sun_direction, e.sun_radius_deg * kPi / 180, e.sun_rgb, e.zenith_rgb,
                                                e.horizon_rgb),

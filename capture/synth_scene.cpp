@@ -21,17 +21,19 @@ Vec3 vec3_in(const YamlMap& m, const std::string& key, double lo, bool lo_open) 
 SynthEnvironment parse_environment(const YAML::Node& node, const std::string& path,
                                    const std::filesystem::path& folder) {
   const YamlMap m(node, path,
-                  {"file", "pattern", "size", "sun_direction", "sun_radius_deg", "sun_rgb",
+                  {"file", "sanitize", "pattern", "size", "sun_direction", "sun_radius_deg", "sun_rgb",
                    "zenith_rgb", "horizon_rgb", "scale"});
   SynthEnvironment e;
   if (m.has("file") == m.has("pattern")) spec_fail(path, "give either file or pattern");
   if (m.has("file")) {
     e.file = std::filesystem::absolute(folder / m.string("file"));
     if (!std::filesystem::exists(*e.file)) spec_fail(m.at("file"), "no such file: " + e.file->string());
+    if (m.has("sanitize")) e.sanitize = m.boolean("sanitize");
     for (const char* k : {"size", "sun_direction", "sun_radius_deg", "sun_rgb", "zenith_rgb", "horizon_rgb"})
       if (m.has(k)) spec_fail(m.at(k), "only for pattern: sun_and_sky");
   } else {
     m.choice("pattern", {"sun_and_sky"});
+    if (m.has("sanitize")) spec_fail(m.at("sanitize"), "only for file");
     if (m.has("size")) e.size = int(spec_in_range(double(m.integer("size")), m.at("size"), 8, false, 8192, false));
     if (m.has("sun_direction")) {
       e.sun_direction = m.vec3("sun_direction");

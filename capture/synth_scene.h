@@ -21,6 +21,7 @@ namespace rsibr {
 struct SynthEnvironment {
   // Either a file (EXR or .hdr, path absolute after loading) ...
   std::optional<std::filesystem::path> file;
+  bool sanitize = false;  // zero NaN, Inf and negative values (lossy EXR ringing) instead of failing
   // ... or an analytic sky (core/patterns.h sun_and_sky) rendered into a lat-long map.
   int size = 256;  // lat-long width of the rendered pattern
   Vec3 sun_direction = Vec3(0.4, 0.7, 0.6);

@@ -45,10 +45,10 @@ MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const 
     const auto brdf = parse_brdf(spec.str());
     mv.material = brdf->spec();
     IntegratorOptions options;
-    options.reference_width = 256;
+    options.reference_width = 128;
     mv.rgb = make_integrator("reference", env)->radiance_map(*brdf, mv.view, mv.world_from_view, size, options);
     mv.attributes["method"] = "reference";
-    mv.attributes["referenceWidth"] = "256";
+    mv.attributes["referenceWidth"] = "128";
   }
   return mv;
 }

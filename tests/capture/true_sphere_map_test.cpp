@@ -1,0 +1,72 @@
+// capture/true_sphere_map.h: the truth maps are what their contract says, in the view frame.
+#include "capture/true_sphere_map.h"
+
+#include "bake/brdf_spec.h"
+#include "capture/synth_capture.h"
+#include "core/sphere_map.h"
+#include "synth_cases.h"
+
+#include <gtest/gtest.h>
+
+namespace rsibr {
+namespace {
+
+Vec3 exact_irradiance(const EnvMap& env, const Vec3& n) {
+  Vec3 e = Vec3::Zero();
+  for (int r = 0; r < env.layout.height(); ++r)
+    for (int c = 0; c < env.layout.width(); ++c) {
+      const Vec3 w = *env.layout.texel_direction(c, r);
+      const double cosine = n.dot(w);
+      if (cosine <= 0) continue;
+      const float* px = env.pixels.ptr<float>(r) + 3 * c;
+      e += cosine * env.layout.texel_solid_angle(c, r) * Vec3(px[0], px[1], px[2]);
+    }
+  return e;
+}
+
+TEST(TrueSphereMap, GreyMapIsAlbedoTimesExactIrradianceOverPiInTheViewFrame) {
+  const SynthScene scene = testing::small_scene();
+  const EnvMap env = synth_environment(scene);
+  const SynthBall& grey = scene.balls[1];
+  const Vec3 eye(0.3, 1.6, 0.9);
+  const int size = 16;
+  const MapView mv = true_sphere_map(grey, eye, env, size);
+  EXPECT_LT((mv.view - (eye - grey.centre).normalized()).norm(), 1e-12);
+  EXPECT_EQ(mv.warp, "normal");
+  double worst = 0;
+  for (int r = 0; r < size; ++r)
+    for (int c = 0; c < size; ++c) {
+      const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), size, size);
+      const cv::Vec3f got = mv.rgb.at<cv::Vec3f>(r, c);
+      if (xy.squaredNorm() >= 1) {
+        EXPECT_EQ(got, cv::Vec3f(0, 0, 0));
+        continue;
+      }
+      const Vec3 n = mv.world_from_view * sphere_map::g_normal(xy);
+      const Vec3 want = grey.albedo.cwiseProduct(exact_irradiance(env, n)) / kPi;
+      for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(got[k] - want[k]) / want[k]);
+    }
+  EXPECT_LT(worst, 0.01) << worst;
+}
+
+TEST(TrueSphereMap, ChromeMapIsFresnelTimesTheEnvironmentSeenInTheMirror) {
+  // Under a constant environment L, every texel inside the disc is F(cos) L with cos = n.v, and the
+  // centre texels (n ~ v) reflect at normal incidence.
+  SynthScene scene = testing::small_scene();
+  EnvMap env = EnvMap::zeros(Layout::with_size(LayoutKind::LatLong, 32), 3);
+  env.pixels.setTo(cv::Scalar(2, 2, 2));
+  const SynthBall& chrome = scene.balls[0];
+  const MapView mv = true_sphere_map(chrome, Vec3(0, 1.3, 2), env, 32);
+  const auto f = make_fresnel(YAML::Load(chrome.fresnel));
+  EXPECT_EQ(mv.warp, "mirror");
+  for (int r = 0; r < 32; ++r)
+    for (int c = 0; c < 32; ++c) {
+      const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), 32, 32);
+      if (xy.squaredNorm() >= 1) continue;
+      const double cosine = sphere_map::g_normal(xy).z();
+      EXPECT_NEAR(mv.rgb.at<cv::Vec3f>(r, c)[0], 2 * f->eval(cosine)[0], 1e-5);
+    }
+}
+
+}  // namespace
+}  // namespace rsibr
