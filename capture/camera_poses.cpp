@@ -12,9 +12,11 @@ namespace {
 
 constexpr double kDeg = kPi / 180;
 
-Mat3 aim(const Vec3& eye, const Vec3& at, double roll_deg) {
+// Look at `at` with world up, turn right by yaw about the camera's y axis (down), then roll about z.
+Mat3 aim(const Vec3& eye, const Vec3& at, double roll_deg, double yaw_deg) {
   const Camera c = look_at(eye, at, Vec3(0, 1, 0), 60, 64, 64);
-  return c.world_from_cam * Eigen::AngleAxisd(roll_deg * kDeg, Vec3::UnitZ()).toRotationMatrix();
+  return c.world_from_cam * Eigen::AngleAxisd(yaw_deg * kDeg, Vec3::UnitY()).toRotationMatrix() *
+         Eigen::AngleAxisd(roll_deg * kDeg, Vec3::UnitZ()).toRotationMatrix();
 }
 
 Vec3 direction(double azimuth_deg, double elevation_deg) {
@@ -43,7 +45,7 @@ std::vector<CameraPose> plan_camera_poses(const SynthScene& scene) {
     for (std::size_t i = 0; i < dirs.size(); ++i) {
       CameraPose pose;
       pose.eye = at + plan.distance_m * dirs[i];
-      pose.world_from_cam = aim(pose.eye, at, plan.roll_deg);
+      pose.world_from_cam = aim(pose.eye, at, plan.roll_deg, plan.yaw_deg);
       if (plan.plan == "handheld") {
         NoiseRng rng(scene.seed, 0x4A17ull << 32 | (p << 16) | i);
         const Vec3 dp(sample_normal(rng), sample_normal(rng), sample_normal(rng));
@@ -51,7 +53,7 @@ std::vector<CameraPose> plan_camera_poses(const SynthScene& scene) {
         axis = axis.norm() > 0 ? axis.normalized() : Vec3::UnitY();
         const double angle = plan.jitter_deg * kDeg * sample_normal(rng);
         pose.eye += plan.jitter_m * dp;
-        pose.world_from_cam = Eigen::AngleAxisd(angle, axis).toRotationMatrix() * aim(pose.eye, at, plan.roll_deg);
+        pose.world_from_cam = Eigen::AngleAxisd(angle, axis).toRotationMatrix() * aim(pose.eye, at, plan.roll_deg, plan.yaw_deg);
       }
       char name[32];
       std::snprintf(name, sizeof name, "view%02zu", out.size());

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace rsibr {
 
@@ -47,13 +48,20 @@ double sample_normal(NoiseRng& rng) {
 double record_electrons(double mu, const SensorNoise& noise, NoiseRng& rng) {
   // Far above the full well the clip is certain: skip the draws (a sun can be 1e9 electrons).
   if (mu > noise.full_well + 40 * std::sqrt(mu) + 40 * noise.read_noise) return noise.full_well;
-  const double x = sample_poisson(mu, rng) + noise.read_noise * sample_normal(rng);
+  const double x = sample_poisson(mu, rng) + (noise.read_noise > 0 ? noise.read_noise * sample_normal(rng) : 0.0);
   return std::clamp(x, 0.0, noise.full_well);
 }
 
+// round(f(x) M) = #{i : f(x) M >= i + 1/2} = #{i : x >= f^-1((i + 1/2) / M)} for an increasing f, so
+// the code is the number of thresholds t_i = f^-1((i + 1/2) / M) full_well at or below X: a binary
+// search instead of a pow per sample (same codes up to exact ties).
 cv::Mat expose_bracket(const cv::Mat& radiance, double e, const SensorNoise& noise, const CameraResponse& response,
                        int max_code, std::uint64_t seed, std::uint64_t stream) {
   const int ch = radiance.channels();
+  std::vector<std::vector<double>> thresholds(static_cast<std::size_t>(ch));
+  for (int c = 0; c < ch; ++c)
+    for (int i = 0; i < max_code; ++i)
+      thresholds[std::size_t(c)].push_back(response.relative((i + 0.5) / max_code, ch == 1 ? 1 : c) * noise.full_well);
   cv::Mat out(radiance.rows, radiance.cols, CV_16UC(ch));
   parallel_for_rows(radiance.rows, [&](int y) {
     const float* in = radiance.ptr<float>(y);
@@ -62,9 +70,9 @@ cv::Mat expose_bracket(const cv::Mat& radiance, double e, const SensorNoise& noi
       NoiseRng rng(seed, (stream << 40) + std::uint64_t(y) * std::uint64_t(radiance.cols) + std::uint64_t(x));
       for (int c = 0; c < ch; ++c) {
         const double mu = std::max(0.0, double(in[x * ch + c])) * e * noise.gain;
-        const double rel = record_electrons(mu, noise, rng) / noise.full_well;
-        const double f = response.code(rel, ch == 1 ? 1 : c);
-        o[x * ch + c] = std::uint16_t(std::lround(std::clamp(f, 0.0, 1.0) * max_code));
+        const double X = record_electrons(mu, noise, rng);
+        const auto& t = thresholds[std::size_t(c)];
+        o[x * ch + c] = std::uint16_t(std::upper_bound(t.begin(), t.end(), X) - t.begin());
       }
     }
   });

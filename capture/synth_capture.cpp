@@ -18,6 +18,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -227,12 +228,20 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
     const auto r1 = Clock::now();
     report.seconds_render += secs(r1 - r0);
     if (vi == 0) {
-      const cv::Scalar m = cv::mean(L);
-      const double mean = (m[0] + m[1] + m[2]) / 3;
+      // Metering on the median (a sun in the frame would drag a mean far up).
+      std::vector<float> grey;
+      grey.reserve(L.total());
+      for (int y = 0; y < L.rows; ++y)
+        for (int x = 0; x < L.cols; ++x) {
+          const cv::Vec3f p = L.at<cv::Vec3f>(y, x);
+          grey.push_back((p[0] + p[1] + p[2]) / 3);
+        }
+      std::nth_element(grey.begin(), grey.begin() + long(grey.size() / 2), grey.end());
+      const double median = grey[grey.size() / 2];
       const double e_mid = relative_exposure(scene.exposure.middle_s);
-      noise.gain = cam.gain.value_or(mean > 0 ? 0.18 * cam.full_well / (mean * e_mid) : 1.0);
+      noise.gain = cam.gain.value_or(median > 0 ? 0.18 * cam.full_well / (median * e_mid) : 1.0);
       tc["gain"] = noise.gain;
-      tc["gain_source"] = cam.gain ? "scene" : "auto: 18% of the full well for the first view's mean at the middle exposure";
+      tc["gain_source"] = cam.gain ? "scene" : "auto: the first view's median radiance records 18% of the full well at the middle exposure";
       report.gain = noise.gain;
     }
     PhotoView pv;

@@ -13,8 +13,8 @@
 //                 capture/true_sphere_map.h), chessboards/boardNN.txt (true corner pixels, "x y").
 //
 // Exposure convention (shared with hdr/, capture/sensor_noise.h): X = L e k electrons, e =
-// t * iso/100 / N^2. When the scene gives no gain, k is chosen so that the mean radiance of the
-// first view at the middle exposure records 18% of the full well (a metered exposure).
+// t * iso/100 / N^2. When the scene gives no gain, k is chosen so that the median radiance of the
+// first view (mean of R, G, B) at the middle exposure records 18% of the full well (a metered exposure).
 //
 // The radiance of each view is rendered once; every bracket is derived from it (exposure, noise,
 // response), so brackets cost little. DIR must not exist (or be empty); everything is written to a

@@ -51,6 +51,7 @@ struct SynthViewPlan {
   double distance_m = 1.5;          // camera centre to look_at
   std::optional<Vec3> look_at;      // default: the centre of the balls
   double roll_deg = 0;
+  double yaw_deg = 0;               // after aiming: turn the camera right by this (the target moves left)
   double jitter_m = 0.03, jitter_deg = 1.5;  // handheld: position and orientation jitter (std dev)
 };
 
@@ -72,7 +73,7 @@ struct SynthCamera {
   double vignetting = 0.0;     // v = 1 - vignetting * (r / r_corner)^2
   Vec3 white_balance = Vec3::Ones();
   double full_well = 2e4, read_noise = 3;
-  std::optional<double> gain;  // electrons per unit radiance-exposure; auto when absent
+  std::optional<double> gain;  // electrons per unit radiance-exposure; auto (median metering) when absent
 };
 
 struct SynthChessboards {

@@ -99,6 +99,32 @@ TEST(SensorNoise, BracketCodesFollowTheModelAndClipAtFullWell) {
   expect_moments(g, 40, 40 + 9 + 1.0 / 12, "G");
 }
 
+TEST(SensorNoise, BracketCodesAreTheRoundedResponseOfTheRecordedElectrons) {
+  // The binary search over response thresholds gives round(f(X / full_well) * max_code), X drawn
+  // from the documented stream of each pixel.
+  const SensorNoise noise{3.0, 2e4, 2.5};
+  for (const std::string kind : {"srgb", "measured"}) {
+    const CameraResponse response(kind);
+    cv::Mat L(30, 40, CV_32FC3);
+    for (int y = 0; y < 30; ++y)
+      for (int x = 0; x < 40; ++x) L.at<cv::Vec3f>(y, x) = cv::Vec3f(float(x * x * 5), float(y * 30 + 1), float(x * y));
+    for (int max_code : {255, 65535}) {
+      const cv::Mat codes = expose_bracket(L, 2.0, noise, response, max_code, 4, 6);
+      int mismatched = 0;
+      for (int y = 0; y < 30; ++y)
+        for (int x = 0; x < 40; ++x) {
+          NoiseRng rng(4, (std::uint64_t(6) << 40) + std::uint64_t(y * 40 + x));
+          for (int c = 0; c < 3; ++c) {
+            const double X = record_electrons(L.at<cv::Vec3f>(y, x)[c] * 2.0 * 3.0, noise, rng);
+            const long want = std::lround(response.code(X / noise.full_well, c) * max_code);
+            mismatched += codes.ptr<std::uint16_t>(y)[3 * x + c] != want;
+          }
+        }
+      EXPECT_EQ(mismatched, 0) << kind << " " << max_code;
+    }
+  }
+}
+
 TEST(SensorNoise, SameSeedAndStreamGiveSameCodesOtherwiseDifferent) {
   const SensorNoise noise{5.0, 2e4, 3.0};
   const CameraResponse srgb("srgb");
