@@ -10,6 +10,7 @@
 #include "synth_cases.h"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -44,6 +45,19 @@ TEST(SynthCapture, SameSeedGivesSameBytes) {
   ASSERT_EQ(a.size(), b.size());
   for (const auto& [name, bytes] : a) EXPECT_TRUE(b.at(name) == bytes) << name;
   EXPECT_FALSE(a.at("photos/view00/view00_b01.png") == c.at("photos/view00/view00_b01.png"));
+}
+
+TEST(SynthCapture, BytesDoNotDependOnTheThreadCount) {
+  testing::TempDir dir;
+  const SynthScene scene = testing::small_scene(", vignetting: 0.2");
+  write_synth_capture(scene, dir.path() / "many");
+  {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    write_synth_capture(scene, dir.path() / "one");
+  }
+  const auto a = folder_bytes(dir.path() / "many"), b = folder_bytes(dir.path() / "one");
+  ASSERT_EQ(a.size(), b.size());
+  for (const auto& [name, bytes] : a) EXPECT_TRUE(b.at(name) == bytes) << name;
 }
 
 TEST(SynthCapture, PhotoSetLoadsBackWithExposuresAndTruth) {
