@@ -2,7 +2,7 @@
 
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
-#include "core/mip_pyramid.h"
+#include "capture/irradiance.h"
 #include "core/parallel.h"
 
 #include <atomic>
@@ -11,40 +11,7 @@
 
 namespace rsibr {
 
-// E(n) = sum_p L(p) max(0, n . w_p) Omega_p over the texels p of the source level: exact for the
-// piecewise-constant source, which has the environment's energy (core/mip_pyramid.h).
-EnvMap irradiance_map(const EnvMap& env, int width, int max_source_width) {
-  const MipPyramid pyramid(env);
-  int level = 0;
-  while (level + 1 < pyramid.levels() && pyramid.level(level).layout.width() > max_source_width) ++level;
-  const EnvMap& src = pyramid.level(level);
-  std::vector<Vec3> w, l;
-  for (int r = 0; r < src.layout.height(); ++r)
-    for (int c = 0; c < src.layout.width(); ++c) {
-      const auto dir = src.layout.texel_direction(c, r);
-      if (!dir) continue;
-      const double omega = src.layout.texel_solid_angle(c, r);
-      const float* px = src.pixels.ptr<float>(r) + c * src.channels();
-      const Vec3 L(px[0], px[1], px[2]);
-      if (L.isZero()) continue;
-      w.push_back(*dir);
-      l.push_back(omega * L);
-    }
-  EnvMap out = EnvMap::zeros(Layout::with_size(LayoutKind::LatLong, width), 3);
-  parallel_for_rows(out.layout.height(), [&](int r) {
-    for (int c = 0; c < out.layout.width(); ++c) {
-      const Vec3 n = *out.layout.texel_direction(c, r);
-      Vec3 e = Vec3::Zero();
-      for (std::size_t i = 0; i < w.size(); ++i) {
-        const double cosine = n.dot(w[i]);
-        if (cosine > 0) e += cosine * l[i];
-      }
-      float* px = out.pixels.ptr<float>(r) + 3 * c;
-      for (int k = 0; k < 3; ++k) px[k] = float(e[k]);
-    }
-  });
-  return out;
-}
+EnvMap irradiance_map(const EnvMap& env, int width) { return IrradianceQuadrature(env).latlong_map(width); }
 
 RigRenderer::RigRenderer(const SynthScene& scene, EnvMap env) : scene_(scene), env_(std::move(env)) {
   irradiance_ = irradiance_map(env_);

@@ -9,9 +9,9 @@
 //   grey ball        albedo * E(n) / pi                         Lambert
 //   stand, proxies   albedo * E(n) / pi                         Lambert, n facing the ray
 // E(n) = int L_env(w) max(0, n.w) dw is the unoccluded irradiance: read bilinearly from a
-// 128 x 64 lat-long irradiance map integrated exactly (every texel, solid-angle weighted) from the
-// environment's MIP level at most 256 texels wide (the sun keeps its energy; its position moves by
-// at most 0.7 degrees). Measured accuracy against the exact integral: tests/capture (GreyBall...).
+// 256 x 128 lat-long irradiance map whose texels are capture/irradiance.h's quadrature (bright texels
+// at full resolution, the rest on a 128-wide MIP level). Measured accuracy against brute force over
+// every texel: tests/capture/rig_renderer_test.cpp (GreyPixelEquals...).
 // The balls and proxies do not shadow each other (the truth maps are those of the unoccluded balls).
 //
 // Pixels: n x n stratified samples, jittered per pixel by a counter-based stream keyed by (seed,
@@ -37,7 +37,7 @@
 namespace rsibr {
 
 // The irradiance map described above (lat-long, RGB, E in radiance units times sr).
-EnvMap irradiance_map(const EnvMap& env, int width = 128, int max_source_width = 256);
+EnvMap irradiance_map(const EnvMap& env, int width = 256);
 
 struct RenderOptions {
   int supersampling = 2;  // n: n x n samples per pixel

@@ -1,7 +1,7 @@
 #include "capture/true_sphere_map.h"
 
 #include "bake/brdf_spec.h"
-#include "bake/integrator.h"
+#include "capture/irradiance.h"
 #include "core/parallel.h"
 #include "core/sphere_map.h"
 
@@ -42,13 +42,20 @@ MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const 
     std::ostringstream spec;
     spec.precision(17);
     spec << "{type: lambert, albedo: [" << ball.albedo.x() << ", " << ball.albedo.y() << ", " << ball.albedo.z() << "]}";
-    const auto brdf = parse_brdf(spec.str());
-    mv.material = brdf->spec();
-    IntegratorOptions options;
-    options.reference_width = 128;
-    mv.rgb = make_integrator("reference", env)->radiance_map(*brdf, mv.view, mv.world_from_view, size, options);
-    mv.attributes["method"] = "reference";
-    mv.attributes["referenceWidth"] = "128";
+    mv.material = parse_brdf(spec.str())->spec();
+    // Lambert: L_o = albedo E(n) / pi (the integral of bake/'s LambertBrdf against the environment).
+    const IrradianceQuadrature irradiance(env);
+    mv.rgb = cv::Mat::zeros(size, size, CV_32FC3);
+    parallel_for_rows(size, [&](int r) {
+      for (int c = 0; c < size; ++c) {
+        const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), size, size);
+        if (xy.squaredNorm() >= 1) continue;
+        const Vec3 e = ball.albedo.cwiseProduct(irradiance(mv.world_from_view * sphere_map::g_normal(xy))) / kPi;
+        float* px = mv.rgb.ptr<float>(r) + 3 * c;
+        for (int k = 0; k < 3; ++k) px[k] = float(e[k]);
+      }
+    });
+    mv.attributes["method"] = "irradiance quadrature (capture/irradiance.h)";
   }
   return mv;
 }

@@ -3,8 +3,8 @@
 // centre, world_from_view = world_from_view_for(v) (core/vec.h). Texel p (centre inside the disc):
 //   chrome   F(n.v) * L_env(2 (n.v) n - v),  n = world_from_view * g_normal(p)   (a perfect mirror
 //            with the ball's Fresnel; the environment sampled bilinearly as the renderer does)
-//   grey     the Lambert map of bake/'s reference integrator (exact quadrature over the environment's
-//            MIP level at most 128 texels wide): albedo * E(n) / pi
+//   grey     Lambert: albedo * E(n) / pi, E by capture/irradiance.h's quadrature at the texel's
+//            normal (bright texels at full resolution, the rest on a 128-wide MIP level)
 // Texels outside the disc are 0. The camera body, photographer and stand are NOT in these maps
 // (the photos show them; extraction must remove them).
 #pragma once

@@ -25,7 +25,9 @@ Vec3 exact_irradiance(const EnvMap& env, const Vec3& n) {
 }
 
 TEST(TrueSphereMap, GreyMapIsAlbedoTimesExactIrradianceOverPiInTheViewFrame) {
-  const SynthScene scene = testing::small_scene();
+  // A 256-wide sky: the quadrature's rest level is 128 wide, so this measures that approximation too.
+  SynthScene scene = testing::small_scene();
+  scene.environment.size = 256;
   const EnvMap env = synth_environment(scene);
   const SynthBall& grey = scene.balls[1];
   const Vec3 eye(0.3, 1.6, 0.9);
@@ -46,7 +48,8 @@ TEST(TrueSphereMap, GreyMapIsAlbedoTimesExactIrradianceOverPiInTheViewFrame) {
       const Vec3 want = grey.albedo.cwiseProduct(exact_irradiance(env, n)) / kPi;
       for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(got[k] - want[k]) / want[k]);
     }
-  EXPECT_LT(worst, 0.01) << worst;
+  EXPECT_LT(worst, 0.002) << worst;  // measured 0.08%
+  std::cout << "grey truth map: worst relative error against the exact irradiance " << worst << "\n";
 }
 
 TEST(TrueSphereMap, ChromeMapIsFresnelTimesTheEnvironmentSeenInTheMirror) {
