@@ -159,8 +159,15 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
     fs::create_directories(d);
 
   const SynthCamera& cam = scene.camera;
-  const EnvMap env = synth_environment(scene);
   const std::vector<CameraPose> poses = plan_camera_poses(scene);
+  // A camera inside (or touching) a ball, or whose body proxy would reach into one, sees nothing
+  // sensible: refuse the spec before any work.
+  for (const CameraPose& pose : poses)
+    for (const SynthBall& b : scene.balls)
+      if ((pose.eye - b.centre).norm() < 0.5 * b.diameter_m + 0.1)
+        throw std::invalid_argument(scene.file.string() + ": " + pose.name + ": the camera is within 0.1 m of ball " +
+                                    b.name + "'s surface");
+  const EnvMap env = synth_environment(scene);
   const RigRenderer renderer(scene, env);
   const RayTable rays(cam.lens, 8);
   const CameraResponse response(cam.response);

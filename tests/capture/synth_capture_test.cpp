@@ -133,6 +133,12 @@ TEST(SynthCapture, RefusesANonEmptyOutputAndLeavesNothingOnError) {
   bad.balls[1].name = "no/such/folder";
   EXPECT_THROW(write_synth_capture(bad, dir.path() / "new"), std::runtime_error);
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"full"});
+  // A camera inside a ball is refused before any work.
+  SynthScene inside = testing::small_scene();
+  inside.views[0].distance_m = 0.02;
+  inside.views[0].look_at = inside.balls[0].centre;
+  EXPECT_THROW(write_synth_capture(inside, dir.path() / "inside"), std::invalid_argument);
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"full"});
 }
 
 TEST(SynthScene, UnknownKeysAndBadValuesNameTheirPath) {
