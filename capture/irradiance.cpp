@@ -42,7 +42,8 @@ IrradianceQuadrature::IrradianceQuadrature(const EnvMap& env, int rest_width, do
   rest.pixels = env.pixels.clone();
   for (const Candidate& b : bright) {
     float* p = rest.pixels.ptr<float>(b.r) + b.c * ch;
-    add(*lay.texel_direction(b.c, b.r), lay.texel_solid_angle(b.c, b.r) * Vec3(p[0], p[1], p[2]));
+    add(*lay.texel_direction(b.c, b.r), lay.texel_solid_angle(b.c, b.r) * Vec3(p[0], p[1], p[2]),
+        lay.texel_solid_angle(b.c, b.r));
     for (int k = 0; k < ch; ++k) p[k] = 0;
   }
   const MipPyramid pyramid(rest);
@@ -55,17 +56,24 @@ IrradianceQuadrature::IrradianceQuadrature(const EnvMap& env, int rest_width, do
       const float* p = src.pixels.ptr<float>(r) + c * src.channels();
       const Vec3 L(p[0], p[1], p[2]);
       if (!d || L.isZero()) continue;
-      add(*d, src.layout.texel_solid_angle(c, r) * L);
+      add(*d, src.layout.texel_solid_angle(c, r) * L, src.layout.texel_solid_angle(c, r));
     }
 }
 
-void IrradianceQuadrature::add(const Vec3& dir, const Vec3& power) {
+void IrradianceQuadrature::add(const Vec3& dir, const Vec3& power, double omega) {
+  omega_.push_back(omega);
   x_.push_back(dir.x());
   y_.push_back(dir.y());
   z_.push_back(dir.z());
   r_.push_back(power.x());
   g_.push_back(power.y());
   b_.push_back(power.z());
+}
+
+void IrradianceQuadrature::set_node_radiance(std::size_t i, const Vec3& radiance) {
+  r_[i] = omega_[i] * radiance.x();
+  g_[i] = omega_[i] * radiance.y();
+  b_[i] = omega_[i] * radiance.z();
 }
 
 Vec3 IrradianceQuadrature::operator()(const Vec3& n) const {

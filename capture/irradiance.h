@@ -24,11 +24,16 @@ class IrradianceQuadrature {
   // E at every texel centre of a lat-long map `width` wide (RGB, CV_32FC3), for bilinear lookups.
   EnvMap latlong_map(int width) const;
   std::size_t nodes() const { return x_.size(); }
+  Vec3 node_direction(std::size_t i) const { return Vec3(x_[i], y_[i], z_[i]); }
+  double node_solid_angle(std::size_t i) const { return omega_[i]; }
+  Vec3 node_power(std::size_t i) const { return Vec3(r_[i], g_[i], b_[i]); }
+  // Replaces the radiance seen through node i (power = radiance * its solid angle): occlusion.
+  void set_node_radiance(std::size_t i, const Vec3& radiance);
 
  private:
-  void add(const Vec3& dir, const Vec3& power);
+  void add(const Vec3& dir, const Vec3& power, double omega);
   // Quadrature nodes as arrays (the sum vectorises): unit direction, and L * Omega per channel.
-  std::vector<double> x_, y_, z_, r_, g_, b_;
+  std::vector<double> x_, y_, z_, r_, g_, b_, omega_;
 };
 
 }  // namespace rsibr

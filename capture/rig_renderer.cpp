@@ -13,8 +13,9 @@ namespace rsibr {
 
 EnvMap irradiance_map(const EnvMap& env, int width) { return IrradianceQuadrature(env).latlong_map(width); }
 
-RigRenderer::RigRenderer(const SynthScene& scene, EnvMap env) : scene_(scene), env_(std::move(env)) {
-  irradiance_ = irradiance_map(env_);
+RigRenderer::RigRenderer(const SynthScene& scene, EnvMap env)
+    : scene_(scene), env_(std::move(env)), quadrature_(env_) {
+  irradiance_ = quadrature_.latlong_map(256);
   for (const SynthBall& b : scene.balls) {
     Ball ball{b.centre, 0.5 * b.diameter_m, b.kind == "chrome", b.albedo, nullptr};
     if (ball.chrome) ball.fresnel = make_fresnel(YAML::Load(b.fresnel));
@@ -34,33 +35,92 @@ Vec3 RigRenderer::irradiance(const Vec3& n) const {
   return Vec3(v[0], v[1], v[2]);
 }
 
-Vec3 RigRenderer::radiance(const Vec3& o, const Vec3& d, const RayScene* scene, const RigMesh* mesh, int depth) const {
+int RigRenderer::trace(const Vec3& o, const Vec3& d, const ViewScene& view, double* t, RayHit* mesh_hit) const {
   double best = std::numeric_limits<double>::infinity();
-  int ball = -1;
+  int ball = -2;
   for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (auto t = intersect_sphere(o, d, balls_[i].centre, balls_[i].radius, 1e-9); t && *t < best) {
-      best = *t;
+    if (auto ti = intersect_sphere(o, d, balls_[i].centre, balls_[i].radius, 1e-9); ti && *ti < best) {
+      best = *ti;
       ball = int(i);
     }
-  if (scene && mesh) {
-    const RayHit hit = scene->intersect(o, d, 1e-7, best);
+  if (view.scene && view.mesh) {
+    const RayHit hit = view.scene->intersect(o, d, 1e-7, best);
     if (hit.hit && hit.t < best) {
-      Vec3 n = scene->shading_normal(hit);
-      if (n.dot(d) > 0) n = -n;
-      return mesh->albedo[hit.triangle].cwiseProduct(irradiance(n)) / kPi;
+      best = hit.t;
+      ball = -1;
+      *mesh_hit = hit;
     }
   }
-  if (ball < 0) return environment(d);
-  const Ball& b = balls_[std::size_t(ball)];
-  const Vec3 p = o + best * d;
+  *t = best;
+  return ball;
+}
+
+Vec3 RigRenderer::shade_mesh(const ViewScene& view, const RayHit& hit, const Vec3& d) const {
+  Vec3 n = view.scene->shading_normal(hit);
+  if (n.dot(d) > 0) n = -n;
+  return view.mesh->albedo[hit.triangle].cwiseProduct(irradiance(n)) / kPi;
+}
+
+RigRenderer::ViewScene RigRenderer::view_scene(const RayScene* scene, const RigMesh* mesh) const {
+  ViewScene view;
+  view.scene = scene;
+  view.mesh = mesh;
+  view.ball_irradiance.resize(balls_.size());
+  ViewScene unoccluded = view;  // blockers are shaded without occlusion of their own
+  for (std::size_t b = 0; b < balls_.size(); ++b) {
+    if (balls_[b].chrome) continue;
+    IrradianceQuadrature q = quadrature_;
+    bool any = false;
+    for (std::size_t i = 0; i < q.nodes(); ++i) {
+      const Vec3 w = q.node_direction(i);
+      double t;
+      RayHit hit;
+      const int what = trace(balls_[b].centre + balls_[b].radius * w, w, unoccluded, &t, &hit);
+      if (what == -2) continue;
+      Vec3 L;
+      if (what == -1) {
+        L = shade_mesh(unoccluded, hit, w);
+      } else {
+        const Ball& o = balls_[std::size_t(what)];
+        const Vec3 p = balls_[b].centre + balls_[b].radius * w + t * w;
+        const Vec3 n = (p - o.centre).normalized();
+        // A blocking ball: its Lambert radiance, or the chrome's mirror image of the environment.
+        if (o.chrome)
+          L = o.fresnel->eval(std::max(0.0, -w.dot(n))).cwiseProduct(environment(w - 2 * w.dot(n) * n));
+        else
+          L = o.albedo.cwiseProduct(irradiance(n)) / kPi;
+      }
+      q.set_node_radiance(i, L);
+      any = true;
+    }
+    view.ball_irradiance[b] = any ? q.latlong_map(256) : irradiance_;
+  }
+  return view;
+}
+
+Vec3 RigRenderer::radiance(const Vec3& o, const Vec3& d, const ViewScene& view, int depth) const {
+  double t;
+  RayHit hit;
+  const int what = trace(o, d, view, &t, &hit);
+  if (what == -2) return environment(d);
+  if (what == -1) return shade_mesh(view, hit, d);
+  const Ball& b = balls_[std::size_t(what)];
+  const Vec3 p = o + t * d;
   const Vec3 n = (p - b.centre).normalized();
-  if (!b.chrome) return b.albedo.cwiseProduct(irradiance(n)) / kPi;
+  if (!b.chrome) {
+    const EnvMap& e = view.ball_irradiance.empty() || view.ball_irradiance[std::size_t(what)].pixels.empty()
+                          ? irradiance_
+                          : view.ball_irradiance[std::size_t(what)];
+    float v[kMaxChannels];
+    sample_bilinear(e, n, v);
+    return b.albedo.cwiseProduct(Vec3(v[0], v[1], v[2])) / kPi;
+  }
   const double cosine = std::max(0.0, -d.dot(n));
   const Vec3 r = (d + 2 * cosine * n).normalized();
   const Vec3 f = b.fresnel->eval(cosine);
   if (depth >= 4) return f.cwiseProduct(environment(r));
   // Start the reflected ray on the surface point; t_min in the sphere test skips the start point.
-  return f.cwiseProduct(radiance(b.centre + b.radius * n, r, scene, mesh, depth + 1));
+  return f.cwiseProduct(radiance(b.centre + b.radius * n, r, view, depth + 1));
 }
 
 cv::Mat RigRenderer::render(const CameraPose& pose, const LensModel& lens, const RayTable& rays,
@@ -68,6 +128,7 @@ cv::Mat RigRenderer::render(const CameraPose& pose, const LensModel& lens, const
   const RigMesh mesh = build_rig_mesh(scene_, &pose);
   std::unique_ptr<RayScene> scene;
   if (!mesh.mesh.triangles.empty()) scene = std::make_unique<RayScene>(mesh.mesh);
+  const ViewScene view = view_scene(scene.get(), &mesh);
   const int w = lens.width(), h = lens.height(), n = options.supersampling;
   cv::Mat out(h, w, CV_32FC3);
   std::atomic<int> rows_done{0};
@@ -79,7 +140,7 @@ cv::Mat RigRenderer::render(const CameraPose& pose, const LensModel& lens, const
         for (int i = 0; i < n; ++i) {
           const double u = options.jitter ? rng.uniform() : 0.5, v = options.jitter ? rng.uniform() : 0.5;
           const Vec3 dc = rays.direction(x - 0.5 + (i + u) / n, y - 0.5 + (j + v) / n);
-          sum += radiance(pose.eye, pose.world_from_cam * dc, scene.get(), &mesh);
+          sum += radiance(pose.eye, pose.world_from_cam * dc, view);
         }
       sum /= double(n * n);
       float* px = out.ptr<float>(y) + 3 * x;

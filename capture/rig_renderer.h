@@ -6,13 +6,20 @@
 //   chrome ball      F(cos) * L(p, r), r = d - 2 (d.n) n, cos = -d.n, n the exact sphere normal,
 //                    F the ball's Fresnel (bake/fresnel.h); the reflected ray is traced again
 //                    (the other balls, the stand and the photographer appear in it), up to 4 bounces
-//   grey ball        albedo * E(n) / pi                         Lambert
+//   grey ball        albedo * E_b(n) / pi                       Lambert, E_b the ball's occluded
+//                    irradiance (below)
 //   stand, proxies   albedo * E(n) / pi                         Lambert, n facing the ray
 // E(n) = int L_env(w) max(0, n.w) dw is the unoccluded irradiance: read bilinearly from a
 // 256 x 128 lat-long irradiance map whose texels are capture/irradiance.h's quadrature (bright texels
 // at full resolution, the rest on a 128-wide MIP level). Measured accuracy against brute force over
 // every texel: tests/capture/rig_renderer_test.cpp (GreyPixelEquals...).
-// The balls and proxies do not shadow each other (the truth maps are those of the unoccluded balls).
+// Occlusion of a grey ball (per view): each quadrature node w (capture/irradiance.h) is traced from
+// the ball's surface point facing it, c + R w, against the stand, this view's photographer proxy and
+// the other balls; a blocked node sees the blocker's radiance instead of the environment's. So the
+// photographer's shadow and the stand's occlusion darken the grey ball as in real photos (the truth
+// maps are those of the unoccluded balls). Visibility is per direction, from that one surface point
+// (a parallax of R / distance to the blocker elsewhere on the ball). Stand and proxies themselves
+// are shaded unoccluded.
 //
 // Pixels: n x n stratified samples, jittered per pixel by a counter-based stream keyed by (seed,
 // pixel) (or at the stratum centres without jitter), averaged with equal weights (a box filter
@@ -21,6 +28,7 @@
 
 #include "capture/ball_rig.h"
 #include "capture/camera_poses.h"
+#include "capture/irradiance.h"
 #include "core/env_map.h"
 #include "core/lens_model.h"
 #include "core/ray_scene.h"
@@ -55,10 +63,18 @@ class RigRenderer {
   cv::Mat render(const CameraPose& pose, const LensModel& lens, const RayTable& rays, const RenderOptions& options,
                  const std::function<void(double)>& progress = {}) const;
 
-  // Radiance arriving at o from direction -d, i.e. along the ray o + t d (see above); `scene` may
-  // be null (no meshes).
-  Vec3 radiance(const Vec3& o, const Vec3& d, const RayScene* scene, const RigMesh* mesh, int depth = 0) const;
-  Vec3 irradiance(const Vec3& n) const;
+  // What one view's rays meet besides the environment: its meshes (scene may be null) and, per
+  // ball, the occluded irradiance map of a grey ball (empty for chrome).
+  struct ViewScene {
+    const RayScene* scene = nullptr;
+    const RigMesh* mesh = nullptr;
+    std::vector<EnvMap> ball_irradiance;
+  };
+  ViewScene view_scene(const RayScene* scene, const RigMesh* mesh) const;
+
+  // Radiance arriving at o from direction -d, i.e. along the ray o + t d (see above).
+  Vec3 radiance(const Vec3& o, const Vec3& d, const ViewScene& view, int depth = 0) const;
+  Vec3 irradiance(const Vec3& n) const;  // unoccluded
   Vec3 environment(const Vec3& d) const;
 
   const EnvMap& env() const { return env_; }
@@ -72,8 +88,14 @@ class RigRenderer {
     Vec3 albedo;
     std::shared_ptr<const Fresnel> fresnel;
   };
+  // The first thing the ray o + t d (t > t_min) meets: ball index (>= 0), -1 for a mesh (hit in
+  // *mesh_hit), -2 for nothing.
+  int trace(const Vec3& o, const Vec3& d, const ViewScene& view, double* t, RayHit* mesh_hit) const;
+  Vec3 shade_mesh(const ViewScene& view, const RayHit& hit, const Vec3& d) const;
+
   SynthScene scene_;
   EnvMap env_, irradiance_;
+  IrradianceQuadrature quadrature_;
   std::vector<Ball> balls_;
 };
 

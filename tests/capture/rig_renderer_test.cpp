@@ -155,6 +155,46 @@ TEST(RigRenderer, PhotographerAppearsInTheChromeBallAndNeverBlocksTheView) {
   EXPECT_EQ(changed_off_ball, 0);
 }
 
+// Centre pixel of the first ball of the fixture, rendered with or without the photographer.
+cv::Vec3f centre_pixel(Fixture& f, bool photographer) {
+  f.scene.photographer = photographer;
+  const RigRenderer renderer(f.scene, f.env);
+  const LensModel& lens = f.scene.camera.lens;
+  RenderOptions opt;
+  opt.supersampling = 1;
+  opt.jitter = false;
+  const cv::Mat img = renderer.render(f.pose, lens, RayTable(lens), opt);
+  const Vec2 c = lens.project(f.pose.world_from_cam.transpose() * (f.scene.balls.front().centre - f.pose.eye));
+  return img.at<cv::Vec3f>(int(std::lround(c.y())), int(std::lround(c.x())));
+}
+
+TEST(RigRenderer, PhotographerShadowsTheGreyBallWhenTheSunIsBehindHim) {
+  Fixture f("grey");
+  // The sun straight behind the photographer's torso as seen from the ball (torso box centre in
+  // the camera frame: (0, 0.46, -0.29)).
+  const Vec3 torso = f.pose.eye + f.pose.world_from_cam * Vec3(0, 0.46, -0.29);
+  f.scene.environment.sun_direction = (torso - f.scene.balls.front().centre).normalized();
+  f.scene.environment.sun_rgb = Vec3::Constant(5000);
+  f.env = synth_environment(f.scene);
+  const cv::Vec3f lit = centre_pixel(f, false), shadowed = centre_pixel(f, true);
+  EXPECT_LT(shadowed[1], 0.5f * lit[1]) << lit[1] << " " << shadowed[1];
+  EXPECT_GT(shadowed[1], 0.0f);
+}
+
+TEST(RigRenderer, PhotographerDarkensTheGreyBallSlightlyUnderAnOvercastSky) {
+  Fixture f("grey");
+  f.env = EnvMap::zeros(Layout::with_size(LayoutKind::LatLong, 64), 3);
+  f.env.pixels.setTo(cv::Scalar(1, 1, 1));
+  const cv::Vec3f open = centre_pixel(f, false), blocked = centre_pixel(f, true);
+  // Unoccluded, a constant sky gives exactly albedo * L (E = pi L).
+  EXPECT_NEAR(open[1], 0.18f, 0.18f * 1e-3f);
+  // The proxy (about 0.1 sr right behind the camera at 0.8 m, albedo 0.25 and 0.04) takes a few
+  // percent of the light where the ball faces the camera.
+  EXPECT_LT(blocked[1], open[1] * 0.99f);
+  EXPECT_GT(blocked[1], open[1] * 0.85f);
+  std::cout << "photographer: grey ball centre " << blocked[1] / open[1] << " of its unoccluded value\n";
+}
+
 TEST(RigRenderer, SupersampledEdgeIsAntialiased) {
   Fixture f("grey");
   const RigRenderer renderer(f.scene, f.env);
