@@ -3,6 +3,7 @@
 #include "capture/camera_poses.h"
 #include "capture/camera_response.h"
 #include "capture/chessboard.h"
+#include "capture/irradiance.h"
 #include "capture/photo_set.h"
 #include "capture/rig_renderer.h"
 #include "capture/sensor_noise.h"
@@ -303,9 +304,11 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
   // True sphere maps: one map set per ball, a part per view.
   const auto m0 = Clock::now();
   YAML::Node tballs;
+  const IrradianceQuadrature irradiance(env);
   for (const SynthBall& b : scene.balls) {
     MapSet ms;
-    for (const CameraPose& pose : poses) ms.views.push_back(true_sphere_map(b, pose.eye, env, scene.map_size));
+    for (const CameraPose& pose : poses)
+      ms.views.push_back(true_sphere_map(b, pose.eye, env, scene.map_size, &irradiance));
     write_map_set((truth / "maps" / (b.name + ".exr")).string(), ms);
     YAML::Node tb;
     tb["name"] = b.name;

@@ -5,11 +5,13 @@
 #include "core/parallel.h"
 #include "core/sphere_map.h"
 
+#include <optional>
 #include <sstream>
 
 namespace rsibr {
 
-MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const EnvMap& env, int size) {
+MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const EnvMap& env, int size,
+                        const IrradianceQuadrature* irradiance_in) {
   MapView mv;
   mv.view = (camera_centre - ball.centre).normalized();
   mv.world_from_view = world_from_view_for(mv.view);
@@ -44,7 +46,9 @@ MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const 
     spec << "{type: lambert, albedo: [" << ball.albedo.x() << ", " << ball.albedo.y() << ", " << ball.albedo.z() << "]}";
     mv.material = parse_brdf(spec.str())->spec();
     // Lambert: L_o = albedo E(n) / pi (the integral of bake/'s LambertBrdf against the environment).
-    const IrradianceQuadrature irradiance(env);
+    std::optional<IrradianceQuadrature> own;
+    if (!irradiance_in) own.emplace(env);
+    const IrradianceQuadrature& irradiance = irradiance_in ? *irradiance_in : *own;
     mv.rgb = cv::Mat::zeros(size, size, CV_32FC3);
     parallel_for_rows(size, [&](int r) {
       for (int c = 0; c < size; ++c) {

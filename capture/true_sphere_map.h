@@ -9,12 +9,15 @@
 // (the photos show them; extraction must remove them).
 #pragma once
 
+#include "capture/irradiance.h"
 #include "capture/synth_scene.h"
 #include "core/env_map.h"
 #include "core/map_set.h"
 
 namespace rsibr {
 
-MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const EnvMap& env, int size);
+// `irradiance`, when given, must be IrradianceQuadrature(env) (reused across views and balls).
+MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const EnvMap& env, int size,
+                        const IrradianceQuadrature* irradiance = nullptr);
 
 }  // namespace rsibr
