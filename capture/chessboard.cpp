@@ -34,8 +34,8 @@ ChessboardShot render_chessboard(const LensModel& lens, const RayTable& rays, co
     const double distance = f * board_w / (0.5 * lens.width()) * (0.9 + 0.3 * rng.uniform());
     const double deg = kPi / 180;
     const Mat3 R = (Eigen::AngleAxisd((rng.uniform() * 2 - 1) * 15 * deg, Vec3::UnitZ()) *
-                    Eigen::AngleAxisd((rng.uniform() * 2 - 1) * 35 * deg, Vec3::UnitY()) *
-                    Eigen::AngleAxisd((rng.uniform() * 2 - 1) * 35 * deg, Vec3::UnitX()))
+                    Eigen::AngleAxisd((rng.uniform() * 2 - 1) * 25 * deg, Vec3::UnitY()) *
+                    Eigen::AngleAxisd((rng.uniform() * 2 - 1) * 25 * deg, Vec3::UnitX()))
                        .toRotationMatrix();
     const Vec3 centre((rng.uniform() * 2 - 1) * 0.25 * distance * lens.width() / f,
                       (rng.uniform() * 2 - 1) * 0.25 * distance * lens.height() / f, distance);

@@ -8,8 +8,9 @@
 // ((i + 1 - (corners+1)/2) spacing, (j + 1 - (corners+1)/2) spacing, 0).
 //
 // Poses are drawn per board from a seeded stream: distance such that the board spans about half the
-// image width, tilts up to 35 degrees about x and y, a roll up to 15 degrees, and an offset that keeps
-// every corner at least 2 squares' image size inside the image (draws that do not are redrawn).
+// image width, tilts up to 25 degrees about x and y (mrgingham missed some boards tilted up to 35
+// about both), a roll up to 15 degrees, and an offset that keeps every corner at least 2 squares'
+// image size inside the image (draws that do not are redrawn).
 #pragma once
 
 #include "capture/synth_scene.h"
