@@ -2,6 +2,8 @@
 #include "capture/true_sphere_map.h"
 
 #include "bake/brdf_spec.h"
+#include "capture/camera_poses.h"
+#include "capture/rig_renderer.h"
 #include "capture/synth_capture.h"
 #include "core/sphere_map.h"
 #include "synth_cases.h"
@@ -50,6 +52,36 @@ TEST(TrueSphereMap, GreyMapIsAlbedoTimesExactIrradianceOverPiInTheViewFrame) {
     }
   EXPECT_LT(worst, 0.002) << worst;  // measured 0.08%
   std::cout << "grey truth map: worst relative error against the exact irradiance " << worst << "\n";
+}
+
+// The ray through the pixel where a ball's centre projects meets the ball where its normal is the
+// view direction v (ball centre -> camera), so that pixel of the photo (before noise) must equal the
+// truth map's centre texel (normal v), for both balls: the photo and its truth agree.
+TEST(TrueSphereMap, CentreTexelEqualsThePhotoAtTheBallCentre) {
+  SynthScene scene = testing::small_scene();
+  scene.stand = false;
+  scene.photographer = false;
+  scene.camera.lens = LensModel::pinhole(300, 95, 71);  // principal point (47, 35): a pixel centre
+  const EnvMap env = synth_environment(scene);
+  const RigRenderer renderer(scene, env);
+  RenderOptions opt;
+  opt.supersampling = 1;
+  opt.jitter = false;
+  for (std::size_t b = 0; b < 2; ++b) {
+    SynthViewPlan plan;
+    plan.plan = "ring";
+    plan.count = 1;
+    plan.azimuth0_deg = 30;
+    plan.distance_m = 0.7;
+    plan.look_at = scene.balls[b].centre;
+    scene.views = {plan};
+    const CameraPose pose = plan_camera_poses(scene).front();
+    const cv::Mat img = renderer.render(pose, scene.camera.lens, RayTable(scene.camera.lens), opt);
+    const MapView mv = true_sphere_map(scene.balls[b], pose.eye, env, 17);
+    const cv::Vec3f photo = img.at<cv::Vec3f>(35, 47), truth = mv.rgb.at<cv::Vec3f>(8, 8);
+    const double tol = b == 0 ? 1e-5 : 2e-3;  // chrome: the same lookup; grey: the irradiance map
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(photo[k], truth[k], tol * truth[k]) << scene.balls[b].name << " " << k;
+  }
 }
 
 TEST(TrueSphereMap, ChromeMapIsFresnelTimesTheEnvironmentSeenInTheMirror) {
