@@ -3,6 +3,7 @@
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
 #include "capture/irradiance.h"
+#include "capture/true_sphere_map.h"
 #include "core/parallel.h"
 
 #include <atomic>
@@ -17,8 +18,9 @@ RigRenderer::RigRenderer(const SynthScene& scene, EnvMap env)
     : scene_(scene), env_(std::move(env)), quadrature_(env_) {
   irradiance_ = quadrature_.latlong_map(256);
   for (const SynthBall& b : scene.balls) {
-    Ball ball{b.centre, 0.5 * b.diameter_m, b.kind == "chrome", b.albedo, nullptr};
+    Ball ball{b.centre, 0.5 * b.diameter_m, b.kind == "chrome", b.kind == "glossy", b.albedo, nullptr};
     if (ball.chrome) ball.fresnel = make_fresnel(YAML::Load(b.fresnel));
+    if (ball.glossy && !fis_) fis_ = make_integrator("fis", env_);
     balls_.push_back(ball);
   }
 }
@@ -61,14 +63,33 @@ Vec3 RigRenderer::shade_mesh(const ViewScene& view, const RayHit& hit, const Vec
   return view.mesh->albedo[hit.triangle].cwiseProduct(irradiance(n)) / kPi;
 }
 
-RigRenderer::ViewScene RigRenderer::view_scene(const RayScene* scene, const RigMesh* mesh) const {
+Vec3 RigRenderer::glossy_radiance(const ViewScene& view, std::size_t ball, const Vec3& n) const {
+  // The texel of normal n holds the light reflected toward v; look it up by its mirror direction
+  // (the sphere layout's direction), which is continuous up to the rim.
+  const Vec3 nv = view.ball_world_from_view[ball].transpose() * n;
+  const Vec3 r(2 * nv.z() * nv.x(), 2 * nv.z() * nv.y(), 2 * nv.z() * nv.z() - 1);
+  float v[kMaxChannels];
+  sample_bilinear(view.ball_map[ball], r, v);
+  return Vec3(v[0], v[1], v[2]);
+}
+
+RigRenderer::ViewScene RigRenderer::view_scene(const RayScene* scene, const RigMesh* mesh, const Vec3& eye) const {
   ViewScene view;
   view.scene = scene;
   view.mesh = mesh;
   view.ball_irradiance.resize(balls_.size());
+  view.ball_map.resize(balls_.size());
+  view.ball_world_from_view.resize(balls_.size(), Mat3::Identity());
+  for (std::size_t b = 0; b < balls_.size(); ++b) {
+    if (!balls_[b].glossy) continue;
+    const MapView mv = true_sphere_map(scene_.balls[b], eye, env_, scene_.map_size, nullptr, fis_.get());
+    view.ball_map[b].layout = Layout(LayoutKind::Sphere, mv.rgb.cols, mv.rgb.rows);
+    view.ball_map[b].pixels = mv.rgb;
+    view.ball_world_from_view[b] = mv.world_from_view;
+  }
   ViewScene unoccluded = view;  // blockers are shaded without occlusion of their own
   for (std::size_t b = 0; b < balls_.size(); ++b) {
-    if (balls_[b].chrome) continue;
+    if (balls_[b].chrome || balls_[b].glossy) continue;
     IrradianceQuadrature q = quadrature_;
     bool any = false;
     for (std::size_t i = 0; i < q.nodes(); ++i) {
@@ -87,6 +108,8 @@ RigRenderer::ViewScene RigRenderer::view_scene(const RayScene* scene, const RigM
         // A blocking ball: its Lambert radiance, or the chrome's mirror image of the environment.
         if (o.chrome)
           L = o.fresnel->eval(std::max(0.0, -w.dot(n))).cwiseProduct(environment(w - 2 * w.dot(n) * n));
+        else if (o.glossy)
+          L = glossy_radiance(unoccluded, std::size_t(what), n);  // as seen from the camera (approximate)
         else
           L = o.albedo.cwiseProduct(irradiance(n)) / kPi;
       }
@@ -107,6 +130,7 @@ Vec3 RigRenderer::radiance(const Vec3& o, const Vec3& d, const ViewScene& view, 
   const Ball& b = balls_[std::size_t(what)];
   const Vec3 p = o + t * d;
   const Vec3 n = (p - b.centre).normalized();
+  if (b.glossy) return glossy_radiance(view, std::size_t(what), n);
   if (!b.chrome) {
     const EnvMap& e = view.ball_irradiance.empty() || view.ball_irradiance[std::size_t(what)].pixels.empty()
                           ? irradiance_
@@ -128,7 +152,7 @@ cv::Mat RigRenderer::render(const CameraPose& pose, const LensModel& lens, const
   const RigMesh mesh = build_rig_mesh(scene_, &pose);
   std::unique_ptr<RayScene> scene;
   if (!mesh.mesh.triangles.empty()) scene = std::make_unique<RayScene>(mesh.mesh);
-  const ViewScene view = view_scene(scene.get(), &mesh);
+  const ViewScene view = view_scene(scene.get(), &mesh, pose.eye);
   const int w = lens.width(), h = lens.height(), n = options.supersampling;
   cv::Mat out(h, w, CV_32FC3);
   std::atomic<int> rows_done{0};

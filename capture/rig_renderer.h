@@ -8,6 +8,9 @@
 //                    (the other balls, the stand and the photographer appear in it), up to 4 bounces
 //   grey ball        albedo * E_b(n) / pi                       Lambert, E_b the ball's occluded
 //                    irradiance (below)
+//   glossy ball      its true sphere map for this view (capture/true_sphere_map.h: bake/'s FIS
+//                    integral of the BRDF) read at the normal: exact where n = v, elsewhere the view
+//                    direction is taken as v (ball centre -> camera), off by up to asin(R / D)
 //   stand, proxies   albedo * E(n) / pi                         Lambert, n facing the ray
 // E(n) = int L_env(w) max(0, n.w) dw is the unoccluded irradiance: read bilinearly from a
 // 256 x 128 lat-long irradiance map whose texels are capture/irradiance.h's quadrature (bright texels
@@ -34,6 +37,7 @@
 #include "core/ray_scene.h"
 
 #include "bake/fresnel.h"
+#include "bake/integrator.h"
 
 #include <opencv2/core.hpp>
 
@@ -69,8 +73,10 @@ class RigRenderer {
     const RayScene* scene = nullptr;
     const RigMesh* mesh = nullptr;
     std::vector<EnvMap> ball_irradiance;
+    std::vector<EnvMap> ball_map;           // glossy: the view's sphere map (sphere layout, view frame)
+    std::vector<Mat3> ball_world_from_view;  // glossy: its frame
   };
-  ViewScene view_scene(const RayScene* scene, const RigMesh* mesh) const;
+  ViewScene view_scene(const RayScene* scene, const RigMesh* mesh, const Vec3& eye) const;
 
   // Radiance arriving at o from direction -d, i.e. along the ray o + t d (see above).
   Vec3 radiance(const Vec3& o, const Vec3& d, const ViewScene& view, int depth = 0) const;
@@ -84,10 +90,12 @@ class RigRenderer {
   struct Ball {
     Vec3 centre;
     double radius;
-    bool chrome;
+    bool chrome, glossy;
     Vec3 albedo;
     std::shared_ptr<const Fresnel> fresnel;
   };
+  Vec3 glossy_radiance(const ViewScene& view, std::size_t ball, const Vec3& n) const;
+  std::unique_ptr<Integrator> fis_;  // only when there is a glossy ball
   // The first thing the ray o + t d (t > t_min) meets: ball index (>= 0), -1 for a mesh (hit in
   // *mesh_hit), -2 for nothing.
   int trace(const Vec3& o, const Vec3& d, const ViewScene& view, double* t, RayHit* mesh_hit) const;

@@ -195,7 +195,8 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
   set.folder = photos;
   set.camera_name = cam.name;
   for (const SynthBall& b : scene.balls)
-    set.balls.push_back({b.name, b.kind == "chrome" ? BallKind::chrome : BallKind::grey, b.diameter_m});
+    set.balls.push_back(
+        {b.name, b.kind == "chrome" ? BallKind::chrome : b.kind == "grey" ? BallKind::grey : BallKind::glossy, b.diameter_m});
 
   YAML::Node ty;
   ty["rsibr_synth_truth"] = 1;
@@ -305,10 +306,13 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
   const auto m0 = Clock::now();
   YAML::Node tballs;
   const IrradianceQuadrature irradiance(env);
+  std::unique_ptr<Integrator> fis;
+  for (const SynthBall& b : scene.balls)
+    if (b.kind == "glossy" && !fis) fis = make_integrator("fis", env);
   for (const SynthBall& b : scene.balls) {
     MapSet ms;
     for (const CameraPose& pose : poses)
-      ms.views.push_back(true_sphere_map(b, pose.eye, env, scene.map_size, &irradiance));
+      ms.views.push_back(true_sphere_map(b, pose.eye, env, scene.map_size, &irradiance, fis.get()));
     write_map_set((truth / "maps" / (b.name + ".exr")).string(), ms);
     YAML::Node tb;
     tb["name"] = b.name;

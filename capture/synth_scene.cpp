@@ -50,16 +50,22 @@ SynthEnvironment parse_environment(const YAML::Node& node, const std::string& pa
 }
 
 SynthBall parse_ball(const YAML::Node& node, const std::string& path) {
-  const YamlMap m(node, path, {"name", "kind", "diameter_m", "centre", "fresnel", "albedo"});
+  const YamlMap m(node, path, {"name", "kind", "diameter_m", "centre", "fresnel", "albedo", "brdf"});
   SynthBall b;
   b.name = m.string("name");
   // Names become file names (truth/maps/<name>.exr).
   if (b.name.empty() || b.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") != std::string::npos)
     spec_fail(m.at("name"), "use letters, digits, '_' and '-' only");
-  b.kind = m.choice("kind", {"chrome", "grey"});
+  b.kind = m.choice("kind", {"chrome", "grey", "glossy"});
+  if (b.kind != "glossy" && m.has("brdf")) spec_fail(m.at("brdf"), "only for kind: glossy");
   if (m.has("diameter_m")) b.diameter_m = m.positive("diameter_m");
   if (m.has("centre")) b.centre = m.vec3("centre");
-  if (b.kind == "chrome") {
+  if (b.kind == "glossy") {
+    if (m.has("albedo") || m.has("fresnel")) spec_fail(m.at(m.has("albedo") ? "albedo" : "fresnel"), "glossy balls take a brdf");
+    const YAML::Node f = m.has("brdf") ? m.get("brdf")
+                                       : YAML::Load("{type: ggx, roughness: 0.15, fresnel: {type: dielectric, ior: 1.5}}");
+    b.brdf = make_brdf(f, m.at("brdf"))->spec();
+  } else if (b.kind == "chrome") {
     if (m.has("albedo")) spec_fail(m.at("albedo"), "only for kind: grey");
     // Chromium-like conductor: about 57% reflectance at normal incidence (real chrome balls reflect
     // roughly 60%).

@@ -34,11 +34,12 @@ struct SynthEnvironment {
 
 struct SynthBall {
   std::string name;
-  std::string kind;  // "chrome" or "grey"
+  std::string kind;  // "chrome", "grey" or "glossy"
   double diameter_m = 0.1;
   Vec3 centre = Vec3(0, 1.3, 0);
   std::string fresnel;  // chrome: a Fresnel spec (bake/brdf_spec.h), flow YAML
   Vec3 albedo = Vec3::Constant(0.18);  // grey: Lambert albedo
+  std::string brdf;  // glossy: a BRDF spec (bake/brdf_spec.h), flow YAML, e.g. GGX with Fresnel
 };
 
 struct SynthViewPlan {

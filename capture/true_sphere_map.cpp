@@ -11,7 +11,7 @@
 namespace rsibr {
 
 MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const EnvMap& env, int size,
-                        const IrradianceQuadrature* irradiance_in) {
+                        const IrradianceQuadrature* irradiance_in, const Integrator* fis) {
   MapView mv;
   mv.view = (camera_centre - ball.centre).normalized();
   mv.world_from_view = world_from_view_for(mv.view);
@@ -39,6 +39,18 @@ MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const 
         for (int k = 0; k < 3; ++k) px[k] = float(F[k] * L[k]);
       }
     });
+  } else if (ball.kind == "glossy") {
+    const auto brdf = parse_brdf(ball.brdf);
+    mv.material = brdf->spec();
+    mv.warp = brdf->central_direction() == Lobe::Normal ? "normal" : "mirror";
+    std::unique_ptr<Integrator> own;
+    if (!fis) own = make_integrator("fis", env);
+    IntegratorOptions options;
+    options.samples = 64;
+    options.seed = 0;
+    mv.rgb = (fis ? fis : own.get())->radiance_map(*brdf, mv.view, mv.world_from_view, size, options);
+    mv.attributes["method"] = "fis";
+    mv.attributes["samples"] = "64";
   } else {
     mv.warp = "normal";
     std::ostringstream spec;

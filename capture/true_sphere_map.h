@@ -5,10 +5,13 @@
 //            with the ball's Fresnel; the environment sampled bilinearly as the renderer does)
 //   grey     Lambert: albedo * E(n) / pi, E by capture/irradiance.h's quadrature at the texel's
 //            normal (bright texels at full resolution, the rest on a 128-wide MIP level)
+//   glossy   the ball's BRDF baked by bake/'s filtered importance sampling integrator (64 samples,
+//            seed 0): the integral of L_env against the BRDF for viewer v
 // Texels outside the disc are 0. The camera body, photographer and stand are NOT in these maps
 // (the photos show them; extraction must remove them).
 #pragma once
 
+#include "bake/integrator.h"
 #include "capture/irradiance.h"
 #include "capture/synth_scene.h"
 #include "core/env_map.h"
@@ -16,8 +19,9 @@
 
 namespace rsibr {
 
-// `irradiance`, when given, must be IrradianceQuadrature(env) (reused across views and balls).
+// `irradiance`, when given, must be IrradianceQuadrature(env), and `fis` make_integrator("fis", env)
+// (both reused across views and balls).
 MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const EnvMap& env, int size,
-                        const IrradianceQuadrature* irradiance = nullptr);
+                        const IrradianceQuadrature* irradiance = nullptr, const Integrator* fis = nullptr);
 
 }  // namespace rsibr

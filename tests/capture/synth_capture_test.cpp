@@ -157,6 +157,10 @@ TEST(SynthScene, UnknownKeysAndBadValuesNameTheirPath) {
   const std::string bad_name = testing::small_scene_text();
   EXPECT_NE(error_of(std::string(bad_name).replace(bad_name.find("name: grey"), 10, "name: a/b")).find("balls[1].name"),
             std::string::npos);
+  EXPECT_NE(error_of(std::string(bad_name).replace(bad_name.find("name: grey, kind: grey"), 22,
+                                                    "name: grey, kind: glossy"))
+                .find("balls[1].albedo: glossy balls take a brdf"),
+            std::string::npos);
   EXPECT_NE(error_of("rsibr_synth: 2\n").find("rsibr_synth"), std::string::npos);
 }
 
