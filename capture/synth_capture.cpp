@@ -211,6 +211,8 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
   tc["format"] = cam.format;
   tc["full_well"] = cam.full_well;
   tc["read_noise"] = cam.read_noise;
+  tc["shot_normalised"] = 1.0 / cam.full_well;
+  tc["read_variance_normalised"] = (cam.read_noise / cam.full_well) * (cam.read_noise / cam.full_well);
   tc["vignetting"] = cam.vignetting;
   tc["white_balance"] = vec(cam.white_balance);
   tc["supersampling"] = cam.supersampling;
@@ -250,6 +252,8 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
       const double e_mid = relative_exposure(scene.exposure.middle_s);
       noise.gain = cam.gain.value_or(median > 0 ? 0.18 * cam.full_well / (median * e_mid) : 1.0);
       tc["gain"] = noise.gain;
+      // hdr/'s normalised units (X / X_sat, X_sat = full_well): docs/conventions.md.
+      tc["gain_normalised"] = noise.gain / cam.full_well;
       tc["gain_source"] = cam.gain ? "scene" : "auto: the first view's median radiance records 18% of the full well at the middle exposure";
       report.gain = noise.gain;
     }

@@ -10,6 +10,7 @@
 #include "synth_cases.h"
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 #include <tbb/global_control.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -90,6 +91,11 @@ TEST(SynthCapture, PhotoSetLoadsBackWithExposuresAndTruth) {
   const cv::Mat L = read_truth_image(truth / "views" / "view01_radiance.exr");
   EXPECT_EQ(L.cols, 96);
   EXPECT_TRUE(cv::checkRange(L, true, nullptr, 0, 1e30));
+  const YAML::Node ty = YAML::LoadFile((truth / "truth.yaml").string());
+  EXPECT_DOUBLE_EQ(ty["camera"]["gain"].as<double>(), r.gain);
+  EXPECT_DOUBLE_EQ(ty["camera"]["gain_normalised"].as<double>(), r.gain / scene.camera.full_well);
+  EXPECT_EQ(ty["views"].size(), 2u);
+  EXPECT_EQ(ty["views"][1]["brackets"].size(), 3u);
   std::ifstream csv(truth / "response.csv");
   std::string header;
   std::getline(csv, header);
