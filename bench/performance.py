@@ -24,10 +24,12 @@ PAIRS = {
     "BM_Blend": ("BM_OpenCvBlend", "OpenCV per frame: exact-warp coordinate maps, remap of the three sources, weighted sum"),
     "BM_OpenCvBlend": ("BM_RemapThreeMaps", "three bare OpenCV remaps, maps precomputed"),
     "BM_Render": ("BM_RenderBaseline", "one rtcIntersect1 per pixel centre, no shading"),
+    "BM_SynthBracket": ("BM_SynthBracketFromScratch", "every one of the 7 brackets rendered from scratch"),
 }
 # Section titles where the family name alone does not say it.
 TITLES = {"BM_Render": "Rendering (the bunny, 1280x720, 12-view 256^2 map set, turntable frames)",
-          "BM_OpenCvBlend": "Blend baseline (issue 4's OpenCV blend against three bare remaps)"}
+          "BM_OpenCvBlend": "Blend baseline (issue 4's OpenCV blend against three bare remaps)",
+          "BM_SynthBracket": "Synthetic capture (one view, 2000x1500, OPENCV8, 4 samples per pixel, 7 brackets, PNG)"}
 
 
 def parts(name):
@@ -133,6 +135,9 @@ def main():
         "the mesh's bounding box projects to, then shades the hits: paper mode blends one destination map per",
         "frame and reads it by normal; per-pixel mode blends the located sources for every hit's own view.",
         "Case 0 is the packet ray pass alone. The camera orbits (a turntable), so every frame is a new view.",
+        "Synthetic capture (bench/synth_bench.cpp): case 0 renders the view's radiance once and derives the 7",
+        "brackets from it (exposure, Poisson + read noise, response, PNG encode); case 1 is the render alone,",
+        "case 2 the 7 brackets alone. `bench/performance.py --filter BM_Synth` regenerates only that section.",
     ]
     path = args.out
     with open(path + ".tmp", "w") as f:

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   runners["view"] = rsibr::cli::add_view(app);
   runners["hdr"] = rsibr::cli::add_hdr(app);
   runners["compare"] = rsibr::cli::add_compare(app);
+  runners["synth"] = rsibr::cli::add_synth(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

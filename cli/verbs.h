@@ -19,5 +19,6 @@ Runner add_render(CLI::App& app);
 Runner add_view(CLI::App& app);
 Runner add_hdr(CLI::App& app);
 Runner add_compare(CLI::App& app);
+Runner add_synth(CLI::App& app);
 
 }  // namespace rsibr::cli

@@ -1,0 +1,53 @@
+#include "capture/camera_response.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace rsibr {
+namespace {
+
+struct NakaRushton {
+  double g, a;
+};
+constexpr NakaRushton kMeasured[3] = {{0.62, 0.35}, {0.58, 0.30}, {0.66, 0.42}};
+
+}  // namespace
+
+const std::vector<std::string>& CameraResponse::kinds() {
+  static const std::vector<std::string> k = {"linear", "srgb", "measured"};
+  return k;
+}
+
+CameraResponse::CameraResponse(const std::string& kind) : kind_(kind) {
+  if (std::find(kinds().begin(), kinds().end(), kind) == kinds().end())
+    throw std::invalid_argument("unknown camera response '" + kind + "' (linear, srgb, measured)");
+}
+
+double CameraResponse::code(double x, int c) const {
+  x = std::clamp(x, 0.0, 1.0);
+  if (kind_ == "linear") return x;
+  if (kind_ == "srgb") return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
+  const NakaRushton& p = kMeasured[c];
+  const double xg = std::pow(x, p.g);
+  return (1 + p.a) * xg / (xg + p.a);
+}
+
+double CameraResponse::relative(double f, int c) const {
+  f = std::clamp(f, 0.0, 1.0);
+  if (kind_ == "linear") return f;
+  if (kind_ == "srgb") return f <= 0.04045 ? f / 12.92 : std::pow((f + 0.055) / 1.055, 2.4);
+  const NakaRushton& p = kMeasured[c];
+  return std::pow(p.a * f / (1 + p.a - f), 1.0 / p.g);
+}
+
+std::vector<std::vector<double>> CameraResponse::table(int max_code) const {
+  std::vector<std::vector<double>> out;
+  for (int i = 0; i <= max_code; ++i) {
+    const double f = double(i) / max_code;
+    out.push_back({double(i), relative(f, 0), relative(f, 1), relative(f, 2)});
+  }
+  return out;
+}
+
+}  // namespace rsibr

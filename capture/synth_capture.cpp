@@ -1,0 +1,394 @@
+#include "capture/synth_capture.h"
+
+#include "capture/camera_poses.h"
+#include "capture/camera_response.h"
+#include "capture/chessboard.h"
+#include "capture/irradiance.h"
+#include "capture/photo_set.h"
+#include "capture/rig_renderer.h"
+#include "capture/sensor_noise.h"
+#include "capture/true_sphere_map.h"
+#include "capture/truth_image.h"
+#include "core/atomic_file.h"
+#include "core/exr_io.h"
+#include "core/patterns.h"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+
+namespace rsibr {
+namespace fs = std::filesystem;
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secs(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+void write_bytes(const fs::path& file, const std::vector<uchar>& bytes) {
+  std::ofstream out(file, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+}
+
+// Codes (CV_16UC1/3, RGB) -> an encoded image file of the camera's format.
+void write_codes(const fs::path& file, const cv::Mat& codes, const std::string& format) {
+  cv::Mat bgr;
+  if (codes.channels() == 3)
+    cv::cvtColor(codes, bgr, cv::COLOR_RGB2BGR);
+  else
+    bgr = codes;
+  if (format != "tiff") bgr.convertTo(bgr, CV_8U);  // codes are already <= 255
+  std::vector<uchar> bytes;
+  std::vector<int> params;
+  if (format == "jpeg") params = {cv::IMWRITE_JPEG_QUALITY, 95};
+  const std::string ext = format == "png" ? ".png" : format == "jpeg" ? ".jpg" : ".tif";
+  if (!cv::imencode(ext, bgr, bytes, params)) throw std::runtime_error(file.string() + ": cannot encode");
+  write_bytes(file, bytes);
+}
+
+std::string ext_of(const std::string& format) { return format == "png" ? "png" : format == "jpeg" ? "jpg" : "tif"; }
+
+YAML::Node vec(const Vec3& v) {
+  YAML::Node n(YAML::NodeType::Sequence);
+  for (int i = 0; i < 3; ++i) n.push_back(v[i]);
+  n.SetStyle(YAML::EmitterStyle::Flow);
+  return n;
+}
+YAML::Node vec2(const Vec2& v) {
+  YAML::Node n(YAML::NodeType::Sequence);
+  n.push_back(v.x());
+  n.push_back(v.y());
+  n.SetStyle(YAML::EmitterStyle::Flow);
+  return n;
+}
+YAML::Node mat(const Mat3& m) {
+  YAML::Node n(YAML::NodeType::Sequence);
+  for (int r = 0; r < 3; ++r) n.push_back(vec(m.row(r).transpose()));
+  return n;
+}
+
+// v(p) = 1 - a (|p - c| / |corner - c|)^2, c the principal point (image centre without a core).
+cv::Mat vignetting_field(const LensModel& lens, double a) {
+  const auto& in = lens.intrinsics();
+  const Vec2 c = in.size() >= 4 ? Vec2(in[2], in[3]) : Vec2(0.5 * (lens.width() - 1), 0.5 * (lens.height() - 1));
+  double r2max = 0;
+  for (const Vec2& k : {Vec2(-0.5, -0.5), Vec2(lens.width() - 0.5, -0.5), Vec2(-0.5, lens.height() - 0.5),
+                        Vec2(lens.width() - 0.5, lens.height() - 0.5)})
+    r2max = std::max(r2max, (k - c).squaredNorm());
+  cv::Mat v(lens.height(), lens.width(), CV_32FC1);
+  for (int y = 0; y < v.rows; ++y)
+    for (int x = 0; x < v.cols; ++x) v.at<float>(y, x) = float(1 - a * (Vec2(x, y) - c).squaredNorm() / r2max);
+  return v;
+}
+
+double clipped_fraction(const cv::Mat& codes, int max_code) {
+  long n = 0;
+  const int ch = codes.channels();
+  for (int y = 0; y < codes.rows; ++y) {
+    const auto* p = codes.ptr<std::uint16_t>(y);
+    for (int x = 0; x < codes.cols; ++x) {
+      bool any = false;
+      for (int c = 0; c < ch; ++c) any = any || p[x * ch + c] >= max_code;
+      n += any;
+    }
+  }
+  return double(n) / double(codes.total());
+}
+
+}  // namespace
+
+EnvMap synth_environment(const SynthScene& scene) {
+  const SynthEnvironment& e = scene.environment;
+  EnvMap env;
+  if (e.file) {
+    env = read_environment(e.file->string());
+    if (env.channels() > 3) {
+      cv::Mat rgb;
+      cv::cvtColor(env.pixels, rgb, cv::COLOR_RGBA2RGB);
+      env.pixels = rgb;
+    }
+    long bad = 0;
+    for (int y = 0; y < env.pixels.rows; ++y) {
+      float* p = env.pixels.ptr<float>(y);
+      for (int i = 0; i < env.pixels.cols * env.channels(); ++i)
+        if (!(std::isfinite(p[i]) && p[i] >= 0)) {
+          ++bad;
+          p[i] = 0;
+        }
+    }
+    if (bad && !e.sanitize)
+      throw std::invalid_argument(e.file->string() + ": " + std::to_string(bad) +
+                                  " NaN, Inf or negative values (set environment.sanitize: true to zero them)");
+  } else {
+    env = render_pattern(patterns::sun_and_sky(e.sun_direction, e.sun_radius_deg * kPi / 180, e.sun_rgb, e.zenith_rgb,
+                                               e.horizon_rgb),
+                         Layout::with_size(LayoutKind::LatLong, e.size), 4);
+  }
+  if (e.scale != 1.0) env.pixels *= e.scale;
+  return env;
+}
+
+SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir,
+                                const std::function<void(double)>& progress) {
+  const auto t0 = Clock::now();
+  const fs::path out = fs::absolute(out_dir).lexically_normal();
+  if (fs::exists(out) && !(fs::is_directory(out) && fs::is_empty(out)))
+    throw std::invalid_argument(out_dir.string() + ": exists and is not an empty folder");
+  if (!fs::is_directory(out.parent_path()))
+    throw std::invalid_argument(out_dir.string() + ": the folder it goes in does not exist");
+  const fs::path tmp = out.parent_path() / ("." + out.filename().string() + ".partial-" + std::to_string(::getpid()));
+  fs::remove_all(tmp);
+  struct Cleanup {
+    fs::path p;
+    bool keep = false;
+    ~Cleanup() {
+      std::error_code ec;
+      if (!keep) fs::remove_all(p, ec);
+    }
+  } cleanup{tmp};
+  const fs::path photos = tmp / "photos", truth = tmp / "truth";
+  for (const fs::path& d : {photos / "chessboards", truth / "views", truth / "maps", truth / "chessboards"})
+    fs::create_directories(d);
+
+  const SynthCamera& cam = scene.camera;
+  const std::vector<CameraPose> poses = plan_camera_poses(scene);
+  // A camera inside (or touching) a ball, or whose body proxy would reach into one, sees nothing
+  // sensible: refuse the spec before any work.
+  for (const CameraPose& pose : poses)
+    for (const SynthBall& b : scene.balls)
+      if ((pose.eye - b.centre).norm() < 0.5 * b.diameter_m + 0.1)
+        throw std::invalid_argument(scene.file.string() + ": " + pose.name + ": the camera is within 0.1 m of ball " +
+                                    b.name + "'s surface");
+  const EnvMap env = synth_environment(scene);
+  const RigRenderer renderer(scene, env);
+  const RayTable rays(cam.lens, 8);
+  const CameraResponse response(cam.response);
+  const int max_code = cam.format == "tiff" ? 65535 : 255;
+  const std::vector<double> times = scene.exposure.times();
+  auto relative_exposure = [&](double t) {
+    return t * scene.exposure.iso / 100.0 / (scene.exposure.aperture * scene.exposure.aperture);
+  };
+  const double work = double(poses.size()) * (1 + 0.1 * double(times.size())) + 0.3 * scene.chessboards.count + 1;
+  double done = 0;
+  auto advance = [&](double units) {
+    done += units;
+    if (progress) progress(std::min(1.0, done / work));
+  };
+
+  SynthReport report;
+  SensorNoise noise{1.0, cam.full_well, cam.read_noise};
+  const cv::Mat vignette = vignetting_field(cam.lens, cam.vignetting);
+  RenderOptions ropt;
+  ropt.supersampling = cam.supersampling;
+  ropt.seed = scene.seed;
+
+  PhotoSet set;
+  set.folder = photos;
+  set.camera_name = cam.name;
+  for (const SynthBall& b : scene.balls)
+    set.balls.push_back(
+        {b.name, b.kind == "chrome" ? BallKind::chrome : b.kind == "grey" ? BallKind::grey : BallKind::glossy, b.diameter_m});
+
+  YAML::Node ty;
+  ty["rsibr_synth_truth"] = 1;
+  ty["scene"] = scene.file.string();
+  ty["seed"] = scene.seed;
+  YAML::Node tc;
+  tc["model"] = "camera.cameramodel";
+  tc["lens"] = cam.lens.name();
+  tc["response"] = cam.response;
+  tc["response_table"] = "response.csv";
+  tc["max_code"] = max_code;
+  tc["format"] = cam.format;
+  tc["full_well"] = cam.full_well;
+  tc["read_noise"] = cam.read_noise;
+  tc["shot_normalised"] = 1.0 / cam.full_well;
+  tc["read_variance_normalised"] = (cam.read_noise / cam.full_well) * (cam.read_noise / cam.full_well);
+  tc["vignetting"] = cam.vignetting;
+  tc["white_balance"] = vec(cam.white_balance);
+  tc["supersampling"] = cam.supersampling;
+  tc["convention"] = "X = L e k electrons (L after vignetting and white balance, e = t*iso/100/N^2); "
+                     "X = clamp(Poisson(X) + Normal(0, read_noise^2), 0, full_well); code = round(f(X/full_well)*max_code)";
+
+  for (std::size_t vi = 0; vi < poses.size(); ++vi) {
+    const CameraPose& pose = poses[vi];
+    const auto r0 = Clock::now();
+    const double before = done;
+    const cv::Mat scene_radiance =
+        renderer.render(pose, cam.lens, rays, ropt, [&](double f) { if (progress) progress(std::min(1.0, (before + f) / work)); });
+    report.pixels_rendered += (long long)(scene_radiance.total()) * cam.supersampling * cam.supersampling;
+    advance(1);
+    // L at the pixel: vignetting and white balance applied to the scene radiance.
+    cv::Mat L(scene_radiance.size(), CV_32FC3);
+    for (int y = 0; y < L.rows; ++y)
+      for (int x = 0; x < L.cols; ++x) {
+        const float v = vignette.at<float>(y, x);
+        const cv::Vec3f s = scene_radiance.at<cv::Vec3f>(y, x);
+        L.at<cv::Vec3f>(y, x) = cv::Vec3f(float(s[0] * v * cam.white_balance[0]), float(s[1] * v * cam.white_balance[1]),
+                                          float(s[2] * v * cam.white_balance[2]));
+      }
+    const auto r1 = Clock::now();
+    report.seconds_render += secs(r1 - r0);
+    if (vi == 0) {
+      // Metering on the median (a sun in the frame would drag a mean far up).
+      std::vector<float> grey;
+      grey.reserve(L.total());
+      for (int y = 0; y < L.rows; ++y)
+        for (int x = 0; x < L.cols; ++x) {
+          const cv::Vec3f p = L.at<cv::Vec3f>(y, x);
+          grey.push_back((p[0] + p[1] + p[2]) / 3);
+        }
+      std::nth_element(grey.begin(), grey.begin() + long(grey.size() / 2), grey.end());
+      const double median = grey[grey.size() / 2];
+      const double e_mid = relative_exposure(scene.exposure.middle_s);
+      noise.gain = cam.gain.value_or(median > 0 ? 0.18 * cam.full_well / (median * e_mid) : 1.0);
+      tc["gain"] = noise.gain;
+      // hdr/'s normalised units (X / X_sat, X_sat = full_well): docs/conventions.md.
+      tc["gain_normalised"] = noise.gain / cam.full_well;
+      tc["gain_source"] = cam.gain ? "scene" : "auto: the first view's median radiance records 18% of the full well at the middle exposure";
+      report.gain = noise.gain;
+    }
+    PhotoView pv;
+    pv.name = pose.name;
+    fs::create_directories(photos / pose.name);
+    YAML::Node tv;
+    tv["name"] = pose.name;
+    tv["eye"] = vec(pose.eye);
+    tv["world_from_cam"] = mat(pose.world_from_cam);
+    tv["radiance"] = "views/" + pose.name + "_radiance.exr";
+    tv["scene_radiance"] = "views/" + pose.name + "_scene.exr";
+    for (std::size_t bi = 0; bi < times.size(); ++bi) {
+      const double e = relative_exposure(times[bi]);
+      const cv::Mat codes = expose_bracket(L, e, noise, response, max_code, scene.seed, 1 + vi * 64 + bi);
+      char name[64];
+      std::snprintf(name, sizeof name, "%s_b%02zu.%s", pose.name.c_str(), bi, ext_of(cam.format).c_str());
+      const fs::path file = photos / pose.name / name;
+      write_codes(file, codes, cam.format);
+      pv.brackets.push_back({file, times[bi], scene.exposure.iso, scene.exposure.aperture});
+      YAML::Node tb;
+      tb["file"] = pose.name + "/" + name;
+      tb["exposure_s"] = times[bi];
+      tb["relative_exposure"] = e;
+      tb["clipped_fraction"] = clipped_fraction(codes, max_code);
+      tv["brackets"].push_back(tb);
+      ++report.brackets;
+      advance(0.1);
+    }
+    report.seconds_brackets += secs(Clock::now() - r1);
+    const auto r2 = Clock::now();
+    std::map<std::string, std::string> attrs = {{"version", RSIBR_VERSION},
+                                                {"view", pose.name},
+                                                {"cameraModel", cam.lens.name()},
+                                                {"seed", std::to_string(scene.seed)}};
+    attrs["content"] = "L at the pixel (after vignetting and white balance): X = L e k";
+    write_truth_image(truth / "views" / (pose.name + "_radiance.exr"), L, &pose, attrs);
+    attrs["content"] = "scene radiance along each pixel's rays (before vignetting and white balance)";
+    write_truth_image(truth / "views" / (pose.name + "_scene.exr"), scene_radiance, &pose, attrs);
+    for (const SynthBall& b : scene.balls) {
+      YAML::Node tb;
+      tb["name"] = b.name;
+      const Vec3 cam_pt = pose.world_from_cam.transpose() * (b.centre - pose.eye);
+      if (cam_pt.z() > 0) tb["centre_px"] = vec2(cam.lens.project(cam_pt));
+      tb["distance_m"] = cam_pt.norm();
+      tv["balls"].push_back(tb);
+    }
+    ty["views"].push_back(tv);
+    set.views.push_back(pv);
+    report.seconds_truth += secs(Clock::now() - r2);
+  }
+
+  // True sphere maps: one map set per ball, a part per view.
+  const auto m0 = Clock::now();
+  YAML::Node tballs;
+  const IrradianceQuadrature irradiance(env);
+  std::unique_ptr<Integrator> fis;
+  for (const SynthBall& b : scene.balls)
+    if (b.kind == "glossy" && !fis) fis = make_integrator("fis", env);
+  for (const SynthBall& b : scene.balls) {
+    MapSet ms;
+    for (const CameraPose& pose : poses)
+      ms.views.push_back(true_sphere_map(b, pose.eye, env, scene.map_size, &irradiance, fis.get()));
+    write_map_set((truth / "maps" / (b.name + ".exr")).string(), ms);
+    YAML::Node tb;
+    tb["name"] = b.name;
+    tb["kind"] = b.kind;
+    tb["centre"] = vec(b.centre);
+    tb["diameter_m"] = b.diameter_m;
+    tb["material"] = ms.views.front().material;
+    tb["map"] = "maps/" + b.name + ".exr";
+    tballs.push_back(tb);
+  }
+  ty["balls"] = tballs;
+  report.seconds_truth += secs(Clock::now() - m0);
+  advance(1);
+
+  // Chessboards through the same lens, exposed like a photo (white at about 70% of the full well).
+  if (scene.chessboards.count > 0) {
+    ChessboardSet cs;
+    cs.corners_x = cs.corners_y = scene.chessboards.corners;
+    cs.spacing_m = scene.chessboards.spacing_m;
+    const SensorNoise board_noise{0.7 * cam.full_well / 0.9, cam.full_well, cam.read_noise};
+    const CameraResponse board_response("srgb");
+    for (int i = 0; i < scene.chessboards.count; ++i) {
+      const ChessboardShot shot = render_chessboard(cam.lens, rays, scene.chessboards, i, scene.seed, cam.supersampling);
+      cv::Mat lit = shot.reflectance.mul(vignette);
+      const cv::Mat codes = expose_bracket(lit, 1.0, board_noise, board_response, 255, scene.seed, 0xB0000 + std::uint64_t(i));
+      char name[32];
+      std::snprintf(name, sizeof name, "board%02d", i);
+      write_codes(photos / "chessboards" / (std::string(name) + ".png"), codes, "png");
+      cs.files.push_back(photos / "chessboards" / (std::string(name) + ".png"));
+      std::ofstream corners(truth / "chessboards" / (std::string(name) + ".txt"));
+      corners.precision(10);
+      corners << "# true pixel positions of the inner corners, row-major (j outer, i inner); mrcal pixel convention\n";
+      for (const Vec2& p : shot.corners) corners << p.x() << " " << p.y() << "\n";
+      if (!corners) throw std::runtime_error((truth / "chessboards" / name).string() + ".txt: cannot write");
+      YAML::Node tb;
+      tb["file"] = std::string("chessboards/") + name + ".png";
+      tb["corners"] = std::string("chessboards/") + name + ".txt";
+      tb["cam_from_board"] = mat(shot.cam_from_board);
+      tb["board_centre_cam"] = vec(shot.board_centre_cam);
+      ty["chessboards"].push_back(tb);
+      ++report.chessboards;
+      advance(0.3);
+    }
+    set.chessboards = cs;
+  }
+
+  ty["camera"] = tc;
+  cam.lens.write(truth / "camera.cameramodel");
+  {
+    std::ofstream csv(truth / "response.csv");
+    csv.precision(17);
+    csv << "code,R,G,B\n";
+    for (const auto& row : response.table(max_code)) csv << row[0] << "," << row[1] << "," << row[2] << "," << row[3] << "\n";
+    if (!csv) throw std::runtime_error((truth / "response.csv").string() + ": cannot write");
+  }
+  {
+    YAML::Emitter em;
+    em.SetDoublePrecision(17);
+    em << ty;
+    std::ofstream f(truth / "truth.yaml");
+    f << "# Ground truth of a synthetic capture (rsibr synth); see capture/synth_capture.h.\n" << em.c_str() << "\n";
+    if (!f) throw std::runtime_error((truth / "truth.yaml").string() + ": cannot write");
+  }
+  save_photo_set(set);
+
+  if (fs::exists(out)) fs::remove(out);  // an empty folder (checked above)
+  fs::rename(tmp, out);
+  cleanup.keep = true;
+  report.views = int(poses.size());
+  report.seconds_total = secs(Clock::now() - t0);
+  if (progress) progress(1.0);
+  return report;
+}
+
+}  // namespace rsibr

@@ -1,0 +1,251 @@
+#include "capture/synth_scene.h"
+
+#include "bake/brdf_spec.h"
+#include "capture/camera_response.h"
+#include "core/yaml_spec.h"
+
+#include <cmath>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace rsibr {
+namespace {
+
+Vec3 vec3_in(const YamlMap& m, const std::string& key, double lo, bool lo_open) {
+  const Vec3 v = m.vec3(key);
+  for (int i = 0; i < 3; ++i) spec_in_range(v[i], m.at(key) + "[" + std::to_string(i) + "]", lo, lo_open, INFINITY, true);
+  return v;
+}
+
+SynthEnvironment parse_environment(const YAML::Node& node, const std::string& path,
+                                   const std::filesystem::path& folder) {
+  const YamlMap m(node, path,
+                  {"file", "sanitize", "pattern", "size", "sun_direction", "sun_radius_deg", "sun_rgb",
+                   "zenith_rgb", "horizon_rgb", "scale"});
+  SynthEnvironment e;
+  if (m.has("file") == m.has("pattern")) spec_fail(path, "give either file or pattern");
+  if (m.has("file")) {
+    e.file = std::filesystem::absolute(folder / m.string("file"));
+    if (!std::filesystem::exists(*e.file)) spec_fail(m.at("file"), "no such file: " + e.file->string());
+    if (m.has("sanitize")) e.sanitize = m.boolean("sanitize");
+    for (const char* k : {"size", "sun_direction", "sun_radius_deg", "sun_rgb", "zenith_rgb", "horizon_rgb"})
+      if (m.has(k)) spec_fail(m.at(k), "only for pattern: sun_and_sky");
+  } else {
+    m.choice("pattern", {"sun_and_sky"});
+    if (m.has("sanitize")) spec_fail(m.at("sanitize"), "only for file");
+    if (m.has("size")) e.size = int(spec_in_range(double(m.integer("size")), m.at("size"), 8, false, 8192, false));
+    if (m.has("sun_direction")) {
+      e.sun_direction = m.vec3("sun_direction");
+      if (!(e.sun_direction.norm() > 0)) spec_fail(m.at("sun_direction"), "must be non-zero");
+      e.sun_direction.normalize();
+    }
+    if (m.has("sun_radius_deg")) e.sun_radius_deg = m.number_in("sun_radius_deg", 0, false, 45, false);
+    if (m.has("sun_rgb")) e.sun_rgb = vec3_in(m, "sun_rgb", 0, false);
+    if (m.has("zenith_rgb")) e.zenith_rgb = vec3_in(m, "zenith_rgb", 0, false);
+    if (m.has("horizon_rgb")) e.horizon_rgb = vec3_in(m, "horizon_rgb", 0, false);
+  }
+  if (m.has("scale")) e.scale = m.positive("scale");
+  return e;
+}
+
+SynthBall parse_ball(const YAML::Node& node, const std::string& path) {
+  const YamlMap m(node, path, {"name", "kind", "diameter_m", "centre", "fresnel", "albedo", "brdf"});
+  SynthBall b;
+  b.name = m.string("name");
+  // Names become file names (truth/maps/<name>.exr).
+  if (b.name.empty() || b.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") != std::string::npos)
+    spec_fail(m.at("name"), "use letters, digits, '_' and '-' only");
+  b.kind = m.choice("kind", {"chrome", "grey", "glossy"});
+  if (b.kind != "glossy" && m.has("brdf")) spec_fail(m.at("brdf"), "only for kind: glossy");
+  if (m.has("diameter_m")) b.diameter_m = m.positive("diameter_m");
+  if (m.has("centre")) b.centre = m.vec3("centre");
+  if (b.kind == "glossy") {
+    if (m.has("albedo") || m.has("fresnel")) spec_fail(m.at(m.has("albedo") ? "albedo" : "fresnel"), "glossy balls take a brdf");
+    const YAML::Node f = m.has("brdf") ? m.get("brdf")
+                                       : YAML::Load("{type: ggx, roughness: 0.15, fresnel: {type: dielectric, ior: 1.5}}");
+    b.brdf = make_brdf(f, m.at("brdf"))->spec();
+  } else if (b.kind == "chrome") {
+    if (m.has("albedo")) spec_fail(m.at("albedo"), "only for kind: grey");
+    // Chromium-like conductor: about 57% reflectance at normal incidence (real chrome balls reflect
+    // roughly 60%).
+    YAML::Node f = m.has("fresnel") ? m.get("fresnel") : YAML::Load("{type: conductor, eta: [2.9, 2.9, 2.6], k: [3.4, 3.4, 3.2]}");
+    b.fresnel = make_fresnel(f, m.at("fresnel"))->spec();
+  } else {
+    if (m.has("fresnel")) spec_fail(m.at("fresnel"), "only for kind: chrome");
+    if (m.has("albedo")) {
+      b.albedo = m.vec3("albedo");
+      for (int i = 0; i < 3; ++i) spec_in_range(b.albedo[i], m.at("albedo"), 0, false, 1, false);
+    }
+  }
+  return b;
+}
+
+LensModel parse_lens(const YAML::Node& node, const std::string& path, int width, int height,
+                     const std::filesystem::path& folder) {
+  const YamlMap m(node, path, {"file", "model", "focal_px", "distortion", "intrinsics"});
+  if (m.has("file")) {
+    for (const char* k : {"model", "focal_px", "distortion", "intrinsics"})
+      if (m.has(k)) spec_fail(m.at(k), "not with file");
+    LensModel lens = LensModel::read(folder / m.string("file"));
+    if (lens.width() != width || lens.height() != height)
+      spec_fail(m.at("file"), "its image size differs from camera.width x camera.height");
+    return lens;
+  }
+  const std::string model = m.string("model");
+  std::vector<double> intr;
+  if (m.has("intrinsics")) {
+    if (m.has("focal_px") || m.has("distortion")) spec_fail(m.at("intrinsics"), "give intrinsics or focal_px");
+    intr = m.numbers("intrinsics");
+  } else {
+    const double f = m.positive("focal_px");
+    intr = {f, f, 0.5 * (width - 1), 0.5 * (height - 1)};
+    if (m.has("distortion"))
+      for (double d : m.numbers("distortion")) intr.push_back(d);
+  }
+  try {
+    return LensModel(model, intr, width, height);
+  } catch (const std::invalid_argument& e) {
+    spec_fail(path, e.what());
+  }
+}
+
+SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const std::filesystem::path& folder) {
+  const YamlMap m(node, path,
+                  {"name", "width", "height", "lens", "response", "format", "supersampling", "vignetting",
+                   "white_balance", "full_well", "read_noise", "gain"});
+  SynthCamera c;
+  const int w = int(spec_in_range(double(m.integer("width")), m.at("width"), 16, false, 16384, false));
+  const int h = int(spec_in_range(double(m.integer("height")), m.at("height"), 16, false, 16384, false));
+  c.lens = parse_lens(m.get("lens"), m.at("lens"), w, h, folder);
+  if (c.lens.can_project_behind_camera())
+    spec_fail(m.at("lens"), "models that see behind the camera (stereographic, splined) are not supported yet");
+  if (m.has("name")) c.name = m.string("name");
+  if (m.has("response")) c.response = m.choice("response", CameraResponse::kinds());
+  if (m.has("format")) c.format = m.choice("format", {"png", "jpeg", "tiff"});
+  if (m.has("supersampling"))
+    c.supersampling = int(spec_in_range(double(m.integer("supersampling")), m.at("supersampling"), 1, false, 16, false));
+  if (m.has("vignetting")) c.vignetting = m.number_in("vignetting", 0, false, 1, true);
+  if (m.has("white_balance")) c.white_balance = vec3_in(m, "white_balance", 0, true);
+  if (m.has("full_well")) c.full_well = m.number_in("full_well", 1, false, 1e9, false);
+  if (m.has("read_noise")) c.read_noise = m.number_in("read_noise", 0, false, 1e6, false);
+  if (m.has("gain")) c.gain = m.positive("gain");
+  return c;
+}
+
+SynthViewPlan parse_plan(const YAML::Node& node, const std::string& path) {
+  const YamlMap m(node, path,
+                  {"plan", "count", "azimuths_deg", "azimuth0_deg", "elevation_deg", "min_elevation_deg",
+                   "distance_m", "look_at", "roll_deg", "yaw_deg", "jitter_m", "jitter_deg"});
+  SynthViewPlan p;
+  p.plan = m.choice("plan", {"ring", "icosa", "handheld"});
+  auto only = [&](const char* key, std::initializer_list<const char*> plans) {
+    if (!m.has(key)) return false;
+    for (const char* q : plans)
+      if (p.plan == q) return true;
+    spec_fail(m.at(key), "not a key of plan: " + p.plan);
+  };
+  if (only("count", {"ring", "handheld"}))
+    p.count = int(spec_in_range(double(m.integer("count")), m.at("count"), 1, false, 1000, false));
+  if (only("azimuths_deg", {"ring"})) {
+    if (m.has("count")) spec_fail(m.at("azimuths_deg"), "give count or azimuths_deg");
+    p.azimuths_deg = m.numbers("azimuths_deg");
+    if (p.azimuths_deg.empty()) spec_fail(m.at("azimuths_deg"), "must not be empty");
+  }
+  if (only("azimuth0_deg", {"ring", "handheld"})) p.azimuth0_deg = m.number("azimuth0_deg");
+  if (only("elevation_deg", {"ring", "handheld"})) p.elevation_deg = m.number_in("elevation_deg", -89, false, 89, false);
+  if (only("min_elevation_deg", {"icosa"})) p.min_elevation_deg = m.number_in("min_elevation_deg", -90, false, 90, false);
+  if (m.has("distance_m")) p.distance_m = m.positive("distance_m");
+  if (m.has("look_at")) p.look_at = m.vec3("look_at");
+  if (m.has("roll_deg")) p.roll_deg = m.number_in("roll_deg", -180, false, 180, false);
+  if (m.has("yaw_deg")) p.yaw_deg = m.number_in("yaw_deg", -89, false, 89, false);
+  if (only("jitter_m", {"handheld"})) p.jitter_m = m.number_in("jitter_m", 0, false, 10, false);
+  if (only("jitter_deg", {"handheld"})) p.jitter_deg = m.number_in("jitter_deg", 0, false, 45, false);
+  return p;
+}
+
+SynthScene parse_root(const YAML::Node& root, const std::filesystem::path& folder) {
+  const YamlMap m(root, "scene",
+                  {"rsibr_synth", "seed", "environment", "balls", "stand", "photographer", "camera", "exposure",
+                   "views", "chessboards", "truth_map_size"});
+  if (m.integer("rsibr_synth") != 1) spec_fail(m.at("rsibr_synth"), "unsupported version (expected 1)");
+  SynthScene s;
+  if (m.has("seed")) s.seed = std::uint64_t(spec_in_range(double(m.integer("seed")), m.at("seed"), 0, false, 9e15, false));
+  s.environment = parse_environment(m.get("environment"), m.at("environment"), folder);
+  const YAML::Node balls = m.get("balls");
+  if (!balls.IsSequence() || balls.size() == 0) spec_fail(m.at("balls"), "expected a non-empty list");
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < balls.size(); ++i) {
+    const std::string p = m.at("balls") + "[" + std::to_string(i) + "]";
+    s.balls.push_back(parse_ball(balls[i], p));
+    if (!names.insert(s.balls.back().name).second) spec_fail(p + ".name", "duplicate ball name");
+  }
+  for (std::size_t i = 0; i < s.balls.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if ((s.balls[i].centre - s.balls[j].centre).norm() < 0.5 * (s.balls[i].diameter_m + s.balls[j].diameter_m))
+        spec_fail(m.at("balls") + "[" + std::to_string(i) + "]", "overlaps ball " + s.balls[j].name);
+  if (m.has("stand")) s.stand = m.boolean("stand");
+  if (m.has("photographer")) s.photographer = m.boolean("photographer");
+  s.camera = parse_camera(m.get("camera"), m.at("camera"), folder);
+  if (m.has("exposure")) {
+    const YamlMap e(m.get("exposure"), m.at("exposure"), {"middle_s", "count", "step_ev", "iso", "aperture"});
+    if (e.has("middle_s")) s.exposure.middle_s = e.positive("middle_s");
+    if (e.has("count")) s.exposure.count = int(spec_in_range(double(e.integer("count")), e.at("count"), 1, false, 32, false));
+    if (e.has("step_ev")) s.exposure.step_ev = e.number_in("step_ev", 0, true, 8, false);
+    if (e.has("iso")) s.exposure.iso = e.positive("iso");
+    if (e.has("aperture")) s.exposure.aperture = e.positive("aperture");
+  }
+  const YAML::Node views = m.get("views");
+  if (!views.IsSequence() || views.size() == 0) spec_fail(m.at("views"), "expected a non-empty list of plans");
+  for (std::size_t i = 0; i < views.size(); ++i)
+    s.views.push_back(parse_plan(views[i], m.at("views") + "[" + std::to_string(i) + "]"));
+  if (m.has("chessboards")) {
+    const YamlMap c(m.get("chessboards"), m.at("chessboards"), {"count", "corners", "spacing_m"});
+    s.chessboards.count = int(spec_in_range(double(c.integer("count")), c.at("count"), 0, false, 1000, false));
+    if (c.has("corners")) s.chessboards.corners = int(spec_in_range(double(c.integer("corners")), c.at("corners"), 2, false, 64, false));
+    if (c.has("spacing_m")) s.chessboards.spacing_m = c.positive("spacing_m");
+  }
+  if (m.has("truth_map_size"))
+    s.map_size = int(spec_in_range(double(m.integer("truth_map_size")), m.at("truth_map_size"), 8, false, 4096, false));
+  return s;
+}
+
+}  // namespace
+
+std::vector<double> SynthExposure::times() const {
+  std::vector<double> t;
+  for (int i = 0; i < count; ++i) t.push_back(middle_s * std::exp2(step_ev * (i - 0.5 * (count - 1))));
+  return t;
+}
+
+Vec3 SynthScene::rig_centre() const {
+  Vec3 c = Vec3::Zero();
+  for (const SynthBall& b : balls) c += b.centre;
+  return balls.empty() ? c : c / double(balls.size());
+}
+
+SynthScene parse_synth_scene(const std::string& text, const std::string& what, const std::filesystem::path& folder) {
+  try {
+    SynthScene s = parse_root(YAML::Load(text), folder);
+    s.file = what;
+    return s;
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(what + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                                ": " + e.msg);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(what + ": " + e.what());
+  }
+}
+
+SynthScene load_synth_scene(const std::filesystem::path& file) {
+  const YAML::Node root = load_yaml_file(file);
+  try {
+    SynthScene s = parse_root(root, std::filesystem::absolute(file).parent_path());
+    s.file = std::filesystem::absolute(file);
+    return s;
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(file.string() + ": " + e.what());
+  }
+}
+
+}  // namespace rsibr

@@ -1,0 +1,105 @@
+// The scene spec of `rsibr synth` (datasets-synthetic/README.md documents it with examples): an
+// environment at infinity, a ball rig, a camera (lens, response, noise, vignetting, white balance,
+// output format), exposure brackets, view plans and chessboards. Loading is strict
+// (core/yaml_spec.h): unknown keys, wrong types and out-of-range values are errors naming the key
+// path, std::invalid_argument("<file>: <path>: <problem>").
+//
+// World frame: +Y up, metres. Defaults are the values the README states.
+#pragma once
+
+#include "core/lens_model.h"
+#include "core/vec.h"
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rsibr {
+
+struct SynthEnvironment {
+  // Either a file (EXR or .hdr, path absolute after loading) ...
+  std::optional<std::filesystem::path> file;
+  bool sanitize = false;  // zero NaN, Inf and negative values (lossy EXR ringing) instead of failing
+  // ... or an analytic sky (core/patterns.h sun_and_sky) rendered into a lat-long map.
+  int size = 256;  // lat-long width of the rendered pattern
+  Vec3 sun_direction = Vec3(0.4, 0.7, 0.6);
+  double sun_radius_deg = 1.5;
+  Vec3 sun_rgb = Vec3(2e4, 1.9e4, 1.7e4);
+  Vec3 zenith_rgb = Vec3(0.25, 0.45, 1.0);
+  Vec3 horizon_rgb = Vec3(1.0, 0.95, 0.85);
+  double scale = 1.0;  // multiplies the environment
+};
+
+struct SynthBall {
+  std::string name;
+  std::string kind;  // "chrome", "grey" or "glossy"
+  double diameter_m = 0.1;
+  Vec3 centre = Vec3(0, 1.3, 0);
+  std::string fresnel;  // chrome: a Fresnel spec (bake/brdf_spec.h), flow YAML
+  Vec3 albedo = Vec3::Constant(0.18);  // grey: Lambert albedo
+  std::string brdf;  // glossy: a BRDF spec (bake/brdf_spec.h), flow YAML, e.g. GGX with Fresnel
+};
+
+struct SynthViewPlan {
+  std::string plan;                 // "ring", "icosa" or "handheld"
+  int count = 3;                    // ring, handheld: views evenly spaced in azimuth
+  std::vector<double> azimuths_deg; // ring: explicit azimuths instead of count
+  double azimuth0_deg = 0;          // first azimuth (0 = +Z, 90 = +X)
+  double elevation_deg = 10;        // above the horizontal through look_at
+  double min_elevation_deg = -90;   // icosa: directions below this are dropped
+  double distance_m = 1.5;          // camera centre to look_at
+  std::optional<Vec3> look_at;      // default: the centre of the balls
+  double roll_deg = 0;
+  double yaw_deg = 0;               // after aiming: turn the camera right by this (the target moves left)
+  double jitter_m = 0.03, jitter_deg = 1.5;  // handheld: position and orientation jitter (std dev)
+};
+
+struct SynthExposure {
+  double middle_s = 0.01;
+  int count = 3;
+  double step_ev = 2;
+  double iso = 100;
+  double aperture = 8;
+  std::vector<double> times() const;  // shortest first
+};
+
+struct SynthCamera {
+  LensModel lens = LensModel::pinhole(600, 640, 480);
+  std::string name = "synthetic camera";
+  std::string response = "srgb";
+  std::string format = "png";  // "png" (8-bit), "jpeg" (8-bit), "tiff" (16-bit)
+  int supersampling = 2;       // n: n x n stratified, jittered samples per pixel
+  double vignetting = 0.0;     // v = 1 - vignetting * (r / r_corner)^2
+  Vec3 white_balance = Vec3::Ones();
+  double full_well = 2e4, read_noise = 3;
+  std::optional<double> gain;  // electrons per unit radiance-exposure; auto (median metering) when absent
+};
+
+struct SynthChessboards {
+  int count = 0;
+  int corners = 10;  // inner corners along each side (mrgingham --gridn)
+  double spacing_m = 0.03;
+};
+
+struct SynthScene {
+  std::filesystem::path file;
+  std::uint64_t seed = 1;
+  SynthEnvironment environment;
+  std::vector<SynthBall> balls;
+  bool stand = true, photographer = true;
+  SynthCamera camera;
+  SynthExposure exposure;
+  std::vector<SynthViewPlan> views;
+  SynthChessboards chessboards;
+  int map_size = 64;  // truth sphere maps, square
+
+  Vec3 rig_centre() const;  // mean of the ball centres
+};
+
+SynthScene load_synth_scene(const std::filesystem::path& file);
+// The same from YAML text (`what` names it in errors; relative paths resolve against `folder`).
+SynthScene parse_synth_scene(const std::string& text, const std::string& what, const std::filesystem::path& folder);
+
+}  // namespace rsibr
