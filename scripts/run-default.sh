@@ -3,7 +3,9 @@
 # needs, builds it, fetches CC0 data (a Poly Haven sky and the bunny via @pmndrs/assets) and runs
 # the pipeline stages that exist so far: inspect the sky, convert it to every layout with PNG
 # previews; bake a copper map set under it (12 views), blend a novel view, render the bunny with the
-# maps (the runtime) and with the Embree reference path tracer, side by side.
+# maps (the runtime) and with the Embree reference path tracer, side by side; compare the FIS bake
+# with an MIS bake of the same maps; synthesize a minimal ball-rig capture with its ground truth
+# and merge its exposure brackets into radiance.
 # Outputs go to out/default/ (or the folder given as $1).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -39,4 +41,14 @@ printf '{type: ggx, roughness: 0.2, fresnel: {type: conductor, eta: [0.2, 0.92, 
 "$rsibr" reference --mesh "$mesh" --env "$env" --brdf "$out/copper.yaml" --size 640x360 --spp 16 --no-shadows \
   --background black --sanitize --preview "$out/bunny-reference.png" --json "$out/bunny-reference.json" \
   "$out/bunny-reference.exr"
+# Two integrators compared (metrics, fitted exposure/white balance, heat maps).
+"$rsibr" bake --env "$env" --brdf "$out/copper.yaml" --views icosa --res 128 --method mis --samples 64 \
+  --sanitize -q "$out/copper-maps-mis.exr"
+rm -rf "$out/copper-compare"
+"$rsibr" compare "$out/copper-maps.exr" "$out/copper-maps-mis.exr" --out "$out/copper-compare" \
+  --json "$out/copper-compare.json"
+# A synthetic capture (chrome ball, pinhole, 3 views, brackets, chessboards) and its HDR merge.
+rm -rf "$out/synth-minimal"
+"$rsibr" synth datasets-synthetic/minimal.yaml --out "$out/synth-minimal" --json "$out/synth-minimal.json"
+"$rsibr" hdr "$out/synth-minimal/photos" --out "$out/synth-minimal/hdr" --json "$out/synth-minimal-hdr.json"
 echo "run-default: results in $out/ (EXR, PNG previews, JSON summaries)"
