@@ -114,7 +114,9 @@ TEST(SphereMapExtraction, OrthographicErrorFallsWithDistanceExactStaysSmall) {
                 e.ortho.relative_rms, e.exact.relative_rms);
     EXPECT_LT(e.ortho.relative_rms, previous);
     EXPECT_LT(e.exact.relative_rms, 0.01);
-    if (d <= 1.0) EXPECT_LT(e.exact.relative_rms, e.ortho.relative_rms);
+    if (d <= 1.0) {
+      EXPECT_LT(e.exact.relative_rms, e.ortho.relative_rms);
+    }
     previous = e.ortho.relative_rms;
   }
 }
