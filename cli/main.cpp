@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   runners["hdr"] = rsibr::cli::add_hdr(app);
   runners["compare"] = rsibr::cli::add_compare(app);
   runners["synth"] = rsibr::cli::add_synth(app);
+  runners["extract"] = rsibr::cli::add_extract(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

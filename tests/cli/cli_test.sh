@@ -25,7 +25,7 @@ expect_error() {
 }
 no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
 
-for verb in convert info pattern blend bake reference render view hdr compare synth; do
+for verb in convert info pattern blend bake reference render view hdr compare synth extract; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
 done
 check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
@@ -339,6 +339,29 @@ expect_error "synth: missing spec" "nospec.yaml" synth "$work/nospec.yaml" --out
 expect_error "synth: output not empty" "syn1" synth "$spec" --out "$work/syn1"
 check "synth: no output after errors" test ! -e "$work/syn4" -a ! -e "$work/syn5"
 check "synth: no partial folders" bash -c "! ls -A '$work' | grep -q partial"
+
+# --- extract (calib/): the ball of synth's minimal spec found, located to 0.1 px of the truth,
+# its map paired with the true map by rsibr compare; determinism; one-line errors, no partial output.
+lens="$work/syn1/truth/camera.cameramodel"
+"$rsibr" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$lens" --out "$work/ext1.exr" --size 64 --json "$work/ext.json" -q
+"$rsibr" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$lens" --out "$work/ext2.exr" --size 64 -q
+check "extract writes a captured map set" bash -c "'$rsibr' info '$work/ext1.exr' | grep -q captured"
+check "extract: ball centre within 0.1 px of the truth" python3 -c "
+import json; j = json.load(open('$work/ext.json')); c = j['ball']['centre_px']
+assert abs(c[0] - 159.5) < 0.1 and abs(c[1] - 119.5) < 0.1 and j['pose_from_header'], j"
+check "extract: same input, same bytes" cmp -s "$work/ext1.exr" "$work/ext2.exr"
+check "extract: the map pairs with the true map" "$rsibr" compare "$work/ext1.exr" "$work/syn1/truth/maps/chrome.exr" --json "$work/ext-cmp.json" -q
+"$rsibr" hdr "$work/syn1/photos" --out "$work/ext-hdr" --no-preview -q
+check "extract: from a merged view (clipped pixels carry no confidence)" "$rsibr" extract "$work/ext-hdr/view00.exr" --lens "$lens" --out "$work/ext3.exr" --size 32 -q
+sed 's/320, 240/640, 480/' "$lens" >"$work/wrong-size.cameramodel"
+expect_error "extract: lens of another size" "wrong-size.cameramodel" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$work/wrong-size.cameramodel" --out "$work/ext-e1.exr"
+expect_error "extract: no ball at the given place" "ball at (20.0, 20.0)" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$lens" --out "$work/ext-e2.exr" --ball 20,20,15
+expect_error "extract: missing image" "nothere.exr" extract "$work/nothere.exr" --lens "$lens" --out "$work/ext-e3.exr"
+expect_error "extract: bad kind" "--kind" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$lens" --out "$work/ext-e4.exr" --kind glass
+expect_error "extract: malformed --ball" "--ball" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$lens" --out "$work/ext-e5.exr" --ball 20,20
+expect_error "extract: output folder missing" "nofolder" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$lens" --out "$work/nofolder/e.exr"
+check "extract: no output after errors" bash -c "! ls -A '$work' | grep -q '^ext-e'"
+check "extract: no temporaries" no_temporaries "$work"
 
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
