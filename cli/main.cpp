@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   runners["compare"] = rsibr::cli::add_compare(app);
   runners["synth"] = rsibr::cli::add_synth(app);
   runners["extract"] = rsibr::cli::add_extract(app);
+  runners["calibrate"] = rsibr::cli::add_calibrate(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -21,5 +21,6 @@ Runner add_hdr(CLI::App& app);
 Runner add_compare(CLI::App& app);
 Runner add_synth(CLI::App& app);
 Runner add_extract(CLI::App& app);
+Runner add_calibrate(CLI::App& app);
 
 }  // namespace rsibr::cli

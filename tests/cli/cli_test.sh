@@ -25,7 +25,7 @@ expect_error() {
 }
 no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
 
-for verb in convert info pattern blend bake reference render view hdr compare synth extract; do
+for verb in convert info pattern blend bake reference render view hdr compare synth extract calibrate; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
 done
 check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
@@ -362,6 +362,22 @@ expect_error "extract: malformed --ball" "--ball" extract "$work/syn1/truth/view
 expect_error "extract: output folder missing" "nofolder" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$lens" --out "$work/nofolder/e.exr"
 check "extract: no output after errors" bash -c "! ls -A '$work' | grep -q '^ext-e'"
 check "extract: no temporaries" no_temporaries "$work"
+
+# --- calibrate (calib/intrinsics.h): 8 chessboards of the minimal spec's pinhole (f = 700 px).
+sed 's/chessboards: {count: 2,/chessboards: {count: 8,/' "$spec" >"$work/min8.yaml"
+"$rsibr" synth "$work/min8.yaml" --out "$work/syn8" -q
+"$rsibr" calibrate "$work/syn8/photos" --out "$work/cal1.cameramodel" --json "$work/cal.json" -q
+"$rsibr" calibrate "$work/syn8/photos" --out "$work/cal2.cameramodel" -q
+check "calibrate: pinhole chosen, f within 1%, RMS below 0.5 px" python3 -c "
+import json; j = json.load(open('$work/cal.json'))
+assert j['model'] == 'LENSMODEL_PINHOLE' and abs(j['intrinsics'][0] / 700 - 1) < 0.01 and j['rms_px'] < 0.5, j
+assert len(j['models']) == 3 and j['boards_found'] == 8 and len(j['residual_grid_4x3']) == 12, j"
+check "calibrate: same photos, same bytes" cmp -s "$work/cal1.cameramodel" "$work/cal2.cameramodel"
+check "calibrate: the model serves extract" "$rsibr" extract "$work/syn8/truth/views/view00_radiance.exr" --lens "$work/cal1.cameramodel" --out "$work/ext-cal.exr" -q
+expect_error "calibrate: too few boards" "need at least 4" calibrate "$work/syn1/photos" --out "$work/cal-e1.cameramodel"
+expect_error "calibrate: missing photo set" "nothere" calibrate "$work/nothere" --out "$work/cal-e2.cameramodel"
+expect_error "calibrate: unknown model" "LENSMODEL_FANCY" calibrate "$work/syn8/photos" --out "$work/cal-e3.cameramodel" --model LENSMODEL_FANCY
+check "calibrate: no output after errors" bash -c "! ls -A '$work' | grep -q '^cal-e'"
 
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
