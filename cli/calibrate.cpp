@@ -47,7 +47,7 @@ int run_calibrate(const CalibrateArgs& a) {
   p.spacing_m = cb.spacing_m;
   nlohmann::json missed = nlohmann::json::array();
   {
-    Progress progress("corners", !a.quiet && stderr_is_terminal());
+    Progress progress("corners", !a.quiet && Progress::stderr_is_terminal());
     for (std::size_t i = 0; i < cb.files.size(); ++i) {
       const cv::Mat img = read_grey8(cb.files[i]);
       if (p.width == 0) p.width = img.cols, p.height = img.rows;
