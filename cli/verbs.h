@@ -22,5 +22,6 @@ Runner add_compare(CLI::App& app);
 Runner add_synth(CLI::App& app);
 Runner add_extract(CLI::App& app);
 Runner add_calibrate(CLI::App& app);
+Runner add_probe(CLI::App& app);
 
 }  // namespace rsibr::cli

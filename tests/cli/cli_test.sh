@@ -25,7 +25,7 @@ expect_error() {
 }
 no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
 
-for verb in convert info pattern blend bake reference render view hdr compare synth extract calibrate; do
+for verb in convert info pattern blend bake reference render view hdr compare synth extract calibrate probe; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
 done
 check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
@@ -378,6 +378,21 @@ expect_error "calibrate: too few boards" "need at least 4" calibrate "$work/syn1
 expect_error "calibrate: missing photo set" "nothere" calibrate "$work/nothere" --out "$work/cal-e2.cameramodel"
 expect_error "calibrate: unknown model" "LENSMODEL_FANCY" calibrate "$work/syn8/photos" --out "$work/cal-e3.cameramodel" --model LENSMODEL_FANCY
 check "calibrate: no output after errors" bash -c "! ls -A '$work' | grep -q '^cal-e'"
+
+# --- probe (calib/probe.h): the minimal spec's three chrome views (poses from the truth headers).
+for v in 0 1 2; do
+  "$rsibr" extract "$work/syn1/truth/views/view0${v}_radiance.exr" --lens "$lens" --out "$work/pv$v.exr" --size 64 --camera-mask-deg 40 -q
+done
+"$rsibr" probe "$work/pv0.exr" "$work/pv1.exr" "$work/pv2.exr" --out "$work/probe.exr" --width 128 --json "$work/probe.json" -q \
+  --fresnel '{type: conductor, eta: [2.9, 2.9, 2.6], k: [3.4, 3.4, 3.2]}'
+check "probe writes a lat-long environment" bash -c "'$rsibr' info '$work/probe.exr' | grep -qi latlong"
+check "probe: three views cover the sphere" python3 -c "import json; j = json.load(open('$work/probe.json')); assert j['views'] == 3 and j['covered_fraction'] > 0.95, j"
+"$rsibr" extract "$work/ext-hdr/view00.exr" --lens "$lens" --out "$work/pc0.exr" -q
+"$rsibr" extract "$work/syn1/photos/../truth/views/view01_radiance.exr" --lens "$lens" --out "$work/pc1.exr" -q
+expect_error "probe: a view without a pose" "camera's frame" probe "$work/pc0.exr" "$work/pc1.exr" --out "$work/probe-e1.exr"
+expect_error "probe: computed maps" "not a captured map" probe "$work/syn1/truth/maps/chrome.exr" --out "$work/probe-e2.exr"
+expect_error "probe: bad Fresnel" "--fresnel" probe "$work/pv0.exr" --out "$work/probe-e3.exr" --fresnel '{type: glass}'
+check "probe: no output after errors" bash -c "! ls -A '$work' | grep -q '^probe-e'"
 
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
