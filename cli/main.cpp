@@ -28,6 +28,9 @@ int main(int argc, char** argv) {
   runners["hdr"] = rsibr::cli::add_hdr(app);
   runners["compare"] = rsibr::cli::add_compare(app);
   runners["synth"] = rsibr::cli::add_synth(app);
+  runners["extract"] = rsibr::cli::add_extract(app);
+  runners["calibrate"] = rsibr::cli::add_calibrate(app);
+  runners["probe"] = rsibr::cli::add_probe(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

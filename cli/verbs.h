@@ -20,5 +20,8 @@ Runner add_view(CLI::App& app);
 Runner add_hdr(CLI::App& app);
 Runner add_compare(CLI::App& app);
 Runner add_synth(CLI::App& app);
+Runner add_extract(CLI::App& app);
+Runner add_calibrate(CLI::App& app);
+Runner add_probe(CLI::App& app);
 
 }  // namespace rsibr::cli

@@ -25,7 +25,7 @@ expect_error() {
 }
 no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
 
-for verb in convert info pattern blend bake reference render view hdr compare synth; do
+for verb in convert info pattern blend bake reference render view hdr compare synth extract calibrate probe; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
 done
 check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
@@ -339,6 +339,60 @@ expect_error "synth: missing spec" "nospec.yaml" synth "$work/nospec.yaml" --out
 expect_error "synth: output not empty" "syn1" synth "$spec" --out "$work/syn1"
 check "synth: no output after errors" test ! -e "$work/syn4" -a ! -e "$work/syn5"
 check "synth: no partial folders" bash -c "! ls -A '$work' | grep -q partial"
+
+# --- extract (calib/): the ball of synth's minimal spec found, located to 0.1 px of the truth,
+# its map paired with the true map by rsibr compare; determinism; one-line errors, no partial output.
+lens="$work/syn1/truth/camera.cameramodel"
+"$rsibr" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$lens" --out "$work/ext1.exr" --size 64 --json "$work/ext.json" -q
+"$rsibr" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$lens" --out "$work/ext2.exr" --size 64 -q
+check "extract writes a captured map set" bash -c "'$rsibr' info '$work/ext1.exr' | grep -q captured"
+check "extract: ball centre within 0.1 px of the truth" python3 -c "
+import json; j = json.load(open('$work/ext.json')); c = j['ball']['centre_px']
+assert abs(c[0] - 159.5) < 0.1 and abs(c[1] - 119.5) < 0.1 and j['pose_from_header'], j"
+check "extract: same input, same bytes" cmp -s "$work/ext1.exr" "$work/ext2.exr"
+check "extract: the map pairs with the true map" "$rsibr" compare "$work/ext1.exr" "$work/syn1/truth/maps/chrome.exr" --json "$work/ext-cmp.json" -q
+"$rsibr" hdr "$work/syn1/photos" --out "$work/ext-hdr" --no-preview -q
+check "extract: from a merged view (clipped pixels carry no confidence)" "$rsibr" extract "$work/ext-hdr/view00.exr" --lens "$lens" --out "$work/ext3.exr" --size 32 -q
+sed 's/320, 240/640, 480/' "$lens" >"$work/wrong-size.cameramodel"
+expect_error "extract: lens of another size" "wrong-size.cameramodel" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$work/wrong-size.cameramodel" --out "$work/ext-e1.exr"
+expect_error "extract: no ball at the given place" "ball at (20.0, 20.0)" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$lens" --out "$work/ext-e2.exr" --ball 20,20,15
+expect_error "extract: missing image" "nothere.exr" extract "$work/nothere.exr" --lens "$lens" --out "$work/ext-e3.exr"
+expect_error "extract: bad kind" "--kind" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$lens" --out "$work/ext-e4.exr" --kind glass
+expect_error "extract: malformed --ball" "--ball" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$lens" --out "$work/ext-e5.exr" --ball 20,20
+expect_error "extract: output folder missing" "nofolder" extract "$work/syn1/truth/views/view00_radiance.exr" --lens "$lens" --out "$work/nofolder/e.exr"
+check "extract: no output after errors" bash -c "! ls -A '$work' | grep -q '^ext-e'"
+check "extract: no temporaries" no_temporaries "$work"
+
+# --- calibrate (calib/intrinsics.h): 8 chessboards of the minimal spec's pinhole (f = 700 px).
+sed 's/chessboards: {count: 2,/chessboards: {count: 8,/' "$spec" >"$work/min8.yaml"
+"$rsibr" synth "$work/min8.yaml" --out "$work/syn8" -q
+"$rsibr" calibrate "$work/syn8/photos" --out "$work/cal1.cameramodel" --json "$work/cal.json" -q
+"$rsibr" calibrate "$work/syn8/photos" --out "$work/cal2.cameramodel" -q
+check "calibrate: pinhole chosen, f within 1%, RMS below 0.5 px" python3 -c "
+import json; j = json.load(open('$work/cal.json'))
+assert j['model'] == 'LENSMODEL_PINHOLE' and abs(j['intrinsics'][0] / 700 - 1) < 0.01 and j['rms_px'] < 0.5, j
+assert len(j['models']) == 3 and j['boards_found'] == 8 and len(j['residual_grid_4x3']) == 12, j"
+check "calibrate: same photos, same bytes" cmp -s "$work/cal1.cameramodel" "$work/cal2.cameramodel"
+check "calibrate: the model serves extract" "$rsibr" extract "$work/syn8/truth/views/view00_radiance.exr" --lens "$work/cal1.cameramodel" --out "$work/ext-cal.exr" -q
+expect_error "calibrate: too few boards" "need at least 4" calibrate "$work/syn1/photos" --out "$work/cal-e1.cameramodel"
+expect_error "calibrate: missing photo set" "nothere" calibrate "$work/nothere" --out "$work/cal-e2.cameramodel"
+expect_error "calibrate: unknown model" "LENSMODEL_FANCY" calibrate "$work/syn8/photos" --out "$work/cal-e3.cameramodel" --model LENSMODEL_FANCY
+check "calibrate: no output after errors" bash -c "! ls -A '$work' | grep -q '^cal-e'"
+
+# --- probe (calib/probe.h): the minimal spec's three chrome views (poses from the truth headers).
+for v in 0 1 2; do
+  "$rsibr" extract "$work/syn1/truth/views/view0${v}_radiance.exr" --lens "$lens" --out "$work/pv$v.exr" --size 64 --camera-mask-deg 40 -q
+done
+"$rsibr" probe "$work/pv0.exr" "$work/pv1.exr" "$work/pv2.exr" --out "$work/probe.exr" --width 128 --json "$work/probe.json" -q \
+  --fresnel '{type: conductor, eta: [2.9, 2.9, 2.6], k: [3.4, 3.4, 3.2]}'
+check "probe writes a lat-long environment" bash -c "'$rsibr' info '$work/probe.exr' | grep -qi latlong"
+check "probe: three views cover the sphere" python3 -c "import json; j = json.load(open('$work/probe.json')); assert j['views'] == 3 and j['covered_fraction'] > 0.95, j"
+"$rsibr" extract "$work/ext-hdr/view00.exr" --lens "$lens" --out "$work/pc0.exr" -q
+"$rsibr" extract "$work/syn1/photos/../truth/views/view01_radiance.exr" --lens "$lens" --out "$work/pc1.exr" -q
+expect_error "probe: a view without a pose" "camera's frame" probe "$work/pc0.exr" "$work/pc1.exr" --out "$work/probe-e1.exr"
+expect_error "probe: computed maps" "not a captured map" probe "$work/syn1/truth/maps/chrome.exr" --out "$work/probe-e2.exr"
+expect_error "probe: bad Fresnel" "--fresnel" probe "$work/pv0.exr" --out "$work/probe-e3.exr" --fresnel '{type: glass}'
+check "probe: no output after errors" bash -c "! ls -A '$work' | grep -q '^probe-e'"
 
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

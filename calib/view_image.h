@@ -1,0 +1,26 @@
+// A view's linear image as calibration reads it: a merged view of `rsibr hdr` (R, G, B, variance,
+// clipped/black/ghost flags; hdr/merged_exr.h) or any float RGB OpenEXR (e.g. the truth radiance
+// of `rsibr synth`), with the camera's orientation when the header carries one
+// (rsibr.worldFromCam, M33f, columns = camera x right, y down, z forward in world).
+#pragma once
+
+#include "core/vec.h"
+
+#include <opencv2/core.hpp>
+
+#include <optional>
+#include <string>
+
+namespace rsibr {
+
+struct ViewImage {
+  cv::Mat radiance;  // CV_32FC3 RGB
+  cv::Mat flags;     // CV_8UC1 hdr/merge.h MergeFlag bits, or empty (not a merged view)
+  std::optional<Mat3> world_from_cam;
+  bool merged = false;
+};
+
+// Throws std::runtime_error("<path>: <problem>").
+ViewImage read_view_image(const std::string& path);
+
+}  // namespace rsibr

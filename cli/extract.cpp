@@ -1,0 +1,163 @@
+// rsibr extract: one view's linear image (a merged view of `rsibr hdr`, or any float RGB EXR) + the
+// lens model -> the ball located (calib/ball_locator.h) -> its sphere map with a confidence channel
+// (calib/sphere_map_extraction.h), written as a captured one-view map set.
+#include "cli/summary.h"
+#include "cli/verbs.h"
+
+#include "calib/ball_locator.h"
+#include "calib/sphere_map_extraction.h"
+#include "calib/view_image.h"
+#include "core/atomic_file.h"
+#include "core/lens_model.h"
+#include "core/map_set.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+namespace rsibr::cli {
+namespace {
+
+struct ExtractArgs {
+  std::string image, lens, out, ball, kind = "chrome", indexing = "reflection", json;
+  int which = 0, size = 128;
+  double camera_mask_deg = -1, stand_mask_deg = 8;
+  bool quiet = false, no_stand = false;
+};
+
+BallGuess parse_ball(const std::string& text) {
+  BallGuess g;
+  char c1 = 0, c2 = 0;
+  std::istringstream in(text);
+  double x = 0, y = 0, r = 0;
+  if (!(in >> x >> c1 >> y >> c2 >> r) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof() || !std::isfinite(x) ||
+      !std::isfinite(y) || !(r > 1) || !std::isfinite(r))
+    throw std::invalid_argument("--ball '" + text + "': expected X,Y,R in pixels with R > 1");
+  g.centre_px = Vec2(x, y);
+  g.radius_px = r;
+  return g;
+}
+
+int run_extract(const ExtractArgs& a) {
+  check_output_path(a.out, {a.image, a.lens});
+  if (!a.json.empty() && a.json != "-") check_output_path(a.json, {a.image, a.lens});
+  if (a.kind != "chrome" && a.kind != "grey")
+    throw std::invalid_argument("--kind '" + a.kind + "': expected chrome or grey");
+  if (a.indexing != "reflection" && a.indexing != "orthographic")
+    throw std::invalid_argument("--indexing '" + a.indexing + "': expected reflection or orthographic");
+  std::optional<BallGuess> given;
+  if (!a.ball.empty()) given = parse_ball(a.ball);
+
+  const LensModel lens = LensModel::read(a.lens);
+  const ViewImage view = read_view_image(a.image);
+  if (view.radiance.cols != lens.width() || view.radiance.rows != lens.height())
+    throw std::invalid_argument(a.image + ": " + std::to_string(view.radiance.cols) + "x" +
+                                std::to_string(view.radiance.rows) + " but the lens model " + a.lens + " is " +
+                                std::to_string(lens.width()) + "x" + std::to_string(lens.height()));
+
+  BallGuess guess;
+  int candidates = 0;
+  if (given) {
+    guess = *given;
+  } else {
+    const double m = std::min(lens.width(), lens.height());
+    std::vector<BallGuess> found = detect_balls(view.radiance, std::max(4.0, m / 40), m / 2, 8);
+    candidates = static_cast<int>(found.size());
+    if (a.which >= candidates)
+      throw std::invalid_argument(a.image + ": found " + std::to_string(candidates) + " ball(s), --which " +
+                                  std::to_string(a.which) + " asked for; give the ball with --ball X,Y,R");
+    std::sort(found.begin(), found.end(), [](const BallGuess& p, const BallGuess& q) { return p.centre_px.x() < q.centre_px.x(); });
+    guess = found[a.which];
+  }
+  BallLocation loc;
+  try {
+    loc = locate_ball(view.radiance, lens, guess);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(a.image + ": " + e.what());
+  }
+
+  ExtractOptions o;
+  o.size = a.size;
+  o.indexing = a.indexing == "reflection" ? SphereIndexing::reflection : SphereIndexing::orthographic;
+  o.mirror = a.kind == "chrome";
+  o.camera_mask_deg = a.camera_mask_deg >= 0 ? a.camera_mask_deg : (o.mirror ? 12.0 : 0.0);
+  const Mat3 world_from_cam = view.world_from_cam.value_or(Mat3::Identity());
+  if (!a.no_stand) {
+    o.down = world_from_cam.transpose() * Vec3(0, -1, 0);  // world down (camera frame); the camera's when no pose
+    o.stand_mask_deg = a.stand_mask_deg;
+  }
+  o.material = o.mirror ? "{type: mirror}" : "{type: lambert}";
+  MapView mv = extract_sphere_map(view.radiance, view.flags, lens, loc.fit.cone, world_from_cam, o);
+  std::ostringstream centre;
+  centre.precision(10);
+  centre << loc.centre_px.x() << " " << loc.centre_px.y();
+  mv.attributes["image"] = std::filesystem::path(a.image).filename().string();
+  mv.attributes["lens"] = std::filesystem::path(a.lens).filename().string();
+  mv.attributes["ballCentrePx"] = centre.str();
+  mv.attributes["ballHalfAngleRad"] = std::to_string(loc.fit.cone.half_angle);
+  mv.attributes["ballKind"] = a.kind;
+  mv.attributes["frame"] = view.world_from_cam ? "world (image header pose)" : "camera (no pose)";
+  MapSet set;
+  set.views.push_back(std::move(mv));
+  write_map_set(a.out, set);
+
+  const cv::Mat& conf = set.views.front().confidence;
+  nlohmann::json j;
+  j["image"] = a.image;
+  j["lens"] = a.lens;
+  j["out"] = a.out;
+  j["kind"] = a.kind;
+  j["indexing"] = a.indexing;
+  j["size"] = a.size;
+  j["detected_candidates"] = candidates;
+  j["ball"] = {{"centre_px", {loc.centre_px.x(), loc.centre_px.y()}},
+               {"radius_px", loc.radius_px},
+               {"axis_cam", {loc.fit.cone.axis.x(), loc.fit.cone.axis.y(), loc.fit.cone.axis.z()}},
+               {"half_angle_deg", loc.fit.cone.half_angle * 180 / kPi},
+               {"distance_in_radii", 1 / std::sin(loc.fit.cone.half_angle)},
+               {"outline_points", loc.outline_px.size()},
+               {"inliers", loc.fit.inliers},
+               {"rms_px", loc.fit.rms_px}};
+  j["pose_from_header"] = view.world_from_cam.has_value();
+  j["mean_confidence_in_disc"] = cv::mean(conf, conf > 0)[0];
+  j["confident_fraction"] = cv::countNonZero(conf > 0.5) / (kPi / 4 * a.size * a.size);
+  write_summary(a.json, j);
+  if (!a.quiet && a.json != "-")
+    std::cerr << "ball at (" << loc.centre_px.x() << ", " << loc.centre_px.y() << "), radius " << loc.radius_px
+              << " px, outline RMS " << loc.fit.rms_px << " px -> " << a.out << "\n";
+  return 0;
+}
+
+}  // namespace
+
+Runner add_extract(CLI::App& app) {
+  auto a = std::make_shared<ExtractArgs>();
+  CLI::App* c = app.add_subcommand("extract", "Locate a ball in a view's HDR image and extract its sphere map (captured map set)");
+  c->footer(
+      "The ball is found by a Hough transform (or --ball X,Y,R), located to sub-pixel accuracy by a cone fit to its "
+      "outline through the lens model, and its sphere map is extracted in the view frame (z from the ball toward the "
+      "camera): each texel from the surface point that reflects its mirror direction (--indexing reflection, exact "
+      "for chrome) or whose normal is the texel's (orthographic, exact for grey). The confidence channel is 0 outside "
+      "the ball, on clipped pixels, at the camera's reflection and the stand, and fades at the stretched rim. "
+      "The map's world frame is the image header's rsibr.worldFromCam when present, else the camera's.\n"
+      "Example: rsibr extract hdr/north.exr --lens camera.cameramodel --out north-chrome.exr --json -");
+  c->add_option("image", a->image, "Merged view EXR (rsibr hdr) or float RGB EXR")->required();
+  c->add_option("--lens", a->lens, "mrcal .cameramodel of the camera")->required();
+  c->add_option("--out", a->out, "Output map set (.exr)")->required();
+  c->add_option("--ball", a->ball, "Ball guess X,Y,R in pixels (default: detected)");
+  c->add_option("--which", a->which, "Detected ball to use, 0 = leftmost")->check(CLI::Range(0, 7));
+  c->add_option("--kind", a->kind, "chrome (mirror map) or grey (normal map)");
+  c->add_option("--indexing", a->indexing, "reflection (exact for mirrors) or orthographic");
+  c->add_option("--size", a->size, "Map size in texels (square)")->check(CLI::Range(8, 4096));
+  c->add_option("--camera-mask-deg", a->camera_mask_deg, "Mask reflections within this of the camera (default 12 chrome, 0 grey)")
+      ->check(CLI::Range(0.0, 90.0));
+  c->add_option("--stand-mask-deg", a->stand_mask_deg, "Mask directions within this of straight down")->check(CLI::Range(0.0, 90.0));
+  c->add_flag("--no-stand", a->no_stand, "No stand mask");
+  c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
+  c->add_flag("-q,--quiet", a->quiet, "No report line");
+  return [a] { return run_extract(*a); };
+}
+
+}  // namespace rsibr::cli
