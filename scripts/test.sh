@@ -3,7 +3,9 @@
 #   1. installs the Debian packages (scripts/install-deps.sh, idempotent),
 #   2. fetches the CC0 real-world data (scripts/fetch-assets.sh; tests that need it skip with a
 #      message when the npm registry cannot be reached),
-#   3. builds and tests the release preset, then the address+undefined sanitizer preset.
+#   3. builds and tests the release preset, then the address+undefined sanitizer preset (which skips
+#      ten long numerical sweeps, listed in CMakePresets.json's asan test preset: their code paths are
+#      run under the sanitizers by shorter tests, and the release run keeps CI under 30 minutes with them).
 # Options: --fast skips the sanitizer build.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
