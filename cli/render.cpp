@@ -2,6 +2,7 @@
 // options (cli/camera_options.h); PNG through the OpenColorIO display transform, or RGBA float EXR.
 #include "cli/camera_options.h"
 #include "cli/render_image.h"
+#include "cli/rgba_png.h"
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
@@ -50,34 +51,6 @@ std::string extension_of(const std::string& path) {
 }
 
 std::string file_name(const std::string& path) { return std::filesystem::path(path).filename().string(); }
-
-// 8-bit RGBA PNG, straight alpha: the colour un-premultiplied, then the display transform.
-void write_png(const std::string& path, const cv::Mat& rgba, float exposure) {
-  cv::Mat straight = rgba.clone();
-  for (int r = 0; r < straight.rows; ++r) {
-    float* p = straight.ptr<float>(r);
-    for (int c = 0; c < straight.cols; ++c, p += 4)
-      if (p[3] > 0 && p[3] < 1)
-        for (int k = 0; k < 3; ++k) p[k] /= p[3];
-  }
-  const cv::Mat bgr = display_encode(straight, exposure);
-  cv::Mat bgra(bgr.rows, bgr.cols, CV_8UC4);
-  for (int r = 0; r < bgr.rows; ++r) {
-    const unsigned char* s = bgr.ptr<unsigned char>(r);
-    const float* a = rgba.ptr<float>(r);
-    unsigned char* d = bgra.ptr<unsigned char>(r);
-    for (int c = 0; c < bgr.cols; ++c) {
-      d[4 * c] = s[3 * c];
-      d[4 * c + 1] = s[3 * c + 1];
-      d[4 * c + 2] = s[3 * c + 2];
-      d[4 * c + 3] = (unsigned char)std::lround(std::clamp(a[4 * c + 3], 0.f, 1.f) * 255.f);
-    }
-  }
-  write_atomically(path, [&](const std::string& tmp) {
-    if (!cv::imwrite(tmp, bgra, {cv::IMWRITE_PNG_COMPRESSION, 3}))
-      throw std::runtime_error(path + ": cannot write the PNG image");
-  });
-}
 
 int run_render(const RenderArgs& a) {
   const std::string ext = extension_of(a.output);
@@ -157,7 +130,7 @@ int run_render(const RenderArgs& a) {
     auto p = provenance;
     if (a.camera.turntable > 0) p["frame"] = std::to_string(k) + "/" + std::to_string(a.camera.turntable);
     if (ext == ".exr") write_render_exr(path, image, cam, p);
-    else write_png(path, image, a.exposure);
+    else write_rgba_png(path, image, a.exposure);
     jframes.push_back({{"path", path},
                        {"seconds", stats.seconds},
                        {"seconds_blend", stats.seconds_blend},
