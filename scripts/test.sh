@@ -24,9 +24,13 @@ bash scripts/fetch-assets.sh || echo "test.sh: real-world data unavailable; the 
 jobs=$(nproc)
 presets=(release)
 ((fast)) || presets+=(asan)
+# CI (.ci/run sets RSIBR_SKIP_BENCH=1) does not compile the benchmark programs: no test uses them, and
+# they are a sizeable part of the build (each bench/*.py names the target it needs; run-default.sh builds all).
+extra=()
+[ -n "${RSIBR_SKIP_BENCH:-}" ] && extra+=(-DRSIBR_BUILD_BENCH=OFF)
 for preset in "${presets[@]}"; do
   echo "== $preset =="
-  cmake --preset "$preset"
+  cmake --preset "$preset" "${extra[@]}"
   cmake --build --preset "$preset" -j "$jobs"
   ctest --preset "$preset" -j "$jobs"
 done
