@@ -12,6 +12,7 @@
 #include "core/map_set.h"
 #include "core/mesh.h"
 #include "core/progress.h"
+#include "core/text.h"
 #include "runtime/renderer.h"
 
 #include <OpenEXR/ImfChannelList.h>
@@ -50,7 +51,6 @@ std::string extension_of(const std::string& path) {
   return e;
 }
 
-std::string file_name(const std::string& path) { return std::filesystem::path(path).filename().string(); }
 
 int run_render(const RenderArgs& a) {
   const std::string ext = extension_of(a.output);

@@ -12,6 +12,7 @@
 #include "core/map_set.h"
 #include "core/mesh.h"
 #include "core/progress.h"
+#include "core/text.h"
 #include "runtime/renderer.h"
 #if RSIBR_HAVE_VIEWER
 #include "runtime/viewer/viewer.h"
@@ -38,7 +39,6 @@ struct ViewArgs {
 };
 
 #if RSIBR_HAVE_VIEWER
-std::string file_name(const std::string& path) { return std::filesystem::path(path).filename().string(); }
 
 MapSet load_maps(const std::string& path) {
   MapSet set = read_map_set(path);

@@ -1,5 +1,7 @@
 #include "core/colour.h"
 
+#include "core/text.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -22,14 +24,6 @@ namespace {
 
 std::mutex g_config_mutex;
 OCIO::ConstConfigRcPtr g_config;  // guarded by g_config_mutex
-
-// OCIO messages may span lines; keep ours to one.
-std::string one_line(std::string s) {
-  for (char& ch : s) {
-    if (ch == '\n' || ch == '\r') ch = ' ';
-  }
-  return s;
-}
 
 OCIO::ConstConfigRcPtr load_config() {
   const char* env = std::getenv("OCIO");

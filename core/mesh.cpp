@@ -10,6 +10,8 @@
 // the indices come from the Draco stream), and the Draco buffer view is decoded here.
 #include "core/mesh.h"
 
+#include "core/text.h"
+
 #include <draco/compression/decode.h>
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
@@ -55,19 +57,6 @@ void compute_vertex_normals(Mesh& mesh, const std::vector<bool>& needs) {
 }
 
 namespace {
-
-std::string one_line(std::string s) {
-  while (!s.empty() && (s.back() == '\n' || s.back() == '\r' || s.back() == ' ')) s.pop_back();
-  std::string out;
-  for (char c : s) {
-    if (c == '\n') {
-      out += "; ";
-    } else if (c != '\r') {
-      out += c;
-    }
-  }
-  return out;
-}
 
 void finalize_mesh(Mesh& mesh, std::vector<bool>& has_normal, MeshLoadReport& report) {
   const std::size_t n = mesh.positions.size();
@@ -627,12 +616,6 @@ Mesh load_gltf(const std::string& path, bool binary, MeshLoadReport& report) {
     for (std::size_t i = 0; i < model.meshes.size(); ++i) assembler.add_mesh(int(i), identity);
   }
   return assembler.finish();
-}
-
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return ext;
 }
 
 }  // namespace

@@ -7,8 +7,7 @@
 #include <random>
 
 namespace fs = std::filesystem;
-using namespace rsibr;
-
+namespace rsibr {
 namespace {
 
 class PhotoSetTest : public ::testing::Test {
@@ -43,8 +42,6 @@ views:
       - {file: v0/b.png}
 chessboards: {corners: [10, 7], spacing_m: 0.03, files: [board0.png]}
 )";
-
-}  // namespace
 
 TEST_F(PhotoSetTest, ReadsEveryFieldAndResolvesPathsAgainstTheFolder) {
   write(kGood);
@@ -131,3 +128,6 @@ TEST_F(PhotoSetTest, AMissingFileIsAClearError) {
   fs::remove_all(dir_ / "photoset.yaml");
   EXPECT_NE(load_error().find("cannot read"), std::string::npos);
 }
+
+}  // namespace
+}  // namespace rsibr

@@ -3,6 +3,7 @@
 
 #include "bake/brdf_spec.h"
 #include "capture/synth_capture.h"
+#include "exact_irradiance.h"
 #include "synth_cases.h"
 
 #include <gtest/gtest.h>
@@ -84,20 +85,6 @@ TEST(RigRenderer, ChromeReflectsAboutSixtyPercentAtNormalIncidence) {
   }
 }
 
-// E(n) by brute force over every texel of the environment (no MIP level, no irradiance map).
-Vec3 exact_irradiance(const EnvMap& env, const Vec3& n) {
-  Vec3 e = Vec3::Zero();
-  for (int r = 0; r < env.layout.height(); ++r)
-    for (int c = 0; c < env.layout.width(); ++c) {
-      const Vec3 w = *env.layout.texel_direction(c, r);
-      const double cosine = n.dot(w);
-      if (cosine <= 0) continue;
-      const float* px = env.pixels.ptr<float>(r) + 3 * c;
-      e += cosine * env.layout.texel_solid_angle(c, r) * Vec3(px[0], px[1], px[2]);
-    }
-  return e;
-}
-
 TEST(RigRenderer, GreyPixelEqualsAlbedoTimesIrradianceOverPi) {
   Fixture f("grey");
   const SynthBall& ball = f.scene.balls.front();
@@ -115,7 +102,7 @@ TEST(RigRenderer, GreyPixelEqualsAlbedoTimesIrradianceOverPi) {
       Vec3 p;
       if (!hit_sphere(f.pose.eye, d, ball.centre, 0.5 * ball.diameter_m, &p)) continue;
       const Vec3 n = (p - ball.centre).normalized();
-      const Vec3 want = ball.albedo.cwiseProduct(exact_irradiance(f.env, n)) / kPi;
+      const Vec3 want = ball.albedo.cwiseProduct(testing::exact_irradiance(f.env, n)) / kPi;
       const cv::Vec3f got = img.at<cv::Vec3f>(y, x);
       for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(got[k] - want[k]) / want[k]);
       ++checked;

@@ -6,25 +6,13 @@
 #include "capture/rig_renderer.h"
 #include "capture/synth_capture.h"
 #include "core/sphere_map.h"
+#include "exact_irradiance.h"
 #include "synth_cases.h"
 
 #include <gtest/gtest.h>
 
 namespace rsibr {
 namespace {
-
-Vec3 exact_irradiance(const EnvMap& env, const Vec3& n) {
-  Vec3 e = Vec3::Zero();
-  for (int r = 0; r < env.layout.height(); ++r)
-    for (int c = 0; c < env.layout.width(); ++c) {
-      const Vec3 w = *env.layout.texel_direction(c, r);
-      const double cosine = n.dot(w);
-      if (cosine <= 0) continue;
-      const float* px = env.pixels.ptr<float>(r) + 3 * c;
-      e += cosine * env.layout.texel_solid_angle(c, r) * Vec3(px[0], px[1], px[2]);
-    }
-  return e;
-}
 
 TEST(TrueSphereMap, GreyMapIsAlbedoTimesExactIrradianceOverPiInTheViewFrame) {
   // A 256-wide sky: the quadrature's rest level is 128 wide, so this measures that approximation too.
@@ -47,7 +35,7 @@ TEST(TrueSphereMap, GreyMapIsAlbedoTimesExactIrradianceOverPiInTheViewFrame) {
         continue;
       }
       const Vec3 n = mv.world_from_view * sphere_map::g_normal(xy);
-      const Vec3 want = grey.albedo.cwiseProduct(exact_irradiance(env, n)) / kPi;
+      const Vec3 want = grey.albedo.cwiseProduct(testing::exact_irradiance(env, n)) / kPi;
       for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(got[k] - want[k]) / want[k]);
     }
   EXPECT_LT(worst, 0.002) << worst;  // measured 0.08%

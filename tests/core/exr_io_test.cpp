@@ -2,6 +2,7 @@
 #include "core/exr_io.h"
 
 #include "core/colour.h"
+#include "bitwise_equal.h"
 #include "test_data.h"
 
 #include <OpenEXR/ImfChannelList.h>
@@ -49,13 +50,6 @@ cv::Mat random_pixels(int w, int h, int channels, std::mt19937& rng) {
   return m;
 }
 
-bool bitwise_equal(const cv::Mat& a, const cv::Mat& b) {
-  if (a.size() != b.size() || a.type() != b.type()) return false;
-  for (int r = 0; r < a.rows; ++r)
-    if (std::memcmp(a.ptr(r), b.ptr(r), a.cols * a.elemSize()) != 0) return false;
-  return true;
-}
-
 // Writes a float EXR with the raw OpenEXR API: the named channels (interleaved in `pixels`, in
 // that order) and whatever the caller put in the header.
 void write_raw_exr(const std::string& path, const cv::Mat& pixels, const std::vector<std::string>& names,
@@ -99,7 +93,7 @@ TEST(ExrIo, EnvironmentRoundTripIsBitExact) {
       EXPECT_EQ(back.layout.kind(), layout.kind());
       EXPECT_EQ(back.layout, layout);
       if (channels == 3) {
-        EXPECT_TRUE(bitwise_equal(back.pixels, map.pixels));
+        EXPECT_TRUE(testing::bitwise_equal(back.pixels, map.pixels));
       } else {
         // The reader returns RGB; the first three channels must be untouched.
         cv::Mat rgb;
@@ -107,7 +101,7 @@ TEST(ExrIo, EnvironmentRoundTripIsBitExact) {
         cv::split(map.pixels, planes);
         planes.resize(3);
         cv::merge(planes, rgb);
-        EXPECT_TRUE(bitwise_equal(back.pixels, rgb));
+        EXPECT_TRUE(testing::bitwise_equal(back.pixels, rgb));
       }
       EXPECT_EQ(back.attributes, map.attributes);
       EXPECT_FALSE(report.chromaticities_converted);
@@ -315,7 +309,7 @@ TEST(ExrIo, ChromaticitiesAreConvertedToTheWorkingSpace) {
   write_environment(dir.file("ours.exr"), ours);
   const EnvMap back = read_environment(dir.file("ours.exr"), std::nullopt, &report);
   EXPECT_FALSE(report.chromaticities_converted);
-  EXPECT_TRUE(bitwise_equal(back.pixels, px));
+  EXPECT_TRUE(testing::bitwise_equal(back.pixels, px));
 }
 
 TEST(ExrIo, LuminanceOnlyFileIsReadAsGrey) {

@@ -11,6 +11,7 @@
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfVecAttribute.h>
+#include "bitwise_equal.h"
 #include "test_data.h"
 
 #include <gtest/gtest.h>
@@ -29,13 +30,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::TempDir;
-
-bool bitwise_equal(const cv::Mat& a, const cv::Mat& b) {
-  if (a.size() != b.size() || a.type() != b.type()) return false;
-  for (int r = 0; r < a.rows; ++r)
-    if (std::memcmp(a.ptr(r), b.ptr(r), a.cols * a.elemSize()) != 0) return false;
-  return true;
-}
 
 std::string read_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -101,10 +95,10 @@ TEST(MapSet, RoundTripKeepsEveryPixelAndAttribute) {
   for (std::size_t i = 0; i < set.views.size(); ++i) {
     SCOPED_TRACE("view " + std::to_string(i));
     const MapView &a = set.views[i], &b = back.views[i];
-    EXPECT_TRUE(bitwise_equal(a.rgb, b.rgb));
+    EXPECT_TRUE(testing::bitwise_equal(a.rgb, b.rgb));
     EXPECT_EQ(a.confidence.empty(), b.confidence.empty());
     if (!a.confidence.empty()) {
-      EXPECT_TRUE(bitwise_equal(a.confidence, b.confidence));
+      EXPECT_TRUE(testing::bitwise_equal(a.confidence, b.confidence));
     }
     EXPECT_EQ(b.view, float_rounded(a.view));
     EXPECT_EQ(b.world_from_view, float_rounded(a.world_from_view));

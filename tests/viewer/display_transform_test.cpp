@@ -17,8 +17,6 @@ namespace {
 using viewer::DisplayTransform;
 using viewer::GlFrame;
 
-void window() { testing::gl_test_context(); }
-
 // Linear values from 0 to 4 (past the display's 1) in every channel mix, alpha 1; the last texel
 // has alpha 0 (nothing drawn: the background).
 cv::Mat ramp(int n) {
@@ -35,7 +33,7 @@ cv::Mat ramp(int n) {
 // its 8-bit quantisation (the CPU rounds to the nearest level: |gpu * 255 - cpu| <= 0.5, plus float
 // slack for the shader's own pow/exp2).
 TEST(DisplayTransform, MatchesTheCpuDisplayEncoding) {
-  window();
+  testing::gl_test_context();
   const int n = 258;
   const cv::Mat linear = ramp(n);
   for (const std::string& view : DisplayTransform::views()) {
@@ -60,7 +58,7 @@ TEST(DisplayTransform, MatchesTheCpuDisplayEncoding) {
 }
 
 TEST(DisplayTransform, UnknownViewIsAnError) {
-  window();
+  testing::gl_test_context();
   EXPECT_THROW(DisplayTransform("", "no such view"), std::runtime_error);
   EXPECT_THROW(DisplayTransform("no such display", ""), std::runtime_error);
 }

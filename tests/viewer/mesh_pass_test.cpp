@@ -40,8 +40,6 @@ using viewer::GlMesh;
 using viewer::MeshPass;
 using viewer::MeshPassOptions;
 
-void window() { testing::gl_test_context(); }
-
 struct Agreement {
   long coverage_mismatch = 0, both = 0, within_tight = 0;
   double max_relative = 0;
@@ -89,7 +87,7 @@ Mesh scene_mesh() {
 
 cv::Mat gpu_frame(const Camera& cam, const Mesh& mesh, const MapSet& maps, const RenderOptions& ro,
                   const MeshPassOptions& mo) {
-  window();
+  testing::gl_test_context();
   const GlMesh gm(mesh);
   GlMapSet gs(maps, ro.blend, ro.warp, ro.map_size);
   const MeshPass pass;
