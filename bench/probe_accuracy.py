@@ -20,6 +20,7 @@ folder, each probe and a comparison picture (rsibr compare --out) per mask to lo
 """
 import argparse
 import json
+import math
 import os
 import shutil
 import struct
@@ -121,6 +122,15 @@ def measure_dataset(args, name):
         views.append((v["name"], image, radiance, "%.2f,%.2f,%.2f" % (ball["centre_px"][0], ball["centre_px"][1], r_px)))
         d = [e - c for e, c in zip(v["eye"], chrome["centre"])]
         cameras.append("%.6f,%.6f,%.6f" % tuple(d))
+    # The rig's other balls as the chrome ball sees them: caps of half angle asin(r / distance).
+    occluders = []
+    for b in truth["balls"]:
+        if b["name"] == chrome["name"]:
+            continue
+        d = [p - c for p, c in zip(b["centre"], chrome["centre"])]
+        dist = math.sqrt(sum(x * x for x in d))
+        half = math.degrees(math.asin(min(1.0, 0.5 * b["diameter_m"] / dist)))
+        occluders.append("%.6f,%.6f,%.6f,%.3f" % (d[0], d[1], d[2], half + 2))
     poses_file = os.path.join(work, "poses.yaml")
     if use_poses:
         with open(poses_file, "w") as fo:
@@ -149,7 +159,8 @@ def measure_dataset(args, name):
         if os.path.exists(probe):
             os.remove(probe)
         run(args.rsibr, "probe", *maps, "--out", probe, "--width", args.width, "--fresnel", fresnel, "-q")
-        acc = json.loads(run(args.metric, probe, env, *sum([["--camera", c] for c in cameras], [])))
+        acc = json.loads(run(args.metric, probe, env, *sum([["--camera", c] for c in cameras], []),
+                             *sum([["--occluder", o] for o in occluders], [])))
         # The same maps into a coarse probe: how much of the error is the ball's resolution.
         coarse = os.path.join(out, "probe-coarse.exr")
         if os.path.exists(coarse):
@@ -158,13 +169,13 @@ def measure_dataset(args, name):
         acc["no_sun_coarse"] = json.loads(run(args.metric, coarse, env))["no_sun"]
         pictures = os.path.join(out, "compare")
         shutil.rmtree(pictures, ignore_errors=True)
-        cmp = json.loads(run(args.rsibr, "compare", probe, truth_latlong, "--out", pictures, "--json", "-", "-q"))
-        overall = cmp.get("overall", cmp)
-        log_rms = overall.get("after", {}).get("log_rms_stops")
+        run(args.rsibr, "compare", probe, truth_latlong, "--out", pictures, "-q")
+        log_rms = acc["log_rms_stops"]
         rows.append({"dataset": name, "source": source, "lens": lens_name, "mask": mask, "log_rms": log_rms, **acc})
         print("%-14s %-8s %-10s mask %2d: covered %.4f, rel RMS all %.4f, no sun %.4f (coarse %.4f), at cameras %.4f, "
-              "sun energy %.3f, log RMS %s" % (name, source, lens_name, mask, acc["covered_fraction"], acc["all"], acc["no_sun"],
-                                                acc["no_sun_coarse"], acc["cameras"], acc["sun_energy"], log_rms),
+              "no rig %.4f, sun energy %.3f, log RMS %.3f stops" % (name, source, lens_name, mask, acc["covered_fraction"], acc["all"],
+                                                acc["no_sun"], acc["no_sun_coarse"], acc["cameras"], acc["no_rig"],
+                                                acc["sun_energy"], log_rms),
               flush=True)
     return rows, cal, len(views)
 
@@ -203,22 +214,33 @@ def main():
         "around the directions from the ball to every camera (where the camera and the photographer reflect); *coarse* is "
         "*no sun* for a probe %d texels wide from the same maps (the ball spans under 100 pixels in these images, so "
         "the full-width probe's error is partly resolution); *sun energy* is the probe's over the truth's inside the "
-        "sun's cap (below 1: the shortest bracket clipped the sun). "
+        "sun's cap (below 1: the shortest bracket clipped the sun); *no rig* also leaves out the rig's other balls as "
+        "the chrome ball sees them (caps of asin(radius / distance) + 2 degrees: about 40 degrees across for the "
+        "neighbour, which the chrome ball reflects and extract does not mask). "
         "*views*: `merged` are `rsibr hdr`'s merged views (the pipeline), `radiance` the synth's true linear "
         "images (no clipping, noise or response: what extraction and blending alone cost). "
-        "Log RMS: `rsibr compare` after its gain fit, in stops (it counts the uncovered texels straight down, "
-        "under the stand mask, as large errors). Pictures: WORK/DATASET/VIEWS-LENS-maskNN/compare/."
+        "*log RMS*: sqrt(mean w log2((g a + eps)/(b + eps))^2) outside the sun's cap over the covered texels, eps "
+        "= 1%% of the truth's median level, g fitted in the log domain, in stops (the shape error where the relative RMS is dominated by a few "
+        "bright lamps). Pictures: WORK/DATASET/VIEWS-LENS-maskNN/compare/."
         % (args.size, args.width, args.coarse_width),
         "",
-        "| dataset | views | lens | --camera-mask-deg | covered | rel. RMS (all) | rel. RMS (no sun) | (coarse) | rel. RMS (cameras) | sun energy | log RMS (stops) |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "| dataset | views | lens | --camera-mask-deg | covered | rel. RMS (all) | rel. RMS (no sun) | (coarse) | rel. RMS (cameras) | rel. RMS (no sun, no rig) | sun energy | log RMS no sun (stops) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in table:
-        lines.append("| %s | %s | %s | %d | %.4f | %.3f | %.3f | %.3f | %.3f | %.3f | %s |" % (
+        lines.append("| %s | %s | %s | %d | %.4f | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %s |" % (
             r["dataset"], r["source"], r["lens"], r["mask"], r["covered_fraction"], r["all"], r["no_sun"], r["no_sun_coarse"],
-            r["cameras"], r["sun_energy"],
-            "%.3f" % r["log_rms"] if isinstance(r["log_rms"], (int, float)) else "-"))
+            r["cameras"], r["no_rig"], r["sun_energy"],
+            "%.3f" % r["log_rms"]))
     lines += ["", *["- " + n for n in notes]]
+    # The mask sweep's verdict, per dataset: the mask with the lowest error outside the sun, and the
+    # one with the lowest error at the camera directions (merged views, true lens).
+    for name in args.datasets:
+        sweep = [r for r in table if r["dataset"] == name and r["source"] == "merged" and r["lens"] == "true"]
+        best = min(sweep, key=lambda r: (round(r["no_sun"], 3), abs(r["mask"] - DEFAULT_MASK)))
+        best_cam = min(sweep, key=lambda r: (round(r["cameras"], 3), abs(r["mask"] - DEFAULT_MASK)))
+        lines.append("- %s: lowest error outside the sun at --camera-mask-deg %d, at the camera directions at %d "
+                     "(default %d)" % (name, best["mask"], best_cam["mask"], DEFAULT_MASK))
     body = "\n".join(lines)
     print(body)
     if not args.no_docs:
