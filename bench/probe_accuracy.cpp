@@ -156,24 +156,28 @@ int main(int argc, char** argv) {
           if (!x.sun) sum += x.w * log_error(x, ch), ws += x.w;
         if (ws > 0) log_gain[ch] *= std::exp2(-sum / ws);
       }
-    double log2_sum = 0, log_w = 0;
-    for (const Texel& x : texels)
-      if (!x.sun)
-        for (int ch = 0; ch < 3; ++ch) {
-          const double d = log_error(x, ch);
-          log2_sum += x.w * d * d;
-          log_w += x.w;
-        }
-    const double log_rms = log_w > 0 ? std::sqrt(log2_sum / log_w) : 0.0;
+    auto log_rms_where = [&](auto&& keep) {
+      double log2_sum = 0, log_w = 0;
+      for (const Texel& x : texels)
+        if (keep(x))
+          for (int ch = 0; ch < 3; ++ch) {
+            const double d = log_error(x, ch);
+            log2_sum += x.w * d * d;
+            log_w += x.w;
+          }
+      return log_w > 0 ? std::sqrt(log2_sum / log_w) : 0.0;
+    };
+    const double log_rms = log_rms_where([](const Texel& x) { return !x.sun; });
+    const double log_rms_no_rig = log_rms_where([](const Texel& x) { return !x.sun && !x.rig; });
     double sun_a = 0, sun_b = 0;
     for (const Texel& x : texels)
       if (x.sun)
         for (int ch = 0; ch < 3; ++ch) sun_a += x.w * gain[ch] * x.a[ch], sun_b += x.w * x.b[ch];
     const double sun_energy = sun_b > 0 ? sun_a / sun_b : 0.0;
     std::printf(
-        "{\"covered_fraction\": %.6f, \"all\": %.6f, \"no_sun\": %.6f, \"cameras\": %.6f, \"no_rig\": %.6f, \"sun_energy\": %.6f, \"log_rms_stops\": %.6f, \"gain\": [%.6g, %.6g, %.6g], "
+        "{\"covered_fraction\": %.6f, \"all\": %.6f, \"no_sun\": %.6f, \"cameras\": %.6f, \"no_rig\": %.6f, \"sun_energy\": %.6f, \"log_rms_stops\": %.6f, \"log_rms_no_rig_stops\": %.6f, \"gain\": [%.6g, %.6g, %.6g], "
         "\"sun\": [%.5f, %.5f, %.5f]}\n",
-        covered / total, all, no_sun, at_cameras, no_rig, sun_energy, log_rms, gain[0], gain[1], gain[2], sun.x(), sun.y(), sun.z());
+        covered / total, all, no_sun, at_cameras, no_rig, sun_energy, log_rms, log_rms_no_rig, gain[0], gain[1], gain[2], sun.x(), sun.y(), sun.z());
   } catch (const std::exception& e) {
     std::cerr << "rsibr_probe_accuracy: " << e.what() << "\n";
     return 1;

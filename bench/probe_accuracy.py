@@ -224,14 +224,14 @@ def main():
         "bright lamps). Pictures: WORK/DATASET/VIEWS-LENS-maskNN/compare/."
         % (args.size, args.width, args.coarse_width),
         "",
-        "| dataset | views | lens | --camera-mask-deg | covered | rel. RMS (all) | rel. RMS (no sun) | (coarse) | rel. RMS (cameras) | rel. RMS (no sun, no rig) | sun energy | log RMS no sun (stops) |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| dataset | views | lens | --camera-mask-deg | covered | rel. RMS (all) | rel. RMS (no sun) | (coarse) | rel. RMS (cameras) | rel. RMS (no sun, no rig) | sun energy | log RMS no sun (stops) | log RMS no sun, no rig (stops) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in table:
-        lines.append("| %s | %s | %s | %d | %.4f | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %s |" % (
+        lines.append("| %s | %s | %s | %d | %.4f | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %s | %.3f |" % (
             r["dataset"], r["source"], r["lens"], r["mask"], r["covered_fraction"], r["all"], r["no_sun"], r["no_sun_coarse"],
             r["cameras"], r["no_rig"], r["sun_energy"],
-            "%.3f" % r["log_rms"]))
+            "%.3f" % r["log_rms"], r["log_rms_no_rig_stops"]))
     lines += ["", *["- " + n for n in notes]]
     # The mask sweep's verdict, per dataset: the mask with the lowest error outside the sun, and the
     # one with the lowest error at the camera directions (merged views, true lens).
