@@ -3,7 +3,10 @@
 // mrcal's C header has no extern "C" guard of its own.
 extern "C" {
 #include <mrcal/mrcal.h>
+// _mrcal_num_j_nonzero: the Jacobian's size, to allocate it for mrcal_optimizer_callback.
+#include <mrcal/mrcal-internal.h>
 }
+#include <suitesparse/cholmod.h>
 #include <mrgingham/mrgingham.hh>
 
 #include <opencv2/calib3d.hpp>
@@ -95,6 +98,73 @@ std::vector<mrcal_point3_t> observation_pool(const IntrinsicsProblem& p, const s
   return pool;
 }
 
+// The covariance of the intrinsics at the optimum of one mrcal problem (formula in intrinsics.h).
+// mrcal's Jacobian is in its packed (unitless) state b_p = b / d; Var(b) = D Var(b_p) D, D = diag(d).
+Eigen::MatrixXd covariance(const IntrinsicsProblem& p, int n, const mrcal_lensmodel_t& model,
+                           const std::vector<double>& intrinsics, const std::vector<mrcal_pose_t>& frames,
+                           const std::vector<mrcal_point3_t>& pool, mrcal_problem_selections_t sel, double* sigma) {
+  std::vector<mrcal_observation_board_t> obs(n);
+  for (int k = 0; k < n; ++k) {
+    obs[k].icam.intrinsics = 0;
+    obs[k].icam.extrinsics = -1;
+    obs[k].iframe = k;
+  }
+  const int sizes[2] = {p.width, p.height};
+  mrcal_problem_constants_t constants{};
+  constants.point_min_range = 1e-3;
+  constants.point_max_range = 1e4;
+  const int nstate = mrcal_num_states(1, 0, n, 0, 0, n, sel, &model);
+  const int nmeas = mrcal_num_measurements(n, 0, p.corners_x, p.corners_y, 1, 0, n, 0, 0, sel, &model);
+  const int nboard = mrcal_num_measurements_boards(n, p.corners_x, p.corners_y);
+  const int nnz = _mrcal_num_j_nonzero(n, 0, p.corners_x, p.corners_y, 1, 0, n, 0, 0, obs.data(), nullptr, sel, &model);
+  cholmod_common common;
+  cholmod_start(&common);
+  cholmod_sparse* jt = cholmod_allocate_sparse(nstate, nmeas, nnz, 1, 1, 0, CHOLMOD_REAL, &common);
+  std::vector<double> b(nstate), x(nmeas);
+  const bool ok = jt && mrcal_optimizer_callback(b.data(), nstate * int(sizeof(double)), x.data(),
+                                                 nmeas * int(sizeof(double)), jt, intrinsics.data(), nullptr,
+                                                 frames.data(), nullptr, nullptr, 1, 0, n, 0, 0, obs.data(), nullptr, n,
+                                                 0, pool.data(), &model, sizes, sel, &constants, p.spacing_m,
+                                                 p.corners_x, p.corners_y, false);
+  Eigen::MatrixXd j = Eigen::MatrixXd::Zero(nmeas, nstate);
+  if (ok) {
+    // Jt is compressed by column: column r holds row r of J.
+    const int* cp = static_cast<const int*>(jt->p);
+    const int* ri = static_cast<const int*>(jt->i);
+    const double* v = static_cast<const double*>(jt->x);
+    for (int r = 0; r < nmeas; ++r)
+      for (int k = cp[r]; k < cp[r + 1]; ++k) j(r, ri[k]) = v[k];
+  }
+  if (jt) cholmod_free_sparse(&jt, &common);
+  cholmod_finish(&common);
+  if (!ok) throw std::runtime_error("intrinsics: mrcal_optimizer_callback failed");
+
+  int inliers = 0;
+  for (const mrcal_point3_t& q : pool) inliers += q.z >= 0;
+  double sum2 = 0;
+  for (int r = 0; r < nboard; ++r) sum2 += x[r] * x[r];
+  const int dof = 2 * inliers - nstate;
+  const double s2 = dof > 0 ? sum2 / dof : 0.0;
+  if (sigma) *sigma = std::sqrt(s2);
+
+  const Eigen::MatrixXd jtj = j.transpose() * j;
+  const Eigen::MatrixXd jo = j.topRows(nboard);
+  const Eigen::MatrixXd m = jo.transpose() * jo;
+  // Pseudo-inverse through the symmetric eigen-decomposition: a direction the data and the
+  // regularisation leave free (none in a well-posed problem) gets no variance rather than NaN.
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(jtj);
+  const Eigen::VectorXd ev = eig.eigenvalues();
+  Eigen::VectorXd inv(ev.size());
+  for (int k = 0; k < ev.size(); ++k) inv[k] = ev[k] > 1e-12 * ev.maxCoeff() ? 1.0 / ev[k] : 0.0;
+  const Eigen::MatrixXd a = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+  Eigen::VectorXd d = Eigen::VectorXd::Ones(nstate);
+  mrcal_unpack_solver_state_vector(d.data(), 1, 0, n, 0, 0, sel, &model);
+  const Eigen::MatrixXd cov = s2 * d.asDiagonal() * (a * m * a) * d.asDiagonal();
+  const int i0 = mrcal_state_index_intrinsics(0, 1, 0, n, 0, 0, n, sel, &model);
+  const int ni = mrcal_num_states_intrinsics(1, sel, &model);
+  return cov.block(i0, i0, ni, ni);
+}
+
 std::vector<int> all_boards(const IntrinsicsProblem& p) {
   std::vector<int> s(p.boards.size());
   std::iota(s.begin(), s.end(), 0);
@@ -145,10 +215,19 @@ IntrinsicsFit fit_intrinsics(const IntrinsicsProblem& p, const std::string& mode
   std::vector<mrcal_point3_t> pool = observation_pool(p, subset);
 
   // Stage 1: core and poses, distortions at zero; stage 2: everything, regularised, outliers out.
+  // A splined model's stage 1 is a LENSMODEL_STEREOGRAPHIC solve (its zero-spline equivalent).
   mrcal_problem_selections_t sel{};
   sel.do_optimize_intrinsics_core = true;
   sel.do_optimize_frames = true;
-  optimize(p, subset, model, intrinsics, frames, pool, sel);
+  if (model.type == MRCAL_LENSMODEL_SPLINED_STEREOGRAPHIC) {
+    mrcal_lensmodel_t stereographic{};
+    stereographic.type = MRCAL_LENSMODEL_STEREOGRAPHIC;
+    std::vector<double> core(intrinsics.begin(), intrinsics.begin() + 4);
+    optimize(p, subset, stereographic, core, frames, pool, sel);
+    std::copy(core.begin(), core.end(), intrinsics.begin());
+  } else {
+    optimize(p, subset, model, intrinsics, frames, pool, sel);
+  }
   sel.do_optimize_intrinsics_distortions = true;
   sel.do_apply_regularization = true;
   sel.do_apply_outlier_rejection = true;
@@ -173,7 +252,63 @@ IntrinsicsFit fit_intrinsics(const IntrinsicsProblem& p, const std::string& mode
       if (pool[q].z >= 0) sum2 += fit.residuals[q].squaredNorm(), ++used;
   }
   fit.rms_px = used > 0 ? std::sqrt(sum2 / used) : 0.0;
+  fit.intrinsics_covariance =
+      covariance(p, static_cast<int>(subset.size()), model, intrinsics, frames, pool, sel, &fit.noise_sigma_px);
+  if (!fit.intrinsics_covariance.allFinite())
+    throw std::runtime_error("intrinsics: the covariance of " + model_name + " is not finite");
   return fit;
+}
+
+Eigen::Matrix2d projection_covariance(const LensModel& lens, const Eigen::MatrixXd& c, const Vec3& cam) {
+  const mrcal_lensmodel_t model = lensmodel(lens.name());
+  const int ni = static_cast<int>(lens.intrinsics().size());
+  if (c.rows() != ni || c.cols() != ni)
+    throw std::invalid_argument("projection_covariance: a " + std::to_string(c.rows()) + "x" +
+                                std::to_string(c.cols()) + " covariance for " + std::to_string(ni) + " intrinsics");
+  mrcal_point3_t v;
+  v.x = cam.x();
+  v.y = cam.y();
+  v.z = cam.z();
+  mrcal_point2_t q;
+  Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor> g(2, ni);
+  if (!mrcal_project(&q, nullptr, g.data(), &v, 1, &model, lens.intrinsics().data()))
+    throw std::runtime_error(lens.name() + ": mrcal_project failed");
+  return g * c * g.transpose();
+}
+
+std::string splined_candidate(const IntrinsicsProblem& p, int nx) {
+  if (nx < 4) throw std::invalid_argument("splined_candidate: Nx must be >= 4");
+  const std::vector<int> all = all_boards(p);
+  check(p, all);
+  std::vector<std::vector<cv::Point3f>> object;
+  std::vector<std::vector<cv::Point2f>> image;
+  for (int i : all) {
+    object.push_back(board_points(p));
+    image.push_back(image_points(p.boards[i]));
+  }
+  cv::Mat k, dist;
+  std::vector<cv::Mat> rvecs, tvecs;
+  cv::calibrateCamera(object, image, cv::Size(p.width, p.height), k, dist, rvecs, tvecs,
+                      cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3 | cv::CALIB_ZERO_TANGENT_DIST);
+  const double fx = k.at<double>(0, 0), cx = k.at<double>(0, 2);
+  const double half = std::max(cx + 0.5, p.width - 0.5 - cx);
+  const double fov = std::ceil(1.15 * 2 * std::atan(half / fx) * 180 / M_PI);
+  const int ny = std::max(3, static_cast<int>(std::lround(nx * double(p.height) / p.width)));
+  return "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=" + std::to_string(nx) + "_Ny=" + std::to_string(ny) +
+         "_fov_x_deg=" + std::to_string(static_cast<int>(std::min(fov, 179.0)));
+}
+
+double board_coverage(const IntrinsicsProblem& p, int cells_x, int cells_y) {
+  if (cells_x < 1 || cells_y < 1 || p.width <= 0 || p.height <= 0)
+    throw std::invalid_argument("board_coverage: needs a positive grid and image size");
+  std::vector<char> hit(cells_x * cells_y, 0);
+  for (const auto& b : p.boards)
+    for (const Vec2& q : b.corners) {
+      const int cx = std::clamp(static_cast<int>((q.x() + 0.5) / p.width * cells_x), 0, cells_x - 1);
+      const int cy = std::clamp(static_cast<int>((q.y() + 0.5) / p.height * cells_y), 0, cells_y - 1);
+      hit[cy * cells_x + cx] = 1;
+    }
+  return double(std::count(hit.begin(), hit.end(), 1)) / hit.size();
 }
 
 double held_out_rms(const IntrinsicsProblem& p, const LensModel& lens, const std::vector<int>& subset) {

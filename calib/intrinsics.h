@@ -7,12 +7,25 @@
 // poses refitted with the intrinsics held), both ways round; the simplest model within 5% of the
 // best held-out RMS wins.
 //
+// Splined models (LENSMODEL_SPLINED_STEREOGRAPHIC_...) are staged as mrcal-calibrate-cameras does:
+// a LENSMODEL_STEREOGRAPHIC core and the board poses first, then the spline's control points from
+// zero (the splined model with zero control points is the stereographic one) and everything with
+// regularisation. splined_candidate() names a spline that covers the seed's field of view.
+//
+// Uncertainty (intrinsics_covariance): at the optimum, mrcal's Jacobian J (observations and
+// regularisation rows) gives the covariance of the whole state b for per-axis corner noise s:
+//   db = -(J^T J)^-1 J_obs^T dq  =>  Var(b) = s^2 (J^T J)^-1 (J_obs^T J_obs) (J^T J)^-1
+// (mrcal's formula: the regularisation rows carry no noise). The intrinsics block of Var(b) is
+// the intrinsics' covariance with the board poses marginalised. s^2 is estimated from the
+// residuals: sum of squared inlier residuals / (inlier measurements - states).
+//
 // Board frame (mrcal's): corner (i, j) (i along x, 0..corners_x-1; j along y) at (i s, j s, 0);
 // corners are listed row-major (j outer, i inner), as mrgingham writes them.
 #pragma once
 
 #include "core/lens_model.h"
 
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 #include <array>
@@ -40,9 +53,32 @@ struct IntrinsicsFit {
   int outliers = 0;         // corners rejected by mrcal
   std::vector<std::array<double, 6>> rt_cam_board;  // per board: Rodrigues rotation, translation (m)
   std::vector<Vec2> residuals;  // observed - projected, every corner of every board, in board order
+  // Covariance of lens.intrinsics() (mrcal's order), board poses marginalised; px^2 per unit^2.
+  Eigen::MatrixXd intrinsics_covariance;
+  double noise_sigma_px = 0;  // per-axis corner noise estimated from the residuals
 };
 
-// Fits `model` (an mrcal model name with a core: LENSMODEL_PINHOLE, _OPENCV4/5/8/12) to the boards
+// The 2x2 covariance (px^2) of the projection of a fixed camera-frame point v, propagated from the
+// intrinsics covariance: Var(q) = G C G^T, G = dq/dintrinsics at v (mrcal_project's gradient).
+// Unlike mrcal's projection_uncertainty this holds v fixed in the camera frame; mrcal instead
+// fixes the point relative to the observed boards and lets the camera frame move with the
+// solution (the reference-frame shift), which removes the part of the principal-point uncertainty
+// that a small rotation of the whole camera frame would absorb. Ours is therefore the larger
+// (conservative) number, and it is the right one for comparing a fitted lens with a true one at
+// the same camera-frame direction, as the tests do.
+Eigen::Matrix2d projection_covariance(const LensModel& lens, const Eigen::MatrixXd& intrinsics_covariance,
+                                      const Vec3& cam);
+
+// The splined candidate for a problem: "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=<nx>_Ny=<ny>_fov_x_deg=<f>"
+// with Ny = round(nx * height / width) and f the pinhole seed's horizontal field of view plus 15%,
+// rounded up to a whole degree (the spline's knots must span the image).
+std::string splined_candidate(const IntrinsicsProblem& problem, int nx = 10);
+
+// Fraction of the cells of a cells_x x cells_y grid over the image that hold at least one corner.
+double board_coverage(const IntrinsicsProblem& problem, int cells_x, int cells_y);
+
+// Fits `model` (an mrcal model name with a core: LENSMODEL_PINHOLE, _OPENCV4/5/8/12, _STEREOGRAPHIC,
+// _SPLINED_STEREOGRAPHIC_...) to the boards
 // listed in `subset` (all when empty). Throws std::invalid_argument for fewer than 3 boards, corner
 // lists of the wrong length or an unknown model; std::runtime_error when the solve fails.
 IntrinsicsFit fit_intrinsics(const IntrinsicsProblem& problem, const std::string& model,

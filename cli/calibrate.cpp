@@ -10,7 +10,11 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <Eigen/Eigenvalues>
+
 #include <cmath>
+#include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 
@@ -19,7 +23,7 @@ namespace {
 
 struct CalibrateArgs {
   std::string photoset, out, json;
-  std::vector<std::string> models = {"LENSMODEL_PINHOLE", "LENSMODEL_OPENCV4", "LENSMODEL_OPENCV8"};
+  std::vector<std::string> models = {"LENSMODEL_PINHOLE", "LENSMODEL_OPENCV4", "LENSMODEL_OPENCV8", "splined"};
   bool quiet = false;
 };
 
@@ -29,6 +33,28 @@ cv::Mat read_grey8(const std::filesystem::path& file) {
   if (img.depth() == CV_16U) img.convertTo(img, CV_8U, 1.0 / 257);
   if (img.depth() != CV_8U) throw std::runtime_error(file.string() + ": expected an 8- or 16-bit image");
   return img;
+}
+
+// The splined candidate ("splined" among --model) needs boards over most of the image: a spline
+// control point that no corner constrains is set by mrcal's regularisation alone, and the
+// cross-validation halves must each constrain the spline. Cells of an 8 x 6 grid over the image.
+constexpr int kSplineNx = 8;
+constexpr int kCoverageCellsX = 8, kCoverageCellsY = 6;
+constexpr double kMinSplineCoverage = 0.6;
+constexpr std::size_t kMinSplineBoards = 8;
+
+// The .cameramodel text mrcal writes, preceded by '#' comment lines (mrcal's reader skips them).
+void write_with_comment(const LensModel& lens, const std::filesystem::path& out, const std::string& comment) {
+  write_atomically(out, [&](const std::string& tmp) {
+    lens.write(tmp);
+    std::ifstream in(tmp, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    in.close();
+    std::ofstream o(tmp, std::ios::binary | std::ios::trunc);
+    o << comment << text.str();
+    if (!o) throw std::runtime_error(out.string() + ": cannot write");
+  });
 }
 
 int run_calibrate(const CalibrateArgs& a) {
@@ -69,10 +95,57 @@ int run_calibrate(const CalibrateArgs& a) {
     throw std::invalid_argument(a.photoset + ": chessboards found in " + std::to_string(p.boards.size()) + " of " +
                                 std::to_string(cb.files.size()) + " images; need at least 4 (2 per cross-validation half)");
 
+  // "splined" -> a spline over the seed's field of view, or skipped (with the reason) when the boards
+  // do not cover enough of the image.
+  std::vector<std::string> models;
+  nlohmann::json skipped = nlohmann::json::array();
+  const double coverage = board_coverage(p, kCoverageCellsX, kCoverageCellsY);
+  for (const std::string& m : a.models) {
+    if (m != "splined") {
+      models.push_back(m);
+      continue;
+    }
+    std::ostringstream why;
+    if (coverage < kMinSplineCoverage)
+      why << "boards cover " << std::lround(100 * coverage) << "% of the image's " << kCoverageCellsX << "x"
+          << kCoverageCellsY << " cells, the spline needs " << std::lround(100 * kMinSplineCoverage) << "%";
+    else if (p.boards.size() < kMinSplineBoards)
+      why << p.boards.size() << " boards, the spline needs " << kMinSplineBoards << " (4 per cross-validation half)";
+    if (why.str().empty())
+      models.push_back(splined_candidate(p, kSplineNx));
+    else
+      skipped.push_back({{"model", "splined"}, {"reason", why.str()}});
+  }
+  if (models.empty()) throw std::invalid_argument(a.photoset + ": no lens model left to fit (" + skipped.dump() + ")");
+
   int chosen = 0;
-  const std::vector<ModelScore> scores = cross_validate_models(p, a.models, &chosen);
-  const IntrinsicsFit fit = fit_intrinsics(p, a.models[chosen]);
-  fit.lens.write(a.out);
+  const std::vector<ModelScore> scores = cross_validate_models(p, models, &chosen);
+  const IntrinsicsFit fit = fit_intrinsics(p, models[chosen]);
+
+  // Projection uncertainty (calib/intrinsics.h: projection_covariance) at a 3 x 3 grid of pixels:
+  // 1-sigma along the worst direction.
+  nlohmann::json points = nlohmann::json::array();
+  double worst_sigma = 0;
+  for (const double fy : {0.1, 0.5, 0.9})
+    for (const double fx : {0.1, 0.5, 0.9}) {
+      const Vec2 q(fx * (p.width - 1), fy * (p.height - 1));
+      const Eigen::Matrix2d c = projection_covariance(fit.lens, fit.intrinsics_covariance, fit.lens.unproject(q));
+      const double s = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(c).eigenvalues()(1)));
+      worst_sigma = std::max(worst_sigma, s);
+      points.push_back({{"pixel", {q.x(), q.y()}},
+                        {"sigma_px", s},
+                        {"covariance_px2", {c(0, 0), c(0, 1), c(1, 1)}}});
+    }
+  nlohmann::json intrinsics_sigma = nlohmann::json::array();
+  for (Eigen::Index k = 0; k < fit.intrinsics_covariance.rows(); ++k)
+    intrinsics_sigma.push_back(std::sqrt(std::max(0.0, fit.intrinsics_covariance(k, k))));
+
+  std::ostringstream comment;
+  comment << std::setprecision(4) << "# rsibr calibrate: " << models[chosen] << " chosen by cross-validation over "
+          << p.boards.size() << " boards\n# RMS " << fit.rms_px << " px, corner noise " << fit.noise_sigma_px
+          << " px per axis, " << fit.outliers << " outliers\n# projection uncertainty (1 sigma, 3x3 grid over the image): "
+          << "worst " << worst_sigma << " px, centre " << points[4]["sigma_px"].get<double>() << " px\n";
+  write_with_comment(fit.lens, a.out, comment.str());
 
   // Residual pattern: mean residual vector and RMS per cell of a 4 x 3 grid over the image.
   const int gx = 4, gy = 3;
@@ -109,7 +182,7 @@ int run_calibrate(const CalibrateArgs& a) {
   j["image_size"] = {p.width, p.height};
   j["boards_found"] = p.boards.size();
   j["boards_missed"] = missed;
-  j["model"] = a.models[chosen];
+  j["model"] = models[chosen];
   j["intrinsics"] = fit.lens.intrinsics();
   j["rms_px"] = fit.rms_px;
   j["outliers"] = fit.outliers;
@@ -117,11 +190,22 @@ int run_calibrate(const CalibrateArgs& a) {
   for (const ModelScore& s : scores)
     sc.push_back({{"model", s.model}, {"held_out_rms_px", s.held_out_rms_px}, {"fit_rms_px", s.fit_rms_px}});
   j["models"] = sc;
+  j["skipped_models"] = skipped;
+  j["board_coverage"] = coverage;
+  j["uncertainty"] = {
+      {"noise_sigma_px", fit.noise_sigma_px},
+      {"intrinsics_sigma", intrinsics_sigma},
+      {"projection", points},
+      {"worst_projection_sigma_px", worst_sigma},
+      {"note",
+       "1-sigma of the projection of a fixed camera-frame direction, propagated from the intrinsics covariance "
+       "(board poses marginalised); includes the principal-point part that mrcal's uncertainty attributes to a "
+       "shift of the reference frame; for splined models excludes the small rotation that regularisation pins"}};
   j["boards"] = boards;
   j["residual_grid_4x3"] = pattern;
   write_summary(a.json, j);
   if (!a.quiet && a.json != "-")
-    std::cerr << a.models[chosen] << ": RMS " << fit.rms_px << " px over " << p.boards.size() << " boards -> " << a.out
+    std::cerr << models[chosen] << ": RMS " << fit.rms_px << " px over " << p.boards.size() << " boards -> " << a.out
               << "\n";
   return 0;
 }
@@ -136,11 +220,16 @@ Runner add_calibrate(CLI::App& app) {
       "pinhole core and the board poses (OpenCV), and solves with mrcal in two stages (core and poses, then "
       "everything with regularisation and outlier rejection). Each --model is fitted to one half of the boards and "
       "scored on the other (both ways); the simplest within 5% of the best held-out RMS is written. The JSON reports "
-      "every model's scores, the RMS per board and the residual pattern over a 4x3 grid of the image.\n"
+      "every model's scores, the RMS per board, the residual pattern over a 4x3 grid of the image and the "
+      "uncertainty: the corner noise estimated from the residuals, the intrinsics' standard deviations (board poses "
+      "marginalised) and the projection's 1-sigma at a 3x3 grid of pixels (also in the .cameramodel's comment "
+      "header). The candidate 'splined' is LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=8 over the seed's field of "
+      "view, fitted from a LENSMODEL_STEREOGRAPHIC core; it is skipped (with the reason in the JSON) when the boards "
+      "cover less than 60% of an 8x6 grid over the image or number fewer than 8.\n"
       "Example: rsibr calibrate shoot/photoset.yaml --out shoot/camera.cameramodel --json -");
   c->add_option("photoset", a->photoset, "photoset.yaml or the folder holding it")->required();
   c->add_option("--out", a->out, "Output .cameramodel")->required();
-  c->add_option("--model", a->models, "Candidate mrcal models, simplest first (repeatable)");
+  c->add_option("--model", a->models, "Candidate mrcal models, simplest first (repeatable; 'splined' for the automatic spline)");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or report line");
   return [a] { return run_calibrate(*a); };

@@ -15,6 +15,7 @@ packages=(
   # bake / capture / calib / hdr
   libqhull-dev
   libembree-dev libceres-dev libmrcal-dev libmrgingham-dev mrgingham mrcal libexiv2-dev
+  libsuitesparse-dev  # calib/intrinsics.cpp: cholmod (mrcal's Jacobian for the intrinsics covariance)
   # viewer (runtime/viewer; optional at build time) and its CI test under Xvfb (Mesa llvmpipe)
   libglfw3-dev libimgui-dev libepoxy-dev xvfb xauth libgl1-mesa-dri
   # tests and benchmarks

@@ -371,13 +371,28 @@ sed 's/chessboards: {count: 2,/chessboards: {count: 8,/' "$spec" >"$work/min8.ya
 check "calibrate: pinhole chosen, f within 1%, RMS below 0.5 px" python3 -c "
 import json; j = json.load(open('$work/cal.json'))
 assert j['model'] == 'LENSMODEL_PINHOLE' and abs(j['intrinsics'][0] / 700 - 1) < 0.01 and j['rms_px'] < 0.5, j
-assert len(j['models']) == 3 and j['boards_found'] == 8 and len(j['residual_grid_4x3']) == 12, j"
+assert len(j['models']) == 4 and j['boards_found'] == 8 and len(j['residual_grid_4x3']) == 12, j"
 check "calibrate: same photos, same bytes" cmp -s "$work/cal1.cameramodel" "$work/cal2.cameramodel"
 check "calibrate: the model serves extract" "$rsibr" extract "$work/syn8/truth/views/view00_radiance.exr" --lens "$work/cal1.cameramodel" --out "$work/ext-cal.exr" -q
 expect_error "calibrate: too few boards" "need at least 4" calibrate "$work/syn1/photos" --out "$work/cal-e1.cameramodel"
 expect_error "calibrate: missing photo set" "nothere" calibrate "$work/nothere" --out "$work/cal-e2.cameramodel"
 expect_error "calibrate: unknown model" "LENSMODEL_FANCY" calibrate "$work/syn8/photos" --out "$work/cal-e3.cameramodel" --model LENSMODEL_FANCY
 check "calibrate: no output after errors" bash -c "! ls -A '$work' | grep -q '^cal-e'"
+
+# --- calibrate, lens branch: the splined candidate and the uncertainty (calib/intrinsics.h).
+check "calibrate: splined scored, not chosen for a pinhole; f within 3 sigma; uncertainty reported" python3 -c "
+import json; j = json.load(open('$work/cal.json'))
+assert j['models'][3]['model'].startswith('LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=8_Ny=6_') and j['skipped_models'] == [], j
+u = j['uncertainty']
+assert abs(j['intrinsics'][0] - 700) < 3 * u['intrinsics_sigma'][0] and 0.05 < u['noise_sigma_px'] < 0.5, u
+assert len(u['projection']) == 9 and all(0 < p['sigma_px'] <= u['worst_projection_sigma_px'] for p in u['projection']), u"
+check "calibrate: the .cameramodel carries the uncertainty in its comment header" grep -q "^# projection uncertainty (1 sigma" "$work/cal1.cameramodel"
+sed 's/chessboards: {count: 2,/chessboards: {count: 6,/' "$spec" >"$work/min6.yaml"
+"$rsibr" synth "$work/min6.yaml" --out "$work/syn6" -q
+"$rsibr" calibrate "$work/syn6/photos" --out "$work/cal6.cameramodel" --json "$work/cal6.json" -q
+check "calibrate: splined skipped with a reason for 6 boards" python3 -c "
+import json; j = json.load(open('$work/cal6.json'))
+assert len(j['models']) == 3 and j['skipped_models'][0]['model'] == 'splined' and '6 boards' in j['skipped_models'][0]['reason'], j"
 
 # --- probe (calib/probe.h): the minimal spec's three chrome views (poses from the truth headers).
 for v in 0 1 2; do
