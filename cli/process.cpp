@@ -4,6 +4,7 @@
 #include "cli/verbs.h"
 
 #include "core/atomic_file.h"
+#include "core/camera.h"
 #include "core/progress.h"
 #include "pipeline/process_pipeline.h"
 
@@ -16,7 +17,7 @@ namespace {
 
 struct ProcessArgs {
   ProcessOptions o;
-  std::string size = "320x240", json;
+  std::string size = "320x240", json, up = "0,-1,0";
   bool quiet = false;
 };
 
@@ -26,6 +27,8 @@ int run_process_verb(ProcessArgs a) {
   std::istringstream in(a.size);
   if (!(in >> w >> x >> h) || x != 'x' || !(in >> std::ws).eof() || w < 16 || h < 16 || w > 8192 || h > 8192)
     throw std::invalid_argument("--size '" + a.size + "': expected WxH, 16..8192 each");
+  if (a.up == "none") a.o.up.reset();
+  else a.o.up = parse_vec3(a.up, "--up");
   a.o.render_width = w;
   a.o.render_height = h;
   if (!a.json.empty() && a.json != "-") check_output_path(a.json, {a.o.photoset});
@@ -55,7 +58,7 @@ Runner add_process(CLI::App& app) {
   c->footer(
       "Steps (each skipped when its outputs are newer than its inputs and its settings are unchanged; records in "
       "DIR/steps/<step>.json): calibrate (chessboards, or --lens) -> hdr (response + merge per view) -> orient "
-      "(--poses) -> extract (every ball of every view; chrome by reflection indexing, grey orthographic) -> probe "
+      "(solved from the chrome ball's features, or --poses) -> extract (every ball of every view; chrome by reflection indexing, grey orthographic) -> probe "
       "(chrome maps blended) -> bake (grey balls from the probe, Lambert) -> compare (captured vs computed, gains "
       "fitted) -> render (turntable of --mesh or a torus lit by the probe) -> report (DIR/report.html, "
       "self-contained). Prints the report's path.\n"
@@ -64,6 +67,8 @@ Runner add_process(CLI::App& app) {
   c->add_option("--out", a->o.out, "Output folder DIR (created; its parent must exist)")->required();
   c->add_option("--lens", a->o.lens, "The camera's .cameramodel (instead of calibrating from chessboards)");
   c->add_option("--poses", a->o.poses, "Camera orientations: poses.yaml (rsibr orient) or a synth truth.yaml");
+  c->add_option("--up", a->up, "World up X,Y,Z in the first camera's frame for the orientation solve ('none': "
+                              "world = first camera)")->capture_default_str();
   c->add_option("--mesh", a->o.mesh, "Mesh for the turntable (.glb, .gltf, .obj; default: a torus)");
   c->add_option("--force", a->o.force, "Re-run this step even if up to date (repeatable; 'all')");
   c->add_option("--map-size", a->o.map_size, "Sphere maps' size in texels")->check(CLI::Range(8, 2048));

@@ -7,6 +7,8 @@
 #include "calib/probe.h"
 #include "calib/sphere_map_extraction.h"
 #include "calib/view_image.h"
+#include "calib/view_orientation.h"
+#include "calib/pose_file.h"
 #include "capture/photo_set.h"
 #include "core/atomic_file.h"
 #include "core/atomic_folder.h"
@@ -221,48 +223,56 @@ void step_hdr(Context& c) {
   });
 }
 
-// ---- orient: world_from_cam per view.
-void write_poses_yaml(const fs::path& path, const GivenPoses& poses, const std::vector<PhotoView>& views) {
-  std::ostringstream s;
-  s << std::setprecision(17);
-  s << "# Camera orientations (rsibr process, orient step; source: " << poses.source << ")\n";
-  s << "rsibr_poses: 1\ngauge: " << (poses.gauge == "truth" ? "up" : poses.gauge) << "\nviews:\n";
-  for (const PhotoView& v : views) {
-    const GivenPose& p = poses.views.at(v.name);
-    s << "  - {name: " << v.name << ", world_from_cam: [";
-    for (int i = 0; i < 9; ++i) s << (i ? ", " : "") << p.world_from_cam(i / 3, i % 3);
-    s << "], sigma_deg: " << p.sigma_deg << "}\n";
-  }
-  write_atomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp);
-    out << s.str();
-    if (!out) throw std::runtime_error(tmp + ": cannot write");
-  });
-}
-
+// ---- orient: world_from_cam per view, solved from the chrome ball's reflected features
+// (calib/view_orientation.h; world +Y up when `up` gives the world's up in the first camera's
+// frame), or given (--poses).
 void step_orient(Context& c) {
   std::vector<fs::path> inputs = hdr_files(c);
   inputs.push_back(c.dir / "camera.cameramodel");
-  if (c.o.poses.empty())
-    throw std::runtime_error(
-        "orient: the orientation solve (calib/view_orientation.h) is not in this build; give the camera orientations "
-        "with --poses FILE (poses.yaml of rsibr orient, or the truth.yaml of rsibr synth)");
-  inputs.push_back(c.o.poses);
-  const GivenPoses given = read_given_poses(c.o.poses);
-  for (const PhotoView& v : c.set.views)
-    if (!given.views.count(v.name)) throw std::invalid_argument(c.o.poses + ": no pose for view '" + v.name + "'");
-  run_step(c, "orient", {{"source", "given"}}, inputs, [&](StepRecord& r) {
+  if (!c.o.poses.empty()) {
+    inputs.push_back(c.o.poses);
+    const PoseSet given = read_given_poses(c.o.poses);
+    for (const PhotoView& v : c.set.views)
+      if (!given.find(v.name)) throw std::invalid_argument(c.o.poses + ": no pose for view '" + v.name + "'");
+  }
+  const nlohmann::json settings = {{"source", c.o.poses.empty() ? "solve" : "given"},
+                                   {"up", c.o.up ? nlohmann::json{c.o.up->x(), c.o.up->y(), c.o.up->z()} : nlohmann::json()}};
+  run_step(c, "orient", settings, inputs, [&](StepRecord& r) {
+    PoseSet poses;
+    std::string source;
+    nlohmann::json solve;
+    if (!c.o.poses.empty()) {
+      poses = read_given_poses(c.o.poses);
+      source = "given (" + c.o.poses + ")";
+    } else {
+      const LensModel lens = LensModel::read(c.dir / "camera.cameramodel");
+      std::vector<std::string> names;
+      std::vector<ViewImage> images;
+      for (const PhotoView& v : c.set.views) {
+        names.push_back(v.name);
+        images.push_back(read_view_image((c.dir / "hdr" / (v.name + ".exr")).string()));
+      }
+      ViewOrientationOptions vo;
+      vo.up = c.o.up;
+      ViewOrientationReport report;
+      poses = orient_views(names, images, lens, vo, &report);
+      source = "solved (chrome-ball features)";
+      solve = {{"tracks", report.tracks}, {"observations", report.observations}, {"inliers", report.inliers},
+               {"rms_sigmas", report.rms_sigmas}, {"features", report.features}};
+    }
+    // In the set's order, only its views.
+    PoseSet ordered;
+    ordered.gauge = poses.gauge;
+    for (const PhotoView& v : c.set.views) ordered.views.push_back(*poses.find(v.name));
     const fs::path out = c.dir / "poses.yaml";
-    write_poses_yaml(out, given, c.set.views);
+    write_pose_file(out.string(), ordered);
     nlohmann::json views = nlohmann::json::array();
-    for (const PhotoView& v : c.set.views) {
-      const Mat3& m = given.views.at(v.name).world_from_cam;
-      const Vec3 forward = m.col(2);
-      views.push_back({{"name", v.name}, {"sigma_deg", given.views.at(v.name).sigma_deg},
-                       {"forward", {forward.x(), forward.y(), forward.z()}}});
+    for (const ViewPose& p : ordered.views) {
+      const Vec3 forward = p.world_from_cam.col(2);
+      views.push_back({{"name", p.name}, {"sigma_deg", p.sigma_deg}, {"forward", {forward.x(), forward.y(), forward.z()}}});
     }
     r.outputs = {out};
-    r.summary = {{"source", given.source + " (" + c.o.poses + ")"}, {"gauge", given.gauge}, {"views", views}};
+    r.summary = {{"source", source}, {"gauge", ordered.gauge}, {"views", views}, {"solve", solve}};
   });
 }
 
@@ -310,7 +320,9 @@ void step_extract(Context& c) {
   run_step(c, "extract", {{"map_size", c.o.map_size}, {"balls", balls}}, inputs, [&](StepRecord& r) {
     if (c.set.balls.empty()) throw std::invalid_argument(c.o.photoset + ": balls: the photo set lists no ball");
     const LensModel lens = LensModel::read(c.dir / "camera.cameramodel");
-    const GivenPoses poses = read_given_poses((c.dir / "poses.yaml").string());
+    const PoseSet poses = read_pose_file((c.dir / "poses.yaml").string());
+    // World down for the stand mask: -Y when the world is +Y up, else the first camera's +y.
+    const Vec3 world_down = poses.gauge == "up" ? Vec3(0, -1, 0) : Vec3(0, 1, 0);
     std::vector<MapSet> sets(c.set.balls.size());
     nlohmann::json views = nlohmann::json::array();
     Progress bar("extract", c.o.progress);
@@ -348,7 +360,7 @@ void step_extract(Context& c) {
       std::stable_sort(by_kind.begin(), by_kind.end(), [&](std::size_t p, std::size_t q) {
         return kind_rank(c.set.balls[p].kind) > kind_rank(c.set.balls[q].kind);
       });
-      const Mat3 world_from_cam = poses.views.at(v.name).world_from_cam;
+      const Mat3 world_from_cam = poses.find(v.name)->world_from_cam;
       nlohmann::json vj = {{"name", v.name}, {"balls", nlohmann::json::array()}};
       for (std::size_t k = 0; k < by_kind.size(); ++k) {
         const std::size_t bi = by_kind[k];
@@ -359,7 +371,7 @@ void step_extract(Context& c) {
         eo.mirror = ball.kind == BallKind::chrome;
         eo.indexing = eo.mirror ? SphereIndexing::reflection : SphereIndexing::orthographic;
         eo.camera_mask_deg = eo.mirror ? 12.0 : 0.0;
-        eo.down = world_from_cam.transpose() * Vec3(0, -1, 0);
+        eo.down = world_from_cam.transpose() * world_down;
         eo.material = eo.mirror ? "{type: mirror}" : "{type: lambert}";
         MapView mv = extract_sphere_map(img.radiance, img.flags, lens, loc.fit.cone, world_from_cam, eo);
         mv.attributes["image"] = v.name;
@@ -598,6 +610,7 @@ ProcessResult run_process(const ProcessOptions& o) {
   if (!o.lens.empty() && !fs::is_regular_file(o.lens)) throw std::invalid_argument(o.lens + ": no such file");
   if (!o.mesh.empty() && !fs::is_regular_file(o.mesh)) throw std::invalid_argument(o.mesh + ": no such file");
   if (!o.poses.empty()) read_given_poses(o.poses);  // errors before any work
+  if (o.up && !(o.up->norm() > 0 && o.up->allFinite())) throw std::invalid_argument("--up: expected a non-zero direction");
   parse_brdf(o.render_brdf);
   if (!o.chrome_fresnel.empty()) {
     try {

@@ -3,7 +3,8 @@
 //
 //   calibrate  chessboards -> DIR/camera.cameramodel (mrcal, model by cross-validation), or --lens
 //   hdr        brackets -> DIR/hdr/<view>.exr, DIR/hdr/response.json (response recovered once)
-//   orient     -> DIR/poses.yaml (world_from_cam per view; from --poses until the solve lands)
+//   orient     -> DIR/poses.yaml (world_from_cam per view: solved from the chrome ball's features,
+//              calib/view_orientation.h, world +Y up given the up of the first camera; or --poses)
 //   extract    every ball of every view -> DIR/maps/captured-<ball>.exr, one part per view in the
 //              world frame (chrome: reflection indexing, mirror warp; grey/glossy: orthographic)
 //   probe      chrome maps -> DIR/probe.exr (lat-long, confidence-weighted blend)
@@ -18,11 +19,14 @@
 // atomically and then its record. Frames: world +Y up (the gauge of the poses).
 #pragma once
 
+#include "core/vec.h"
+
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,7 +36,8 @@ struct ProcessOptions {
   std::string photoset;      // photoset.yaml or its folder
   std::filesystem::path out; // DIR (created; its parent must exist)
   std::string lens;          // given .cameramodel (skips the chessboards)
-  std::string poses;         // given poses (pipeline/pose_input.h)
+  std::string poses;         // given poses (pipeline/pose_input.h); empty: the orientation solve
+  std::optional<Vec3> up = Vec3(0, -1, 0);  // world up in the first camera's frame (a level camera); none: first-view gauge
   std::string mesh;          // render: .glb/.gltf/.obj; empty: a built-in torus
   std::vector<std::string> force;  // steps to re-run ("all" for every step)
   int map_size = 64;         // extracted and computed sphere maps (texels a side)

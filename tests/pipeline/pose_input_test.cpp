@@ -1,4 +1,5 @@
-// Given poses (pipeline/pose_input.h): both formats read, bad matrices and duplicates refused.
+// Given poses (pipeline/pose_input.h): poses.yaml (through calib/pose_file.h) and synth truth.yaml
+// read, bad matrices and duplicates refused with the file's name.
 #include "pipeline/pose_input.h"
 
 #include <gtest/gtest.h>
@@ -23,12 +24,12 @@ TEST(GivenPoses, PosesFileRowsAreRowMajor) {
   const fs::path p = write_temp("a.yaml",
                                 "rsibr_poses: 1\ngauge: up\nviews:\n"
                                 "  - {name: north, world_from_cam: [0, 0, 1, 0, 1, 0, -1, 0, 0], sigma_deg: 0.03}\n");
-  const GivenPoses g = read_given_poses(p.string());
+  const PoseSet g = read_given_poses(p.string());
   ASSERT_EQ(g.views.size(), 1u);
-  const Mat3& m = g.views.at("north").world_from_cam;
-  EXPECT_EQ(m(0, 2), 1);   // row 0, column 2
-  EXPECT_EQ(m(2, 0), -1);
-  EXPECT_DOUBLE_EQ(g.views.at("north").sigma_deg, 0.03);
+  const Mat3& m = g.find("north")->world_from_cam;
+  EXPECT_NEAR(m(0, 2), 1, 1e-12);   // row 0, column 2
+  EXPECT_NEAR(m(2, 0), -1, 1e-12);
+  EXPECT_DOUBLE_EQ(g.find("north")->sigma_deg, 0.03);
   EXPECT_EQ(g.gauge, "up");
   fs::remove(p);
 }
@@ -37,10 +38,10 @@ TEST(GivenPoses, SynthTruthRowsAreRead) {
   const fs::path p = write_temp("t.yaml",
                                 "rsibr_synth_truth: 1\nviews:\n  - name: view00\n    world_from_cam:\n"
                                 "      - [1, 0, 0]\n      - [0, -1, 0]\n      - [0, 0, -1]\n");
-  const GivenPoses g = read_given_poses(p.string());
-  EXPECT_EQ(g.gauge, "truth");
-  EXPECT_EQ(g.views.at("view00").world_from_cam(1, 1), -1);
-  EXPECT_EQ(g.views.at("view00").sigma_deg, 0);
+  const PoseSet g = read_given_poses(p.string());
+  EXPECT_EQ(g.gauge, "up");  // the synthetic world is +Y up
+  EXPECT_EQ(g.find("view00")->world_from_cam(1, 1), -1);
+  EXPECT_EQ(g.find("view00")->sigma_deg, 0);
   fs::remove(p);
 }
 
@@ -51,7 +52,8 @@ TEST(GivenPoses, NonRotationsDuplicatesAndUnknownFormatsAreErrorsNamingTheFile) 
         head + "  - {name: a, world_from_cam: [-1, 0, 0, 0, 1, 0, 0, 0, 1]}\n",  // a reflection
         head + "  - {name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0]}\n",
         head + "  - {name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, 1]}\n  - {name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, 1]}\n",
-        std::string("views: []\n"), std::string("rsibr_poses: 1\ngauge: sideways\nviews: []\n")}) {
+        std::string("views: []\n"), std::string("rsibr_poses: 1\ngauge: sideways\nviews: []\n"),
+        std::string("rsibr_synth_truth: 1\nviews:\n  - {name: a, world_from_cam: [[1, 0, 0], [0, 1, 0], [0, 0, 2]]}\n")}) {
     const fs::path p = write_temp("bad.yaml", bad);
     try {
       read_given_poses(p.string());
