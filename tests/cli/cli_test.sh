@@ -25,7 +25,7 @@ expect_error() {
 }
 no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
 
-for verb in convert info pattern blend bake reference render view hdr compare synth extract calibrate probe orient; do
+for verb in convert info pattern blend bake reference render view hdr compare synth extract calibrate probe orient process; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
 done
 check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
@@ -441,6 +441,29 @@ import json; j = json.load(open('$work/ext-poses.json')); assert j['pose_from_fi
   check "orient: no output after errors" bash -c "! ls -A '$work' | grep -q '^or-e'"
   check "orient: no temporaries" no_temporaries "$work"
 fi
+
+# --- process (pipeline/): the minimal-grey rig end to end (poses from the truth), the report's
+# path on stdout, a second run skips every step, one-line errors before any work, no partial output.
+pspec="$(dirname "$0")/../../datasets-synthetic/minimal-grey.yaml"
+"$rsibr" synth "$pspec" --out "$work/psyn" -q
+fres='{type: conductor, eta: [2.9, 2.9, 2.6], k: [3.4, 3.4, 3.2]}'
+"$rsibr" process "$work/psyn/photos" --out "$work/pout" --poses "$work/psyn/truth/truth.yaml" --chrome-fresnel "$fres" \
+  --map-size 32 --turntable 2 --size 64x48 --json "$work/p1.json" -q >"$work/p1.out" 2>/dev/null
+check "process prints the report's path" bash -c "[ \"\$(cat '$work/p1.out')\" = '$work/pout/report.html' ] && test -s '$work/pout/report.html'"
+check "process: every step ran, captured grey within 10% of computed" python3 -c "
+import json; j = json.load(open('$work/p1.json')); assert all(s['ran'] for s in j['steps']), j['steps']
+b = j['results']['compare']['balls'][0]; assert b['ball'] == 'grey' and b['overall']['after']['relative_rms'] < 0.1, b['overall']"
+"$rsibr" process "$work/psyn/photos" --out "$work/pout" --poses "$work/psyn/truth/truth.yaml" --chrome-fresnel "$fres" \
+  --map-size 32 --turntable 2 --size 64x48 --json "$work/p2.json" -q >/dev/null
+check "process: a second run skips every step" python3 -c "
+import json; j = json.load(open('$work/p2.json')); assert not any(s['ran'] for s in j['steps']), j['steps']"
+expect_error "process: missing photo set" "nothere" process "$work/nothere" --out "$work/pe1" -q
+expect_error "process: unknown --force step" "--force 'merge'" process "$work/psyn/photos" --out "$work/pe2" --force merge -q
+expect_error "process: missing poses file" "noposes.yaml" process "$work/psyn/photos" --out "$work/pe3" --poses "$work/noposes.yaml" -q
+expect_error "process: output parent missing" "nofolder" process "$work/psyn/photos" --out "$work/nofolder/pe4" --poses "$work/psyn/truth/truth.yaml" -q
+expect_error "process: bad --size" "--size" process "$work/psyn/photos" --out "$work/pe5" --size 10 -q
+check "process: no output after errors" bash -c "! ls -A '$work' | grep -q '^pe[0-9]'"
+check "process: no temporaries" no_temporaries "$work/pout"
 
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
