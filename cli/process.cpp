@@ -69,6 +69,8 @@ Runner add_process(CLI::App& app) {
   c->add_option("--poses", a->o.poses, "Camera orientations: poses.yaml (rsibr orient) or a synth truth.yaml");
   c->add_option("--up", a->up, "World up X,Y,Z in the first camera's frame for the orientation solve ('none': "
                               "world = first camera)")->capture_default_str();
+  c->add_option("--radiance", a->o.radiance_dir, "Use these linear EXRs (<view>_radiance.exr or <view>.exr) instead of the merge");
+  c->add_option("--probe", a->o.probe_file, "Use this environment as the probe instead of the chrome maps' blend");
   c->add_option("--mesh", a->o.mesh, "Mesh for the turntable (.glb, .gltf, .obj; default: a torus)");
   c->add_option("--force", a->o.force, "Re-run this step even if up to date (repeatable; 'all')");
   c->add_option("--map-size", a->o.map_size, "Sphere maps' size in texels")->check(CLI::Range(8, 2048));

@@ -21,6 +21,7 @@
 #include "core/map_set.h"
 #include "core/mesh.h"
 #include "core/progress.h"
+#include "core/resample.h"
 #include "core/view_set.h"
 #include "hdr/bracket_set.h"
 #include "hdr/merge.h"
@@ -172,7 +173,39 @@ void step_calibrate(Context& c) {
 }
 
 // ---- hdr: response once (from the view with the most brackets), then every view's merge.
+// The stage swapped for given linear images (the truth of a synthetic capture, for the error
+// budget): DIR/<view>_radiance.exr or DIR/<view>.exr per view, written as merged views with zero
+// variance and no flags.
+void step_given_radiance(Context& c) {
+  std::vector<fs::path> inputs;
+  for (const PhotoView& v : c.set.views) {
+    const fs::path a = fs::path(c.o.radiance_dir) / (v.name + "_radiance.exr"), b = fs::path(c.o.radiance_dir) / (v.name + ".exr");
+    if (fs::is_regular_file(a)) inputs.push_back(a);
+    else if (fs::is_regular_file(b)) inputs.push_back(b);
+    else throw std::invalid_argument(c.o.radiance_dir + ": no " + a.filename().string() + " or " + b.filename().string());
+  }
+  run_step(c, "hdr", {{"response", "given radiance"}, {"radiance", c.o.radiance_dir}}, inputs, [&](StepRecord& r) {
+    fs::create_directories(c.dir / "hdr");
+    nlohmann::json views = nlohmann::json::array();
+    for (std::size_t i = 0; i < c.set.views.size(); ++i) {
+      const ViewImage img = read_view_image(inputs[i].string());
+      MergedImage m;
+      m.radiance = img.radiance;
+      m.variance = cv::Mat::zeros(img.radiance.size(), CV_32FC3);
+      m.flags = cv::Mat::zeros(img.radiance.size(), CV_8UC1);
+      const fs::path exr = c.dir / "hdr" / (c.set.views[i].name + ".exr");
+      write_merged_exr(exr.string(), m, {{"version", RSIBR_VERSION}, {"view", c.set.views[i].name},
+                                          {"source", inputs[i].string()}, {"producer", "rsibr process (given radiance)"}});
+      r.outputs.push_back(exr);
+      views.push_back({{"name", c.set.views[i].name}, {"brackets", 0}, {"clipped_fraction", 0.0}, {"ghost_fraction", 0.0}});
+    }
+    r.summary = {{"model", "given radiance (" + c.o.radiance_dir + ")"}, {"recovered_from", "-"},
+                 {"curve", nlohmann::json::array()}, {"views", views}};
+  });
+}
+
 void step_hdr(Context& c) {
+  if (!c.o.radiance_dir.empty()) return step_given_radiance(c);
   std::vector<fs::path> inputs;
   for (const PhotoView& v : c.set.views)
     for (const BracketPhoto& b : v.brackets) inputs.push_back(b.file);
@@ -406,6 +439,19 @@ void step_probe(Context& c) {
   if (chrome.empty()) throw std::invalid_argument(c.o.photoset + ": balls: no chrome ball (the probe needs one)");
   std::vector<fs::path> inputs;
   for (const BallSpec* b : chrome) inputs.push_back(captured_path(c, *b));
+  if (!c.o.probe_file.empty()) {
+    // The stage swapped for a given environment (the truth, for the error budget): resampled
+    // (area-weighted, core/resample.h) to the probe's lat-long size.
+    run_step(c, "probe", {{"width", c.o.probe_width}, {"given", c.o.probe_file}}, {c.o.probe_file}, [&](StepRecord& r) {
+      EnvMap env = resample(read_environment(c.o.probe_file), Layout(LayoutKind::LatLong, c.o.probe_width, c.o.probe_width / 2));
+      env.attributes["producer"] = "rsibr process (given probe " + fs::path(c.o.probe_file).filename().string() + ")";
+      const fs::path out = c.dir / "probe.exr";
+      write_environment(out.string(), env);
+      r.outputs = {out};
+      r.summary = {{"views", 0}, {"width", c.o.probe_width}, {"covered_fraction", 1.0}, {"fresnel", "given: " + c.o.probe_file}};
+    });
+    return;
+  }
   run_step(c, "probe", {{"width", c.o.probe_width}, {"fresnel", c.o.chrome_fresnel}}, inputs, [&](StepRecord& r) {
     MapSet all;
     for (const fs::path& p : inputs)
@@ -609,6 +655,9 @@ ProcessResult run_process(const ProcessOptions& o) {
                                   "compare, render, report, all)");
   if (!o.lens.empty() && !fs::is_regular_file(o.lens)) throw std::invalid_argument(o.lens + ": no such file");
   if (!o.mesh.empty() && !fs::is_regular_file(o.mesh)) throw std::invalid_argument(o.mesh + ": no such file");
+  if (!o.probe_file.empty() && !fs::is_regular_file(o.probe_file)) throw std::invalid_argument(o.probe_file + ": no such file");
+  if (!o.radiance_dir.empty() && !fs::is_directory(o.radiance_dir))
+    throw std::invalid_argument(o.radiance_dir + ": no such folder");
   if (!o.poses.empty()) read_given_poses(o.poses);  // errors before any work
   if (o.up && !(o.up->norm() > 0 && o.up->allFinite())) throw std::invalid_argument("--up: expected a non-zero direction");
   parse_brdf(o.render_brdf);

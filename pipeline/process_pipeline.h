@@ -38,6 +38,9 @@ struct ProcessOptions {
   std::string lens;          // given .cameramodel (skips the chessboards)
   std::string poses;         // given poses (pipeline/pose_input.h); empty: the orientation solve
   std::optional<Vec3> up = Vec3(0, -1, 0);  // world up in the first camera's frame (a level camera); none: first-view gauge
+  // Stages swapped for given data (the truth of a synthetic capture: the error budget):
+  std::string radiance_dir;  // hdr: linear EXRs <view>_radiance.exr or <view>.exr instead of the merge
+  std::string probe_file;    // probe: this environment (resampled) instead of the chrome maps' blend
   std::string mesh;          // render: .glb/.gltf/.obj; empty: a built-in torus
   std::vector<std::string> force;  // steps to re-run ("all" for every step)
   int map_size = 64;         // extracted and computed sphere maps (texels a side)

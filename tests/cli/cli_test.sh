@@ -462,6 +462,7 @@ expect_error "process: unknown --force step" "--force 'merge'" process "$work/ps
 expect_error "process: missing poses file" "noposes.yaml" process "$work/psyn/photos" --out "$work/pe3" --poses "$work/noposes.yaml" -q
 expect_error "process: output parent missing" "nofolder" process "$work/psyn/photos" --out "$work/nofolder/pe4" --poses "$work/psyn/truth/truth.yaml" -q
 expect_error "process: bad --size" "--size" process "$work/psyn/photos" --out "$work/pe5" --size 10 -q
+expect_error "process: missing --probe environment" "noenv.exr" process "$work/psyn/photos" --out "$work/pe6" --probe "$work/noenv.exr" -q
 check "process: no output after errors" bash -c "! ls -A '$work' | grep -q '^pe[0-9]'"
 check "process: no temporaries" no_temporaries "$work/pout"
 
