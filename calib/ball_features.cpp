@@ -74,6 +74,7 @@ BallFeatures ball_features(const cv::Mat& image, const LensModel& lens, const Ba
     out.directions.push_back(*r);
     out.sigma.push_back(std::max(options.sigma_px * per_px, 1e-6));
     out.pixels.push_back(q);
+    out.rays.push_back(lens.unproject(q).normalized());
     out.descriptors.push_back(desc.row(static_cast<int>(i)));
   }
   return out;
@@ -118,7 +119,8 @@ std::vector<DirectionObservation> match_ball_features(const std::vector<BallFeat
     for (const auto& [v, i] : members) {
       if (seen[v]) continue;
       seen[v] = 1;
-      obs.push_back({v, id, views[v].directions[i], views[v].sigma[i]});
+      obs.push_back({v, id, views[v].directions[i], views[v].sigma[i],
+                     i < static_cast<int>(views[v].rays.size()) ? views[v].rays[i] : Vec3::Zero()});
     }
     ++id;
   }

@@ -31,6 +31,7 @@ struct BallFeatures {
   std::vector<Vec3> directions;  // camera frame, unit
   std::vector<double> sigma;     // radians
   std::vector<Vec2> pixels;
+  std::vector<Vec3> rays;        // camera frame, unit: lens.unproject(pixel)
   cv::Mat descriptors;           // CV_32F, one row per feature
 };
 
