@@ -16,7 +16,7 @@
 int main(int argc, char** argv) {
   using namespace rsibr;
   CLI::App app("Orientation accuracy on rendered views");
-  double radius_px = 120, noise = 0.01, ball_prior_px = 0.25, max_radius_fraction = 0.85;
+  double radius_px = 120, noise = 0.01, ball_prior_px = 0.25, max_radius_fraction = 0.85, contrast = 0.04;
   int views = 4, max_features = 800;
   std::uint64_t seed = 5;
   bool refine = true;
@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   app.add_option("--ball-prior-px", ball_prior_px, "Ball centre prior floor, pixels");
   app.add_option("--max-features", max_features, "SIFT features per view");
   app.add_option("--max-radius-fraction", max_radius_fraction, "Features within this fraction of the ball's angular radius");
+  app.add_option("--contrast-threshold", contrast, "SIFT contrast threshold");
   CLI11_PARSE(app, argc, argv);
   const double distance = 0.5, f = radius_px * distance / 0.05;
   const int w = int(radius_px * 2.5), h = int(radius_px * 2.3);
@@ -60,6 +61,7 @@ int main(int argc, char** argv) {
   o.ball_prior_px = ball_prior_px;
   o.features.max_features = max_features;
   o.features.max_radius_fraction = max_radius_fraction;
+  o.features.contrast_threshold = contrast;
   ViewOrientationReport rep;
   const auto t0 = std::chrono::steady_clock::now();
   const PoseSet p = orient_views(names, images, scene.camera.lens, o, &rep);

@@ -59,7 +59,7 @@ BallFeatures ball_features(const cv::Mat& image, const LensModel& lens, const Ba
   cv::Mat u8;
   lg.convertTo(u8, CV_8U, 255.0 / (hi - lo), -lo * 255.0 / (hi - lo));
   u8.setTo(0, mask == 0);
-  cv::Ptr<cv::SIFT> sift = cv::SIFT::create(options.max_features);
+  cv::Ptr<cv::SIFT> sift = cv::SIFT::create(options.max_features, 3, options.contrast_threshold);
   std::vector<cv::KeyPoint> kps;
   cv::Mat desc;
   sift->detectAndCompute(u8, mask, kps, desc);

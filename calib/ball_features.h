@@ -25,6 +25,7 @@ struct BallFeatureOptions {
   double sigma_px = 0.3;             // keypoint localisation std dev, pixels
   double max_radius_fraction = 0.85; // of the angular radius alpha
   double camera_mask_deg = 25;
+  double contrast_threshold = 0.04;  // SIFT's (OpenCV's default); lower finds more, weaker features
 };
 
 struct BallFeatures {
