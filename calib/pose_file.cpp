@@ -92,7 +92,9 @@ void write_pose_file(const std::string& path, const PoseSet& poses) {
     name << YAML::DoubleQuoted << v.name;  // any name survives the round trip
     out << "  - name: " << name.c_str() << "\n    world_from_cam: [";
     for (int k = 0; k < 9; ++k) out << (k ? ", " : "") << v.world_from_cam(k / 3, k % 3);
-    out << "]\n    sigma_deg: " << v.sigma_deg << "\n";
+    // The std dev with 6 significant digits: an estimate, and its last bits vary between runs (the
+    // sparse factorisations behind ceres::Covariance), which would break same input -> same bytes.
+    out << "]\n    sigma_deg: " << std::setprecision(6) << v.sigma_deg << std::setprecision(17) << "\n";
   }
   write_atomically(path, [&](const std::string& tmp) {
     std::ofstream f(tmp, std::ios::binary);

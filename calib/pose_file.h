@@ -36,7 +36,8 @@ struct PoseSet {
 // rotation, a negative or non-finite sigma are errors. Throws std::invalid_argument("<path>: <problem>").
 PoseSet read_pose_file(const std::string& path);
 
-// Atomic (core/atomic_file.h); numbers with 17 significant digits so a round trip is exact.
+// Atomic (core/atomic_file.h); rotations with 17 significant digits (a round trip is exact to
+// rounding), sigma_deg with 6.
 // Throws std::invalid_argument for an invalid set (the same checks as reading).
 void write_pose_file(const std::string& path, const PoseSet& poses);
 

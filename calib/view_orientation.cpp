@@ -124,12 +124,29 @@ PoseSet orient_views(const std::vector<std::string>& names, const std::vector<Vi
   const std::vector<DirectionObservation> obs = match_ball_features(feats, &tracks);
   OrientationOptions so = options.solve;
   so.first_world_from_cam = gauge;
+  if (options.refine_balls) {
+    // Prior: the ball centre known to the outline points' scatter (their errors are correlated along
+    // the outline, so the fit's formal std dev, RMS / sqrt(points), would be far too small).
+    so.balls.clear();
+    for (const BallLocation& b : rep.balls) {
+      const Vec3 a = b.fit.cone.axis.normalized();
+      const Vec3 t = a.unitOrthogonal();
+      const double h = 1e-4;
+      const double px_per_rad = (lens.project((a + h * t).normalized()) - lens.project(a)).norm() / h;
+      so.balls.push_back({a, b.fit.cone.half_angle, std::max(b.fit.rms_px, options.ball_prior_px) / px_per_rad});
+    }
+  }
   OrientationSolution s;
   try {
     s = solve_orientations(static_cast<int>(views.size()), tracks, obs, so);
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(with_names(e.what(), names));
   }
+  if (options.refine_balls)
+    for (std::size_t v = 0; v < views.size(); ++v) {
+      rep.balls[v].fit.cone.axis = s.ball_axes[v];
+      rep.balls[v].centre_px = lens.project(s.ball_axes[v]);
+    }
   rep.tracks = tracks;
   rep.observations = s.observations;
   rep.inliers = s.inliers;

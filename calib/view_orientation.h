@@ -31,12 +31,16 @@ struct ViewOrientationOptions {
   double min_radius_px = 0;            // detection range; 0: min(width, height) / 40
   double max_radius_px = 0;            // 0: min(width, height) / 2
   BallFeatureOptions features;
+  // Ball centres refined jointly with the orientations (OrientationOptions::balls), with a prior
+  // std dev of the ball centre of max(outline RMS, ball_prior_px) pixels.
+  bool refine_balls = true;
+  double ball_prior_px = 0.25;
   OrientationOptions solve;            // its first_world_from_cam is set from the gauge
 };
 
 // What orient_views saw, for reports (--json).
 struct ViewOrientationReport {
-  std::vector<BallLocation> balls;      // per view
+  std::vector<BallLocation> balls;      // per view (centre_px and the cone's axis refined when refine_balls)
   std::vector<int> features;            // per view: features in the ball
   int tracks = 0, observations = 0, inliers = 0;
   double rms_sigmas = 0;

@@ -31,7 +31,7 @@ std::string error_of(const std::string& path) {
 
 void write_text(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
 
-TEST(PoseFile, RoundTripIsBitExact) {
+TEST(PoseFile, RoundTripKeepsRotationsExactAndSigmasToSixDigits) {
   PoseSet p;
   p.gauge = "up";
   p.views.push_back({"north", Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix(), 0.0312345678901});
@@ -43,7 +43,7 @@ TEST(PoseFile, RoundTripIsBitExact) {
   EXPECT_EQ(q.gauge, "up");
   for (int v = 0; v < 2; ++v) {
     EXPECT_EQ(q.views[v].name, p.views[v].name);
-    EXPECT_EQ(q.views[v].sigma_deg, p.views[v].sigma_deg);
+    EXPECT_NEAR(q.views[v].sigma_deg, p.views[v].sigma_deg, 1e-5 * p.views[v].sigma_deg);
     // Re-orthonormalising an orthonormal matrix written with 17 digits moves it by rounding only.
     EXPECT_LT((q.views[v].world_from_cam - p.views[v].world_from_cam).cwiseAbs().maxCoeff(), 1e-15);
   }
