@@ -132,7 +132,7 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
        "body{font-family:sans-serif;max-width:1100px;margin:1em auto;padding:0 1em;color:#222}"
        "table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}"
        "th{background:#eee}td:first-child,th:first-child{text-align:left}img{max-width:100%;image-rendering:pixelated}"
-       ".frames img{width:24%;margin:.2%}h2{border-bottom:1px solid #ccc}</style></head><body>\n";
+       ".frames img{width:24%;margin:.2%}h2{border-bottom:1px solid #ccc}.warn{background:#fff3cd;padding:4px}</style></head><body>\n";
   h << "<h1>rsibr process report</h1><p>Photo set: <code>" << html_escape(photoset) << "</code><br>Output: <code>"
     << html_escape(dir.string()) << "</code><br>rsibr " << RSIBR_VERSION << "</p>\n";
 
@@ -220,6 +220,16 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
     h << "<h2>Captured vs computed</h2><p>Captured grey-ball maps against maps baked from the probe (Lambert). "
          "Errors after the global exposure / white-balance fit are errors of shape; the fitted gains are the "
          "calibration offset. Heat maps: log2 error (stops).</p>";
+    // Pixels clipped in every bracket hold lower bounds; in the chrome views they are left out of
+    // the probe, so light from there (a sun) is missing from the computed maps.
+    long clipped = 0;
+    if (rec.count("hdr"))
+      for (const auto& v : rec["hdr"].summary["views"]) clipped = std::max(clipped, v.value("clipped_pixels", 0L));
+    if (clipped > 0)
+      h << "<p class=\"warn\"><b>Clipped pixels:</b> up to " << clipped
+        << " pixel(s) of a view saturated in every bracket (lower bounds, left out of the probe). A sun "
+           "reflected in a chrome ball covers a pixel or two and holds most of the light: if it is among them, "
+           "the computed maps are too dark on the side it lights. Shoot shorter brackets.</p>";
     for (const auto& b : s["balls"]) {
       h << "<h3>" << html_escape(b["ball"].get<std::string>()) << "</h3>";
       if (b.contains("fit"))

@@ -247,6 +247,7 @@ void step_hdr(Context& c) {
       r.outputs.push_back(exr);
       const double px = double(m.radiance.total());
       views.push_back({{"name", v.name}, {"brackets", b.size()}, {"clipped_fraction", m.clipped / px},
+                       {"clipped_pixels", m.clipped},
                        {"ghost_fraction", m.ghost / px}, {"noise_read", noise.read}, {"noise_shot", noise.shot}});
       bar.update(double(i + 1) / double(c.set.views.size()));
     }
