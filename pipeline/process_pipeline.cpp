@@ -27,6 +27,7 @@
 #include "hdr/merge.h"
 #include "hdr/merged_exr.h"
 #include "hdr/noise_model.h"
+#include "hdr/photo_set_merge.h"
 #include "hdr/response_recovery.h"
 #include "pipeline/chessboard_problem.h"
 #include "pipeline/html_report.h"
@@ -211,10 +212,11 @@ void step_hdr(Context& c) {
     for (const BracketPhoto& b : v.brackets) inputs.push_back(b.file);
   run_step(c, "hdr", {{"response", "auto"}}, inputs, [&](StepRecord& r) {
     fs::create_directories(c.dir / "hdr");
-    const PhotoView* richest = &c.set.views.front();
-    for (const PhotoView& v : c.set.views)
-      if (v.brackets.size() > richest->brackets.size()) richest = &v;
-    const ResponseRecovery rec = recover_response(load_brackets(*richest), RecoveryOptions{});
+    std::vector<const PhotoView*> all;
+    for (const PhotoView& v : c.set.views) all.push_back(&v);
+    const PhotoSetResponse psr = recover_photo_set_response(all, RecoveryOptions{}, false);
+    const ResponseRecovery& rec = psr.recovery;
+    const PhotoView* richest = psr.from;
     const ResponseCurve& curve = rec.curve;
     nlohmann::json cands = nlohmann::json::array();
     for (const auto& k : rec.candidates)
@@ -233,11 +235,10 @@ void step_hdr(Context& c) {
     Progress bar("hdr", c.o.progress);
     for (std::size_t i = 0; i < c.set.views.size(); ++i) {
       const PhotoView& v = c.set.views[i];
-      const BracketSet b = load_brackets(v);
-      if (b.max_code != curve.max_code)
-        throw std::runtime_error("view " + v.name + ": its photos' bit depth differs from the response curve's");
-      const NoiseModel noise = estimate_noise(b, curve, default_saturation_code(b.max_code));
-      const MergedImage m = merge_brackets(b, curve, noise, MergeOptions{});
+      const ViewMerge vm = merge_photo_view(v, curve, std::nullopt, false);
+      const BracketSet& b = vm.brackets;
+      const NoiseModel& noise = vm.noise;
+      const MergedImage& m = vm.image;
       const fs::path exr = c.dir / "hdr" / (v.name + ".exr");
       write_merged_exr(exr.string(), m,
                        {{"version", RSIBR_VERSION}, {"view", v.name}, {"responseModel", curve.model},
