@@ -59,7 +59,7 @@ BallFeatures ball_features(const cv::Mat& image, const LensModel& lens, const Ba
   cv::Mat u8;
   lg.convertTo(u8, CV_8U, 255.0 / (hi - lo), -lo * 255.0 / (hi - lo));
   u8.setTo(0, mask == 0);
-  cv::Ptr<cv::SIFT> sift = cv::SIFT::create(options.max_features);
+  cv::Ptr<cv::SIFT> sift = cv::SIFT::create(options.max_features, 3, options.contrast_threshold);
   std::vector<cv::KeyPoint> kps;
   cv::Mat desc;
   sift->detectAndCompute(u8, mask, kps, desc);
@@ -74,6 +74,7 @@ BallFeatures ball_features(const cv::Mat& image, const LensModel& lens, const Ba
     out.directions.push_back(*r);
     out.sigma.push_back(std::max(options.sigma_px * per_px, 1e-6));
     out.pixels.push_back(q);
+    out.rays.push_back(lens.unproject(q).normalized());
     out.descriptors.push_back(desc.row(static_cast<int>(i)));
   }
   return out;
@@ -118,7 +119,8 @@ std::vector<DirectionObservation> match_ball_features(const std::vector<BallFeat
     for (const auto& [v, i] : members) {
       if (seen[v]) continue;
       seen[v] = 1;
-      obs.push_back({v, id, views[v].directions[i], views[v].sigma[i]});
+      obs.push_back({v, id, views[v].directions[i], views[v].sigma[i],
+                     i < static_cast<int>(views[v].rays.size()) ? views[v].rays[i] : Vec3::Zero()});
     }
     ++id;
   }

@@ -38,6 +38,13 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
       throw std::invalid_argument("orientation: invalid observation (view " + std::to_string(o.view) + ", feature " +
                                   std::to_string(o.feature) + ")");
   std::vector<std::map<int, Vec3>> seen(views);  // per view: feature -> direction
+  if (!options.balls.empty()) {
+    if (static_cast<int>(options.balls.size()) != views) throw std::invalid_argument("orientation: ball priors must be given for every view or none");
+    for (const BallPrior& b : options.balls)
+      if (!b.axis.allFinite() || std::abs(b.axis.norm() - 1) > 1e-6 || !(b.half_angle > 0 && b.half_angle < kPi / 2) ||
+          !(b.sigma_axis > 0) || !std::isfinite(b.sigma_axis))
+        throw std::invalid_argument("orientation: invalid ball prior");
+  }
   for (const auto& o : obs) seen[o.view][o.feature] = o.direction;
 
   // Start: place views one by one against the world directions known so far (view 0 is the gauge).
@@ -98,9 +105,26 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
   for (int f = 0; f < features; ++f)
     if (sum[f].squaredNorm() > 0) d[f] = sum[f].normalized();
   ceres::Problem problem;
+  const bool refine_balls = !options.balls.empty();
+  std::vector<Vec3> axes;
+  for (const BallPrior& b : options.balls) axes.push_back(b.axis);
   for (const auto& o : obs) {
+    if (refine_balls && o.ray.squaredNorm() > 0) {
+      auto* cost = new ceres::AutoDiffCostFunction<BallReflectionResidual, 3, 4, 3, 3>(
+          new BallReflectionResidual(o.ray.normalized(), std::sin(options.balls[o.view].half_angle), o.sigma));
+      problem.AddResidualBlock(cost, new ceres::CauchyLoss(options.loss_sigmas), q[o.view].coeffs().data(),
+                               axes[o.view].data(), d[o.feature].data());
+      continue;
+    }
     auto* cost = new ceres::AutoDiffCostFunction<DirectionResidual, 3, 4, 3>(new DirectionResidual(o.direction, o.sigma));
     problem.AddResidualBlock(cost, new ceres::CauchyLoss(options.loss_sigmas), q[o.view].coeffs().data(), d[o.feature].data());
+  }
+  for (int v = 0; v < views && refine_balls; ++v) {
+    if (!problem.HasParameterBlock(axes[v].data())) continue;
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BallAxisPrior, 3, 3>(
+                                 new BallAxisPrior(options.balls[v].axis, options.balls[v].sigma_axis)),
+                             nullptr, axes[v].data());
+    problem.SetManifold(axes[v].data(), new ceres::SphereManifold<3>);
   }
   for (int v = 0; v < views; ++v) problem.SetManifold(q[v].coeffs().data(), new ceres::EigenQuaternionManifold);
   for (int f = 0; f < features; ++f)
@@ -120,9 +144,14 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
   out.world_from_cam.resize(views);
   for (int v = 0; v < views; ++v) out.world_from_cam[v] = q[v].normalized().toRotationMatrix();
   out.feature_directions = d;
+  for (Vec3& a : axes) a.normalize();
+  out.ball_axes = axes;
   double sum2 = 0;
   for (const auto& o : obs) {
-    const double e2 = (out.world_from_cam[o.view] * o.direction - d[o.feature]).squaredNorm() / (o.sigma * o.sigma);
+    const Vec3 dir = refine_balls && o.ray.squaredNorm() > 0
+                         ? reflect_off_ball<double>(o.ray.normalized(), axes[o.view], std::sin(options.balls[o.view].half_angle)).normalized()
+                         : o.direction;
+    const double e2 = (out.world_from_cam[o.view] * dir - d[o.feature]).squaredNorm() / (o.sigma * o.sigma);
     ++out.observations;
     if (e2 < options.loss_sigmas * options.loss_sigmas) sum2 += e2, ++out.inliers;
   }

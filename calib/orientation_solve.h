@@ -18,6 +18,7 @@
 
 #include "core/vec.h"
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -28,6 +29,18 @@ struct DirectionObservation {
   int view = 0, feature = 0;
   Vec3 direction;     // unit, camera frame of `view`
   double sigma = 0;   // angular std dev, radians (> 0)
+  // The unit camera ray of the feature's pixel (lens.unproject), or zero. With a ball prior for the
+  // view (OrientationOptions::balls) the direction is recomputed from it and the view's ball axis in
+  // the solve (BallReflectionResidual), so the ball centre is refined by the features.
+  Vec3 ray = Vec3::Zero();
+};
+
+// A view's ball as located in its image (calib/ball_cone.h), with the std dev of its axis
+// (radians, per tangent axis): the prior of the joint refinement.
+struct BallPrior {
+  Vec3 axis = Vec3(0, 0, 1);
+  double half_angle = 0;
+  double sigma_axis = 0;  // > 0
 };
 
 struct OrientationOptions {
@@ -36,12 +49,17 @@ struct OrientationOptions {
   int ransac_iterations = 200;
   std::uint64_t seed = 1;
   Mat3 first_world_from_cam = Mat3::Identity();  // the gauge
+  // Per view, or empty: each view's ball axis a_v joins the problem (ceres::SphereManifold<3>) with
+  // the prior residual (a_v - axis) / sigma_axis, and observations with a ray use
+  // BallReflectionResidual. The half angle stays fixed (its error moves directions ~ 100x less).
+  std::vector<BallPrior> balls;
 };
 
 struct OrientationSolution {
   std::vector<Mat3> world_from_cam;     // per view
   std::vector<double> sigma_deg;        // per view: rotation std dev, all axes together (0 for the gauge view)
   std::vector<Vec3> feature_directions; // per feature, world, unit (zero for unobserved features)
+  std::vector<Vec3> ball_axes;          // per view, the refined ball axes (camera frame; with balls only)
   double rms_sigmas = 0;                // RMS whitened residual over inliers
   int inliers = 0, observations = 0;
 };
@@ -57,6 +75,50 @@ struct DirectionResidual {
     return true;
   }
   Vec3 o_;
+  double inv_sigma_;
+};
+
+// The reflected direction (camera frame, unit) of the camera ray `ray` (unit) off a ball of radius 1
+// centred at C = axis / sin(alpha) (axis unit): the ray meets the sphere first at P = t ray,
+// t = b - sqrt(b^2 - (|C|^2 - 1)), b = ray . C; n = P - C; r = ray - 2 (ray . n) n. A ray that misses
+// the ball (b^2 < |C|^2 - 1) is clamped to the tangent point (the discriminant to 0).
+template <class T>
+Eigen::Matrix<T, 3, 1> reflect_off_ball(const Eigen::Matrix<T, 3, 1>& ray, const Eigen::Matrix<T, 3, 1>& axis,
+                                        double sin_alpha) {
+  using std::sqrt;
+  const Eigen::Matrix<T, 3, 1> c = axis / (axis.norm() * T(sin_alpha));
+  const T b = ray.dot(c);
+  T disc = b * b - (c.squaredNorm() - T(1));
+  if (disc < T(1e-12)) disc = T(1e-12);
+  const Eigen::Matrix<T, 3, 1> n = (b - sqrt(disc)) * ray - c;
+  return ray - T(2) * ray.dot(n) * n;
+}
+
+// Cost of one observation with its view's ball refined: (R(q) reflect_off_ball(ray, a) - d) / sigma.
+struct BallReflectionResidual {
+  BallReflectionResidual(const Vec3& ray, double sin_alpha, double sigma)
+      : ray_(ray), sin_alpha_(sin_alpha), inv_sigma_(1.0 / sigma) {}
+  template <class T>
+  bool operator()(const T* q, const T* a, const T* d, T* r) const {  // q: x, y, z, w; a: 3; d: 3
+    const Eigen::Map<const Eigen::Quaternion<T>> rot(q);
+    const Eigen::Matrix<T, 3, 1> o = reflect_off_ball<T>(ray_.cast<T>(), Eigen::Matrix<T, 3, 1>(a[0], a[1], a[2]), sin_alpha_);
+    const Eigen::Matrix<T, 3, 1> ro = rot * o;
+    for (int k = 0; k < 3; ++k) r[k] = (ro[k] - d[k]) * T(inv_sigma_);
+    return true;
+  }
+  Vec3 ray_;
+  double sin_alpha_, inv_sigma_;
+};
+
+// The ball axis prior: (a - axis0) / sigma, 3 values (the chord, = the angle to second order).
+struct BallAxisPrior {
+  BallAxisPrior(const Vec3& axis, double sigma) : axis_(axis), inv_sigma_(1.0 / sigma) {}
+  template <class T>
+  bool operator()(const T* a, T* r) const {
+    for (int k = 0; k < 3; ++k) r[k] = (a[k] - T(axis_[k])) * T(inv_sigma_);
+    return true;
+  }
+  Vec3 axis_;
   double inv_sigma_;
 };
 

@@ -6,6 +6,7 @@
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfMatrixAttribute.h>
+#include <OpenEXR/ImfStringAttribute.h>
 
 #include <Eigen/Dense>
 
@@ -29,6 +30,7 @@ ViewImage read_view_image(const std::string& path) {
   }
   try {
     Imf::InputFile file(path.c_str());
+    if (const auto* a = file.header().findTypedAttribute<Imf::StringAttribute>("rsibr.view")) v.name = a->value();
     if (const auto* a = file.header().findTypedAttribute<Imf::M33fAttribute>("rsibr.worldFromCam")) {
       Mat3 m;
       for (int r = 0; r < 3; ++r)

@@ -1,7 +1,8 @@
 // A view's linear image as calibration reads it: a merged view of `rsibr hdr` (R, G, B, variance,
 // clipped/black/ghost flags; hdr/merged_exr.h) or any float RGB OpenEXR (e.g. the truth radiance
 // of `rsibr synth`), with the camera's orientation when the header carries one
-// (rsibr.worldFromCam, M33f, columns = camera x right, y down, z forward in world).
+// (rsibr.worldFromCam, M33f, columns = camera x right, y down, z forward in world) and the view's
+// name when the header carries one (rsibr.view, a string).
 #pragma once
 
 #include "core/vec.h"
@@ -18,6 +19,7 @@ struct ViewImage {
   cv::Mat flags;     // CV_8UC1 hdr/merge.h MergeFlag bits, or empty (not a merged view)
   std::optional<Mat3> world_from_cam;
   bool merged = false;
+  std::string name;  // the header's rsibr.view string attribute (rsibr hdr writes the view's name), or empty
 };
 
 // Throws std::runtime_error("<path>: <problem>").

@@ -4,11 +4,10 @@
 #include "cli/verbs.h"
 
 #include "calib/intrinsics.h"
+#include "pipeline/chessboard_problem.h"
 #include "capture/photo_set.h"
 #include "core/atomic_file.h"
 #include "core/progress.h"
-
-#include <opencv2/imgcodecs.hpp>
 
 #include <Eigen/Eigenvalues>
 
@@ -26,14 +25,6 @@ struct CalibrateArgs {
   std::vector<std::string> models = {"LENSMODEL_PINHOLE", "LENSMODEL_OPENCV4", "LENSMODEL_OPENCV8", "splined"};
   bool quiet = false;
 };
-
-cv::Mat read_grey8(const std::filesystem::path& file) {
-  cv::Mat img = cv::imread(file.string(), cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
-  if (img.empty()) throw std::runtime_error(file.string() + ": cannot read the image");
-  if (img.depth() == CV_16U) img.convertTo(img, CV_8U, 1.0 / 257);
-  if (img.depth() != CV_8U) throw std::runtime_error(file.string() + ": expected an 8- or 16-bit image");
-  return img;
-}
 
 // The splined candidate ("splined" among --model) needs boards over most of the image: a spline
 // control point that no corner constrains is set by mrcal's regularisation alone, and the
@@ -61,39 +52,14 @@ int run_calibrate(const CalibrateArgs& a) {
   const PhotoSet set = load_photo_set(a.photoset);
   check_output_path(a.out, {a.photoset});
   if (!a.json.empty() && a.json != "-") check_output_path(a.json, {a.photoset});
-  if (!set.chessboards) throw std::invalid_argument(a.photoset + ": no chessboards listed (photoset.yaml: chessboards)");
-  const ChessboardSet& cb = *set.chessboards;
-  if (cb.corners_x != cb.corners_y)
-    throw std::invalid_argument(a.photoset + ": chessboards.corners: mrgingham finds square grids only (got " +
-                                std::to_string(cb.corners_x) + " x " + std::to_string(cb.corners_y) + ")");
-
+  std::vector<std::string> missed_files;
   IntrinsicsProblem p;
-  p.corners_x = cb.corners_x;
-  p.corners_y = cb.corners_y;
-  p.spacing_m = cb.spacing_m;
-  nlohmann::json missed = nlohmann::json::array();
   {
     Progress progress("corners", !a.quiet && Progress::stderr_is_terminal());
-    for (std::size_t i = 0; i < cb.files.size(); ++i) {
-      const cv::Mat img = read_grey8(cb.files[i]);
-      if (p.width == 0) p.width = img.cols, p.height = img.rows;
-      if (img.cols != p.width || img.rows != p.height)
-        throw std::invalid_argument(cb.files[i].string() + ": " + std::to_string(img.cols) + "x" +
-                                    std::to_string(img.rows) + ", the other chessboards are " +
-                                    std::to_string(p.width) + "x" + std::to_string(p.height));
-      const auto corners = find_chessboard(img, cb.corners_x);
-      if (corners) {
-        p.boards.push_back({cb.files[i].filename().string(), *corners});
-      } else {
-        missed.push_back(cb.files[i].filename().string());
-      }
-      progress.update(double(i + 1) / cb.files.size());
-    }
+    p = chessboard_problem(set, a.photoset, &missed_files, [&](double f) { progress.update(f); });
     progress.done();
   }
-  if (p.boards.size() < 4)
-    throw std::invalid_argument(a.photoset + ": chessboards found in " + std::to_string(p.boards.size()) + " of " +
-                                std::to_string(cb.files.size()) + " images; need at least 4 (2 per cross-validation half)");
+  const nlohmann::json missed = missed_files;
 
   // "splined" -> a spline over the seed's field of view, or skipped (with the reason) when the boards
   // do not cover enough of the image.

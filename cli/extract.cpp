@@ -5,6 +5,7 @@
 #include "cli/verbs.h"
 
 #include "calib/ball_locator.h"
+#include "calib/pose_file.h"
 #include "calib/sphere_map_extraction.h"
 #include "calib/view_image.h"
 #include "core/atomic_file.h"
@@ -21,7 +22,7 @@ namespace rsibr::cli {
 namespace {
 
 struct ExtractArgs {
-  std::string image, lens, out, ball, kind = "chrome", indexing = "reflection", json;
+  std::string image, lens, out, ball, kind = "chrome", indexing = "reflection", json, poses;
   int which = 0, size = 128;
   double camera_mask_deg = -1, stand_mask_deg = 8;
   bool quiet = false, no_stand = false;
@@ -41,8 +42,8 @@ BallGuess parse_ball(const std::string& text) {
 }
 
 int run_extract(const ExtractArgs& a) {
-  check_output_path(a.out, {a.image, a.lens});
-  if (!a.json.empty() && a.json != "-") check_output_path(a.json, {a.image, a.lens});
+  check_output_path(a.out, {a.image, a.lens, a.poses});
+  if (!a.json.empty() && a.json != "-") check_output_path(a.json, {a.image, a.lens, a.poses});
   if (a.kind != "chrome" && a.kind != "grey")
     throw std::invalid_argument("--kind '" + a.kind + "': expected chrome or grey");
   if (a.indexing != "reflection" && a.indexing != "orthographic")
@@ -50,8 +51,18 @@ int run_extract(const ExtractArgs& a) {
   std::optional<BallGuess> given;
   if (!a.ball.empty()) given = parse_ball(a.ball);
 
+  std::optional<PoseSet> poses;
+  if (!a.poses.empty()) poses = read_pose_file(a.poses);
   const LensModel lens = LensModel::read(a.lens);
-  const ViewImage view = read_view_image(a.image);
+  ViewImage view = read_view_image(a.image);
+  // --poses: the world frame of the pose file's entry named like the image (header rsibr.view, else the stem).
+  std::string pose_name;
+  if (poses) {
+    pose_name = view.name.empty() ? std::filesystem::path(a.image).stem().string() : view.name;
+    const ViewPose* p = poses->find(pose_name);
+    if (!p) throw std::invalid_argument(a.poses + ": no view named '" + pose_name + "' (the view of " + a.image + ")");
+    view.world_from_cam = p->world_from_cam;
+  }
   if (view.radiance.cols != lens.width() || view.radiance.rows != lens.height())
     throw std::invalid_argument(a.image + ": " + std::to_string(view.radiance.cols) + "x" +
                                 std::to_string(view.radiance.rows) + " but the lens model " + a.lens + " is " +
@@ -98,7 +109,9 @@ int run_extract(const ExtractArgs& a) {
   mv.attributes["ballCentrePx"] = centre.str();
   mv.attributes["ballHalfAngleRad"] = std::to_string(loc.fit.cone.half_angle);
   mv.attributes["ballKind"] = a.kind;
-  mv.attributes["frame"] = view.world_from_cam ? "world (image header pose)" : "camera (no pose)";
+  mv.attributes["frame"] = poses                 ? "world (pose file " + std::filesystem::path(a.poses).filename().string() + ", view " + pose_name + ")"
+                          : view.world_from_cam ? "world (image header pose)"
+                                                : "camera (no pose)";
   MapSet set;
   set.views.push_back(std::move(mv));
   write_map_set(a.out, set);
@@ -120,7 +133,8 @@ int run_extract(const ExtractArgs& a) {
                {"outline_points", loc.outline_px.size()},
                {"inliers", loc.fit.inliers},
                {"rms_px", loc.fit.rms_px}};
-  j["pose_from_header"] = view.world_from_cam.has_value();
+  j["pose_from_header"] = view.world_from_cam.has_value() && !poses;
+  j["pose_from_file"] = poses ? nlohmann::json(pose_name) : nlohmann::json(nullptr);
   j["mean_confidence_in_disc"] = cv::mean(conf, conf > 0)[0];
   j["confident_fraction"] = cv::countNonZero(conf > 0.5) / (kPi / 4 * a.size * a.size);
   write_summary(a.json, j);
@@ -141,7 +155,8 @@ Runner add_extract(CLI::App& app) {
       "camera): each texel from the surface point that reflects its mirror direction (--indexing reflection, exact "
       "for chrome) or whose normal is the texel's (orthographic, exact for grey). The confidence channel is 0 outside "
       "the ball, on clipped pixels, at the camera's reflection and the stand, and fades at the stretched rim. "
-      "The map's world frame is the image header's rsibr.worldFromCam when present, else the camera's.\n"
+      "The map's world frame is the pose file's (--poses, from rsibr orient; the entry named like the image: its "
+      "header's rsibr.view, else the file stem), else the image header's rsibr.worldFromCam, else the camera's.\n"
       "Example: rsibr extract hdr/north.exr --lens camera.cameramodel --out north-chrome.exr --json -");
   c->add_option("image", a->image, "Merged view EXR (rsibr hdr) or float RGB EXR")->required();
   c->add_option("--lens", a->lens, "mrcal .cameramodel of the camera")->required();
@@ -155,6 +170,7 @@ Runner add_extract(CLI::App& app) {
       ->check(CLI::Range(0.0, 90.0));
   c->add_option("--stand-mask-deg", a->stand_mask_deg, "Mask directions within this of straight down")->check(CLI::Range(0.0, 90.0));
   c->add_flag("--no-stand", a->no_stand, "No stand mask");
+  c->add_option("--poses", a->poses, "Pose file (rsibr orient): the world frame of the entry named like the image");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   c->add_flag("-q,--quiet", a->quiet, "No report line");
   return [a] { return run_extract(*a); };

@@ -14,6 +14,7 @@
 #include "hdr/merge.h"
 #include "hdr/merged_exr.h"
 #include "hdr/noise_model.h"
+#include "hdr/photo_set_merge.h"
 #include "hdr/response_recovery.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -167,21 +168,9 @@ int run_hdr(const HdrArgs& a) {
       curve = *given_curve;
       response_json = {{"model", curve.model}, {"source", a.response}};
     } else {
-      const PhotoView* richest = views.front();
-      for (const PhotoView* v : views)
-        if (v->brackets.size() > richest->brackets.size()) richest = v;
-      BracketSet b = load_brackets(*richest);
-      if (a.align) align_brackets(b);
-      ResponseRecovery rec;
-      if (a.model == "identity") {  // linear input: nothing to fit (and no samples needed)
-        rec.curve = ResponseCurve::identity(b.max_code);
-      } else {
-        try {
-          rec = recover_response(b, ro);
-        } catch (const std::runtime_error& e) {
-          throw std::runtime_error("view " + richest->name + ": " + e.what());
-        }
-      }
+      const PhotoSetResponse psr = recover_photo_set_response(views, ro, a.align);
+      const ResponseRecovery& rec = psr.recovery;
+      const PhotoView* richest = psr.from;
       curve = rec.curve;
       nlohmann::json cands = nlohmann::json::array();
       for (const auto& c : rec.candidates)
@@ -218,21 +207,17 @@ int run_hdr(const HdrArgs& a) {
     nlohmann::json view_list = nlohmann::json::array();
     for (std::size_t vi = 0; vi < views.size(); ++vi) {
       const PhotoView& v = *views[vi];
-      const auto t0 = std::chrono::steady_clock::now();
-      BracketSet b = load_brackets(v);
-      if (b.max_code != curve.max_code)
-        throw std::runtime_error("view " + v.name + ": " + std::to_string(b.max_code == 255 ? 8 : 16) +
-                                 "-bit photos, but the response curve is for " +
-                                 std::to_string(curve.max_code == 255 ? 8 : 16) + "-bit input");
-      std::vector<cv::Point> shifts(b.size(), cv::Point(0, 0));
-      if (a.align) shifts = align_brackets(b);
-      const int sat = default_saturation_code(b.max_code);
-      const NoiseModel noise = given_noise ? *given_noise : estimate_noise(b, curve, sat);
-      const auto t1 = std::chrono::steady_clock::now();
       MergeOptions mo;
       mo.ghost_sigmas = a.ghost_sigmas;
       mo.deghost = a.deghost;
-      MergedImage m = merge_brackets(b, curve, noise, mo);
+      const auto t0 = std::chrono::steady_clock::now();
+      ViewMerge vm = merge_photo_view(v, curve, given_noise, a.align, mo);
+      const auto t1 = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                               std::chrono::duration<double>(vm.seconds_load));
+      const BracketSet& b = vm.brackets;
+      const std::vector<cv::Point>& shifts = vm.shifts;
+      const NoiseModel& noise = vm.noise;
+      MergedImage& m = vm.image;
       if (to_working) {
         convert_colour_space(m.radiance, a.input_colour_space, working);
         // Variances through the squared matrix (channel covariances are not kept).

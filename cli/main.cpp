@@ -31,6 +31,8 @@ int main(int argc, char** argv) {
   runners["extract"] = rsibr::cli::add_extract(app);
   runners["calibrate"] = rsibr::cli::add_calibrate(app);
   runners["probe"] = rsibr::cli::add_probe(app);
+  runners["orient"] = rsibr::cli::add_orient(app);
+  runners["process"] = rsibr::cli::add_process(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -23,5 +23,7 @@ Runner add_synth(CLI::App& app);
 Runner add_extract(CLI::App& app);
 Runner add_calibrate(CLI::App& app);
 Runner add_probe(CLI::App& app);
+Runner add_orient(CLI::App& app);
+Runner add_process(CLI::App& app);
 
 }  // namespace rsibr::cli

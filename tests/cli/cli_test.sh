@@ -25,7 +25,7 @@ expect_error() {
 }
 no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
 
-for verb in convert info pattern blend bake reference render view hdr compare synth extract calibrate probe; do
+for verb in convert info pattern blend bake reference render view hdr compare synth extract calibrate probe orient process; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
 done
 check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
@@ -408,6 +408,78 @@ expect_error "probe: a view without a pose" "camera's frame" probe "$work/pc0.ex
 expect_error "probe: computed maps" "not a captured map" probe "$work/syn1/truth/maps/chrome.exr" --out "$work/probe-e2.exr"
 expect_error "probe: bad Fresnel" "--fresnel" probe "$work/pv0.exr" --out "$work/probe-e3.exr" --fresnel '{type: glass}'
 check "probe: no output after errors" bash -c "! ls -A '$work' | grep -q '^probe-e'"
+
+# --- orient (calib/view_orientation.h): three views 20 degrees apart of a chrome ball in a real
+# environment (cache/, skipped without it); the relative rotation, determinism, extract --poses, errors.
+lobby="$(cd "$(dirname "$0")/../.." && pwd)/cache/assets/hdri/lobby.exr"
+if [ -f "$lobby" ]; then
+  cat >"$work/orient.yaml" <<EOF
+rsibr_synth: 1
+seed: 2
+environment: {file: $lobby, sanitize: true}
+balls: [{name: chrome, kind: chrome, diameter_m: 0.1, centre: [0, 1.3, 0]}]
+stand: false
+photographer: false
+camera: {width: 240, height: 220, lens: {model: LENSMODEL_PINHOLE, focal_px: 1000}, response: srgb, format: png, supersampling: 2}
+exposure: {middle_s: 0.004, count: 1, step_ev: 2, iso: 100, aperture: 8}
+views: [{plan: ring, azimuths_deg: [0, 20, 40], elevation_deg: 10, distance_m: 0.5, roll_deg: 5}]
+truth_map_size: 16
+EOF
+  "$rsibr" synth "$work/orient.yaml" --out "$work/or" -q
+  ov="$work/or/truth/views"
+  olens="$work/or/truth/camera.cameramodel"
+  "$rsibr" orient "$ov/view00_radiance.exr" "$ov/view01_radiance.exr" "$ov/view02_radiance.exr" --lens "$olens" \
+    --out "$work/poses1.yaml" --json "$work/orient.json" --up 0,-1,0 -q
+  "$rsibr" orient "$ov/view00_radiance.exr" "$ov/view01_radiance.exr" "$ov/view02_radiance.exr" --lens "$olens" \
+    --out "$work/poses2.yaml" --up 0,-1,0 -q
+  check "orient: views named by their headers, 20 degrees apart (+-3), sigmas reported" python3 -c "
+import json, math; j = json.load(open('$work/orient.json')); v = j['views']
+assert [x['name'] for x in v] == ['view00', 'view01', 'view02'] and j['gauge'] == 'up', j
+R = [[x['world_from_cam'][3 * r:3 * r + 3] for r in range(3)] for x in v]
+def rel(a, b): return math.degrees(math.acos(max(-1, min(1, (sum(a[k][i] * b[k][i] for k in range(3) for i in range(3)) - 1) / 2))))
+assert abs(rel(R[0], R[1]) - 20) < 3 and abs(rel(R[1], R[2]) - 20) < 3 and abs(rel(R[0], R[2]) - 40) < 3, j
+assert v[0]['sigma_deg'] == 0 and all(0 < x['sigma_deg'] < 2 for x in v[1:]) and j['tracks'] >= 3, j"
+  check "orient: same input, same bytes" cmp -s "$work/poses1.yaml" "$work/poses2.yaml"
+  check "orient: --up levels the first view (its y axis is world down)" grep -q "world_from_cam: \[-1, 0, 0, 0, -1, 0, 0, 0, 1\]" "$work/poses1.yaml"
+  "$rsibr" extract "$ov/view01_radiance.exr" --lens "$olens" --poses "$work/poses1.yaml" --out "$work/ext-poses.exr" --size 32 --json "$work/ext-poses.json" -q
+  check "extract --poses takes the entry named like the image" python3 -c "
+import json; j = json.load(open('$work/ext-poses.json')); assert j['pose_from_file'] == 'view01' and not j['pose_from_header'], j"
+  expect_error "orient: one view" "need at least 2" orient "$ov/view00_radiance.exr" --lens "$olens" --out "$work/or-e1.yaml"
+  expect_error "orient: bad --up" "--up" orient "$ov/view00_radiance.exr" "$ov/view01_radiance.exr" --lens "$olens" --out "$work/or-e2.yaml" --up 0,0
+  expect_error "orient: two images of one view" "view name 'view00' is already taken" orient "$ov/view00_radiance.exr" "$ov/view00_scene.exr" --lens "$olens" --out "$work/or-e3.yaml"
+  expect_error "orient: missing image" "nothere.exr" orient "$ov/view00_radiance.exr" "$work/nothere.exr" --lens "$olens" --out "$work/or-e4.yaml"
+  expect_error "orient: output folder missing" "nofolder" orient "$ov/view00_radiance.exr" "$ov/view01_radiance.exr" --lens "$olens" --out "$work/nofolder/p.yaml"
+  sed 's/"view01"/"north"/' "$work/poses1.yaml" >"$work/renamed.yaml"
+  expect_error "extract --poses: no entry for the image" "no view named 'view01'" extract "$ov/view01_radiance.exr" --lens "$olens" --poses "$work/renamed.yaml" --out "$work/or-e5.exr"
+  sed 's/sigma_deg: 0$/sigma_deg: -1/' "$work/poses1.yaml" >"$work/badposes.yaml"
+  expect_error "extract --poses: strict pose file" "badposes.yaml: poses.views\[0\].sigma_deg" extract "$ov/view00_radiance.exr" --lens "$olens" --poses "$work/badposes.yaml" --out "$work/or-e6.exr"
+  check "orient: no output after errors" bash -c "! ls -A '$work' | grep -q '^or-e'"
+  check "orient: no temporaries" no_temporaries "$work"
+fi
+
+# --- process (pipeline/): the minimal-grey rig end to end (poses from the truth), the report's
+# path on stdout, a second run skips every step, one-line errors before any work, no partial output.
+pspec="$(dirname "$0")/../../datasets-synthetic/minimal-grey.yaml"
+"$rsibr" synth "$pspec" --out "$work/psyn" -q
+fres='{type: conductor, eta: [2.9, 2.9, 2.6], k: [3.4, 3.4, 3.2]}'
+"$rsibr" process "$work/psyn/photos" --out "$work/pout" --poses "$work/psyn/truth/truth.yaml" --chrome-fresnel "$fres" \
+  --map-size 32 --turntable 2 --size 64x48 --json "$work/p1.json" -q >"$work/p1.out" 2>/dev/null
+check "process prints the report's path" bash -c "[ \"\$(cat '$work/p1.out')\" = '$work/pout/report.html' ] && test -s '$work/pout/report.html'"
+check "process: every step ran, captured grey within 10% of computed" python3 -c "
+import json; j = json.load(open('$work/p1.json')); assert all(s['ran'] for s in j['steps']), j['steps']
+b = j['results']['compare']['balls'][0]; assert b['ball'] == 'grey' and b['overall']['after']['relative_rms'] < 0.1, b['overall']"
+"$rsibr" process "$work/psyn/photos" --out "$work/pout" --poses "$work/psyn/truth/truth.yaml" --chrome-fresnel "$fres" \
+  --map-size 32 --turntable 2 --size 64x48 --json "$work/p2.json" -q >/dev/null
+check "process: a second run skips every step" python3 -c "
+import json; j = json.load(open('$work/p2.json')); assert not any(s['ran'] for s in j['steps']), j['steps']"
+expect_error "process: missing photo set" "nothere" process "$work/nothere" --out "$work/pe1" -q
+expect_error "process: unknown --force step" "--force 'merge'" process "$work/psyn/photos" --out "$work/pe2" --force merge -q
+expect_error "process: missing poses file" "noposes.yaml" process "$work/psyn/photos" --out "$work/pe3" --poses "$work/noposes.yaml" -q
+expect_error "process: output parent missing" "nofolder" process "$work/psyn/photos" --out "$work/nofolder/pe4" --poses "$work/psyn/truth/truth.yaml" -q
+expect_error "process: bad --size" "--size" process "$work/psyn/photos" --out "$work/pe5" --size 10 -q
+expect_error "process: missing --probe environment" "noenv.exr" process "$work/psyn/photos" --out "$work/pe6" --probe "$work/noenv.exr" -q
+check "process: no output after errors" bash -c "! ls -A '$work' | grep -q '^pe[0-9]'"
+check "process: no temporaries" no_temporaries "$work/pout"
 
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

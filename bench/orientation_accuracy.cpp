@@ -1,0 +1,82 @@
+// Orientation accuracy of calib/view_orientation.h on rendered views: a chrome ball of a given
+// radius in pixels in a real environment (cache/), views 20 degrees apart around it, Gaussian noise
+// of a given relative std dev; the ball found and every view oriented from the images alone (gauge:
+// the true up of the first view), compared with the renderer's poses. One JSON line per run;
+// bench/orientation_accuracy.py runs a grid and writes the docs/tradeoffs.md section.
+#include "calib/view_orientation.h"
+
+#include "calib_cases.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <iostream>
+
+int main(int argc, char** argv) {
+  using namespace rsibr;
+  CLI::App app("Orientation accuracy on rendered views");
+  double radius_px = 120, noise = 0.01, ball_prior_px = 0.25, max_radius_fraction = 0.85, contrast = 0.04;
+  int views = 4, max_features = 800;
+  std::uint64_t seed = 5;
+  bool refine = true;
+  std::string env = std::string(RSIBR_CACHE_DIR) + "/assets/hdri/lobby.exr";
+  app.add_option("--radius-px", radius_px, "Ball radius in pixels");
+  app.add_option("--noise", noise, "Relative noise std dev");
+  app.add_option("--views", views, "Views, 20 degrees apart");
+  app.add_option("--env", env, "Environment EXR");
+  app.add_option("--seed", seed, "Noise seed");
+  app.add_option("--refine", refine, "Refine ball centres jointly (1) or not (0)");
+  app.add_option("--ball-prior-px", ball_prior_px, "Ball centre prior floor, pixels");
+  app.add_option("--max-features", max_features, "SIFT features per view");
+  app.add_option("--max-radius-fraction", max_radius_fraction, "Features within this fraction of the ball's angular radius");
+  app.add_option("--contrast-threshold", contrast, "SIFT contrast threshold");
+  CLI11_PARSE(app, argc, argv);
+  const double distance = 0.5, f = radius_px * distance / 0.05;
+  const int w = int(radius_px * 2.5), h = int(radius_px * 2.3);
+  SynthScene scene = testing::rig_scene(LensModel::pinhole(f, w, h), distance, false);
+  scene.balls.resize(1);
+  scene.environment.file = env;
+  scene.environment.sanitize = true;
+  scene.views.front().azimuths_deg.clear();
+  for (int v = 0; v < views; ++v) scene.views.front().azimuths_deg.push_back(20.0 * v);
+  scene.views.front().roll_deg = 7;
+  scene.views.front().look_at = scene.balls.front().centre;
+  std::vector<ViewImage> images;
+  std::vector<Mat3> truth;
+  std::vector<Vec2> centre;
+  std::vector<std::string> names;
+  for (int v = 0; v < views; ++v) {
+    const auto r = testing::render_view(scene, v, noise, seed + v);
+    ViewImage vi;
+    vi.radiance = r.radiance;
+    images.push_back(vi);
+    truth.push_back(r.pose.world_from_cam);
+    centre.push_back(testing::ball_centre_px(r, 0));
+    names.push_back("v" + std::to_string(v));
+  }
+  ViewOrientationOptions o;
+  o.up = truth[0].transpose() * Vec3(0, 1, 0);
+  o.refine_balls = refine;
+  o.ball_prior_px = ball_prior_px;
+  o.features.max_features = max_features;
+  o.features.max_radius_fraction = max_radius_fraction;
+  o.features.contrast_threshold = contrast;
+  ViewOrientationReport rep;
+  const auto t0 = std::chrono::steady_clock::now();
+  const PoseSet p = orient_views(names, images, scene.camera.lens, o, &rep);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const Mat3 g = p.views[0].world_from_cam * truth[0].transpose();
+  nlohmann::json j = {{"radius_px", radius_px}, {"noise", noise}, {"views", views}, {"seed", seed}, {"refine", refine},
+                      {"tracks", rep.tracks}, {"rms_sigmas", rep.rms_sigmas}, {"seconds", seconds}};
+  for (int v = 1; v < views; ++v) {
+    j["error_deg"].push_back(Eigen::AngleAxisd(p.views[v].world_from_cam.transpose() * g * truth[v]).angle() * 180 / kPi);
+    j["sigma_deg"].push_back(p.views[v].sigma_deg);
+  }
+  for (int v = 0; v < views; ++v) {
+    j["centre_error_px"].push_back((rep.balls[v].centre_px - centre[v]).norm());
+    j["features"].push_back(rep.features[v]);
+  }
+  std::cout << j.dump() << "\n";
+  return 0;
+}

@@ -1,0 +1,77 @@
+#!/usr/bin/env python3
+"""Orientation accuracy of `rsibr orient`'s pipeline (calib/view_orientation.h) against the ball's
+radius in pixels and the image noise, with and without the joint ball-centre refinement.
+
+Runs build/release/rsibr_orientation_accuracy (bench/orientation_accuracy.cpp: four rendered views 20
+degrees apart of a chrome ball in the CC0 `lobby` environment, the ball found and the views oriented
+from the images alone) over a grid and seeds, and writes the section "Orientation (rsibr orient)" of
+docs/tradeoffs.md.
+
+  python3 bench/orientation_accuracy.py [--build build/release] [--seeds 2]
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "bench"))
+from convert_roundtrip import replace_section  # noqa: E402
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default=os.path.join(ROOT, "build/release"))
+    ap.add_argument("--seeds", type=int, default=2)
+    ap.add_argument("--out", default=os.path.join(ROOT, "docs/tradeoffs.md"))
+    args = ap.parse_args()
+    exe = os.path.join(args.build, "rsibr_orientation_accuracy")
+    if not os.path.exists(exe):
+        sys.exit("orientation_accuracy: %s not built (cmake --build %s --target rsibr_orientation_accuracy)" % (exe, args.build))
+    rows = []
+    for radius in (120, 200):
+        for noise in (0.003, 0.01, 0.03):
+            for refine in (0, 1):
+                errs, chi2, cerr, tracks, secs = [], [], [], [], []
+                for seed in range(args.seeds):
+                    out = subprocess.run([exe, "--radius-px", str(radius), "--noise", str(noise), "--refine", str(refine),
+                                          "--seed", str(5 + 10 * seed)], capture_output=True, text=True)
+                    if out.returncode != 0:
+                        sys.exit("orientation_accuracy: run failed: %s" % out.stderr[-500:])
+                    j = json.loads(out.stdout)
+                    errs += j["error_deg"]
+                    chi2 += [(e / s) ** 2 for e, s in zip(j["error_deg"], j["sigma_deg"])]
+                    cerr += j["centre_error_px"]
+                    tracks.append(j["tracks"])
+                    secs.append(j["seconds"])
+                rows.append("| %d | %.3f | %s | %.0f | %.2f | %.3f | %.3f | %.1f | %.1f |" % (
+                    radius, noise, "refined" if refine else "fixed", statistics.mean(tracks), statistics.median(cerr),
+                    statistics.median(errs), max(errs), statistics.mean(chi2), statistics.mean(secs)))
+                print(rows[-1], flush=True)
+    load = os.getloadavg()[0]
+    body = (
+        "Four views 20 degrees apart of a chrome ball (no stand) in the CC0 `lobby` environment, rendered by capture/\n"
+        "with Gaussian noise of relative std dev `noise` (plus a 0.02 floor), the ball found and every view oriented\n"
+        "from the images alone (calib/view_orientation.h; gauge: the first view's true up). Ball centres `fixed` at\n"
+        "their outline fit or `refined` jointly with the orientations (a prior of max(outline RMS, 0.25 px)).\n"
+        "Errors over %d seeds x 3 oriented views; chi2 = mean (error / reported sigma)^2 (1 when the sigmas are\n"
+        "honest). Regenerate: `python3 bench/orientation_accuracy.py` (load average %.1f when this was written).\n\n"
+        "| ball radius px | noise | ball centres | tracks | median centre error px | median error deg | max error deg | chi2 | seconds |\n"
+        "|---|---|---|---|---|---|---|---|---|\n" % (args.seeds, load)
+        + "\n".join(rows) + "\n\n"
+        "The ball centre located from its outline is off by about a pixel on a textured background (a mirror ball's\n"
+        "limb reflects what lies just behind it, so the outline has little contrast), and a pixel of centre error\n"
+        "moves the reflected directions by about 2 / radius_px radians (~1 degree at 120 px): that, not the SIFT\n"
+        "keypoints (0.05-0.15 degrees with the true centre), limits the orientation today. Refining the centres\n"
+        "jointly brings the reported sigmas near the errors (chi2 ~1-6 instead of 8-107) but cannot remove the\n"
+        "error with 50-100 feature tracks,\n"
+        "most near the ball's centre where a centre shift and a rotation look alike; on synthetic rigs with 600\n"
+        "features over the whole ball it cuts a 0.5 px centre error's 0.92 degrees to 0.10 (tests/calib/\n"
+        "ball_refinement_test.cpp).\n")
+    replace_section(args.out, "Orientation (rsibr orient)", body)
+
+
+if __name__ == "__main__":
+    main()

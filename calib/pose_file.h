@@ -1,0 +1,44 @@
+// The views' orientations as a file (poses.yaml), written by `rsibr orient` and read by
+// `rsibr extract --poses` and `rsibr process`:
+//
+//   rsibr_poses: 1
+//   gauge: first-view            # or "up": how the world frame was fixed (calib/view_orientation.h)
+//   views:
+//     - {name: north, world_from_cam: [9 numbers, row-major], sigma_deg: 0.03}
+//
+// world_from_cam: columns = the camera's x (right), y (down), z (forward) axes in the world frame;
+// a proper rotation (checked to 1e-6, then re-orthonormalised). sigma_deg: the orientation's std
+// dev in degrees, all axes together (0 for the gauge view when the gauge is "first-view").
+#pragma once
+
+#include "core/vec.h"
+
+#include <string>
+#include <vector>
+
+namespace rsibr {
+
+struct ViewPose {
+  std::string name;
+  Mat3 world_from_cam = Mat3::Identity();
+  double sigma_deg = 0;
+};
+
+struct PoseSet {
+  std::string gauge = "first-view";  // "first-view" or "up"
+  std::vector<ViewPose> views;
+
+  // The view named `name`, or nullptr.
+  const ViewPose* find(const std::string& name) const;
+};
+
+// Strict (core/yaml_spec.h): unknown keys, missing keys, duplicate names, a matrix that is not a
+// rotation, a negative or non-finite sigma are errors. Throws std::invalid_argument("<path>: <problem>").
+PoseSet read_pose_file(const std::string& path);
+
+// Atomic (core/atomic_file.h); rotations with 17 significant digits (a round trip is exact to
+// rounding), sigma_deg with 6.
+// Throws std::invalid_argument for an invalid set (the same checks as reading).
+void write_pose_file(const std::string& path, const PoseSet& poses);
+
+}  // namespace rsibr

@@ -1,0 +1,60 @@
+// Every view's orientation from its image of the chrome ball: the ball found in each view (Hough
+// candidates -> calib/ball_locator.h; the chrome ball is the candidate with the most texture), SIFT
+// features in it turned into reflected directions (calib/ball_features.h), matched across views and
+// solved in one Ceres problem (calib/orientation_solve.h). The result is a pose file's content
+// (calib/pose_file.h).
+//
+// Gauge (the world frame, which the images cannot fix):
+//   first-view  world = the first view's camera frame (world_from_cam of view 0 = identity).
+//   up          options.up is the world's up (+Y) expressed in the first camera's frame (unit after
+//               normalising; e.g. (0, -1, 0) for a camera levelled on a tripod, whose y axis points
+//               down); the world's +Z is the first camera's forward axis made horizontal (or its
+//               -y axis when it looks straight up or down), X = Y x Z.
+#pragma once
+
+#include "calib/ball_features.h"
+#include "calib/ball_locator.h"
+#include "calib/orientation_solve.h"
+#include "calib/pose_file.h"
+#include "calib/view_image.h"
+#include "core/lens_model.h"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rsibr {
+
+struct ViewOrientationOptions {
+  std::optional<Vec3> up;              // camera frame of the first view; none: the first-view gauge
+  std::vector<BallGuess> balls;        // per view, or empty: detected
+  double min_radius_px = 0;            // detection range; 0: min(width, height) / 40
+  double max_radius_px = 0;            // 0: min(width, height) / 2
+  BallFeatureOptions features;
+  // Ball centres refined jointly with the orientations (OrientationOptions::balls), with a prior
+  // std dev of the ball centre of max(outline RMS, ball_prior_px) pixels.
+  bool refine_balls = true;
+  double ball_prior_px = 0.25;
+  OrientationOptions solve;            // its first_world_from_cam is set from the gauge
+};
+
+// What orient_views saw, for reports (--json).
+struct ViewOrientationReport {
+  std::vector<BallLocation> balls;      // per view (centre_px and the cone's axis refined when refine_balls)
+  std::vector<int> features;            // per view: features in the ball
+  int tracks = 0, observations = 0, inliers = 0;
+  double rms_sigmas = 0;
+};
+
+// The world_from_cam of the first view for the gauge (identity without `up`). Throws
+// std::invalid_argument for a zero or non-finite up.
+Mat3 gauge_world_from_first_cam(const std::optional<Vec3>& up);
+
+// `names` and `views` parallel, >= 2 views, all of the lens's size. Throws std::invalid_argument
+// with a message naming the view ("<name>: no ball found", "orient: view '<name>' shares 0
+// feature(s) with the other views; ...", "orient: 1 view(s), need at least 2") or
+// std::runtime_error when the solve fails.
+PoseSet orient_views(const std::vector<std::string>& names, const std::vector<ViewImage>& views, const LensModel& lens,
+                     const ViewOrientationOptions& options = {}, ViewOrientationReport* report = nullptr);
+
+}  // namespace rsibr

@@ -1,0 +1,129 @@
+// rsibr orient: merged views (rsibr hdr) + the lens model -> every view's orientation from the
+// features in its chrome ball (calib/view_orientation.h), written as a pose file (calib/pose_file.h).
+#include "cli/summary.h"
+#include "cli/verbs.h"
+
+#include "calib/pose_file.h"
+#include "calib/view_orientation.h"
+#include "core/atomic_file.h"
+#include "core/lens_model.h"
+#include "core/progress.h"
+
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <set>
+#include <sstream>
+
+namespace rsibr::cli {
+namespace {
+
+struct OrientArgs {
+  std::vector<std::string> images;
+  std::string lens, out, up, json;
+  bool quiet = false;
+};
+
+Vec3 parse_up(const std::string& text) {
+  std::istringstream in(text);
+  double x = 0, y = 0, z = 0;
+  char c1 = 0, c2 = 0;
+  if (!(in >> x >> c1 >> y >> c2 >> z) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof() || !std::isfinite(x) ||
+      !std::isfinite(y) || !std::isfinite(z) || Vec3(x, y, z).norm() < 1e-12)
+    throw std::invalid_argument("--up '" + text + "': expected X,Y,Z, a non-zero direction in the first camera's frame");
+  return Vec3(x, y, z);
+}
+
+int run_orient(const OrientArgs& a) {
+  std::vector<std::filesystem::path> inputs(a.images.begin(), a.images.end());
+  inputs.push_back(a.lens);
+  check_output_path(a.out, inputs);
+  if (!a.json.empty() && a.json != "-") check_output_path(a.json, inputs);
+  ViewOrientationOptions o;
+  if (!a.up.empty()) o.up = parse_up(a.up);
+  if (a.images.size() < 2)
+    throw std::invalid_argument("orient: " + std::to_string(a.images.size()) + " image(s), need at least 2 views");
+  const LensModel lens = LensModel::read(a.lens);
+  std::vector<std::string> names;
+  std::vector<ViewImage> views;
+  std::set<std::string> seen;
+  {
+    Progress bar("orient", !a.quiet && Progress::stderr_is_terminal());
+    for (std::size_t i = 0; i < a.images.size(); ++i) {
+      views.push_back(read_view_image(a.images[i]));
+      const std::string name =
+          views.back().name.empty() ? std::filesystem::path(a.images[i]).stem().string() : views.back().name;
+      if (!seen.insert(name).second)
+        throw std::invalid_argument(a.images[i] + ": view name '" + name + "' is already taken by another image");
+      names.push_back(name);
+      bar.update(double(i + 1) / a.images.size());
+    }
+  }
+  ViewOrientationReport rep;
+  PoseSet poses;
+  try {
+    poses = orient_views(names, views, lens, o, &rep);
+  } catch (const std::invalid_argument& e) {
+    // "<name>: ..." -> the image's path, so the line names the file.
+    const std::string what = e.what();
+    for (std::size_t i = 0; i < names.size(); ++i)
+      if (what.rfind(names[i] + ": ", 0) == 0) throw std::invalid_argument(a.images[i] + what.substr(names[i].size()));
+    throw;
+  }
+  write_pose_file(a.out, poses);
+
+  nlohmann::json j;
+  j["images"] = a.images;
+  j["lens"] = a.lens;
+  j["out"] = a.out;
+  j["gauge"] = poses.gauge;
+  j["tracks"] = rep.tracks;
+  j["observations"] = rep.observations;
+  j["inliers"] = rep.inliers;
+  j["rms_sigmas"] = rep.rms_sigmas;
+  nlohmann::json jv = nlohmann::json::array();
+  for (std::size_t v = 0; v < poses.views.size(); ++v) {
+    const BallLocation& b = rep.balls[v];
+    std::vector<double> m;
+    for (int k = 0; k < 9; ++k) m.push_back(poses.views[v].world_from_cam(k / 3, k % 3));
+    jv.push_back({{"name", poses.views[v].name},
+                  {"image", a.images[v]},
+                  {"world_from_cam", m},
+                  {"sigma_deg", poses.views[v].sigma_deg},
+                  {"features", rep.features[v]},
+                  {"ball", {{"centre_px", {b.centre_px.x(), b.centre_px.y()}}, {"radius_px", b.radius_px}, {"rms_px", b.fit.rms_px}}}});
+  }
+  j["views"] = jv;
+  write_summary(a.json, j);
+  if (!a.quiet && a.json != "-") {
+    double worst = 0;
+    for (const ViewPose& p : poses.views) worst = std::max(worst, p.sigma_deg);
+    std::cerr << poses.views.size() << " views, " << rep.tracks << " feature tracks, largest orientation sigma " << worst
+              << " deg -> " << a.out << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+Runner add_orient(CLI::App& app) {
+  auto a = std::make_shared<OrientArgs>();
+  CLI::App* c = app.add_subcommand("orient", "Solve every view's camera orientation from the features in its chrome ball");
+  c->footer(
+      "Each image is a merged view (rsibr hdr) of the same ball rig from a different position. The chrome ball is "
+      "found in every view (the most textured of the detected balls), features in it are turned into the world "
+      "directions they reflect, matched across views and solved in one least-squares problem; each view's "
+      "orientation std dev (degrees) is written with it. The world frame is the first view's camera frame, or with "
+      "--up X,Y,Z (the world's up in the first camera's frame; 0,-1,0 for a camera levelled on a tripod) +Y up and "
+      "+Z the first camera's forward made horizontal. A view's name is its header's rsibr.view, else the file stem.\n"
+      "Example: rsibr orient hdr/north.exr hdr/east.exr hdr/south.exr --lens camera.cameramodel --out poses.yaml --up 0,-1,0");
+  c->add_option("images", a->images, "Merged view EXRs (rsibr hdr), at least 2")->required();
+  c->add_option("--lens", a->lens, "mrcal .cameramodel of the camera")->required();
+  c->add_option("--out", a->out, "Output pose file (poses.yaml)")->required();
+  c->add_option("--up", a->up, "World up X,Y,Z in the first camera's frame (default: world = first camera)");
+  c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
+  c->add_flag("-q,--quiet", a->quiet, "No progress bar or report line");
+  return [a] { return run_orient(*a); };
+}
+
+}  // namespace rsibr::cli

@@ -1,0 +1,91 @@
+// rsibr process: the whole job, a photo set to probe, captured and computed maps, their comparison,
+// a turntable and an HTML report (pipeline/process_pipeline.h), resumable step by step.
+#include "cli/summary.h"
+#include "cli/verbs.h"
+
+#include "core/atomic_file.h"
+#include "core/camera.h"
+#include "core/progress.h"
+#include "pipeline/process_pipeline.h"
+
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+namespace rsibr::cli {
+namespace {
+
+struct ProcessArgs {
+  ProcessOptions o;
+  std::string size = "320x240", json, up = "0,-1,0";
+  bool quiet = false;
+};
+
+int run_process_verb(ProcessArgs a) {
+  int w = 0, h = 0;
+  char x = 0;
+  std::istringstream in(a.size);
+  if (!(in >> w >> x >> h) || x != 'x' || !(in >> std::ws).eof() || w < 16 || h < 16 || w > 8192 || h > 8192)
+    throw std::invalid_argument("--size '" + a.size + "': expected WxH, 16..8192 each");
+  if (a.up == "none") a.o.up.reset();
+  else a.o.up = parse_vec3(a.up, "--up");
+  a.o.render_width = w;
+  a.o.render_height = h;
+  if (!a.json.empty() && a.json != "-") check_output_path(a.json, {a.o.photoset});
+  a.o.progress = !a.quiet && Progress::stderr_is_terminal();
+  if (!a.quiet) a.o.log = [](const std::string& line) { std::cerr << "rsibr process: " << line << "\n"; };
+  const ProcessResult r = run_process(a.o);
+  nlohmann::json steps = nlohmann::json::array();
+  for (const StepOutcome& s : r.steps)
+    steps.push_back({{"step", s.step}, {"ran", s.ran}, {"reason", s.reason}, {"seconds", s.seconds},
+                     {"recorded_seconds", s.recorded_seconds}});
+  nlohmann::json j;
+  j["photoset"] = a.o.photoset;
+  j["out"] = a.o.out.string();
+  j["report"] = r.report.string();
+  j["steps"] = steps;
+  j["results"] = r.summary;
+  write_summary(a.json, j);
+  if (a.json != "-") std::cout << r.report.string() << "\n";
+  return 0;
+}
+
+}  // namespace
+
+Runner add_process(CLI::App& app) {
+  auto a = std::make_shared<ProcessArgs>();
+  CLI::App* c = app.add_subcommand("process", "The whole job: photo set -> probe, captured vs computed maps, render, report");
+  c->footer(
+      "Steps (each skipped when its outputs are newer than its inputs and its settings are unchanged; records in "
+      "DIR/steps/<step>.json): calibrate (chessboards, or --lens) -> hdr (response + merge per view) -> orient "
+      "(solved from the chrome ball's features, or --poses) -> extract (every ball of every view; chrome by reflection indexing, grey orthographic) -> probe "
+      "(chrome maps blended) -> bake (grey balls from the probe, Lambert) -> compare (captured vs computed, gains "
+      "fitted) -> render (turntable of --mesh or a torus lit by the probe) -> report (DIR/report.html, "
+      "self-contained). Prints the report's path.\n"
+      "Example: rsibr process shoot/photoset.yaml --out shoot/out --poses shoot/poses.yaml");
+  c->add_option("photoset", a->o.photoset, "photoset.yaml or the folder holding it")->required();
+  c->add_option("--out", a->o.out, "Output folder DIR (created; its parent must exist)")->required();
+  c->add_option("--lens", a->o.lens, "The camera's .cameramodel (instead of calibrating from chessboards)");
+  c->add_option("--poses", a->o.poses, "Camera orientations: poses.yaml (rsibr orient) or a synth truth.yaml");
+  c->add_option("--up", a->up, "World up X,Y,Z in the first camera's frame for the orientation solve ('none': "
+                              "world = first camera)")->capture_default_str();
+  c->add_option("--radiance", a->o.radiance_dir, "Use these linear EXRs (<view>_radiance.exr or <view>.exr) instead of the merge");
+  c->add_option("--probe", a->o.probe_file, "Use this environment as the probe instead of the chrome maps' blend");
+  c->add_option("--mesh", a->o.mesh, "Mesh for the turntable (.glb, .gltf, .obj; default: a torus)");
+  c->add_option("--force", a->o.force, "Re-run this step even if up to date (repeatable; 'all')");
+  c->add_option("--map-size", a->o.map_size, "Sphere maps' size in texels")->check(CLI::Range(8, 2048));
+  c->add_option("--probe-width", a->o.probe_width, "Lat-long probe width")->check(CLI::Range(8, 16384));
+  c->add_option("--chrome-fresnel", a->o.chrome_fresnel, "The chrome ball's Fresnel spec, divided out of the probe");
+  c->add_option("--grey-albedo", a->o.grey_albedo, "The grey ball's albedo")->check(CLI::Range(0.001, 1.0));
+  c->add_option("--bake-method", a->o.bake_method, "Integrator of the computed maps: mis, fis, sh, reference");
+  c->add_option("--bake-samples", a->o.bake_samples, "Samples per texel (mis, fis)")->check(CLI::Range(1, 1 << 20));
+  c->add_option("--seed", a->o.seed, "Seed of every stochastic step");
+  c->add_option("--render-brdf", a->o.render_brdf, "BRDF spec (YAML text) of the turntable's material");
+  c->add_option("--turntable", a->o.turntable, "Turntable frames")->check(CLI::Range(1, 360));
+  c->add_option("--size", a->size, "Turntable frame size WxH");
+  c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
+  c->add_flag("-q,--quiet", a->quiet, "No progress or step lines");
+  return [a] { return run_process_verb(*a); };
+}
+
+}  // namespace rsibr::cli

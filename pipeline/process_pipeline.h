@@ -1,0 +1,83 @@
+// rsibr process: a photo set to light probe, captured and computed maps, their comparison, a
+// turntable render and an HTML report, as a graph of resumable steps (pipeline/step_record.h):
+//
+//   calibrate  chessboards -> DIR/camera.cameramodel (mrcal, model by cross-validation), or --lens
+//   hdr        brackets -> DIR/hdr/<view>.exr, DIR/hdr/response.json (response recovered once)
+//   orient     -> DIR/poses.yaml (world_from_cam per view: solved from the chrome ball's features,
+//              calib/view_orientation.h, world +Y up given the up of the first camera; or --poses)
+//   extract    every ball of every view -> DIR/maps/captured-<ball>.exr, one part per view in the
+//              world frame (chrome: reflection indexing, mirror warp; grey/glossy: orthographic)
+//   probe      chrome maps -> DIR/probe.exr (lat-long, confidence-weighted blend)
+//   bake       probe -> DIR/maps/computed-<ball>.exr for every grey ball, Lambert of albedo
+//              grey_albedo, at the captured views' directions and frames
+//   compare    captured vs computed per grey ball -> DIR/compare/<ball>.json + side-by-side PNGs
+//   render     probe -> DIR/render/maps.exr (icosa views of render_brdf) -> a turntable of the
+//              mesh (or a built-in torus), DIR/render/frame_NN.png
+//   report     -> DIR/report.html (pipeline/html_report.h)
+//
+// Each step reads its inputs from DIR (so a later run can start anywhere), writes its outputs
+// atomically and then its record. Frames: world +Y up (the gauge of the poses).
+#pragma once
+
+#include "core/vec.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rsibr {
+
+struct ProcessOptions {
+  std::string photoset;      // photoset.yaml or its folder
+  std::filesystem::path out; // DIR (created; its parent must exist)
+  std::string lens;          // given .cameramodel (skips the chessboards)
+  std::string poses;         // given poses (pipeline/pose_input.h); empty: the orientation solve
+  std::optional<Vec3> up = Vec3(0, -1, 0);  // world up in the first camera's frame (a level camera); none: first-view gauge
+  // Stages swapped for given data (the truth of a synthetic capture: the error budget):
+  std::string radiance_dir;  // hdr: linear EXRs <view>_radiance.exr or <view>.exr instead of the merge
+  std::string probe_file;    // probe: this environment (resampled) instead of the chrome maps' blend
+  std::string mesh;          // render: .glb/.gltf/.obj; empty: a built-in torus
+  std::vector<std::string> force;  // steps to re-run ("all" for every step)
+  int map_size = 64;         // extracted and computed sphere maps (texels a side)
+  int probe_width = 256;     // lat-long probe width
+  std::string chrome_fresnel;  // the chrome ball's Fresnel spec (YAML text), divided out of the probe; empty: none
+  double grey_albedo = 0.18; // the grey ball's Lambert albedo (compare fits a gain anyway)
+  std::string bake_method = "mis";
+  int bake_samples = 128;
+  std::uint64_t seed = 0;
+  std::string render_brdf = "{type: ggx, roughness: 0.25, fresnel: {type: schlick, f0: [0.95, 0.64, 0.54]}}";
+  int render_views_res = 64; // map size of the render's computed map set (icosa views)
+  int turntable = 8;         // frames
+  int render_width = 320, render_height = 240;
+  bool progress = false;     // progress bars on stderr
+  std::function<void(const std::string&)> log;  // one line per step (empty: silent)
+};
+
+struct StepOutcome {
+  std::string step;
+  bool ran = false;
+  std::string reason;        // why it ran ("" when skipped: up to date)
+  double seconds = 0;        // this run's time (0 when skipped)
+  double recorded_seconds = 0;  // the time of the run that made the outputs
+};
+
+struct ProcessResult {
+  std::vector<StepOutcome> steps;
+  std::filesystem::path report;
+  nlohmann::json summary;    // every step's summary by name
+};
+
+// The step names in order.
+const std::vector<std::string>& process_steps();
+
+// Throws std::invalid_argument("<file>: <problem>") for bad input (checked before any work where
+// possible), std::runtime_error for failures inside a step (prefixed by the step's name). Outputs
+// of steps that completed stay (with their records) so a re-run resumes after them.
+ProcessResult run_process(const ProcessOptions& options);
+
+}  // namespace rsibr
