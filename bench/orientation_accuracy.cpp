@@ -16,7 +16,7 @@
 int main(int argc, char** argv) {
   using namespace rsibr;
   CLI::App app("Orientation accuracy on rendered views");
-  double radius_px = 120, noise = 0.01, ball_prior_px = 0.25, max_radius_fraction = 0.85, contrast = 0.04;
+  double radius_px = 120, noise = 0.01, ball_prior_px = 0.25, max_radius_fraction = 0.95, contrast = 0.01;
   int views = 4, max_features = 800;
   std::uint64_t seed = 5;
   bool refine = true;

@@ -65,8 +65,8 @@ def main():
         "limb reflects what lies just behind it, so the outline has little contrast), and a pixel of centre error\n"
         "moves the reflected directions by about 2 / radius_px radians (~1 degree at 120 px): that, not the SIFT\n"
         "keypoints (0.05-0.15 degrees with the true centre), limits the orientation today. Refining the centres\n"
-        "jointly brings the reported sigmas near the errors (chi2 ~1-6 instead of 8-107) but cannot remove the\n"
-        "error with 50-100 feature tracks,\n"
+        "jointly brings the reported sigmas near the errors (chi2 1.5-10 instead of 25-470) but cannot remove the\n"
+        "error with 130-270 feature tracks,\n"
         "most near the ball's centre where a centre shift and a rotation look alike; on synthetic rigs with 600\n"
         "features over the whole ball it cuts a 0.5 px centre error's 0.92 degrees to 0.10 (tests/calib/\n"
         "ball_refinement_test.cpp).\n")

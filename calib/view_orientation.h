@@ -30,7 +30,11 @@ struct ViewOrientationOptions {
   std::vector<BallGuess> balls;        // per view, or empty: detected
   double min_radius_px = 0;            // detection range; 0: min(width, height) / 40
   double max_radius_px = 0;            // 0: min(width, height) / 2
-  BallFeatureOptions features;
+  // Denser than BallFeatureOptions' defaults: weaker SIFT features (contrast 0.01) and out to 0.95 of
+  // the ball's angular radius. The rim's features are what separates a ball-centre error from a
+  // rotation; on rendered views (bench/orientation_accuracy) this halves the mean error (0.96 -> 0.53
+  // degrees, 120-px ball, 3 seeds) with ~2.5x the tracks.
+  BallFeatureOptions features = {800, 0.3, 0.95, 25, 0.01};
   // Ball centres refined jointly with the orientations (OrientationOptions::balls), with a prior
   // std dev of the ball centre of max(outline RMS, ball_prior_px) pixels.
   bool refine_balls = true;
