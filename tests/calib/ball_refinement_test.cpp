@@ -4,6 +4,7 @@
 #include "calib/orientation_solve.h"
 
 #include "calib/sphere_map_extraction.h"
+#include "random_directions.h"
 
 #include <ceres/ceres.h>
 #include <ceres/manifold.h>
@@ -16,18 +17,6 @@
 
 namespace rsibr {
 namespace {
-
-Vec3 random_direction(std::mt19937_64& rng) {
-  std::normal_distribution<double> g(0, 1);
-  return Vec3(g(rng), g(rng), g(rng)).normalized();
-}
-
-// Tangent perturbation of std dev sigma per axis.
-Vec3 perturb(const Vec3& d, double sigma, std::mt19937_64& rng) {
-  std::normal_distribution<double> g(0, sigma);
-  const Vec3 t1 = d.unitOrthogonal(), t2 = d.cross(t1);
-  return (d + g(rng) * t1 + g(rng) * t2).normalized();
-}
 
 // A cost's autodiff Jacobian in each block's tangent space against central differences along the
 // manifold (written out: ceres::GradientChecker breaks under ASan, see orientation_solve_test.cpp).
@@ -77,7 +66,7 @@ TEST(BallRefinement, ReflectionObeysTheMirrorLaw) {
   std::mt19937_64 rng(2);
   std::uniform_real_distribution<double> u(0, 1);
   for (int i = 0; i < 200; ++i) {
-    const Vec3 a = (Vec3(0, 0, 1) + 0.3 * random_direction(rng)).normalized();
+    const Vec3 a = (Vec3(0, 0, 1) + 0.3 * testing::random_direction(rng)).normalized();
     const double s = 0.05 + 0.5 * u(rng);
     const Vec3 d = ray_on_ball(a, s, 0.99 * u(rng), 2 * kPi * u(rng));
     const Vec3 r = reflect_off_ball<double>(d, a, s);
@@ -106,12 +95,12 @@ TEST(BallRefinement, CostFunctionsPassTheGradientCheck) {
   const ceres::EigenQuaternionManifold qm;
   const ceres::SphereManifold<3> sm;
   for (int trial = 0; trial < 10; ++trial) {
-    const Vec3 a0 = (Vec3(0, 0, 1) + 0.2 * random_direction(rng)).normalized();
+    const Vec3 a0 = (Vec3(0, 0, 1) + 0.2 * testing::random_direction(rng)).normalized();
     const double s = 0.1 + 0.3 * u(rng);
     const Vec3 ray = ray_on_ball(a0, s, 0.9 * u(rng), 2 * kPi * u(rng));
     ceres::AutoDiffCostFunction<BallReflectionResidual, 3, 4, 3, 3> cost(new BallReflectionResidual(ray, s, 0.003));
-    Eigen::Quaterniond q(Eigen::AngleAxisd(3 * u(rng), random_direction(rng)));
-    Vec3 a = perturb(a0, 1e-3, rng), d = random_direction(rng);
+    Eigen::Quaterniond q(Eigen::AngleAxisd(3 * u(rng), testing::random_direction(rng)));
+    Vec3 a = testing::perturb(a0, 1e-3, rng), d = testing::random_direction(rng);
     expect_gradient_matches(cost, {q.coeffs().data(), a.data(), d.data()}, {&qm, &sm, &sm}, 3);
     ceres::AutoDiffCostFunction<BallAxisPrior, 3, 3> prior(new BallAxisPrior(a0, 1e-3));
     expect_gradient_matches(prior, {a.data()}, {&sm}, 3);
@@ -141,14 +130,14 @@ Rig make_rig(int views, double centre_px, std::uint64_t seed) {
     Mat3 r;
     r << y.cross(z), y, z;
     rig.world_from_cam.push_back(r);
-    const Vec3 axis = perturb(Vec3(0, 0, 1), 0.02, rng);  // the ball near the image centre
+    const Vec3 axis = testing::perturb(Vec3(0, 0, 1), 0.02, rng);  // the ball near the image centre
     truth_axis.push_back(axis);
     const double sigma_axis = centre_px / f;
-    rig.priors.push_back({perturb(axis, sigma_axis, rng), std::asin(s), std::max(sigma_axis, 1e-6)});
+    rig.priors.push_back({testing::perturb(axis, sigma_axis, rng), std::asin(s), std::max(sigma_axis, 1e-6)});
   }
   rig.features = 600;
   for (int k = 0; k < rig.features; ++k) {
-    const Vec3 d = random_direction(rng);
+    const Vec3 d = testing::random_direction(rng);
     for (int v = 0; v < views; ++v) {
       const Vec3 o = rig.world_from_cam[v].transpose() * d;  // camera frame
       const Vec3 c = truth_axis[v] / s;
@@ -157,7 +146,7 @@ Rig make_rig(int views, double centre_px, std::uint64_t seed) {
       if (!n) continue;
       const Vec3 ray = (c + *n).normalized();
       if (angle_between(ray, truth_axis[v]) > 0.85 * std::asin(s)) continue;
-      const Vec3 noisy = perturb(ray, pixel_noise, rng);
+      const Vec3 noisy = testing::perturb(ray, pixel_noise, rng);
       const BallPrior& p = rig.priors[v];
       const Vec3 dir = reflect_off_ball<double>(noisy, p.axis, std::sin(p.half_angle)).normalized();
       // Per-observation std dev: the reflection's angular gain at this pixel times the pixel noise.

@@ -1,6 +1,7 @@
 // calib/orientation_solve.h: the cost's gradient, orientation accuracy with realistic noise and
 // outliers, the reported uncertainty against the observed error, clear errors.
 #include "calib/orientation_solve.h"
+#include "random_directions.h"
 
 #include <ceres/ceres.h>
 #include <ceres/manifold.h>
@@ -19,27 +20,15 @@ Mat3 random_rotation(std::mt19937_64& rng) {
   return Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
 }
 
-Vec3 random_direction(std::mt19937_64& rng) {
-  std::normal_distribution<double> g(0, 1);
-  return Vec3(g(rng), g(rng), g(rng)).normalized();
-}
-
-// A small angular perturbation of std dev sigma (radians) per tangent axis.
-Vec3 perturb(const Vec3& d, double sigma, std::mt19937_64& rng) {
-  std::normal_distribution<double> g(0, sigma);
-  const Vec3 t1 = d.unitOrthogonal(), t2 = d.cross(t1);
-  return (d + g(rng) * t1 + g(rng) * t2).normalized();
-}
-
 TEST(OrientationSolve, CostFunctionPassesTheGradientCheck) {
   std::mt19937_64 rng(1);
   for (int trial = 0; trial < 10; ++trial) {
-    const Vec3 o = random_direction(rng);
+    const Vec3 o = testing::random_direction(rng);
     auto* cost = new ceres::AutoDiffCostFunction<DirectionResidual, 3, 4, 3>(new DirectionResidual(o, 0.01));
     const ceres::EigenQuaternionManifold qm;
     const ceres::SphereManifold<3> sm;
     Eigen::Quaterniond q(random_rotation(rng));
-    Vec3 d = random_direction(rng);
+    Vec3 d = testing::random_direction(rng);
     double* x[] = {q.coeffs().data(), d.data()};
     const ceres::Manifold* manifolds[] = {&qm, &sm};
     // The cost's (autodiff) Jacobian in each block's tangent space, J_ambient * PlusJacobian, against
@@ -100,13 +89,13 @@ Truth make_case(const Case& c, std::uint64_t seed) {
   std::uniform_real_distribution<double> u(0, 1);
   Truth t;
   for (int v = 0; v < c.views; ++v) t.world_from_cam.push_back(v == 0 ? Mat3::Identity() : random_rotation(rng));
-  for (int f = 0; f < c.features; ++f) t.d.push_back(random_direction(rng));
+  for (int f = 0; f < c.features; ++f) t.d.push_back(testing::random_direction(rng));
   const double sigma = c.sigma_deg * kPi / 180;
   for (int v = 0; v < c.views; ++v)
     for (int f = 0; f < c.features; ++f) {
       if (u(rng) > c.visible) continue;
-      Vec3 o = perturb(t.world_from_cam[v].transpose() * t.d[f], sigma, rng);
-      if (u(rng) < c.outliers) o = random_direction(rng);
+      Vec3 o = testing::perturb(t.world_from_cam[v].transpose() * t.d[f], sigma, rng);
+      if (u(rng) < c.outliers) o = testing::random_direction(rng);
       t.obs.push_back({v, f, o, sigma});
     }
   return t;
