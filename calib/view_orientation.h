@@ -12,6 +12,7 @@
 //               -y axis when it looks straight up or down), X = Y x Z.
 #pragma once
 
+#include "calib/ball_cube_features.h"
 #include "calib/ball_features.h"
 #include "calib/ball_locator.h"
 #include "calib/orientation_solve.h"
@@ -25,6 +26,11 @@
 
 namespace rsibr {
 
+// Where features are detected: `cube` resamples the world reflected in the ball onto gnomonic cube
+// faces first (calib/ball_cube_features.h; matches across wide baselines), `image` runs SIFT on the
+// ball's image directly (calib/ball_features.h; views < ~20-30 degrees apart only).
+enum class FeatureDomain { cube, image };
+
 struct ViewOrientationOptions {
   std::optional<Vec3> up;              // camera frame of the first view; none: the first-view gauge
   std::vector<BallGuess> balls;        // per view, or empty: detected
@@ -35,6 +41,8 @@ struct ViewOrientationOptions {
   // rotation; on rendered views (bench/orientation_accuracy) this halves the mean error (0.96 -> 0.53
   // degrees, 120-px ball, 3 seeds) with ~2.5x the tracks.
   BallFeatureOptions features = {800, 0.3, 0.95, 25, 0.01};
+  FeatureDomain domain = FeatureDomain::cube;
+  CubeFeatureOptions cube;
   // Ball centres refined jointly with the orientations (OrientationOptions::balls), with a prior
   // std dev of the ball centre of max(outline RMS, ball_prior_px) pixels.
   bool refine_balls = true;
