@@ -1,6 +1,7 @@
 // Every view's orientation from its image of the chrome ball: the ball found in each view (Hough
 // candidates -> calib/ball_locator.h; the chrome ball is the candidate with the most texture), SIFT
-// features in it turned into reflected directions (calib/ball_features.h), matched across views and
+// features of the world it reflects, detected on cube faces (calib/ball_cube_features.h; or in the
+// image itself, calib/ball_features.h) as reflected directions, matched across views and
 // solved in one Ceres problem (calib/orientation_solve.h). The result is a pose file's content
 // (calib/pose_file.h).
 //
