@@ -29,7 +29,9 @@ namespace rsibr {
 
 // Where features are detected: `cube` resamples the world reflected in the ball onto gnomonic cube
 // faces first (calib/ball_cube_features.h; matches across wide baselines), `image` runs SIFT on the
-// ball's image directly (calib/ball_features.h; views < ~20-30 degrees apart only).
+// ball's image directly (calib/ball_features.h; views < ~20-30 degrees apart only). `image` was better
+// in no measured case (docs/tradeoffs.md "Orientation"): it stays as the baseline of that table and
+// of tests/calib/view_orientation_test.cpp, not as a user option.
 enum class FeatureDomain { cube, image };
 
 struct ViewOrientationOptions {
