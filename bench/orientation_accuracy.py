@@ -94,11 +94,15 @@ def main():
         "limb reflects what lies just behind it, so the outline has little contrast), and a pixel of centre error\n"
         "moves the reflected directions by about 2 / radius_px radians (~1 degree at 120 px): that, not the SIFT\n"
         "keypoints (0.05-0.15 degrees with the true centre), limits the orientation today. Refining the centres\n"
-        "jointly brings the reported sigmas near the errors (chi2 1.5-10 instead of 25-470) but cannot remove the\n"
-        "error with 130-270 feature tracks,\n"
+        "jointly brings the reported sigmas nearer the errors (chi2 3-29 instead of 21-380) but cannot remove the\n"
+        "error with 150-275 feature tracks,\n"
         "most near the ball's centre where a centre shift and a rotation look alike; on synthetic rigs with 600\n"
         "features over the whole ball it cuts a 0.5 px centre error's 0.92 degrees to 0.10 (tests/calib/\n"
-        "ball_refinement_test.cpp).\n\n"
+        "ball_refinement_test.cpp). On these four views 20 degrees apart the direct front end (SIFT in the ball's\n"
+        "image, `rsibr_orientation_accuracy --domain image`, same seeds) did better when measured by hand: median\n"
+        "0.44 against 0.63 degrees at 120 px and 0.66 against 0.79 at 200 px (noise 0.01, refined centres), with\n"
+        "sigmas less far from honest at 200 px (chi2 4-22 against 2-62): the cube faces' sigmas are too small on\n"
+        "a large ball (open).\n\n"
         "Wide baselines: two views `spacing` degrees apart (120-px ball, noise 0.01, refined centres, %d seeds),\n"
         "features detected on gnomonic cube faces of the reflected world (`cube`, calib/ball_cube_features.h, the\n"
         "default) or by SIFT on the ball's image itself (`image`, the earlier front end). A world feature near the\n"
@@ -108,10 +112,11 @@ def main():
         "| environment | spacing deg | features | oriented | tracks | median error deg | max error deg | chi2 |\n"
         "|---|---|---|---|---|---|---|---|\n" % args.seeds
         + "\n".join(wide) + "\n\n"
-        "The cube faces find more shared tracks in every case (up to ~10x at 60-90 degrees in `park`) and a\n"
-        "median error as low or lower in most; the direct front end was better in no measured case beyond\n"
-        "the seeds' scatter and stays only as this table's baseline (ViewOrientationOptions::domain). With\n"
-        "two views the error is still the ball centre's (about a pixel from the outline), not the features'.\n")
+        "The cube faces find more shared tracks in every case (7-14x at 60-90 degrees in `park`, 1.2-5x elsewhere)\n"
+        "and the lower median error in 7 of the 9 cases; the direct front end's was lower at 60 degrees in `park`\n"
+        "(on 10 tracks, sigmas far too large: chi2 0.1) and `sky`, so it stays as an option\n"
+        "(ViewOrientationOptions::domain), not the default. With two views the error is still mostly the ball\n"
+        "centre's (about a pixel from the outline), not the features'.\n")
     replace_section(args.out, "Orientation (rsibr orient)", body)
 
 

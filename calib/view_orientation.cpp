@@ -36,9 +36,11 @@ double disc_texture(const cv::Mat& image, const BallGuess& g) {
 
 // The chrome ball among the Hough candidates: each candidate (and its radius scaled by 0.8 and 1.25,
 // as Hough radii in a textured scene are rough) is located (calib/ball_locator.h); a fit counts when
-// most of its outline points agree (inlier fraction >= 0.6, RMS <= 0.5 px). Fits whose centres lie
+// most of its outline points agree (inlier fraction >= 0.6, RMS <= 0.5 px) and its radius and centre
+// are plausible (within the detection range, in the image). Fits whose centres lie
 // within half a radius of each other are one ball, represented by its fit with the most inliers;
-// among the balls the most textured disc wins (a chrome ball reflects the whole world; a grey ball
+// a circle inside another ball's disc is dropped (a reflection in a chrome ball); among the balls
+// the most textured disc wins (a chrome ball reflects the whole world; a grey ball
 // beside it often has the cleaner outline, so the outline alone would pick it).
 BallLocation find_chrome_ball(const cv::Mat& img, const LensModel& lens, double rmin, double rmax, const std::string& name) {
   const std::vector<BallGuess> found = detect_balls(img, rmin, rmax, 8);
@@ -53,6 +55,9 @@ BallLocation find_chrome_ball(const cv::Mat& img, const LensModel& lens, double 
       }
       const double fraction = loc.outline_px.empty() ? 0 : double(loc.fit.inliers) / loc.outline_px.size();
       if (fraction < 0.6 || !(loc.fit.rms_px <= 0.5)) continue;
+      // A straight edge fits a huge circle: the radius must stay near the detection range and the
+      // centre in the image.
+      if (!(loc.radius_px >= rmin / 1.25 && loc.radius_px <= 1.25 * rmax) || !lens.in_image(loc.centre_px)) continue;
       auto same = std::find_if(balls.begin(), balls.end(), [&](const BallLocation& b) {
         return (b.centre_px - loc.centre_px).norm() < 0.5 * std::min(b.radius_px, loc.radius_px);
       });
@@ -60,9 +65,17 @@ BallLocation find_chrome_ball(const cv::Mat& img, const LensModel& lens, double 
       else if (loc.fit.inliers > same->fit.inliers) *same = loc;
     }
   if (balls.empty()) throw std::invalid_argument(name + ": no ball found");
+  // A circle inside another ball's disc is something the ball reflects, not a ball.
+  auto inside_another = [&](std::size_t i) {
+    for (std::size_t k = 0; k < balls.size(); ++k)
+      if (k != i && (balls[i].centre_px - balls[k].centre_px).norm() + balls[i].radius_px <= 1.05 * balls[k].radius_px)
+        return true;
+    return false;
+  };
   std::size_t best = 0;
   double best_texture = -1;
   for (std::size_t i = 0; i < balls.size(); ++i) {
+    if (inside_another(i)) continue;
     const double t = disc_texture(img, {balls[i].centre_px, balls[i].radius_px});
     if (t > best_texture) best = i, best_texture = t;
   }

@@ -152,6 +152,37 @@ TEST(ViewOrientation, ViewsSixtyAndNinetyDegreesApartAreOrientedOnTheCubeFaces) 
   EXPECT_LT(chi2, 4.0);
 }
 
+// The grey ball beside the chrome one often has the cleaner outline (more inlier outline points):
+// the chrome ball is chosen by its texture, and neither a straight edge's huge circle nor a circle
+// reflected inside the chrome ball is taken for a ball.
+TEST(ViewOrientation, TheChromeBallIsChosenOverTheGreyBallBesideIt) {
+  if (!std::filesystem::exists(kLobby)) GTEST_SKIP() << kLobby << " missing (scripts/fetch-assets.sh)";
+  const double radius_px = 60, distance = 0.5, f = radius_px * distance / 0.05;
+  SynthScene scene = testing::rig_scene(LensModel::pinhole(f, 520, 150), distance, false);
+  scene.environment.file = kLobby;
+  scene.environment.sanitize = true;
+  scene.views.front().azimuths_deg = {0, 20};
+  scene.views.front().look_at = Vec3(0, 1.3, 0);  // both balls in the image
+  std::vector<ViewImage> views;
+  std::vector<Vec2> chrome, grey;
+  for (int v = 0; v < 2; ++v) {
+    const auto view = testing::render_view(scene, v, 0.01, 5 + v);
+    ViewImage vi;
+    vi.radiance = view.radiance;
+    views.push_back(vi);
+    chrome.push_back(testing::ball_centre_px(view, 0));
+    grey.push_back(testing::ball_centre_px(view, 1));
+    ASSERT_TRUE(scene.camera.lens.in_image(grey.back(), radius_px)) << grey.back().transpose();
+  }
+  ViewOrientationReport rep;
+  orient_views({"a", "b"}, views, scene.camera.lens, {}, &rep);
+  for (int v = 0; v < 2; ++v) {
+    std::printf("  view %d: ball (%.1f, %.1f), chrome (%.1f, %.1f), grey (%.1f, %.1f)\n", v, rep.balls[v].centre_px.x(),
+                rep.balls[v].centre_px.y(), chrome[v].x(), chrome[v].y(), grey[v].x(), grey[v].y());
+    EXPECT_LT((rep.balls[v].centre_px - chrome[v]).norm(), 3.0);
+  }
+}
+
 TEST(ViewOrientation, OneViewNoBallOrNothingSharedGiveOneClearError) {
   if (!std::filesystem::exists(kLobby)) GTEST_SKIP() << kLobby << " missing (scripts/fetch-assets.sh)";
   const Rendered r = render(kLobby, {0}, 60);
