@@ -20,7 +20,7 @@ namespace {
 
 struct OrientArgs {
   std::vector<std::string> images;
-  std::string lens, out, up, json, features = "cube";
+  std::string lens, out, up, json;
   bool quiet = false;
 };
 
@@ -41,7 +41,6 @@ int run_orient(const OrientArgs& a) {
   if (!a.json.empty() && a.json != "-") check_output_path(a.json, inputs);
   ViewOrientationOptions o;
   if (!a.up.empty()) o.up = parse_up(a.up);
-  o.domain = a.features == "image" ? FeatureDomain::image : FeatureDomain::cube;
   if (a.images.size() < 2)
     throw std::invalid_argument("orient: " + std::to_string(a.images.size()) + " image(s), need at least 2 views");
   const LensModel lens = LensModel::read(a.lens);
@@ -78,7 +77,6 @@ int run_orient(const OrientArgs& a) {
   j["lens"] = a.lens;
   j["out"] = a.out;
   j["gauge"] = poses.gauge;
-  j["feature_domain"] = a.features;
   j["tracks"] = rep.tracks;
   j["observations"] = rep.observations;
   j["inliers"] = rep.inliers;
@@ -113,10 +111,8 @@ Runner add_orient(CLI::App& app) {
   CLI::App* c = app.add_subcommand("orient", "Solve every view's camera orientation from the features in its chrome ball");
   c->footer(
       "Each image is a merged view (rsibr hdr) of the same ball rig from a different position. The chrome ball is "
-      "found in every view (the most textured of the detected balls), the world it reflects is resampled onto the "
-      "six faces of a cube (--features cube, the default; views 60-120 degrees apart share features there) or "
-      "features are taken from the ball's image itself (--features image; views < ~30 degrees apart), each turned "
-      "into the world direction it reflects, matched across views and solved in one least-squares problem; each view's "
+      "found in every view (the most textured of the detected balls), features in it are turned into the world "
+      "directions they reflect, matched across views and solved in one least-squares problem; each view's "
       "orientation std dev (degrees) is written with it. The world frame is the first view's camera frame, or with "
       "--up X,Y,Z (the world's up in the first camera's frame; 0,-1,0 for a camera levelled on a tripod) +Y up and "
       "+Z the first camera's forward made horizontal. A view's name is its header's rsibr.view, else the file stem.\n"
@@ -125,8 +121,6 @@ Runner add_orient(CLI::App& app) {
   c->add_option("--lens", a->lens, "mrcal .cameramodel of the camera")->required();
   c->add_option("--out", a->out, "Output pose file (poses.yaml)")->required();
   c->add_option("--up", a->up, "World up X,Y,Z in the first camera's frame (default: world = first camera)");
-  c->add_option("--features", a->features, "Where features are detected: cube (faces of the reflected world) or image")
-      ->check(CLI::IsMember({"cube", "image"}));
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or report line");
   return [a] { return run_orient(*a); };

@@ -481,20 +481,5 @@ expect_error "process: missing --probe environment" "noenv.exr" process "$work/p
 check "process: no output after errors" bash -c "! ls -A '$work' | grep -q '^pe[0-9]'"
 check "process: no temporaries" no_temporaries "$work/pout"
 
-# --- orient --features (calib/ball_cube_features.h): the cube faces by default, the ball's image
-# itself as an option (same views as the orient block above); a bad value.
-if [ -f "$lobby" ]; then
-  "$rsibr" orient "$ov/view00_radiance.exr" "$ov/view01_radiance.exr" "$ov/view02_radiance.exr" --lens "$olens" \
-    --out "$work/poses-img.yaml" --json "$work/orient-img.json" --up 0,-1,0 --features image -q
-  check "orient: --features image orients too; the summary names the domain" python3 -c "
-import json, math; a = json.load(open('$work/orient.json')); b = json.load(open('$work/orient-img.json'))
-assert a['feature_domain'] == 'cube' and b['feature_domain'] == 'image', (a, b)
-R = [[x['world_from_cam'][3 * r:3 * r + 3] for r in range(3)] for x in b['views']]
-def rel(a, b): return math.degrees(math.acos(max(-1, min(1, (sum(a[k][i] * b[k][i] for k in range(3) for i in range(3)) - 1) / 2))))
-assert abs(rel(R[0], R[1]) - 20) < 3 and abs(rel(R[0], R[2]) - 40) < 3, b"
-  expect_error "orient: bad --features" "--features" orient "$ov/view00_radiance.exr" "$ov/view01_radiance.exr" --lens "$olens" --out "$work/or-e5.yaml" --features sift
-  check "orient: no output after a bad --features" test ! -e "$work/or-e5.yaml"
-fi
-
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
