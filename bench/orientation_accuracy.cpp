@@ -1,5 +1,6 @@
 // Orientation accuracy of calib/view_orientation.h on rendered views: a chrome ball of a given
-// radius in pixels in a real environment (cache/), views 20 degrees apart around it, Gaussian noise
+// radius in pixels in a real environment (cache/), views `spacing` degrees apart around it (20 by
+// default), features on the cube faces or in the image (--domain), Gaussian noise
 // of a given relative std dev; the ball found and every view oriented from the images alone (gauge:
 // the true up of the first view), compared with the renderer's poses. One JSON line per run;
 // bench/orientation_accuracy.py runs a grid and writes the docs/tradeoffs.md section.
@@ -18,12 +19,16 @@ int main(int argc, char** argv) {
   CLI::App app("Orientation accuracy on rendered views");
   double radius_px = 120, noise = 0.01, ball_prior_px = 0.25, max_radius_fraction = 0.95, contrast = 0.01;
   int views = 4, max_features = 800;
+  double spacing = 20;
+  std::string domain = "cube";
   std::uint64_t seed = 5;
   bool refine = true;
   std::string env = std::string(RSIBR_CACHE_DIR) + "/assets/hdri/lobby.exr";
   app.add_option("--radius-px", radius_px, "Ball radius in pixels");
   app.add_option("--noise", noise, "Relative noise std dev");
-  app.add_option("--views", views, "Views, 20 degrees apart");
+  app.add_option("--views", views, "Views, --spacing degrees apart");
+  app.add_option("--spacing", spacing, "Degrees between neighbouring views");
+  app.add_option("--domain", domain, "Feature domain: cube or image")->check(CLI::IsMember({"cube", "image"}));
   app.add_option("--env", env, "Environment EXR");
   app.add_option("--seed", seed, "Noise seed");
   app.add_option("--refine", refine, "Refine ball centres jointly (1) or not (0)");
@@ -39,7 +44,7 @@ int main(int argc, char** argv) {
   scene.environment.file = env;
   scene.environment.sanitize = true;
   scene.views.front().azimuths_deg.clear();
-  for (int v = 0; v < views; ++v) scene.views.front().azimuths_deg.push_back(20.0 * v);
+  for (int v = 0; v < views; ++v) scene.views.front().azimuths_deg.push_back(spacing * v);
   scene.views.front().roll_deg = 7;
   scene.views.front().look_at = scene.balls.front().centre;
   std::vector<ViewImage> images;
@@ -62,12 +67,23 @@ int main(int argc, char** argv) {
   o.features.max_features = max_features;
   o.features.max_radius_fraction = max_radius_fraction;
   o.features.contrast_threshold = contrast;
+  o.domain = domain == "image" ? FeatureDomain::image : FeatureDomain::cube;
   ViewOrientationReport rep;
   const auto t0 = std::chrono::steady_clock::now();
-  const PoseSet p = orient_views(names, images, scene.camera.lens, o, &rep);
+  PoseSet p;
+  try {
+    p = orient_views(names, images, scene.camera.lens, o, &rep);
+  } catch (const std::exception& e) {  // e.g. a view sharing too few features: reported, not fatal
+    std::cout << nlohmann::json({{"radius_px", radius_px}, {"noise", noise}, {"views", views}, {"spacing", spacing},
+                                 {"domain", domain}, {"seed", seed}, {"refine", refine}, {"failed", e.what()}})
+                     .dump()
+              << "\n";
+    return 0;
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const Mat3 g = p.views[0].world_from_cam * truth[0].transpose();
-  nlohmann::json j = {{"radius_px", radius_px}, {"noise", noise}, {"views", views}, {"seed", seed}, {"refine", refine},
+  nlohmann::json j = {{"radius_px", radius_px}, {"noise", noise}, {"views", views}, {"spacing", spacing},
+                      {"domain", domain}, {"seed", seed}, {"refine", refine},
                       {"tracks", rep.tracks}, {"rms_sigmas", rep.rms_sigmas}, {"seconds", seconds}};
   for (int v = 1; v < views; ++v) {
     j["error_deg"].push_back(Eigen::AngleAxisd(p.views[v].world_from_cam.transpose() * g * truth[v]).angle() * 180 / kPi);

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <regex>
 #include <stdexcept>
 
@@ -12,32 +11,40 @@ namespace rsibr {
 
 namespace {
 
-// Std dev of the log luminance inside a candidate's disc (its inner 80%): a chrome ball reflects the
-// whole high-contrast world, a grey ball shows a smooth shading.
+// Texture inside a candidate's disc (its inner 80%): the mean absolute difference of the log
+// luminance between neighbouring pixels. A chrome ball reflects the whole world, edges compressed
+// toward its rim; a grey ball shows a smooth shading, whose log range may be as large (sun and
+// shadow) but changes slowly, so the pixel-to-pixel difference, not the spread, tells them apart.
 double disc_texture(const cv::Mat& image, const BallGuess& g) {
   const double r = 0.8 * g.radius_px;
-  double s = 0, s2 = 0;
+  auto log_lum = [&](int x, int y) {
+    const cv::Vec3f p = image.at<cv::Vec3f>(y, x);
+    return std::log(std::max(1e-6, (double(p[0]) + p[1] + p[2]) / 3));
+  };
+  double s = 0;
   int n = 0;
-  const int x0 = std::max(0, int(g.centre_px.x() - r)), x1 = std::min(image.cols - 1, int(g.centre_px.x() + r));
-  const int y0 = std::max(0, int(g.centre_px.y() - r)), y1 = std::min(image.rows - 1, int(g.centre_px.y() + r));
+  const int x0 = std::max(0, int(g.centre_px.x() - r)), x1 = std::min(image.cols - 2, int(g.centre_px.x() + r));
+  const int y0 = std::max(0, int(g.centre_px.y() - r)), y1 = std::min(image.rows - 2, int(g.centre_px.y() + r));
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {
-      if ((Vec2(x, y) - g.centre_px).norm() > r) continue;
-      const cv::Vec3f p = image.at<cv::Vec3f>(y, x);
-      const double v = std::log(std::max(1e-6, (double(p[0]) + p[1] + p[2]) / 3));
-      s += v, s2 += v * v, ++n;
+      if ((Vec2(x + 0.5, y + 0.5) - g.centre_px).norm() > r - 1) continue;
+      const double v = log_lum(x, y);
+      s += std::abs(log_lum(x + 1, y) - v) + std::abs(log_lum(x, y + 1) - v), n += 2;
     }
-  return n > 1 ? std::sqrt(std::max(0.0, s2 / n - (s / n) * (s / n))) : 0;
+  return n > 0 ? s / n : 0;
 }
 
 // The chrome ball among the Hough candidates: each candidate (and its radius scaled by 0.8 and 1.25,
 // as Hough radii in a textured scene are rough) is located (calib/ball_locator.h); a fit counts when
-// most of its outline points agree (inlier fraction >= 0.6, RMS <= 0.5 px); among those the one with
-// the most inliers wins, ties to the most textured disc (a chrome ball reflects the whole world).
+// most of its outline points agree (inlier fraction >= 0.6, RMS <= 0.5 px) and its radius and centre
+// are plausible (within the detection range, in the image). Fits whose centres lie
+// within half a radius of each other are one ball, represented by its fit with the most inliers;
+// a circle inside another ball's disc is dropped (a reflection in a chrome ball); among the balls
+// the most textured disc wins (a chrome ball reflects the whole world; a grey ball
+// beside it often has the cleaner outline, so the outline alone would pick it).
 BallLocation find_chrome_ball(const cv::Mat& img, const LensModel& lens, double rmin, double rmax, const std::string& name) {
   const std::vector<BallGuess> found = detect_balls(img, rmin, rmax, 8);
-  std::optional<BallLocation> best;
-  double best_score = 0;
+  std::vector<BallLocation> balls;
   for (const BallGuess& g : found)
     for (double scale : {1.0, 0.8, 1.25}) {
       BallLocation loc;
@@ -48,11 +55,31 @@ BallLocation find_chrome_ball(const cv::Mat& img, const LensModel& lens, double 
       }
       const double fraction = loc.outline_px.empty() ? 0 : double(loc.fit.inliers) / loc.outline_px.size();
       if (fraction < 0.6 || !(loc.fit.rms_px <= 0.5)) continue;
-      const double score = loc.fit.inliers * (1 + 1e-3 * disc_texture(img, {loc.centre_px, loc.radius_px}));
-      if (!best || score > best_score) best = loc, best_score = score;
+      // A straight edge fits a huge circle: the radius must stay near the detection range and the
+      // centre in the image.
+      if (!(loc.radius_px >= rmin / 1.25 && loc.radius_px <= 1.25 * rmax) || !lens.in_image(loc.centre_px)) continue;
+      auto same = std::find_if(balls.begin(), balls.end(), [&](const BallLocation& b) {
+        return (b.centre_px - loc.centre_px).norm() < 0.5 * std::min(b.radius_px, loc.radius_px);
+      });
+      if (same == balls.end()) balls.push_back(loc);
+      else if (loc.fit.inliers > same->fit.inliers) *same = loc;
     }
-  if (!best) throw std::invalid_argument(name + ": no ball found");
-  return *best;
+  if (balls.empty()) throw std::invalid_argument(name + ": no ball found");
+  // A circle inside another ball's disc is something the ball reflects, not a ball.
+  auto inside_another = [&](std::size_t i) {
+    for (std::size_t k = 0; k < balls.size(); ++k)
+      if (k != i && (balls[i].centre_px - balls[k].centre_px).norm() + balls[i].radius_px <= 1.05 * balls[k].radius_px)
+        return true;
+    return false;
+  };
+  std::size_t best = 0;
+  double best_texture = -1;
+  for (std::size_t i = 0; i < balls.size(); ++i) {
+    if (inside_another(i)) continue;
+    const double t = disc_texture(img, {balls[i].centre_px, balls[i].radius_px});
+    if (t > best_texture) best = i, best_texture = t;
+  }
+  return balls[best];
 }
 
 // "view 3" in the solver's messages -> "view 'name'".
@@ -116,7 +143,9 @@ PoseSet orient_views(const std::vector<std::string>& names, const std::vector<Vi
     } else {
       loc = find_chrome_ball(img, lens, rmin, rmax, names[v]);
     }
-    feats.push_back(ball_features(img, lens, loc.fit.cone, options.features));
+    feats.push_back(options.domain == FeatureDomain::cube
+                        ? ball_cube_features(img, views[v].flags, lens, loc.fit.cone, options.features, options.cube)
+                        : ball_features(img, lens, loc.fit.cone, options.features));
     rep.balls.push_back(loc);
     rep.features.push_back(static_cast<int>(feats.back().directions.size()));
   }

@@ -1,6 +1,7 @@
 // Every view's orientation from its image of the chrome ball: the ball found in each view (Hough
 // candidates -> calib/ball_locator.h; the chrome ball is the candidate with the most texture), SIFT
-// features in it turned into reflected directions (calib/ball_features.h), matched across views and
+// features of the world it reflects, detected on cube faces (calib/ball_cube_features.h; or in the
+// image itself, calib/ball_features.h) as reflected directions, matched across views and
 // solved in one Ceres problem (calib/orientation_solve.h). The result is a pose file's content
 // (calib/pose_file.h).
 //
@@ -12,6 +13,7 @@
 //               -y axis when it looks straight up or down), X = Y x Z.
 #pragma once
 
+#include "calib/ball_cube_features.h"
 #include "calib/ball_features.h"
 #include "calib/ball_locator.h"
 #include "calib/orientation_solve.h"
@@ -25,6 +27,14 @@
 
 namespace rsibr {
 
+// Where features are detected: `cube` resamples the world reflected in the ball onto gnomonic cube
+// faces first (calib/ball_cube_features.h; matches across wide baselines), `image` runs SIFT on the
+// ball's image directly (calib/ball_features.h; views < ~20-30 degrees apart only). Measured
+// (docs/tradeoffs.md "Orientation"): `cube` finds 1.2-14x the tracks and the lower error in 7 of 9
+// two-view cases; `image` had the lower error in 2 (60 degrees apart, `park` and `sky`, on 10-18
+// tracks) and on four views 20 degrees apart (median 0.44 against 0.63 degrees at 120 px).
+enum class FeatureDomain { cube, image };
+
 struct ViewOrientationOptions {
   std::optional<Vec3> up;              // camera frame of the first view; none: the first-view gauge
   std::vector<BallGuess> balls;        // per view, or empty: detected
@@ -35,6 +45,8 @@ struct ViewOrientationOptions {
   // rotation; on rendered views (bench/orientation_accuracy) this halves the mean error (0.96 -> 0.53
   // degrees, 120-px ball, 3 seeds) with ~2.5x the tracks.
   BallFeatureOptions features = {800, 0.3, 0.95, 25, 0.01};
+  FeatureDomain domain = FeatureDomain::cube;
+  CubeFeatureOptions cube;
   // Ball centres refined jointly with the orientations (OrientationOptions::balls), with a prior
   // std dev of the ball centre of max(outline RMS, ball_prior_px) pixels.
   bool refine_balls = true;

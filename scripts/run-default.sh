@@ -59,9 +59,10 @@ rm -rf "$out/synth-minimal"
 fi
 
 # The main job: photos of a chrome and a grey ball -> rsibr process -> report.html. The orientations
-# are solved from the chrome ball's reflections; where the solve cannot orient a view (too few
-# shared features, see docs/user-guide.md) the synthetic truth's poses are used instead, and the
-# report says so. Steps already done are skipped on the second call.
+# are solved from the chrome ball's reflections (features on cube faces of the reflected world, so
+# the on-set views ~60 degrees apart share features). The featureless minimal-grey sky (no CC0 data)
+# gives too few features: there, and only there, the synthetic truth's poses are used instead, and
+# the report says so. Steps already done are skipped on the second call.
 if [ "$have_assets" = 1 ]; then spec=datasets-synthetic/onset-outdoor.yaml mesh=(--mesh "$mesh"); else
   spec=datasets-synthetic/minimal-grey.yaml mesh=(); fi
 rm -rf "$out/onset"
@@ -69,8 +70,10 @@ rm -rf "$out/onset"
 chrome='{type: conductor, eta: [2.9, 2.9, 2.6], k: [3.4, 3.4, 3.2]}'  # the synthetic chrome ball's
 process=("$rsibr" process "$out/onset/photos" --out "$out/onset/process" --chrome-fresnel "$chrome" "${mesh[@]}"
   --json "$out/onset-process.json")
-if ! report=$("${process[@]}"); then
-  echo "run-default: the orientation solve failed (above); using the synthetic truth's poses" >&2
+if [ "$have_assets" = 1 ]; then
+  report=$("${process[@]}")
+elif ! report=$("${process[@]}"); then
+  echo "run-default: the orientation solve failed (above: the minimal sky is featureless); using the synthetic truth's poses" >&2
   report=$("${process[@]}" --poses "$out/onset/truth/truth.yaml")
 fi
 echo "run-default: results in $out/ (EXR, PNG previews, JSON summaries)"
