@@ -14,7 +14,7 @@
 namespace rsibr {
 namespace {
 
-const std::filesystem::path kLobby = std::filesystem::path(RSIBR_CACHE_DIR) / "assets/hdri/lobby.exr";
+using testing::kLobby;
 
 struct View {
   testing::RenderedView r;

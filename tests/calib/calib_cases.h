@@ -9,10 +9,14 @@
 
 #include <opencv2/core.hpp>
 
+#include <filesystem>
 #include <random>
 #include <string>
 
 namespace rsibr::testing {
+
+// The CC0 lobby environment (scripts/fetch-assets.sh); tests skip when it is missing.
+inline const std::filesystem::path kLobby = std::filesystem::path(RSIBR_CACHE_DIR) / "assets/hdri/lobby.exr";
 
 inline SynthScene rig_scene(const LensModel& lens, double distance_m, bool stand = true, double yaw_deg = 0) {
   const std::string text = R"(

@@ -13,7 +13,7 @@
 namespace rsibr {
 namespace {
 
-const std::filesystem::path kLobby = std::filesystem::path(RSIBR_CACHE_DIR) / "assets/hdri/lobby.exr";
+using testing::kLobby;
 const std::filesystem::path kPark = std::filesystem::path(RSIBR_CACHE_DIR) / "assets/hdri/park.exr";
 
 struct Rendered {
