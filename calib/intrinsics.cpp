@@ -65,21 +65,33 @@ Mat3 rotation(const std::array<double, 6>& rt) {
   return a > 0 ? Mat3(Eigen::AngleAxisd(a, r / a)) : Mat3::Identity();
 }
 
-// One mrcal_optimize call over the boards of `subset` with one camera at the reference.
-mrcal_stats_t optimize(const IntrinsicsProblem& p, const std::vector<int>& subset, const mrcal_lensmodel_t& model,
-                       std::vector<double>& intrinsics, std::vector<mrcal_pose_t>& frames,
-                       std::vector<mrcal_point3_t>& pool, mrcal_problem_selections_t sel) {
-  const int n = static_cast<int>(subset.size());
+// The problem's layout as mrcal sees it: board k seen by the one camera (at the reference, no
+// extrinsics) as frame k; point ranges mrcal needs only for its point observations (none here).
+std::vector<mrcal_observation_board_t> board_observations(int n) {
   std::vector<mrcal_observation_board_t> obs(n);
   for (int k = 0; k < n; ++k) {
     obs[k].icam.intrinsics = 0;
     obs[k].icam.extrinsics = -1;
     obs[k].iframe = k;
   }
-  const int sizes[2] = {p.width, p.height};
+  return obs;
+}
+
+mrcal_problem_constants_t problem_constants() {
   mrcal_problem_constants_t constants{};
   constants.point_min_range = 1e-3;
   constants.point_max_range = 1e4;
+  return constants;
+}
+
+// One mrcal_optimize call over the boards of `subset` with one camera at the reference.
+mrcal_stats_t optimize(const IntrinsicsProblem& p, const std::vector<int>& subset, const mrcal_lensmodel_t& model,
+                       std::vector<double>& intrinsics, std::vector<mrcal_pose_t>& frames,
+                       std::vector<mrcal_point3_t>& pool, mrcal_problem_selections_t sel) {
+  const int n = static_cast<int>(subset.size());
+  std::vector<mrcal_observation_board_t> obs = board_observations(n);
+  const int sizes[2] = {p.width, p.height};
+  const mrcal_problem_constants_t constants = problem_constants();
   return mrcal_optimize(nullptr, 0, nullptr, 0, intrinsics.data(), nullptr, frames.data(), nullptr, nullptr, 1, 0, n,
                         0, 0, obs.data(), nullptr, n, 0, pool.data(), &model, sizes, sel, &constants, p.spacing_m,
                         p.corners_x, p.corners_y, false, false);
@@ -103,16 +115,9 @@ std::vector<mrcal_point3_t> observation_pool(const IntrinsicsProblem& p, const s
 Eigen::MatrixXd covariance(const IntrinsicsProblem& p, int n, const mrcal_lensmodel_t& model,
                            const std::vector<double>& intrinsics, const std::vector<mrcal_pose_t>& frames,
                            const std::vector<mrcal_point3_t>& pool, mrcal_problem_selections_t sel, double* sigma) {
-  std::vector<mrcal_observation_board_t> obs(n);
-  for (int k = 0; k < n; ++k) {
-    obs[k].icam.intrinsics = 0;
-    obs[k].icam.extrinsics = -1;
-    obs[k].iframe = k;
-  }
+  std::vector<mrcal_observation_board_t> obs = board_observations(n);
   const int sizes[2] = {p.width, p.height};
-  mrcal_problem_constants_t constants{};
-  constants.point_min_range = 1e-3;
-  constants.point_max_range = 1e4;
+  const mrcal_problem_constants_t constants = problem_constants();
   const int nstate = mrcal_num_states(1, 0, n, 0, 0, n, sel, &model);
   const int nmeas = mrcal_num_measurements(n, 0, p.corners_x, p.corners_y, 1, 0, n, 0, 0, sel, &model);
   const int nboard = mrcal_num_measurements_boards(n, p.corners_x, p.corners_y);
