@@ -17,7 +17,7 @@
 int main(int argc, char** argv) {
   using namespace rsibr;
   CLI::App app("Orientation accuracy on rendered views");
-  double radius_px = 120, noise = 0.01, ball_prior_px = 0.25, max_radius_fraction = 0.95, contrast = 0.01;
+  double radius_px = 120, noise = 0.01, ball_prior_px = 0.25, radius_prior_px = 2, max_radius_fraction = 0.95, contrast = 0.01;
   int views = 4, max_features = 800;
   double spacing = 20;
   std::string domain = "cube";
@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "Noise seed");
   app.add_option("--refine", refine, "Refine ball centres jointly (1) or not (0)");
   app.add_option("--ball-prior-px", ball_prior_px, "Ball centre prior floor, pixels");
+  app.add_option("--radius-prior-px", radius_prior_px, "Ball radius prior, pixels (0: held at the outline's)");
   app.add_option("--max-features", max_features, "SIFT features per view");
   app.add_option("--max-radius-fraction", max_radius_fraction, "Features within this fraction of the ball's angular radius");
   app.add_option("--contrast-threshold", contrast, "SIFT contrast threshold");
@@ -50,6 +51,7 @@ int main(int argc, char** argv) {
   std::vector<ViewImage> images;
   std::vector<Mat3> truth;
   std::vector<Vec2> centre;
+  std::vector<double> half_angle;
   std::vector<std::string> names;
   for (int v = 0; v < views; ++v) {
     const auto r = testing::render_view(scene, v, noise, seed + v);
@@ -58,12 +60,14 @@ int main(int argc, char** argv) {
     images.push_back(vi);
     truth.push_back(r.pose.world_from_cam);
     centre.push_back(testing::ball_centre_px(r, 0));
+    half_angle.push_back(std::asin(0.5 * scene.balls.front().diameter_m / testing::ball_centre_cam(r, 0).norm()));
     names.push_back("v" + std::to_string(v));
   }
   ViewOrientationOptions o;
   o.up = truth[0].transpose() * Vec3(0, 1, 0);
   o.refine_balls = refine;
   o.ball_prior_px = ball_prior_px;
+  o.ball_radius_prior_px = radius_prior_px;
   o.features.max_features = max_features;
   o.features.max_radius_fraction = max_radius_fraction;
   o.features.contrast_threshold = contrast;
@@ -91,6 +95,9 @@ int main(int argc, char** argv) {
   }
   for (int v = 0; v < views; ++v) {
     j["centre_error_px"].push_back((rep.balls[v].centre_px - centre[v]).norm());
+    // The half angle's error as pixels of image radius (f * d(tan a) = f / cos^2 a da).
+    const double a = half_angle[v];
+    j["radius_error_px"].push_back(f / (std::cos(a) * std::cos(a)) * (rep.balls[v].fit.cone.half_angle - a));
     j["features"].push_back(rep.features[v]);
   }
   std::cout << j.dump() << "\n";

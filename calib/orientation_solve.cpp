@@ -42,7 +42,8 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
     if (static_cast<int>(options.balls.size()) != views) throw std::invalid_argument("orientation: ball priors must be given for every view or none");
     for (const BallPrior& b : options.balls)
       if (!b.axis.allFinite() || std::abs(b.axis.norm() - 1) > 1e-6 || !(b.half_angle > 0 && b.half_angle < kPi / 2) ||
-          !(b.sigma_axis > 0) || !std::isfinite(b.sigma_axis))
+          !(b.sigma_axis > 0) || !std::isfinite(b.sigma_axis) || !(b.sigma_half_angle >= 0) ||
+          !std::isfinite(b.sigma_half_angle))
         throw std::invalid_argument("orientation: invalid ball prior");
   }
   for (const auto& o : obs) seen[o.view][o.feature] = o.direction;
@@ -107,13 +108,14 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
   ceres::Problem problem;
   const bool refine_balls = !options.balls.empty();
   std::vector<Vec3> axes;
-  for (const BallPrior& b : options.balls) axes.push_back(b.axis);
+  std::vector<double> sines;
+  for (const BallPrior& b : options.balls) axes.push_back(b.axis), sines.push_back(std::sin(b.half_angle));
   for (const auto& o : obs) {
     if (refine_balls && o.ray.squaredNorm() > 0) {
-      auto* cost = new ceres::AutoDiffCostFunction<BallReflectionResidual, 3, 4, 3, 3>(
-          new BallReflectionResidual(o.ray.normalized(), std::sin(options.balls[o.view].half_angle), o.sigma));
+      auto* cost = new ceres::AutoDiffCostFunction<BallReflectionResidual, 3, 4, 3, 1, 3>(
+          new BallReflectionResidual(o.ray.normalized(), o.sigma));
       problem.AddResidualBlock(cost, new ceres::CauchyLoss(options.loss_sigmas), q[o.view].coeffs().data(),
-                               axes[o.view].data(), d[o.feature].data());
+                               axes[o.view].data(), &sines[o.view], d[o.feature].data());
       continue;
     }
     auto* cost = new ceres::AutoDiffCostFunction<DirectionResidual, 3, 4, 3>(new DirectionResidual(o.direction, o.sigma));
@@ -121,10 +123,18 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
   }
   for (int v = 0; v < views && refine_balls; ++v) {
     if (!problem.HasParameterBlock(axes[v].data())) continue;
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BallAxisPrior, 3, 3>(
-                                 new BallAxisPrior(options.balls[v].axis, options.balls[v].sigma_axis)),
+    const BallPrior& b = options.balls[v];
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BallAxisPrior, 3, 3>(new BallAxisPrior(b.axis, b.sigma_axis)),
                              nullptr, axes[v].data());
     problem.SetManifold(axes[v].data(), new ceres::SphereManifold<3>);
+    if (b.sigma_half_angle > 0) {
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<HalfAnglePrior, 1, 1>(new HalfAnglePrior(b.half_angle, b.sigma_half_angle)),
+                               nullptr, &sines[v]);
+      problem.SetParameterLowerBound(&sines[v], 0, 1e-6);
+      problem.SetParameterUpperBound(&sines[v], 0, 1 - 1e-6);
+    } else {
+      problem.SetParameterBlockConstant(&sines[v]);
+    }
   }
   for (int v = 0; v < views; ++v) problem.SetManifold(q[v].coeffs().data(), new ceres::EigenQuaternionManifold);
   for (int f = 0; f < features; ++f)
@@ -146,10 +156,11 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
   out.feature_directions = d;
   for (Vec3& a : axes) a.normalize();
   out.ball_axes = axes;
+  for (double sv : sines) out.ball_half_angles.push_back(std::asin(sv));
   double sum2 = 0;
   for (const auto& o : obs) {
     const Vec3 dir = refine_balls && o.ray.squaredNorm() > 0
-                         ? reflect_off_ball<double>(o.ray.normalized(), axes[o.view], std::sin(options.balls[o.view].half_angle)).normalized()
+                         ? reflect_off_ball<double>(o.ray.normalized(), axes[o.view], sines[o.view]).normalized()
                          : o.direction;
     const double e2 = (out.world_from_cam[o.view] * dir - d[o.feature]).squaredNorm() / (o.sigma * o.sigma);
     ++out.observations;

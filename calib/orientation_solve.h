@@ -40,7 +40,8 @@ struct DirectionObservation {
 struct BallPrior {
   Vec3 axis = Vec3(0, 0, 1);
   double half_angle = 0;
-  double sigma_axis = 0;  // > 0
+  double sigma_axis = 0;        // > 0
+  double sigma_half_angle = 0;  // radians; > 0: the half angle is refined too, with this prior; 0: held
 };
 
 struct OrientationOptions {
@@ -51,7 +52,9 @@ struct OrientationOptions {
   Mat3 first_world_from_cam = Mat3::Identity();  // the gauge
   // Per view, or empty: each view's ball axis a_v joins the problem (ceres::SphereManifold<3>) with
   // the prior residual (a_v - axis) / sigma_axis, and observations with a ray use
-  // BallReflectionResidual. The half angle stays fixed (its error moves directions ~ 100x less).
+  // BallReflectionResidual. The half angle's sine s_v joins too where sigma_half_angle > 0 (prior
+  // (s_v - sin half_angle) / (sigma_half_angle cos half_angle)): an outline found a pixel inside the
+  // limb scales the rim's directions radially, which no rotation absorbs.
   std::vector<BallPrior> balls;
 };
 
@@ -60,6 +63,7 @@ struct OrientationSolution {
   std::vector<double> sigma_deg;        // per view: rotation std dev, all axes together (0 for the gauge view)
   std::vector<Vec3> feature_directions; // per feature, world, unit (zero for unobserved features)
   std::vector<Vec3> ball_axes;          // per view, the refined ball axes (camera frame; with balls only)
+  std::vector<double> ball_half_angles; // per view, the refined half angles (radians; with balls only)
   double rms_sigmas = 0;                // RMS whitened residual over inliers
   int inliers = 0, observations = 0;
 };
@@ -82,9 +86,9 @@ struct DirectionResidual {
 // centred at C = axis / sin(alpha) (axis unit): the ray meets the sphere first at P = t ray,
 // t = b - sqrt(b^2 - (|C|^2 - 1)), b = ray . C; n = P - C; r = ray - 2 (ray . n) n. A ray that misses
 // the ball (b^2 < |C|^2 - 1) is clamped to the tangent point (the discriminant to 0).
-template <class T>
+template <class T, class S>
 Eigen::Matrix<T, 3, 1> reflect_off_ball(const Eigen::Matrix<T, 3, 1>& ray, const Eigen::Matrix<T, 3, 1>& axis,
-                                        double sin_alpha) {
+                                        const S& sin_alpha) {
   using std::sqrt;
   const Eigen::Matrix<T, 3, 1> c = axis / (axis.norm() * T(sin_alpha));
   const T b = ray.dot(c);
@@ -94,20 +98,20 @@ Eigen::Matrix<T, 3, 1> reflect_off_ball(const Eigen::Matrix<T, 3, 1>& ray, const
   return ray - T(2) * ray.dot(n) * n;
 }
 
-// Cost of one observation with its view's ball refined: (R(q) reflect_off_ball(ray, a) - d) / sigma.
+// Cost of one observation with its view's ball refined: (R(q) reflect_off_ball(ray, a, s) - d) / sigma,
+// s the sine of the ball's half angle.
 struct BallReflectionResidual {
-  BallReflectionResidual(const Vec3& ray, double sin_alpha, double sigma)
-      : ray_(ray), sin_alpha_(sin_alpha), inv_sigma_(1.0 / sigma) {}
+  BallReflectionResidual(const Vec3& ray, double sigma) : ray_(ray), inv_sigma_(1.0 / sigma) {}
   template <class T>
-  bool operator()(const T* q, const T* a, const T* d, T* r) const {  // q: x, y, z, w; a: 3; d: 3
+  bool operator()(const T* q, const T* a, const T* s, const T* d, T* r) const {  // q: x, y, z, w; a: 3; s: 1; d: 3
     const Eigen::Map<const Eigen::Quaternion<T>> rot(q);
-    const Eigen::Matrix<T, 3, 1> o = reflect_off_ball<T>(ray_.cast<T>(), Eigen::Matrix<T, 3, 1>(a[0], a[1], a[2]), sin_alpha_);
+    const Eigen::Matrix<T, 3, 1> o = reflect_off_ball<T>(ray_.cast<T>(), Eigen::Matrix<T, 3, 1>(a[0], a[1], a[2]), s[0]);
     const Eigen::Matrix<T, 3, 1> ro = rot * o;
     for (int k = 0; k < 3; ++k) r[k] = (ro[k] - d[k]) * T(inv_sigma_);
     return true;
   }
   Vec3 ray_;
-  double sin_alpha_, inv_sigma_;
+  double inv_sigma_;
 };
 
 // The ball axis prior: (a - axis0) / sigma, 3 values (the chord, = the angle to second order).
@@ -120,6 +124,17 @@ struct BallAxisPrior {
   }
   Vec3 axis_;
   double inv_sigma_;
+};
+
+// The half angle prior: (s - sin alpha0) / (sigma cos alpha0), 1 value (the angle to first order).
+struct HalfAnglePrior {
+  HalfAnglePrior(double alpha, double sigma) : s0_(std::sin(alpha)), inv_sigma_(1.0 / (sigma * std::cos(alpha))) {}
+  template <class T>
+  bool operator()(const T* s, T* r) const {
+    r[0] = (s[0] - T(s0_)) * T(inv_sigma_);
+    return true;
+  }
+  double s0_, inv_sigma_;
 };
 
 // Throws std::invalid_argument("orientation: ...") for fewer than two views, a view that shares fewer

@@ -162,7 +162,8 @@ PoseSet orient_views(const std::vector<std::string>& names, const std::vector<Vi
       const Vec3 t = a.unitOrthogonal();
       const double h = 1e-4;
       const double px_per_rad = (lens.project((a + h * t).normalized()) - lens.project(a)).norm() / h;
-      so.balls.push_back({a, b.fit.cone.half_angle, std::max(b.fit.rms_px, options.ball_prior_px) / px_per_rad});
+      so.balls.push_back({a, b.fit.cone.half_angle, std::max(b.fit.rms_px, options.ball_prior_px) / px_per_rad,
+                          options.ball_radius_prior_px / px_per_rad});
     }
   }
   OrientationSolution s;
@@ -173,7 +174,9 @@ PoseSet orient_views(const std::vector<std::string>& names, const std::vector<Vi
   }
   if (options.refine_balls)
     for (std::size_t v = 0; v < views.size(); ++v) {
+      rep.balls[v].radius_px *= std::tan(s.ball_half_angles[v]) / std::tan(rep.balls[v].fit.cone.half_angle);
       rep.balls[v].fit.cone.axis = s.ball_axes[v];
+      rep.balls[v].fit.cone.half_angle = s.ball_half_angles[v];
       rep.balls[v].centre_px = lens.project(s.ball_axes[v]);
     }
   rep.tracks = tracks;

@@ -49,8 +49,12 @@ struct ViewOrientationOptions {
   CubeFeatureOptions cube;
   // Ball centres refined jointly with the orientations (OrientationOptions::balls), with a prior
   // std dev of the ball centre of max(outline RMS, ball_prior_px) pixels.
+  // The half angle too, with a prior std dev of ball_radius_prior_px pixels of image radius (0: held
+  // at the outline's): a chrome ball's outline is found inside its limb (the limb reflects what lies
+  // just behind the ball, so the steepest edge is further in), 0.3-2 px on a 120 px ball.
   bool refine_balls = true;
   double ball_prior_px = 0.25;
+  double ball_radius_prior_px = 2;
   OrientationOptions solve;            // its first_world_from_cam is set from the gauge
 };
 

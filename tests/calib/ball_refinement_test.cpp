@@ -1,6 +1,7 @@
 // calib/orientation_solve.h with ball centres refined jointly: the reflection geometry
-// (reflect_off_ball), the gradients of BallReflectionResidual and BallAxisPrior, and on synthetic
-// rigs with misplaced ball centres, that the refinement makes the reported uncertainty honest.
+// (reflect_off_ball), the gradients of BallReflectionResidual, BallAxisPrior and HalfAnglePrior, and
+// on synthetic rigs with misplaced ball centres and radii, that the refinement makes the reported
+// uncertainty honest.
 #include "calib/orientation_solve.h"
 
 #include "calib/sphere_map_extraction.h"
@@ -94,23 +95,28 @@ TEST(BallRefinement, CostFunctionsPassTheGradientCheck) {
   std::uniform_real_distribution<double> u(0, 1);
   const ceres::EigenQuaternionManifold qm;
   const ceres::SphereManifold<3> sm;
+  const ceres::EuclideanManifold<1> em;
   for (int trial = 0; trial < 10; ++trial) {
     const Vec3 a0 = (Vec3(0, 0, 1) + 0.2 * testing::random_direction(rng)).normalized();
     const double s = 0.1 + 0.3 * u(rng);
     const Vec3 ray = ray_on_ball(a0, s, 0.9 * u(rng), 2 * kPi * u(rng));
-    ceres::AutoDiffCostFunction<BallReflectionResidual, 3, 4, 3, 3> cost(new BallReflectionResidual(ray, s, 0.003));
+    ceres::AutoDiffCostFunction<BallReflectionResidual, 3, 4, 3, 1, 3> cost(new BallReflectionResidual(ray, 0.003));
     Eigen::Quaterniond q(Eigen::AngleAxisd(3 * u(rng), testing::random_direction(rng)));
     Vec3 a = testing::perturb(a0, 1e-3, rng), d = testing::random_direction(rng);
-    expect_gradient_matches(cost, {q.coeffs().data(), a.data(), d.data()}, {&qm, &sm, &sm}, 3);
+    double sv = s * (1 + 1e-3 * (u(rng) - 0.5));
+    expect_gradient_matches(cost, {q.coeffs().data(), a.data(), &sv, d.data()}, {&qm, &sm, &em, &sm}, 3);
     ceres::AutoDiffCostFunction<BallAxisPrior, 3, 3> prior(new BallAxisPrior(a0, 1e-3));
     expect_gradient_matches(prior, {a.data()}, {&sm}, 3);
+    ceres::AutoDiffCostFunction<HalfAnglePrior, 1, 1> half(new HalfAnglePrior(std::asin(s), 1e-3));
+    expect_gradient_matches(half, {&sv}, {&em}, 1);
   }
 }
 
-// A rig: `views` cameras 20 degrees apart around a ball at 10 radii (sin alpha 0.1) seen with
+// A rig: `views` cameras `spacing_deg` (20) degrees apart around a ball at 10 radii (sin alpha 0.1) seen with
 // f = 1200 px (a 120-px ball), features everywhere in the world, each seen where it reflects
 // within 0.85 of the ball's angular radius and away from the camera, its pixel ray with 0.3 px noise.
-// The located ball axes (the priors) are off by `centre_px` (std dev, per axis) from the truth.
+// The located ball axes (the priors) are off by `centre_px` (std dev, per axis) from the truth, their
+// image radii by `radius_bias_px`.
 struct Rig {
   std::vector<Mat3> world_from_cam;
   std::vector<DirectionObservation> obs;  // directions from the located (wrong) balls; rays from the pixels
@@ -118,13 +124,13 @@ struct Rig {
   int features = 0;
 };
 
-Rig make_rig(int views, double centre_px, std::uint64_t seed) {
+Rig make_rig(int views, double centre_px, std::uint64_t seed, double radius_bias_px = 0, double spacing_deg = 20) {
   std::mt19937_64 rng(seed);
   const double f = 1200, s = 0.1, pixel_noise = 0.3 / f;
   Rig rig;
   std::vector<Vec3> truth_axis;
   for (int v = 0; v < views; ++v) {
-    const double az = v * 20 * kPi / 180;
+    const double az = v * spacing_deg * kPi / 180;
     // Camera looking at the ball (world origin) from azimuth az; columns x right, y down, z forward.
     const Vec3 z(-std::sin(az), 0, -std::cos(az)), y(0, -1, 0);
     Mat3 r;
@@ -133,7 +139,9 @@ Rig make_rig(int views, double centre_px, std::uint64_t seed) {
     const Vec3 axis = testing::perturb(Vec3(0, 0, 1), 0.02, rng);  // the ball near the image centre
     truth_axis.push_back(axis);
     const double sigma_axis = centre_px / f;
-    rig.priors.push_back({testing::perturb(axis, sigma_axis, rng), std::asin(s), std::max(sigma_axis, 1e-6)});
+    // Image radius f tan(alpha): a bias of b px moves alpha by b cos^2(alpha) / f.
+    const double alpha = std::asin(s), half_angle = alpha + radius_bias_px * std::pow(std::cos(alpha), 2) / f;
+    rig.priors.push_back({testing::perturb(axis, sigma_axis, rng), half_angle, std::max(sigma_axis, 1e-6)});
   }
   rig.features = 600;
   for (int k = 0; k < rig.features; ++k) {
@@ -189,6 +197,44 @@ TEST(BallRefinement, MisplacedBallCentresAreCorrectedAndTheUncertaintyIsHonest) 
   EXPECT_GT(chi2_refined / n, 0.3);
   EXPECT_LT(chi2_refined / n, 3.0);
   EXPECT_LT(sum_refined, 0.3 * sum_fixed);
+}
+
+// A chrome ball's outline is found inside its limb (0.3-2 px on a 120-px ball: the limb reflects what
+// lies just behind the ball, so the steepest edge is further in). A radius too small scales every
+// rim direction radially, which no rotation absorbs: with the half angle held, the errors exceed
+// the sigmas; refined under a 2-px prior, the features restore the radius and the sigmas are honest.
+TEST(BallRefinement, ARadiusFoundInsideTheLimbIsCorrectedByRefiningTheHalfAngle) {
+  const double f = 1200, alpha = std::asin(0.1);
+  double chi2_held = 0, chi2_refined = 0, sum_held = 0, sum_refined = 0, radius_refined = 0;
+  int n = 0, balls = 0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    const Rig rig = make_rig(4, 0.25, seed, -1.0);
+    OrientationOptions o;
+    o.first_world_from_cam = rig.world_from_cam[0];
+    o.balls = rig.priors;
+    const OrientationSolution held = solve_orientations(4, rig.features, rig.obs, o);
+    for (BallPrior& b : o.balls) b.sigma_half_angle = 2 * std::pow(std::cos(alpha), 2) / f;
+    const OrientationSolution refined = solve_orientations(4, rig.features, rig.obs, o);
+    ASSERT_EQ(refined.ball_half_angles.size(), 4u);
+    for (int v = 0; v < 4; ++v) {
+      EXPECT_NEAR(held.ball_half_angles[v], rig.priors[v].half_angle, 1e-15);
+      radius_refined += std::abs(refined.ball_half_angles[v] - alpha) * f / std::pow(std::cos(alpha), 2), ++balls;
+    }
+    for (int v = 1; v < 4; ++v) {
+      const double eh = Eigen::AngleAxisd(held.world_from_cam[v].transpose() * rig.world_from_cam[v]).angle() * 180 / kPi;
+      const double er = Eigen::AngleAxisd(refined.world_from_cam[v].transpose() * rig.world_from_cam[v]).angle() * 180 / kPi;
+      chi2_held += std::pow(eh / held.sigma_deg[v], 2);
+      chi2_refined += std::pow(er / refined.sigma_deg[v], 2);
+      sum_held += eh, sum_refined += er, ++n;
+    }
+  }
+  std::printf("  half angle held: mean error %.4f deg, (err/sigma)^2 %.2f; refined: %.4f deg, %.2f; radius error %.3f px\n",
+              sum_held / n, chi2_held / n, sum_refined / n, chi2_refined / n, radius_refined / balls);
+  EXPECT_GT(chi2_held / n, 4.0);
+  EXPECT_GT(chi2_refined / n, 0.3);
+  EXPECT_LT(chi2_refined / n, 3.0);
+  EXPECT_LT(sum_refined, 0.5 * sum_held);
+  EXPECT_LT(radius_refined / balls, 0.4);  // from 1 px; measured 0.25
 }
 
 }  // namespace
