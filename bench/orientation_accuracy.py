@@ -22,6 +22,13 @@ sys.path.insert(0, os.path.join(ROOT, "bench"))
 from convert_roundtrip import replace_section  # noqa: E402
 
 
+def run(exe, argv):
+    out = subprocess.run([exe] + argv, capture_output=True, text=True)
+    if out.returncode != 0:
+        sys.exit("orientation_accuracy: run failed: %s" % out.stderr[-500:])
+    return json.loads(out.stdout)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default=os.path.join(ROOT, "build/release"))
@@ -59,25 +66,35 @@ def main():
     if args.wide_only:
         return
     rows = []
+    modes = (("fixed", ["--refine", "0"]), ("centres", ["--refine", "1", "--radius-prior-px", "0"]),
+             ("centres + radii", ["--refine", "1"]))
     for radius in (120, 200):
         for noise in (0.003, 0.01, 0.03):
-            for refine in (0, 1):
-                errs, chi2, cerr, tracks, secs = [], [], [], [], []
+            for mode, flags in modes:
+                errs, chi2, cerr, rerr, tracks, secs = [], [], [], [], [], []
                 for seed in range(args.seeds):
-                    out = subprocess.run([exe, "--radius-px", str(radius), "--noise", str(noise), "--refine", str(refine),
-                                          "--seed", str(5 + 10 * seed)], capture_output=True, text=True)
-                    if out.returncode != 0:
-                        sys.exit("orientation_accuracy: run failed: %s" % out.stderr[-500:])
-                    j = json.loads(out.stdout)
+                    j = run(exe, ["--radius-px", str(radius), "--noise", str(noise), "--seed", str(5 + 10 * seed)] + flags)
                     errs += j["error_deg"]
                     chi2 += [(e / s) ** 2 for e, s in zip(j["error_deg"], j["sigma_deg"])]
                     cerr += j["centre_error_px"]
+                    rerr += [abs(x) for x in j["radius_error_px"]]
                     tracks.append(j["tracks"])
                     secs.append(j["seconds"])
-                rows.append("| %d | %.3f | %s | %.0f | %.2f | %.3f | %.3f | %.1f | %.1f |" % (
-                    radius, noise, "refined" if refine else "fixed", statistics.mean(tracks), statistics.median(cerr),
+                rows.append("| %d | %.3f | %s | %.0f | %.2f | %.2f | %.3f | %.3f | %.1f | %.1f |" % (
+                    radius, noise, mode, statistics.mean(tracks), statistics.median(cerr), statistics.median(rerr),
                     statistics.median(errs), max(errs), statistics.mean(chi2), statistics.mean(secs)))
                 print(rows[-1], flush=True)
+    ring = []
+    for radius in (120, 200, 400):
+        for views, spacing in ((8, 45), (12, 30)):
+            j = run(exe, ["--radius-px", str(radius), "--views", str(views), "--spacing", str(spacing)])
+            errs = j["error_deg"]
+            chi2 = statistics.mean([(e / s) ** 2 for e, s in zip(errs, j["sigma_deg"])])
+            ring.append("| %d | %d x %d | %d | %.3f | %.3f | %.2f | %.3f | %.3f | %.1f | %.0f |" % (
+                radius, views, spacing, j["tracks"], statistics.median(j["centre_error_px"]), max(j["centre_error_px"]),
+                statistics.median([abs(x) for x in j["radius_error_px"]]), statistics.median(errs), max(errs), chi2,
+                j["seconds"]))
+            print(ring[-1], flush=True)
     load = os.getloadavg()[0]
     body = (
         "Four views 20 degrees apart of a chrome ball (no stand) in the CC0 `lobby` environment, rendered by capture/\n"

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 namespace rsibr {
@@ -22,6 +23,7 @@ struct Rendered {
   std::vector<Mat3> truth;
   std::vector<std::string> names;
   std::vector<Vec2> centre_px;  // the chrome ball's true centre pixel
+  std::vector<double> half_angle;  // and its true angular radius, radians
 };
 
 // Views at the given azimuths around a chrome ball of radius_px (the grey ball beside it, off the
@@ -37,7 +39,7 @@ Rendered render(const std::filesystem::path& env, const std::vector<double>& azi
   scene.views.front().azimuths_deg = azimuths;
   scene.views.front().roll_deg = 7;
   scene.views.front().look_at = scene.balls.front().centre;
-  Rendered r{scene.camera.lens, {}, {}, {}, {}};
+  Rendered r{scene.camera.lens, {}, {}, {}, {}, {}};
   for (std::size_t v = 0; v < azimuths.size(); ++v) {
     const auto view = testing::render_view(scene, static_cast<int>(v), 0.01, 5 + v);
     ViewImage vi;
@@ -46,6 +48,7 @@ Rendered render(const std::filesystem::path& env, const std::vector<double>& azi
     r.truth.push_back(view.pose.world_from_cam);
     r.names.push_back("v" + std::to_string(v));
     r.centre_px.push_back(testing::ball_centre_px(view, 0));
+    r.half_angle.push_back(std::asin(0.5 * scene.balls.front().diameter_m / testing::ball_centre_cam(view, 0).norm()));
   }
   return r;
 }
@@ -112,6 +115,55 @@ TEST(ViewOrientation, RenderedViewsAreRecoveredUpToTheGaugeWithDetectedBalls) {
   for (int v = 1; v < 4; ++v) chi2 += std::pow(angle_deg(p.views[v].world_from_cam, g * r.truth[v]) / p.views[v].sigma_deg, 2) / 3;
   std::printf("  mean (error/sigma)^2 = %.2f\n", chi2);
   EXPECT_LT(chi2, 10.0);
+}
+
+// The accuracy target on a realistic capture: twelve views 30 degrees apart around a
+// 400-px chrome ball (an 800-px disc, a light probe's size in a photograph), 1% noise, nothing given
+// but the lens and the first view's up. The outline alone puts the centre ~0.1-3 px off and the
+// radius 0.3-2 px inside the limb; refined with the features, centres and radii come within a tenth
+// of a pixel. The median orientation error measured 0.048, 0.057 and 0.058 degrees over three noise
+// seeds (this one: 0.048), sigmas 0.05-0.06: at the 0.05, limited by the SIFT keypoints
+// (docs/tradeoffs.md "Orientation"); guarded at 0.07. Centre, radius and orientation are each
+// checked against the renderer's truth.
+TEST(ViewOrientation, ARingOfViewsAroundALightProbeSizedBallIsOrientedToHundredthsOfADegreeAndATenthOfAPixel) {
+  if (!std::filesystem::exists(kLobby)) GTEST_SKIP() << kLobby << " missing (scripts/fetch-assets.sh)";
+  std::vector<double> azimuths;
+  for (int v = 0; v < 12; ++v) azimuths.push_back(30.0 * v);
+  const double radius_px = 400;
+  const Rendered r = render(kLobby, azimuths, radius_px, true);
+  ViewOrientationOptions o;
+  o.up = r.truth[0].transpose() * Vec3(0, 1, 0);
+  ViewOrientationReport rep;
+  const PoseSet p = orient_views(r.names, r.views, r.lens, o, &rep);
+  const Mat3 g = p.views[0].world_from_cam * r.truth[0].transpose();
+  std::vector<double> errors, centres;
+  double chi2 = 0, radius_error = 0;
+  const double f = radius_px * 0.5 / 0.05;  // render()'s focal length
+  for (std::size_t v = 0; v < azimuths.size(); ++v) {
+    centres.push_back((rep.balls[v].centre_px - r.centre_px[v]).norm());
+    const double a = r.half_angle[v];
+    radius_error = std::max(radius_error, std::abs(rep.balls[v].fit.cone.half_angle - a) * f / (std::cos(a) * std::cos(a)));
+    if (v == 0) continue;
+    errors.push_back(angle_deg(p.views[v].world_from_cam, g * r.truth[v]));
+    chi2 += std::pow(errors.back() / p.views[v].sigma_deg, 2) / double(azimuths.size() - 1);
+  }
+  auto median = [](std::vector<double> x) {
+    std::nth_element(x.begin(), x.begin() + long(x.size() / 2), x.end());
+    return x[x.size() / 2];
+  };
+  std::printf("  %d tracks; orientation error median %.4f, max %.4f deg; mean (error/sigma)^2 %.2f; centre error median %.3f, "
+              "max %.3f px; radius error max %.3f px\n",
+              rep.tracks, median(errors), *std::max_element(errors.begin(), errors.end()), chi2, median(centres),
+              *std::max_element(centres.begin(), centres.end()), radius_error);
+  EXPECT_LE(median(errors), 0.07);
+  EXPECT_LT(*std::max_element(errors.begin(), errors.end()), 0.15);
+  // Honest sigmas: the mean of 11 (error/sigma)^2, each ~ chi2_3 / 3 when honest, lies in [0.5, 1.6]
+  // with 99% probability; guarded at [0.3, 2.5].
+  EXPECT_GT(chi2, 0.3);
+  EXPECT_LT(chi2, 2.5);
+  EXPECT_LE(median(centres), 0.1);
+  EXPECT_LT(*std::max_element(centres.begin(), centres.end()), 0.3);
+  EXPECT_LT(radius_error, 0.15);
 }
 
 // Wide baselines: a world feature seen near the ball's centre in one view is near the rim,
