@@ -37,6 +37,12 @@ void check(const PoseSet& p) {
     if (!names.insert(v.name).second) spec_fail(key + ".name", "duplicate view name '" + v.name + "'");
     checked_rotation(v.world_from_cam, key + ".world_from_cam");
     if (!(v.sigma_deg >= 0) || !std::isfinite(v.sigma_deg)) spec_fail(key + ".sigma_deg", "must be a finite number >= 0");
+    if (v.ball) {
+      if (!v.ball->axis.allFinite() || std::abs(v.ball->axis.norm() - 1) > 1e-6)
+        spec_fail(key + ".ball.axis", "expected a unit vector");
+      if (!(v.ball->half_angle > 0 && v.ball->half_angle < kPi / 2))
+        spec_fail(key + ".ball.half_angle_deg", "must lie in (0, 90)");
+    }
   }
 }
 
@@ -58,7 +64,7 @@ PoseSet read_pose_file(const std::string& path) {
     const YAML::Node views = top.get("views");
     if (!views.IsSequence() || views.size() == 0) spec_fail(top.at("views"), "expected a non-empty sequence");
     for (std::size_t i = 0; i < views.size(); ++i) {
-      YamlMap v(views[i], top.at("views") + "[" + std::to_string(i) + "]", {"name", "world_from_cam", "sigma_deg"});
+      YamlMap v(views[i], top.at("views") + "[" + std::to_string(i) + "]", {"name", "world_from_cam", "sigma_deg", "ball"});
       ViewPose pose;
       pose.name = v.string("name");
       const std::vector<double> m = v.numbers("world_from_cam");
@@ -67,6 +73,15 @@ PoseSet read_pose_file(const std::string& path) {
       for (int k = 0; k < 9; ++k) r(k / 3, k % 3) = m[k];
       pose.world_from_cam = checked_rotation(r, v.at("world_from_cam"));
       pose.sigma_deg = v.number_in("sigma_deg", 0, false, std::numeric_limits<double>::infinity(), true);
+      if (v.has("ball")) {
+        YamlMap b(v.get("ball"), v.at("ball"), {"axis", "half_angle_deg"});
+        const Vec3 axis = b.vec3("axis");
+        if (!axis.allFinite() || std::abs(axis.norm() - 1) > 1e-6) spec_fail(b.at("axis"), "expected a unit vector");
+        BallCone cone;
+        cone.axis = axis.normalized();
+        cone.half_angle = b.number_in("half_angle_deg", 0, true, 90, true) * kPi / 180;
+        pose.ball = cone;
+      }
       p.views.push_back(pose);
     }
     check(p);
@@ -95,6 +110,11 @@ void write_pose_file(const std::string& path, const PoseSet& poses) {
     // The std dev with 6 significant digits: an estimate, and its last bits vary between runs (the
     // sparse factorisations behind ceres::Covariance), which would break same input -> same bytes.
     out << "]\n    sigma_deg: " << std::setprecision(6) << v.sigma_deg << std::setprecision(17) << "\n";
+    if (v.ball) {
+      const Vec3& a = v.ball->axis;
+      out << "    ball: {axis: [" << a.x() << ", " << a.y() << ", " << a.z()
+          << "], half_angle_deg: " << v.ball->half_angle * 180 / kPi << "}\n";
+    }
   }
   write_atomically(path, [&](const std::string& tmp) {
     std::ofstream f(tmp, std::ios::binary);

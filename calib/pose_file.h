@@ -4,14 +4,21 @@
 //   rsibr_poses: 1
 //   gauge: first-view            # or "up": how the world frame was fixed (calib/view_orientation.h)
 //   views:
-//     - {name: north, world_from_cam: [9 numbers, row-major], sigma_deg: 0.03}
+//     - {name: north, world_from_cam: [9 numbers, row-major], sigma_deg: 0.03,
+//        ball: {axis: [x, y, z], half_angle_deg: 5.7}}     # optional
 //
 // world_from_cam: columns = the camera's x (right), y (down), z (forward) axes in the world frame;
 // a proper rotation (checked to 1e-6, then re-orthonormalised). sigma_deg: the orientation's std
-// dev in degrees, all axes together (0 for the gauge view when the gauge is "first-view").
+// dev in degrees, all axes together (0 for the gauge view when the gauge is "first-view"). ball: the
+// chrome ball's cone (calib/ball_cone.h; axis unit in the camera frame, half angle in (0, 90)
+// degrees) as refined with the orientations, which is nearer the truth than the outline's (the
+// outline lies inside a mirror ball's limb); extraction uses it for the chrome ball.
 #pragma once
 
+#include "calib/ball_cone.h"
 #include "core/vec.h"
+
+#include <optional>
 
 #include <string>
 #include <vector>
@@ -22,6 +29,7 @@ struct ViewPose {
   std::string name;
   Mat3 world_from_cam = Mat3::Identity();
   double sigma_deg = 0;
+  std::optional<BallCone> ball;  // the chrome ball refined by the orientation solve, when known
 };
 
 struct PoseSet {

@@ -115,6 +115,12 @@ Mat3 gauge_world_from_first_cam(const std::optional<Vec3>& up) {
   return cam_from_world.transpose();
 }
 
+BallCone extraction_cone(const BallLocation& located, const ViewPose& pose, const LensModel& lens) {
+  if (!pose.ball) return located.fit.cone;
+  const Vec2 c = lens.project(pose.ball->axis);
+  return c.allFinite() && (c - located.centre_px).norm() < 0.5 * located.radius_px ? *pose.ball : located.fit.cone;
+}
+
 PoseSet orient_views(const std::vector<std::string>& names, const std::vector<ViewImage>& views, const LensModel& lens,
                      const ViewOrientationOptions& options, ViewOrientationReport* report) {
   if (names.size() != views.size()) throw std::invalid_argument("orient: names and views differ in number");
@@ -189,7 +195,10 @@ PoseSet orient_views(const std::vector<std::string>& names, const std::vector<Vi
       throw std::runtime_error("orient: the orientations are not determined by the features (singular covariance)");
   PoseSet out;
   out.gauge = options.up ? "up" : "first-view";
-  for (std::size_t v = 0; v < views.size(); ++v) out.views.push_back({names[v], s.world_from_cam[v], s.sigma_deg[v]});
+  for (std::size_t v = 0; v < views.size(); ++v) {
+    out.views.push_back({names[v], s.world_from_cam[v], s.sigma_deg[v], std::nullopt});
+    if (options.refine_balls) out.views.back().ball = rep.balls[v].fit.cone;
+  }
   return out;
 }
 

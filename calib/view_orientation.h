@@ -70,6 +70,11 @@ struct ViewOrientationReport {
 // std::invalid_argument for a zero or non-finite up.
 Mat3 gauge_world_from_first_cam(const std::optional<Vec3>& up);
 
+// The cone to extract a located ball with: the pose's refined chrome ball (ViewPose::ball) when it is
+// the same ball (its centre's pixel within half the located radius of the located centre), else the
+// located outline's.
+BallCone extraction_cone(const BallLocation& located, const ViewPose& pose, const LensModel& lens);
+
 // `names` and `views` parallel, >= 2 views, all of the lens's size. Throws std::invalid_argument
 // with a message naming the view ("<name>: no ball found", "orient: view '<name>' shares 0
 // feature(s) with the other views; ...", "orient: 1 view(s), need at least 2") or

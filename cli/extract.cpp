@@ -6,6 +6,7 @@
 
 #include "calib/ball_locator.h"
 #include "calib/pose_file.h"
+#include "calib/view_orientation.h"
 #include "calib/sphere_map_extraction.h"
 #include "calib/view_image.h"
 #include "core/atomic_file.h"
@@ -100,6 +101,16 @@ int run_extract(const ExtractArgs& a) {
     o.stand_mask_deg = a.stand_mask_deg;
   }
   o.material = o.mirror ? "{type: mirror}" : "{type: lambert}";
+  // A chrome ball with --poses: the pose file's ball refined with the orientations (rsibr orient),
+  // when it is this ball; the outline lies inside a mirror ball's limb.
+  const ViewPose* pose = poses ? poses->find(pose_name) : nullptr;
+  bool ball_from_pose = false;
+  if (pose && o.mirror) {
+    const BallCone cone = extraction_cone(loc, *pose, lens);
+    ball_from_pose = pose->ball && cone.axis == pose->ball->axis;
+    loc.fit.cone = cone;
+    loc.centre_px = lens.project(cone.axis);
+  }
   MapView mv = extract_sphere_map(view.radiance, view.flags, lens, loc.fit.cone, world_from_cam, o);
   std::ostringstream centre;
   centre.precision(10);
@@ -135,6 +146,7 @@ int run_extract(const ExtractArgs& a) {
                {"rms_px", loc.fit.rms_px}};
   j["pose_from_header"] = view.world_from_cam.has_value() && !poses;
   j["pose_from_file"] = poses ? nlohmann::json(pose_name) : nlohmann::json(nullptr);
+  j["ball_from_pose"] = ball_from_pose;
   j["mean_confidence_in_disc"] = cv::mean(conf, conf > 0)[0];
   j["confident_fraction"] = cv::countNonZero(conf > 0.5) / (kPi / 4 * a.size * a.size);
   write_summary(a.json, j);
@@ -170,7 +182,9 @@ Runner add_extract(CLI::App& app) {
       ->check(CLI::Range(0.0, 90.0));
   c->add_option("--stand-mask-deg", a->stand_mask_deg, "Mask directions within this of straight down")->check(CLI::Range(0.0, 90.0));
   c->add_flag("--no-stand", a->no_stand, "No stand mask");
-  c->add_option("--poses", a->poses, "Pose file (rsibr orient): the world frame of the entry named like the image");
+  c->add_option("--poses", a->poses,
+                "Pose file (rsibr orient): the world frame of the entry named like the image, and for a chrome ball "
+                "its cone as refined with the orientations");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   c->add_flag("-q,--quiet", a->quiet, "No report line");
   return [a] { return run_extract(*a); };

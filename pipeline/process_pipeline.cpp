@@ -395,7 +395,8 @@ void step_extract(Context& c) {
       std::stable_sort(by_kind.begin(), by_kind.end(), [&](std::size_t p, std::size_t q) {
         return kind_rank(c.set.balls[p].kind) > kind_rank(c.set.balls[q].kind);
       });
-      const Mat3 world_from_cam = poses.find(v.name)->world_from_cam;
+      const ViewPose& pose = *poses.find(v.name);
+      const Mat3 world_from_cam = pose.world_from_cam;
       nlohmann::json vj = {{"name", v.name}, {"balls", nlohmann::json::array()}};
       for (std::size_t k = 0; k < by_kind.size(); ++k) {
         const std::size_t bi = by_kind[k];
@@ -408,7 +409,9 @@ void step_extract(Context& c) {
         eo.camera_mask_deg = eo.mirror ? 12.0 : 0.0;
         eo.down = world_from_cam.transpose() * world_down;
         eo.material = eo.mirror ? "{type: mirror}" : "{type: lambert}";
-        MapView mv = extract_sphere_map(img.radiance, img.flags, lens, loc.fit.cone, world_from_cam, eo);
+        // The chrome ball as refined with the orientations (the outline lies inside its limb).
+        const BallCone cone = eo.mirror ? extraction_cone(loc, pose, lens) : loc.fit.cone;
+        MapView mv = extract_sphere_map(img.radiance, img.flags, lens, cone, world_from_cam, eo);
         mv.attributes["image"] = v.name;
         mv.attributes["ball"] = ball.name;
         mv.attributes["ballKind"] = to_string(ball.kind);

@@ -36,6 +36,10 @@ TEST(PoseFile, RoundTripKeepsRotationsExactAndSigmasToSixDigits) {
   p.gauge = "up";
   p.views.push_back({"north", Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix(), 0.0312345678901});
   p.views.push_back({"with space: and 'quote'", Eigen::AngleAxisd(-2.9, Vec3(0, 1, 0)).toRotationMatrix(), 0});
+  BallCone ball;
+  ball.axis = Vec3(0.1, -0.2, 1).normalized();
+  ball.half_angle = 0.0998;
+  p.views[1].ball = ball;
   const fs::path f = temp_dir() / "poses.yaml";
   write_pose_file(f.string(), p);
   const PoseSet q = read_pose_file(f.string());
@@ -47,6 +51,11 @@ TEST(PoseFile, RoundTripKeepsRotationsExactAndSigmasToSixDigits) {
     // Re-orthonormalising an orthonormal matrix written with 17 digits moves it by rounding only.
     EXPECT_LT((q.views[v].world_from_cam - p.views[v].world_from_cam).cwiseAbs().maxCoeff(), 1e-15);
   }
+  // The refined ball: absent stays absent; present comes back to rounding.
+  EXPECT_FALSE(q.views[0].ball.has_value());
+  ASSERT_TRUE(q.views[1].ball.has_value());
+  EXPECT_LT((q.views[1].ball->axis - ball.axis).norm(), 1e-15);
+  EXPECT_NEAR(q.views[1].ball->half_angle, ball.half_angle, 1e-15);
   ASSERT_NE(q.find("north"), nullptr);
   EXPECT_EQ(q.find("south"), nullptr);
   fs::remove_all(f.parent_path());
@@ -76,6 +85,15 @@ TEST(PoseFile, StrictReadingNamesTheFileAndTheKey) {
       {"rsibr_poses: 1\ngauge: up\nviews: [{name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, .nan], sigma_deg: 0}]\n",
        "world_from_cam"},
       {"rsibr_poses: 1\ngauge: [up\n", "poses.yaml"},
+      {"rsibr_poses: 1\ngauge: up\nviews: [{name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], sigma_deg: 0, "
+       "ball: {axis: [0, 0, 2], half_angle_deg: 5}}]\n",
+       "poses.views[0].ball.axis: expected a unit vector"},
+      {"rsibr_poses: 1\ngauge: up\nviews: [{name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], sigma_deg: 0, "
+       "ball: {axis: [0, 0, 1], half_angle_deg: 90}}]\n",
+       "poses.views[0].ball.half_angle_deg"},
+      {"rsibr_poses: 1\ngauge: up\nviews: [{name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], sigma_deg: 0, "
+       "ball: {axis: [0, 0, 1]}}]\n",
+       "poses.views[0].ball.half_angle_deg: missing"},
   };
   for (const Case& c : cases) {
     const fs::path f = d / "poses.yaml";

@@ -117,6 +117,27 @@ TEST(ViewOrientation, RenderedViewsAreRecoveredUpToTheGaugeWithDetectedBalls) {
   EXPECT_LT(chi2, 10.0);
 }
 
+// poses.yaml carries each view's chrome ball as refined with the orientations; extraction takes it
+// for the located ball it describes (centre within half a radius) and keeps the outline's otherwise.
+TEST(ViewOrientation, ExtractionTakesThePoseFilesRefinedBallOnlyForTheSameBall) {
+  const LensModel lens = LensModel::pinhole(1000, 640, 480);
+  BallLocation loc;
+  loc.fit.cone.axis = lens.unproject(Vec2(320, 240)).normalized();
+  loc.fit.cone.half_angle = 0.1;
+  loc.centre_px = Vec2(320, 240);
+  loc.radius_px = 100;
+  ViewPose pose;
+  EXPECT_EQ(extraction_cone(loc, pose, lens).half_angle, 0.1);  // no ball in the pose file
+  BallCone refined;
+  refined.axis = lens.unproject(Vec2(320.3, 239.8)).normalized();
+  refined.half_angle = 0.1008;
+  pose.ball = refined;
+  EXPECT_EQ(extraction_cone(loc, pose, lens).half_angle, 0.1008);
+  EXPECT_EQ(extraction_cone(loc, pose, lens).axis, refined.axis);
+  pose.ball->axis = lens.unproject(Vec2(480, 240)).normalized();  // another ball (the grey one beside it)
+  EXPECT_EQ(extraction_cone(loc, pose, lens).half_angle, 0.1);
+}
+
 // The accuracy target on a realistic capture: twelve views 30 degrees apart around a
 // 400-px chrome ball (an 800-px disc, a light probe's size in a photograph), 1% noise, nothing given
 // but the lens and the first view's up. The outline alone puts the centre ~0.1-3 px off and the
