@@ -187,6 +187,26 @@ void board_residuals(const IntrinsicsProblem& p, int board, const LensModel& len
       out.push_back(p.boards[board].corners[k] - lens.project(r * Vec3(i * p.spacing_m, j * p.spacing_m, 0) + t));
 }
 
+// OpenCV's planar calibration of `subset` with the distortion held at zero: a pinhole core and each
+// board's pose, the seed of every mrcal solve.
+struct PinholeSeed {
+  cv::Mat k;                      // 3x3 CV_64F
+  std::vector<cv::Mat> rvecs, tvecs;  // board -> camera, one per subset entry
+};
+PinholeSeed pinhole_seed(const IntrinsicsProblem& p, const std::vector<int>& subset) {
+  std::vector<std::vector<cv::Point3f>> object;
+  std::vector<std::vector<cv::Point2f>> image;
+  for (int i : subset) {
+    object.push_back(board_points(p));
+    image.push_back(image_points(p.boards[i]));
+  }
+  PinholeSeed seed;
+  cv::Mat dist;
+  cv::calibrateCamera(object, image, cv::Size(p.width, p.height), seed.k, dist, seed.rvecs, seed.tvecs,
+                      cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3 | cv::CALIB_ZERO_TANGENT_DIST);
+  return seed;
+}
+
 }  // namespace
 
 IntrinsicsFit fit_intrinsics(const IntrinsicsProblem& p, const std::string& model_name, const std::vector<int>& subset_in) {
@@ -195,17 +215,8 @@ IntrinsicsFit fit_intrinsics(const IntrinsicsProblem& p, const std::string& mode
   const mrcal_lensmodel_t model = lensmodel(model_name);
   const int nparams = mrcal_lensmodel_num_params(&model);
 
-  // Seed: OpenCV's planar calibration with the distortion held at zero (a pinhole core and poses).
-  std::vector<std::vector<cv::Point3f>> object;
-  std::vector<std::vector<cv::Point2f>> image;
-  for (int i : subset) {
-    object.push_back(board_points(p));
-    image.push_back(image_points(p.boards[i]));
-  }
-  cv::Mat k, dist;
-  std::vector<cv::Mat> rvecs, tvecs;
-  cv::calibrateCamera(object, image, cv::Size(p.width, p.height), k, dist, rvecs, tvecs,
-                      cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3 | cv::CALIB_ZERO_TANGENT_DIST);
+  const PinholeSeed seed = pinhole_seed(p, subset);
+  const cv::Mat& k = seed.k;
   std::vector<double> intrinsics(nparams, 0.0);
   intrinsics[0] = k.at<double>(0, 0);
   intrinsics[1] = k.at<double>(1, 1);
@@ -214,8 +225,8 @@ IntrinsicsFit fit_intrinsics(const IntrinsicsProblem& p, const std::string& mode
   std::vector<mrcal_pose_t> frames(subset.size());
   for (std::size_t b = 0; b < subset.size(); ++b)
     for (int c = 0; c < 3; ++c) {
-      frames[b].r.xyz[c] = rvecs[b].at<double>(c);
-      frames[b].t.xyz[c] = tvecs[b].at<double>(c);
+      frames[b].r.xyz[c] = seed.rvecs[b].at<double>(c);
+      frames[b].t.xyz[c] = seed.tvecs[b].at<double>(c);
     }
   std::vector<mrcal_point3_t> pool = observation_pool(p, subset);
 
@@ -285,16 +296,7 @@ std::string splined_candidate(const IntrinsicsProblem& p, int nx) {
   if (nx < 4) throw std::invalid_argument("splined_candidate: Nx must be >= 4");
   const std::vector<int> all = all_boards(p);
   check(p, all);
-  std::vector<std::vector<cv::Point3f>> object;
-  std::vector<std::vector<cv::Point2f>> image;
-  for (int i : all) {
-    object.push_back(board_points(p));
-    image.push_back(image_points(p.boards[i]));
-  }
-  cv::Mat k, dist;
-  std::vector<cv::Mat> rvecs, tvecs;
-  cv::calibrateCamera(object, image, cv::Size(p.width, p.height), k, dist, rvecs, tvecs,
-                      cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3 | cv::CALIB_ZERO_TANGENT_DIST);
+  const cv::Mat k = pinhole_seed(p, all).k;
   const double fx = k.at<double>(0, 0), cx = k.at<double>(0, 2);
   const double half = std::max(cx + 0.5, p.width - 0.5 - cx);
   const double fov = std::ceil(1.15 * 2 * std::atan(half / fx) * 180 / M_PI);
