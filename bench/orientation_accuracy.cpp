@@ -22,7 +22,8 @@ int main(int argc, char** argv) {
   double spacing = 20;
   std::string domain = "cube";
   std::uint64_t seed = 5;
-  bool refine = true;
+  bool refine = true, refine_tracks = true;
+  int patch_half = 7;
   std::string env = std::string(RSIBR_CACHE_DIR) + "/assets/hdri/lobby.exr";
   app.add_option("--radius-px", radius_px, "Ball radius in pixels");
   app.add_option("--noise", noise, "Relative noise std dev");
@@ -32,6 +33,8 @@ int main(int argc, char** argv) {
   app.add_option("--env", env, "Environment EXR");
   app.add_option("--seed", seed, "Noise seed");
   app.add_option("--refine", refine, "Refine ball centres jointly (1) or not (0)");
+  app.add_option("--refine-tracks", refine_tracks, "Re-locate the tracks by patch alignment (1) or keep SIFT's (0)");
+  app.add_option("--patch-half-size", patch_half, "Half size of the alignment patch, texels");
   app.add_option("--ball-prior-px", ball_prior_px, "Ball centre prior floor, pixels");
   app.add_option("--radius-prior-px", radius_prior_px, "Ball radius prior, pixels (0: held at the outline's)");
   app.add_option("--max-features", max_features, "SIFT features per view");
@@ -66,6 +69,8 @@ int main(int argc, char** argv) {
   ViewOrientationOptions o;
   o.up = truth[0].transpose() * Vec3(0, 1, 0);
   o.refine_balls = refine;
+  o.refine_tracks = refine_tracks;
+  o.tracks.half_size = patch_half;
   o.ball_prior_px = ball_prior_px;
   o.ball_radius_prior_px = radius_prior_px;
   o.features.max_features = max_features;
@@ -88,7 +93,10 @@ int main(int argc, char** argv) {
   const Mat3 g = p.views[0].world_from_cam * truth[0].transpose();
   nlohmann::json j = {{"radius_px", radius_px}, {"noise", noise}, {"views", views}, {"spacing", spacing},
                       {"domain", domain}, {"seed", seed}, {"refine", refine},
-                      {"tracks", rep.tracks}, {"rms_sigmas", rep.rms_sigmas}, {"seconds", seconds}};
+                      {"refine_tracks", refine_tracks}, {"tracks", rep.tracks}, {"rms_sigmas", rep.rms_sigmas},
+                      {"relocated", rep.track_refinement.observations_refined},
+                      {"dropped", rep.track_refinement.observations_dropped},
+                      {"sigma_ratio", rep.track_refinement.median_sigma_ratio}, {"seconds", seconds}};
   for (int v = 1; v < views; ++v) {
     j["error_deg"].push_back(Eigen::AngleAxisd(p.views[v].world_from_cam.transpose() * g * truth[v]).angle() * 180 / kPi);
     j["sigma_deg"].push_back(p.views[v].sigma_deg);

@@ -73,6 +73,23 @@ Vec3 CubeFace::direction(double u, double v) const {
   return (axis + step * (u - c) * right + step * (v - c) * down).normalized();
 }
 
+std::optional<Vec2> CubeFace::texel(const Vec3& r) const {
+  const double z = r.dot(axis);
+  if (!(z > 1e-9)) return std::nullopt;
+  const double c = (size - 1) / 2.0;
+  return Vec2(c + r.dot(right) / (z * step), c + r.dot(down) / (z * step));
+}
+
+std::optional<BallPixel> ball_pixel_of(const LensModel& lens, const BallCone& cone, const BallFeatureOptions& options,
+                                       const Vec3& r) {
+  const BallGeometry g = geometry_of(cone, options);
+  const auto q = pixel_of(lens, g, r);
+  if (!q) return std::nullopt;
+  const double per_px = radians_per_pixel(lens, g, std::sin(cone.half_angle), *q);
+  if (!std::isfinite(per_px)) return std::nullopt;
+  return BallPixel{*q, lens.unproject(*q).normalized(), per_px};
+}
+
 std::vector<CubeFace> ball_cube_faces(const cv::Mat& image, const cv::Mat& flags, const LensModel& lens,
                                       const BallCone& cone, const BallFeatureOptions& options,
                                       const CubeFeatureOptions& cube, unsigned char clipped_mask) {
@@ -132,9 +149,16 @@ std::vector<CubeFace> ball_cube_faces(const cv::Mat& image, const cv::Mat& flags
 BallFeatures ball_cube_features(const cv::Mat& image, const cv::Mat& flags, const LensModel& lens, const BallCone& cone,
                                 const BallFeatureOptions& options, const CubeFeatureOptions& cube,
                                 unsigned char clipped_mask) {
-  const std::vector<CubeFace> faces = ball_cube_faces(image, flags, lens, cone, options, cube, clipped_mask);
-  const BallGeometry g = geometry_of(cone, options);
-  const double sin_alpha = std::sin(cone.half_angle);
+  return ball_cube_feature_set(image, flags, lens, cone, options, cube, clipped_mask).features;
+}
+
+CubeFeatureSet ball_cube_feature_set(const cv::Mat& image, const cv::Mat& flags, const LensModel& lens,
+                                     const BallCone& cone, const BallFeatureOptions& options,
+                                     const CubeFeatureOptions& cube, unsigned char clipped_mask) {
+  CubeFeatureSet set;
+  set.faces = ball_cube_faces(image, flags, lens, cone, options, cube, clipped_mask);
+  std::vector<CubeFace>& faces = set.faces;
+  BallFeatures& out = set.features;
   // One tone map for all faces: log luminance (+ eps, 1e-3 of the mean), scaled to 8 bits over the
   // valid texels' range; invalid texels get the valid mean (no false edges at the mask's border).
   std::vector<cv::Mat> lg(6);
@@ -151,8 +175,8 @@ BallFeatures ball_cube_features(const cv::Mat& image, const cv::Mat& flags, cons
     for (int v = 0; v < faces[f].size; ++v)
       for (int u = 0; u < faces[f].size; ++u)
         if (faces[f].valid.at<unsigned char>(v, u)) lum_sum += lg[f].at<float>(v, u), ++count;
-  BallFeatures out;
-  if (count == 0) return out;
+  for (CubeFace& face : faces) face.radiance.release();
+  if (count == 0) return set;
   const double eps = std::max(1e-3 * lum_sum / count, 1e-30);
   for (int f = 0; f < 6; ++f)
     for (int v = 0; v < faces[f].size; ++v)
@@ -162,7 +186,8 @@ BallFeatures ball_cube_features(const cv::Mat& image, const cv::Mat& flags, cons
         if (!faces[f].valid.at<unsigned char>(v, u)) continue;
         sum += x, lo = std::min(lo, double(x)), hi = std::max(hi, double(x));
       }
-  if (!(hi > lo)) return out;
+  for (int f = 0; f < 6; ++f) faces[f].log_luminance = lg[f].clone();
+  if (!(hi > lo)) return set;
   const double mean = sum / count;
   struct Candidate {
     float response;
@@ -196,17 +221,17 @@ BallFeatures ball_cube_features(const cv::Mat& image, const cv::Mat& flags, cons
   if (options.max_features > 0 && static_cast<int>(cands.size()) > options.max_features) cands.resize(options.max_features);
   for (const Candidate& c : cands) {
     const Vec3 r = faces[c.face].direction(c.kp.pt.x, c.kp.pt.y);
-    const auto q = pixel_of(lens, g, r);
-    if (!q) continue;
-    const double per_px = radians_per_pixel(lens, g, sin_alpha, *q);
-    if (!std::isfinite(per_px)) continue;
+    const auto b = ball_pixel_of(lens, cone, options, r);
+    if (!b) continue;
     out.directions.push_back(r);
-    out.sigma.push_back(std::max(options.sigma_px * per_px, 1e-6));
-    out.pixels.push_back(*q);
-    out.rays.push_back(lens.unproject(*q).normalized());
+    out.sigma.push_back(std::max(options.sigma_px * b->radians_per_pixel, 1e-6));
+    out.pixels.push_back(b->pixel);
+    out.rays.push_back(b->ray);
     out.descriptors.push_back(c.desc);
+    set.face.push_back(c.face);
+    set.face_uv.push_back(Vec2(c.kp.pt.x, c.kp.pt.y));
   }
-  return out;
+  return set;
 }
 
 }  // namespace rsibr

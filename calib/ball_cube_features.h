@@ -31,6 +31,9 @@
 
 #include <opencv2/core.hpp>
 
+#include <optional>
+#include <vector>
+
 namespace rsibr {
 
 struct CubeFeatureOptions {
@@ -39,26 +42,52 @@ struct CubeFeatureOptions {
   double min_face_size = 32, max_face_size = 1024;
 };
 
-// `image` CV_32FC3 linear RGB of the lens's size; `flags` empty or CV_8UC1 of that size (hdr/merge.h
-// bits; those in `clipped_mask` invalidate a texel). Uses options' max_features (the strongest
-// responses over all faces), sigma_px, max_radius_fraction, camera_mask_deg, contrast_threshold.
-BallFeatures ball_cube_features(const cv::Mat& image, const cv::Mat& flags, const LensModel& lens, const BallCone& cone,
-                                const BallFeatureOptions& options = {}, const CubeFeatureOptions& cube = {},
-                                unsigned char clipped_mask = 1);
-
-// The gnomonic face resampling alone (for tests and figures): face f's log-luminance image and its
-// validity mask (CV_32FC1, CV_8UC1 255 valid), N x N texels; face axes in the order +x -x +y -y +z -z.
+// The gnomonic face resampling alone (for tests and figures): face f's linear radiance and its
+// validity mask (CV_32FC3, CV_8UC1 255 valid), N x N texels; face axes in the order +x -x +y -y +z -z.
 struct CubeFace {
   Vec3 axis, right, down;
   int size = 0;
   double step = 0;  // s above: tan units per texel
   cv::Mat radiance;  // CV_32FC3, linear
   cv::Mat valid;     // CV_8UC1
+  cv::Mat log_luminance;  // CV_32FC1: what SIFT saw (log(luminance + eps)); filled by ball_cube_feature_set only
   // The camera-frame direction of texel position (u, v) (sub-texel, gnomonic inverse).
   Vec3 direction(double u, double v) const;
+  // The texel position of camera-frame direction r (gnomonic), or nullopt when r is not in front of the face.
+  std::optional<Vec2> texel(const Vec3& r) const;
 };
 std::vector<CubeFace> ball_cube_faces(const cv::Mat& image, const cv::Mat& flags, const LensModel& lens,
                                       const BallCone& cone, const BallFeatureOptions& options = {},
                                       const CubeFeatureOptions& cube = {}, unsigned char clipped_mask = 1);
+
+// The features with what made them: the faces (log_luminance filled, radiance released) and each
+// feature's face and sub-texel position there (for calib/track_refinement.h).
+struct CubeFeatureSet {
+  BallFeatures features;
+  std::vector<CubeFace> faces;
+  std::vector<int> face;       // per feature
+  std::vector<Vec2> face_uv;   // per feature, texels
+};
+
+// `image` CV_32FC3 linear RGB of the lens's size; `flags` empty or CV_8UC1 of that size (hdr/merge.h
+// bits; those in `clipped_mask` invalidate a texel). Uses options' max_features (the strongest
+// responses over all faces), sigma_px, max_radius_fraction, camera_mask_deg, contrast_threshold.
+CubeFeatureSet ball_cube_feature_set(const cv::Mat& image, const cv::Mat& flags, const LensModel& lens,
+                                     const BallCone& cone, const BallFeatureOptions& options = {},
+                                     const CubeFeatureOptions& cube = {}, unsigned char clipped_mask = 1);
+BallFeatures ball_cube_features(const cv::Mat& image, const cv::Mat& flags, const LensModel& lens, const BallCone& cone,
+                                const BallFeatureOptions& options = {}, const CubeFeatureOptions& cube = {},
+                                unsigned char clipped_mask = 1);
+
+// Where the ball shows the reflected direction r (camera frame, unit): the pixel, its unit camera
+// ray, and the angle r turns per pixel there (|dr/dq|, the larger axis). nullopt when r is not seen
+// in the ball's usable part (options' max_radius_fraction and camera_mask_deg), or off the image.
+struct BallPixel {
+  Vec2 pixel;
+  Vec3 ray;
+  double radians_per_pixel = 0;
+};
+std::optional<BallPixel> ball_pixel_of(const LensModel& lens, const BallCone& cone, const BallFeatureOptions& options,
+                                       const Vec3& r);
 
 }  // namespace rsibr

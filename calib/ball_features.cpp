@@ -120,7 +120,7 @@ std::vector<DirectionObservation> match_ball_features(const std::vector<BallFeat
       if (seen[v]) continue;
       seen[v] = 1;
       obs.push_back({v, id, views[v].directions[i], views[v].sigma[i],
-                     i < static_cast<int>(views[v].rays.size()) ? views[v].rays[i] : Vec3::Zero()});
+                     i < static_cast<int>(views[v].rays.size()) ? views[v].rays[i] : Vec3::Zero(), i});
     }
     ++id;
   }

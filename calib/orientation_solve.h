@@ -33,6 +33,7 @@ struct DirectionObservation {
   // view (OrientationOptions::balls) the direction is recomputed from it and the view's ball axis in
   // the solve (BallReflectionResidual), so the ball centre is refined by the features.
   Vec3 ray = Vec3::Zero();
+  int index = -1;     // the feature's index among its view's detections (calib/ball_features.h), or -1
 };
 
 // A view's ball as located in its image (calib/ball_cone.h), with the std dev of its axis

@@ -133,6 +133,8 @@ PoseSet orient_views(const std::vector<std::string>& names, const std::vector<Vi
   const double rmax = options.max_radius_px > 0 ? options.max_radius_px : m / 2;
   ViewOrientationReport rep;
   std::vector<BallFeatures> feats;
+  std::vector<CubeFeatureSet> sets;  // cube domain, for re-locating the tracks
+  std::vector<BallCone> detected_cones;
   for (std::size_t v = 0; v < views.size(); ++v) {
     const cv::Mat& img = views[v].radiance;
     if (img.type() != CV_32FC3 || img.cols != lens.width() || img.rows != lens.height())
@@ -149,9 +151,14 @@ PoseSet orient_views(const std::vector<std::string>& names, const std::vector<Vi
     } else {
       loc = find_chrome_ball(img, lens, rmin, rmax, names[v]);
     }
-    feats.push_back(options.domain == FeatureDomain::cube
-                        ? ball_cube_features(img, views[v].flags, lens, loc.fit.cone, options.features, options.cube)
-                        : ball_features(img, lens, loc.fit.cone, options.features));
+    if (options.domain == FeatureDomain::cube) {
+      sets.push_back(ball_cube_feature_set(img, views[v].flags, lens, loc.fit.cone, options.features, options.cube));
+      feats.push_back(sets.back().features);
+      if (!options.refine_tracks) sets.back().faces.clear();
+    } else {
+      feats.push_back(ball_features(img, lens, loc.fit.cone, options.features));
+    }
+    detected_cones.push_back(loc.fit.cone);
     rep.balls.push_back(loc);
     rep.features.push_back(static_cast<int>(feats.back().directions.size()));
   }
@@ -175,6 +182,15 @@ PoseSet orient_views(const std::vector<std::string>& names, const std::vector<Vi
   OrientationSolution s;
   try {
     s = solve_orientations(static_cast<int>(views.size()), tracks, obs, so);
+    if (options.domain == FeatureDomain::cube && options.refine_tracks) {
+      std::vector<BallCone> refined_cones = detected_cones;
+      if (options.refine_balls)
+        for (std::size_t v = 0; v < views.size(); ++v) refined_cones[v] = {s.ball_axes[v], s.ball_half_angles[v]};
+      const std::vector<DirectionObservation> refined =
+          refine_tracks(sets, detected_cones, refined_cones, lens, options.features, s.world_from_cam, obs,
+                        options.tracks, &rep.track_refinement);
+      s = solve_orientations(static_cast<int>(views.size()), tracks, refined, so);
+    }
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(with_names(e.what(), names));
   }

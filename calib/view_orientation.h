@@ -18,6 +18,7 @@
 #include "calib/ball_locator.h"
 #include "calib/orientation_solve.h"
 #include "calib/pose_file.h"
+#include "calib/track_refinement.h"
 #include "calib/view_image.h"
 #include "core/lens_model.h"
 
@@ -55,6 +56,12 @@ struct ViewOrientationOptions {
   bool refine_balls = true;
   double ball_prior_px = 0.25;
   double ball_radius_prior_px = 2;
+  // Cube domain: after a first solve, every track re-located by patch alignment against its
+  // sharpest observation (calib/track_refinement.h), then solved again. On 12 rendered views
+  // around a 400-px ball (1% noise) the median error falls from ~0.05 to ~0.008 degrees, the
+  // centres' from 0.075 to 0.017 px; the second solve and the alignments add ~5% to the time.
+  bool refine_tracks = true;
+  TrackRefinementOptions tracks;
   OrientationOptions solve;            // its first_world_from_cam is set from the gauge
 };
 
@@ -64,6 +71,7 @@ struct ViewOrientationReport {
   std::vector<int> features;            // per view: features in the ball
   int tracks = 0, observations = 0, inliers = 0;
   double rms_sigmas = 0;
+  TrackRefinementReport track_refinement;  // zero when tracks were not re-located
 };
 
 // The world_from_cam of the first view for the gauge (identity without `up`). Throws

@@ -81,6 +81,10 @@ int run_orient(const OrientArgs& a) {
   j["observations"] = rep.observations;
   j["inliers"] = rep.inliers;
   j["rms_sigmas"] = rep.rms_sigmas;
+  j["tracks_relocated"] = {{"tracks", rep.track_refinement.tracks_refined},
+                           {"observations", rep.track_refinement.observations_refined},
+                           {"dropped", rep.track_refinement.observations_dropped},
+                           {"median_sigma_ratio", rep.track_refinement.median_sigma_ratio}};
   nlohmann::json jv = nlohmann::json::array();
   for (std::size_t v = 0; v < poses.views.size(); ++v) {
     const BallLocation& b = rep.balls[v];
