@@ -247,19 +247,28 @@ std::vector<DirectionObservation> refine_tracks(const std::vector<CubeFeatureSet
       bool done = false;
       for (int f : faces_facing(b.faces, seen)) {
         const CubeFace& face = b.faces[f];
-        // The patch's texels on B's face: exact at the centre and at +-h on each axis, affine between
-        // (central differences; the map's curvature moves a patch corner by << 0.01 texel).
-        const auto m0 = transfer(geo[va], fa, anchor, geo[ob.view], f, lens, features);
-        const auto mu0 = transfer(geo[va], fa, anchor - Vec2(h, 0), geo[ob.view], f, lens, features);
-        const auto mu1 = transfer(geo[va], fa, anchor + Vec2(h, 0), geo[ob.view], f, lens, features);
-        const auto mv0 = transfer(geo[va], fa, anchor - Vec2(0, h), geo[ob.view], f, lens, features);
-        const auto mv1 = transfer(geo[va], fa, anchor + Vec2(0, h), geo[ob.view], f, lens, features);
+        // The patch's texels on B's face: exact on the 3 x 3 grid of offsets {-h, 0, h}^2,
+        // biquadratic between (an affine map left ~0.07 texel at a 120-px ball's patch corners,
+        // which biased the shifts; the cubic terms are ~100x smaller).
+        Vec2 grid[3][3];
+        bool ok = true;
+        for (int j = 0; j < 3 && ok; ++j)
+          for (int i = 0; i < 3 && ok; ++i) {
+            const auto t = transfer(geo[va], fa, anchor + Vec2((i - 1) * h, (j - 1) * h), geo[ob.view], f, lens, features);
+            if (t) grid[j][i] = *t;
+            ok = t.has_value();
+          }
         const auto kp = face.texel(keypoint_dir);
-        if (!m0 || !mu0 || !mu1 || !mv0 || !mv1 || !kp) continue;
-        Eigen::Matrix2d jac;
-        jac << (*mu1 - *mu0) / (2 * h), (*mv1 - *mv0) / (2 * h);
+        if (!ok || !kp) continue;
         std::vector<Vec2> m;
-        for (const Vec2& x : tmpl->offsets) m.push_back(*m0 + jac * x);
+        for (const Vec2& x : tmpl->offsets) {
+          const auto basis = [](double t) { return Eigen::Vector3d(0.5 * t * (t - 1), 1 - t * t, 0.5 * t * (t + 1)); };
+          const Eigen::Vector3d bu = basis(x.x() / h), bv = basis(x.y() / h);
+          Vec2 p = Vec2::Zero();
+          for (int j = 0; j < 3; ++j)
+            for (int i = 0; i < 3; ++i) p += bv[j] * bu[i] * grid[j][i];
+          m.push_back(p);
+        }
         const auto al = align(*tmpl, m, face, *kp - m[m.size() / 2], *kp, options);
         if (!al) continue;
         const Vec3 r = face.direction(al->uv.x(), al->uv.y());

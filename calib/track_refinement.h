@@ -8,8 +8,8 @@
 //   samples   m_i = the texel of B's face showing what A's texel a + x_i shows: A's texel -> its
 //             pixel (through A's ball as detected, which made the faces) -> the world direction
 //             (through A's ball as refined by the first solve, and R_A) -> B's pixel (B's refined
-//             ball) -> B's texel (B's detected ball); exact at the centre and +-h on each axis,
-//             affine between. The patch takes the shape the views' geometry gives it, and the
+//             ball) -> B's texel (B's detected ball); exact on the grid {-h, 0, h}^2, biquadratic
+//             between. The patch takes the shape the views' geometry gives it, and the
 //             outline's error (up to 2 px of radius, which distorts the faces) cancels.
 //   minimise  sum_i (g L_B(m_i + t) + b + c . x_i - T_i)^2   over the shift t (texels), gain g, bias
 //             b and ramp c (log luminance: exposure, and the mirror's Fresnel, which grows toward

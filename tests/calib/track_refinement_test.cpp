@@ -85,8 +85,8 @@ double median(std::vector<double> x) {
   return x[x.size() / 2];
 }
 
-// Measured: SIFT's 116 tracks agree to a median 0.225 px; 101 re-located ones to 0.067 px, with
-// the mean of (error/sigma)^2 / 2 at 1.35 (1 when honest; each is chi2_2 / 2).
+// Measured: SIFT's 116 tracks agree to a median 0.225 px; 103 re-located ones to 0.046 px, with
+// the mean of (error/sigma)^2 / 2 at 0.63 (1 when honest; each is chi2_2 / 2).
 TEST(TrackRefinement, ReLocatedTracksAgreeWithTheTruthToHundredthsOfAPixelWithHonestSigmas) {
   if (!std::filesystem::exists(kLobby)) GTEST_SKIP() << kLobby << " missing (scripts/fetch-assets.sh)";
   const Pair& p = pair();
@@ -110,9 +110,9 @@ TEST(TrackRefinement, ReLocatedTracksAgreeWithTheTruthToHundredthsOfAPixelWithHo
               median(relocated), mean_whitened, rep.median_sigma_ratio);
   EXPECT_GT(rep.tracks_refined, 0.8 * p.tracks);
   EXPECT_GT(median(sift), 0.1);
-  EXPECT_LT(median(relocated), 0.1);
-  EXPECT_LT(median(relocated), 0.4 * median(sift));
-  EXPECT_GT(mean_whitened, 0.4);
+  EXPECT_LT(median(relocated), 0.08);
+  EXPECT_LT(median(relocated), 0.35 * median(sift));
+  EXPECT_GT(mean_whitened, 0.3);
   EXPECT_LT(mean_whitened, 2.0);
 }
 
