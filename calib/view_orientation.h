@@ -29,11 +29,11 @@
 namespace rsibr {
 
 // Where features are detected: `cube` resamples the world reflected in the ball onto gnomonic cube
-// faces first (calib/ball_cube_features.h; matches across wide baselines), `image` runs SIFT on the
-// ball's image directly (calib/ball_features.h; views < ~20-30 degrees apart only). Measured
-// (docs/tradeoffs.md "Orientation"): `cube` finds 1.2-14x the tracks and the lower error in 7 of 9
-// two-view cases; `image` had the lower error in 2 (60 degrees apart, `park` and `sky`, on 10-18
-// tracks) and on four views 20 degrees apart (median 0.44 against 0.63 degrees at 120 px).
+// faces first (calib/ball_cube_features.h; matches across wide baselines, and its tracks are
+// re-located by patch alignment, calib/track_refinement.h), `image` runs SIFT on the ball's image
+// directly (calib/ball_features.h; views < ~20-30 degrees apart only). Measured (docs/tradeoffs.md
+// "Orientation"): `cube` finds 1.2-14x the tracks and the lower error in all 9 two-view cases
+// (3 environments x 20, 60, 90 degrees apart).
 enum class FeatureDomain { cube, image };
 
 struct ViewOrientationOptions {
