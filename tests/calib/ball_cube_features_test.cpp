@@ -78,6 +78,24 @@ TEST(BallCubeFeatures, FaceTexelsShowTheWorldDirectionTheyName) {
   EXPECT_LT(wrong, 0.6);
 }
 
+// CubeFace::texel inverts CubeFace::direction on every face, sub-texel, out to the face's corners
+// (beyond [0, N-1] too: the gnomonic plane goes on); directions behind a face have no texel.
+TEST(BallCubeFeatures, TexelOfDirectionRoundTripsOnEveryFace) {
+  if (!std::filesystem::exists(kLobby)) GTEST_SKIP() << kLobby << " missing (scripts/fetch-assets.sh)";
+  const View v = render(80);
+  const std::vector<CubeFace> faces = ball_cube_faces(v.r.radiance, {}, v.r.scene.camera.lens, v.cone);
+  for (const CubeFace& f : faces)
+    for (double u : {-3.5, 0.0, 0.25, 47.5, 95.0, 99.75})
+      for (double w : {-3.5, 0.0, 0.25, 47.5, 95.0, 99.75}) {
+        const auto t = f.texel(f.direction(u, w));
+        ASSERT_TRUE(t.has_value());
+        EXPECT_NEAR(t->x(), u, 1e-9);
+        EXPECT_NEAR(t->y(), w, 1e-9);
+      }
+  EXPECT_FALSE(faces[0].texel(-faces[0].axis).has_value());
+  EXPECT_FALSE(faces[0].texel(faces[0].right).has_value());  // in the face's plane: at infinity
+}
+
 TEST(BallCubeFeatures, KeypointsMapBackToPixelsThatReflectTheirDirections) {
   if (!std::filesystem::exists(kLobby)) GTEST_SKIP() << kLobby << " missing (scripts/fetch-assets.sh)";
   const View v = render(80);
