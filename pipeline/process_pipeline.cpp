@@ -293,7 +293,8 @@ void step_orient(Context& c) {
       poses = orient_views(names, images, lens, vo, &report);
       source = "solved (chrome-ball features)";
       solve = {{"tracks", report.tracks}, {"observations", report.observations}, {"inliers", report.inliers},
-               {"rms_sigmas", report.rms_sigmas}, {"features", report.features}};
+               {"rms_sigmas", report.rms_sigmas}, {"features", report.features},
+               {"tracks_relocated", report.track_refinement.tracks_refined}};
     }
     // In the set's order, only its views.
     PoseSet ordered;

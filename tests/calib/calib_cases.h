@@ -9,9 +9,11 @@
 
 #include <opencv2/core.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <random>
 #include <string>
+#include <vector>
 
 namespace rsibr::testing {
 
@@ -70,6 +72,12 @@ inline Vec3 ball_centre_cam(const RenderedView& v, int ball) {
 }
 inline Vec2 ball_centre_px(const RenderedView& v, int ball) {
   return v.scene.camera.lens.project(ball_centre_cam(v, ball));
+}
+
+// The middle element (the upper one of an even count); `x` non-empty.
+inline double median(std::vector<double> x) {
+  std::nth_element(x.begin(), x.begin() + long(x.size() / 2), x.end());
+  return x[x.size() / 2];
 }
 
 }  // namespace rsibr::testing

@@ -15,6 +15,7 @@ namespace rsibr {
 namespace {
 
 using testing::kLobby;
+using testing::median;
 const std::filesystem::path kPark = std::filesystem::path(RSIBR_CACHE_DIR) / "assets/hdri/park.exr";
 
 struct Rendered {
@@ -171,10 +172,6 @@ TEST(ViewOrientation, ARingOfViewsAroundALightProbeSizedBallIsOrientedToAHundred
     errors.push_back(angle_deg(p.views[v].world_from_cam, g * r.truth[v]));
     chi2 += std::pow(errors.back() / p.views[v].sigma_deg, 2) / double(azimuths.size() - 1);
   }
-  auto median = [](std::vector<double> x) {
-    std::nth_element(x.begin(), x.begin() + long(x.size() / 2), x.end());
-    return x[x.size() / 2];
-  };
   std::printf("  %d tracks; orientation error median %.4f, max %.4f deg; mean (error/sigma)^2 %.2f; centre error median %.3f, "
               "max %.3f px; radius error max %.3f px\n",
               rep.tracks, median(errors), *std::max_element(errors.begin(), errors.end()), chi2, median(centres),
