@@ -81,10 +81,11 @@ std::optional<Vec2> CubeFace::texel(const Vec3& r) const {
 }
 
 std::optional<BallPixel> ball_pixel_of(const LensModel& lens, const BallCone& cone, const BallFeatureOptions& options,
-                                       const Vec3& r) {
+                                       const Vec3& r, bool with_angle) {
   const BallGeometry g = geometry_of(cone, options);
   const auto q = pixel_of(lens, g, r);
   if (!q) return std::nullopt;
+  if (!with_angle) return BallPixel{*q, lens.unproject(*q).normalized(), 0};
   const double per_px = radians_per_pixel(lens, g, std::sin(cone.half_angle), *q);
   if (!std::isfinite(per_px)) return std::nullopt;
   return BallPixel{*q, lens.unproject(*q).normalized(), per_px};

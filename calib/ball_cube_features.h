@@ -82,12 +82,13 @@ BallFeatures ball_cube_features(const cv::Mat& image, const cv::Mat& flags, cons
 // Where the ball shows the reflected direction r (camera frame, unit): the pixel, its unit camera
 // ray, and the angle r turns per pixel there (|dr/dq|, the larger axis). nullopt when r is not seen
 // in the ball's usable part (options' max_radius_fraction and camera_mask_deg), or off the image.
+// The angle per pixel costs three more reflections: without `with_angle` it is left at 0.
 struct BallPixel {
   Vec2 pixel;
   Vec3 ray;
   double radians_per_pixel = 0;
 };
 std::optional<BallPixel> ball_pixel_of(const LensModel& lens, const BallCone& cone, const BallFeatureOptions& options,
-                                       const Vec3& r);
+                                       const Vec3& r, bool with_angle = true);
 
 }  // namespace rsibr

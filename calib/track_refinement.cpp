@@ -60,11 +60,11 @@ struct ViewGeometry {
 // reflections, the rotations), or nullopt where either ball does not show it.
 std::optional<Vec2> transfer(const ViewGeometry& a, int fa, const Vec2& uv, const ViewGeometry& b, int fb,
                              const LensModel& lens, const BallFeatureOptions& features) {
-  const auto pa = ball_pixel_of(lens, a.detected, features, a.set->faces[fa].direction(uv.x(), uv.y()));
+  const auto pa = ball_pixel_of(lens, a.detected, features, a.set->faces[fa].direction(uv.x(), uv.y()), false);
   if (!pa) return std::nullopt;
   const Vec3 world =
       a.world_from_cam * reflect_off_ball<double>(pa->ray, a.refined.axis, std::sin(a.refined.half_angle)).normalized();
-  const auto pb = ball_pixel_of(lens, b.refined, features, b.world_from_cam.transpose() * world);
+  const auto pb = ball_pixel_of(lens, b.refined, features, b.world_from_cam.transpose() * world, false);
   if (!pb) return std::nullopt;
   const Vec3 db = reflect_off_ball<double>(pb->ray, b.detected.axis, std::sin(b.detected.half_angle)).normalized();
   return b.set->faces[fb].texel(db);
@@ -168,8 +168,8 @@ std::vector<int> faces_facing(const std::vector<CubeFace>& faces, const Vec3& d)
 std::optional<double> sigma_of(const Eigen::Matrix2d& cov, const CubeFace& face, const Vec2& uv, const LensModel& lens,
                                const BallCone& cone, const BallFeatureOptions& features, const TrackRefinementOptions& o) {
   const auto q0 = ball_pixel_of(lens, cone, features, face.direction(uv.x(), uv.y()));
-  const auto qu = ball_pixel_of(lens, cone, features, face.direction(uv.x() + 1, uv.y()));
-  const auto qv = ball_pixel_of(lens, cone, features, face.direction(uv.x(), uv.y() + 1));
+  const auto qu = ball_pixel_of(lens, cone, features, face.direction(uv.x() + 1, uv.y()), false);
+  const auto qv = ball_pixel_of(lens, cone, features, face.direction(uv.x(), uv.y() + 1), false);
   if (!q0 || !qu || !qv) return std::nullopt;
   Eigen::Matrix2d dq;
   dq << qu->pixel - q0->pixel, qv->pixel - q0->pixel;
@@ -272,7 +272,7 @@ std::vector<DirectionObservation> refine_tracks(const std::vector<CubeFeatureSet
         const auto al = align(*tmpl, m, face, *kp - m[m.size() / 2], *kp, options);
         if (!al) continue;
         const Vec3 r = face.direction(al->uv.x(), al->uv.y());
-        const auto px = ball_pixel_of(lens, detected[ob.view], features, r);
+        const auto px = ball_pixel_of(lens, detected[ob.view], features, r, false);
         const auto s = sigma_of(al->cov, face, al->uv, lens, detected[ob.view], features, options);
         if (!px || !s) continue;
         out_obs[i].direction = r;
