@@ -130,6 +130,26 @@ TEST(TrackRefinement, ATrackNothingReLocatesKeepsItsObservations) {
   EXPECT_EQ(rep.observations_dropped, 0);
 }
 
+// Clipped pixels are invalid texels (calib/ball_cube_features.h): with every texel of one view
+// invalid (as if all its pixels were clipped), no patch there is sampled and every two-view track
+// keeps its SIFT observations.
+TEST(TrackRefinement, InvalidTexelsAreNeverSampledAndTheirTracksKeepTheirObservations) {
+  if (!std::filesystem::exists(kLobby)) GTEST_SKIP() << kLobby << " missing (scripts/fetch-assets.sh)";
+  const Pair& p = pair();
+  std::vector<CubeFeatureSet> sets = p.sets;
+  // Only the mask changes: the luminance is intact, so a sampler that ignored the mask would align
+  // (as the first test shows it does) and change the observations.
+  for (CubeFace& f : sets[1].faces) f.valid = cv::Mat::zeros(f.valid.size(), CV_8UC1);
+  TrackRefinementReport rep;
+  const std::vector<DirectionObservation> out = refine_tracks(sets, p.cones, p.cones, p.lens, p.features, p.truth, p.obs, {}, &rep);
+  ASSERT_EQ(out.size(), p.obs.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    EXPECT_EQ(out[i].direction, p.obs[i].direction);
+    EXPECT_EQ(out[i].sigma, p.obs[i].sigma);
+  }
+  EXPECT_EQ(rep.observations_refined, 0);
+}
+
 TEST(TrackRefinement, InconsistentInputsAreClearErrors) {
   if (!std::filesystem::exists(kLobby)) GTEST_SKIP() << kLobby << " missing (scripts/fetch-assets.sh)";
   const Pair& p = pair();
