@@ -48,7 +48,7 @@ Setup& setup() {
 }
 
 cv::Mat render(Setup& s) {
-  RenderOptions o;
+  RigRenderOptions o;
   o.supersampling = 2;
   return s.renderer.render(s.pose, s.scene.camera.lens, s.rays, o);
 }

@@ -148,7 +148,7 @@ Vec3 RigRenderer::radiance(const Vec3& o, const Vec3& d, const ViewScene& view, 
 }
 
 cv::Mat RigRenderer::render(const CameraPose& pose, const LensModel& lens, const RayTable& rays,
-                            const RenderOptions& options, const std::function<void(double)>& progress) const {
+                            const RigRenderOptions& options, const std::function<void(double)>& progress) const {
   const RigMesh mesh = build_rig_mesh(scene_, &pose);
   std::unique_ptr<RayScene> scene;
   if (!mesh.mesh.triangles.empty()) scene = std::make_unique<RayScene>(mesh.mesh);

@@ -51,7 +51,7 @@ namespace rsibr {
 // The irradiance map described above (lat-long, RGB, E in radiance units times sr).
 EnvMap irradiance_map(const EnvMap& env, int width = 256);
 
-struct RenderOptions {
+struct RigRenderOptions {
   int supersampling = 2;  // n: n x n samples per pixel
   bool jitter = true;     // false: stratum centres (n = 1: the pixel centre)
   std::uint64_t seed = 1;
@@ -64,7 +64,7 @@ class RigRenderer {
 
   // The radiance image of one view (the stand and this pose's photographer proxy in the scene).
   // `progress`, if set, gets the fraction done (from worker threads).
-  cv::Mat render(const CameraPose& pose, const LensModel& lens, const RayTable& rays, const RenderOptions& options,
+  cv::Mat render(const CameraPose& pose, const LensModel& lens, const RayTable& rays, const RigRenderOptions& options,
                  const std::function<void(double)>& progress = {}) const;
 
   // What one view's rays meet besides the environment: its meshes (scene may be null) and, per

@@ -187,7 +187,7 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
   SynthReport report;
   SensorNoise noise{1.0, cam.full_well, cam.read_noise};
   const cv::Mat vignette = vignetting_field(cam.lens, cam.vignetting);
-  RenderOptions ropt;
+  RigRenderOptions ropt;
   ropt.supersampling = cam.supersampling;
   ropt.seed = scene.seed;
 

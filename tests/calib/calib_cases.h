@@ -54,7 +54,7 @@ struct RenderedView {
 inline RenderedView render_view(const SynthScene& scene, int view = 0, double noise = 0.0, std::uint64_t seed = 5) {
   RenderedView r{scene, synth_environment(scene), plan_camera_poses(scene).at(view), {}};
   const RigRenderer renderer(scene, r.env);
-  RenderOptions opt;
+  RigRenderOptions opt;
   opt.supersampling = 3;
   r.radiance = renderer.render(r.pose, scene.camera.lens, RayTable(scene.camera.lens), opt);
   if (noise > 0) {

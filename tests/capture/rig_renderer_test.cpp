@@ -46,7 +46,7 @@ TEST(RigRenderer, ChromePixelEqualsFresnelTimesEnvironmentAlongTheExactReflected
   const SynthBall& ball = f.scene.balls.front();
   const RigRenderer renderer(f.scene, f.env);
   const LensModel& lens = f.scene.camera.lens;
-  RenderOptions opt;
+  RigRenderOptions opt;
   opt.supersampling = 1;
   opt.jitter = false;
   const cv::Mat img = renderer.render(f.pose, lens, RayTable(lens), opt);
@@ -90,7 +90,7 @@ TEST(RigRenderer, GreyPixelEqualsAlbedoTimesIrradianceOverPi) {
   const SynthBall& ball = f.scene.balls.front();
   const RigRenderer renderer(f.scene, f.env);
   const LensModel& lens = f.scene.camera.lens;
-  RenderOptions opt;
+  RigRenderOptions opt;
   opt.supersampling = 1;
   opt.jitter = false;
   const cv::Mat img = renderer.render(f.pose, lens, RayTable(lens), opt);
@@ -119,7 +119,7 @@ TEST(RigRenderer, PhotographerAppearsInTheChromeBallAndNeverBlocksTheView) {
   f.scene.photographer = true;
   const RigRenderer renderer(f.scene, f.env);
   const LensModel& lens = f.scene.camera.lens;
-  RenderOptions opt;
+  RigRenderOptions opt;
   opt.supersampling = 1;
   opt.jitter = false;
   const cv::Mat with = renderer.render(f.pose, lens, RayTable(lens), opt);
@@ -147,7 +147,7 @@ cv::Vec3f centre_pixel(Fixture& f, bool photographer) {
   f.scene.photographer = photographer;
   const RigRenderer renderer(f.scene, f.env);
   const LensModel& lens = f.scene.camera.lens;
-  RenderOptions opt;
+  RigRenderOptions opt;
   opt.supersampling = 1;
   opt.jitter = false;
   const cv::Mat img = renderer.render(f.pose, lens, RayTable(lens), opt);
@@ -186,7 +186,7 @@ TEST(RigRenderer, SupersampledEdgeIsAntialiased) {
   Fixture f("grey");
   const RigRenderer renderer(f.scene, f.env);
   const LensModel& lens = f.scene.camera.lens;
-  RenderOptions opt;
+  RigRenderOptions opt;
   opt.supersampling = 4;
   const cv::Mat img = renderer.render(f.pose, lens, RayTable(lens), opt);
   opt.supersampling = 1;

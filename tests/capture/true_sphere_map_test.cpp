@@ -58,7 +58,7 @@ TEST(TrueSphereMap, CentreTexelEqualsThePhotoAtTheBallCentre) {
   scene.balls.push_back(glossy);
   scene.map_size = 17;  // the glossy ball's render reads its truth map
   const EnvMap env = synth_environment(scene);
-  RenderOptions opt;
+  RigRenderOptions opt;
   opt.supersampling = 1;
   opt.jitter = false;
   const std::vector<SynthBall> balls = scene.balls;
