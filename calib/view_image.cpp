@@ -1,6 +1,6 @@
 #include "calib/view_image.h"
 
-#include "capture/truth_image.h"
+#include "core/truth_image.h"
 #include "hdr/merged_exr.h"
 
 #include <OpenEXR/ImfHeader.h>

@@ -12,17 +12,12 @@
 #pragma once
 
 #include "capture/synth_scene.h"
+#include "core/camera.h"
 
 #include <string>
 #include <vector>
 
 namespace rsibr {
-
-struct CameraPose {
-  std::string name;
-  Vec3 eye = Vec3::Zero();                 // camera centre, world
-  Mat3 world_from_cam = Mat3::Identity();  // columns: camera x (right), y (down), z (forward)
-};
 
 // Every plan's poses in order, named view00, view01, ... Same scene and seed, same poses.
 std::vector<CameraPose> plan_camera_poses(const SynthScene& scene);

@@ -5,7 +5,7 @@
 
 #include "calib/intrinsics.h"
 #include "pipeline/chessboard_problem.h"
-#include "capture/photo_set.h"
+#include "core/photo_set.h"
 #include "core/atomic_file.h"
 #include "core/progress.h"
 

@@ -5,7 +5,7 @@
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
-#include "capture/photo_set.h"
+#include "core/photo_set.h"
 #include "core/atomic_file.h"
 #include "core/colour.h"
 #include "core/progress.h"

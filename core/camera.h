@@ -15,6 +15,13 @@
 
 namespace rsibr {
 
+// A named camera placement (a photo's or a synthetic view's), without intrinsics.
+struct CameraPose {
+  std::string name;
+  Vec3 eye = Vec3::Zero();                 // camera centre, world
+  Mat3 world_from_cam = Mat3::Identity();  // columns: camera x (right), y (down), z (forward)
+};
+
 struct Camera {
   int width = 640;
   int height = 360;

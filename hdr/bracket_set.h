@@ -3,7 +3,7 @@
 // max_code says which range applies). Exposures sorted ascending.
 #pragma once
 
-#include "capture/photo_set.h"
+#include "core/photo_set.h"
 #include "hdr/exposure_metadata.h"
 
 #include <opencv2/core.hpp>

@@ -3,7 +3,7 @@
 // brackets loaded (aligned when asked), its noise estimated (unless given) and merged.
 #pragma once
 
-#include "capture/photo_set.h"
+#include "core/photo_set.h"
 #include "hdr/bracket_set.h"
 #include "hdr/merge.h"
 #include "hdr/noise_model.h"

@@ -4,7 +4,7 @@
 #pragma once
 
 #include "calib/intrinsics.h"
-#include "capture/photo_set.h"
+#include "core/photo_set.h"
 
 #include <functional>
 #include <string>

@@ -9,7 +9,7 @@
 #include "calib/view_image.h"
 #include "calib/view_orientation.h"
 #include "calib/pose_file.h"
-#include "capture/photo_set.h"
+#include "core/photo_set.h"
 #include "core/atomic_file.h"
 #include "core/atomic_folder.h"
 #include "core/camera.h"

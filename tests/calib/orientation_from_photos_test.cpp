@@ -8,7 +8,7 @@
 
 #include "calib_cases.h"
 #include "capture/camera_poses.h"
-#include "capture/photo_set.h"
+#include "core/photo_set.h"
 #include "capture/synth_capture.h"
 #include "capture/synth_scene.h"
 #include "hdr/photo_set_merge.h"

@@ -3,8 +3,8 @@
 
 #include "capture/camera_poses.h"
 #include "capture/camera_response.h"
-#include "capture/photo_set.h"
-#include "capture/truth_image.h"
+#include "core/photo_set.h"
+#include "core/truth_image.h"
 #include "core/map_set.h"
 #include "core/test_data.h"
 #include "synth_cases.h"

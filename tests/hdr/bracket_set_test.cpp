@@ -1,7 +1,7 @@
 // Exposure metadata (photoset.yaml, EXIF via exiv2) and bracket loading.
 #include "hdr/bracket_set.h"
 
-#include "capture/photo_set.h"
+#include "core/photo_set.h"
 #include "core/test_data.h"
 
 #include <exiv2/exiv2.hpp>

@@ -3,7 +3,7 @@
 // camera's x right, y down, z forward in world) and rsibr.eye (V3f, world).
 #pragma once
 
-#include "capture/camera_poses.h"
+#include "core/camera.h"
 
 #include <opencv2/core.hpp>
 

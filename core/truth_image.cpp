@@ -1,4 +1,4 @@
-#include "capture/truth_image.h"
+#include "core/truth_image.h"
 
 #include "core/atomic_file.h"
 

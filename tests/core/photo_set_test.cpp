@@ -1,4 +1,4 @@
-#include "capture/photo_set.h"
+#include "core/photo_set.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "capture/photo_set.h"
+#include "core/photo_set.h"
 
 #include "core/atomic_file.h"
 #include "core/yaml_spec.h"
@@ -202,7 +202,7 @@ fs::path save_photo_set(const PhotoSet& set) {
   const fs::path target = folder / "photoset.yaml";
   write_atomically(target, [&](const std::string& tmp) {
     std::ofstream f(tmp, std::ios::binary);
-    f << "# rsibr photo set (capture/photo_set.h describes the format)\n" << out.c_str() << "\n";
+    f << "# rsibr photo set (core/photo_set.h describes the format)\n" << out.c_str() << "\n";
     if (!f) throw std::runtime_error(target.string() + ": cannot write");
   });
   return target;
