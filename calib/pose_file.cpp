@@ -1,6 +1,7 @@
 #include "calib/pose_file.h"
 
 #include "core/atomic_file.h"
+#include "core/safe_name.h"
 #include "core/yaml_spec.h"
 
 #include <Eigen/Dense>
@@ -9,7 +10,6 @@
 #include <fstream>
 #include <iomanip>
 #include <limits>
-#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -29,12 +29,11 @@ Mat3 checked_rotation(const Mat3& m, const std::string& key) {
 void check(const PoseSet& p) {
   if (p.gauge != "first-view" && p.gauge != "up") spec_fail("poses.gauge", "expected first-view or up, got '" + p.gauge + "'");
   if (p.views.empty()) spec_fail("poses.views", "expected a non-empty sequence");
-  std::set<std::string> names;
+  DistinctNames names;
   for (std::size_t i = 0; i < p.views.size(); ++i) {
     const std::string key = "poses.views[" + std::to_string(i) + "]";
     const ViewPose& v = p.views[i];
-    if (v.name.empty()) spec_fail(key + ".name", "empty name");
-    if (!names.insert(v.name).second) spec_fail(key + ".name", "duplicate view name '" + v.name + "'");
+    names.add(v.name, key + ".name", "view");
     checked_rotation(v.world_from_cam, key + ".world_from_cam");
     if (!(v.sigma_deg >= 0) || !std::isfinite(v.sigma_deg)) spec_fail(key + ".sigma_deg", "must be a finite number >= 0");
     if (v.ball) {

@@ -1,5 +1,6 @@
 #include "calib/view_image.h"
 
+#include "core/safe_name.h"
 #include "core/truth_image.h"
 #include "hdr/merged_exr.h"
 
@@ -47,6 +48,7 @@ ViewImage read_view_image(const std::string& path) {
   } catch (const std::exception& e) {
     throw std::runtime_error(path + ": " + e.what());
   }
+  if (!v.name.empty()) require_safe_name(v.name, path + ": rsibr.view");  // the name goes into pose files
   return v;
 }
 

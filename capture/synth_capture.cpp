@@ -10,6 +10,7 @@
 #include "capture/true_sphere_map.h"
 #include "core/truth_image.h"
 #include "core/atomic_file.h"
+#include "core/atomic_folder.h"
 #include "core/exr_io.h"
 #include "core/patterns.h"
 
@@ -259,7 +260,7 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
     }
     PhotoView pv;
     pv.name = pose.name;
-    fs::create_directories(photos / pose.name);
+    fs::create_directories(file_in_folder(photos, pose.name));
     YAML::Node tv;
     tv["name"] = pose.name;
     tv["eye"] = vec(pose.eye);
@@ -290,9 +291,9 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
                                                 {"cameraModel", cam.lens.name()},
                                                 {"seed", std::to_string(scene.seed)}};
     attrs["content"] = "L at the pixel (after vignetting and white balance): X = L e k";
-    write_truth_image(truth / "views" / (pose.name + "_radiance.exr"), L, &pose, attrs);
+    write_truth_image(file_in_folder(truth / "views", pose.name + "_radiance.exr"), L, &pose, attrs);
     attrs["content"] = "scene radiance along each pixel's rays (before vignetting and white balance)";
-    write_truth_image(truth / "views" / (pose.name + "_scene.exr"), scene_radiance, &pose, attrs);
+    write_truth_image(file_in_folder(truth / "views", pose.name + "_scene.exr"), scene_radiance, &pose, attrs);
     for (const SynthBall& b : scene.balls) {
       YAML::Node tb;
       tb["name"] = b.name;
@@ -317,7 +318,7 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
     MapSet ms;
     for (const CameraPose& pose : poses)
       ms.views.push_back(true_sphere_map(b, pose.eye, env, scene.map_size, &irradiance, fis.get()));
-    write_map_set((truth / "maps" / (b.name + ".exr")).string(), ms);
+    write_map_set(file_in_folder(truth / "maps", b.name + ".exr").string(), ms);
     YAML::Node tb;
     tb["name"] = b.name;
     tb["kind"] = b.kind;

@@ -2,10 +2,11 @@
 
 #include "bake/brdf_spec.h"
 #include "capture/camera_response.h"
+#include "core/safe_name.h"
+#include "core/text.h"
 #include "core/yaml_spec.h"
 
 #include <cmath>
-#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -53,9 +54,6 @@ SynthBall parse_ball(const YAML::Node& node, const std::string& path) {
   const YamlMap m(node, path, {"name", "kind", "diameter_m", "centre", "fresnel", "albedo", "brdf"});
   SynthBall b;
   b.name = m.string("name");
-  // Names become file names (truth/maps/<name>.exr).
-  if (b.name.empty() || b.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") != std::string::npos)
-    spec_fail(m.at("name"), "use letters, digits, '_' and '-' only");
   b.kind = m.choice("kind", {"chrome", "grey", "glossy"});
   if (b.kind != "glossy" && m.has("brdf")) spec_fail(m.at("brdf"), "only for kind: glossy");
   if (m.has("diameter_m")) b.diameter_m = m.positive("diameter_m");
@@ -120,7 +118,7 @@ SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const 
   c.lens = parse_lens(m.get("lens"), m.at("lens"), w, h, folder);
   if (c.lens.can_project_behind_camera())
     spec_fail(m.at("lens"), "models that see behind the camera (stereographic, splined) are not supported yet");
-  if (m.has("name")) c.name = m.string("name");
+  if (m.has("name")) c.name = valid_utf8(m.string("name"));  // free text (bytes that are not UTF-8 replaced)
   if (m.has("response")) c.response = m.choice("response", CameraResponse::kinds());
   if (m.has("format")) c.format = m.choice("format", {"png", "jpeg", "tiff"});
   if (m.has("supersampling"))
@@ -174,11 +172,11 @@ SynthScene parse_root(const YAML::Node& root, const std::filesystem::path& folde
   s.environment = parse_environment(m.get("environment"), m.at("environment"), folder);
   const YAML::Node balls = m.get("balls");
   if (!balls.IsSequence() || balls.size() == 0) spec_fail(m.at("balls"), "expected a non-empty list");
-  std::set<std::string> names;
+  DistinctNames names;  // names become file names (truth/maps/<name>.exr)
   for (std::size_t i = 0; i < balls.size(); ++i) {
     const std::string p = m.at("balls") + "[" + std::to_string(i) + "]";
     s.balls.push_back(parse_ball(balls[i], p));
-    if (!names.insert(s.balls.back().name).second) spec_fail(p + ".name", "duplicate ball name");
+    names.add(s.balls.back().name, p + ".name", "ball");
   }
   for (std::size_t i = 0; i < s.balls.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)

@@ -5,10 +5,12 @@
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
-#include "core/photo_set.h"
 #include "core/atomic_file.h"
+#include "core/atomic_folder.h"
 #include "core/colour.h"
+#include "core/photo_set.h"
 #include "core/progress.h"
+#include "core/text.h"
 #include "hdr/alignment.h"
 #include "hdr/bracket_set.h"
 #include "hdr/merge.h"
@@ -112,7 +114,7 @@ int run_hdr(const HdrArgs& a) {
     for (const PhotoView& v : set.views) views.push_back(&v);
   for (const std::string& name : a.views) {
     const auto it = std::find_if(set.views.begin(), set.views.end(), [&](const PhotoView& v) { return v.name == name; });
-    if (it == set.views.end()) throw std::invalid_argument(a.photoset + ": no view named '" + name + "'");
+    if (it == set.views.end()) throw std::invalid_argument(a.photoset + ": no view named '" + quoted_for_message(name) + "'");
     views.push_back(&*it);
   }
   std::optional<NoiseModel> given_noise;
@@ -141,7 +143,7 @@ int run_hdr(const HdrArgs& a) {
   const fs::path response_out = out_dir / "response.json";
   for (const PhotoView* v : views)
     for (const char* ext : {".exr", ".png"}) {
-      const fs::path target = out_dir / (v->name + ext);
+      const fs::path target = file_in_folder(out_dir, v->name + ext);
       for (const fs::path& in : inputs) check_not_same_file(in, target);
     }
   for (const fs::path& in : inputs) check_not_same_file(in, response_out);
@@ -249,14 +251,14 @@ int run_hdr(const HdrArgs& a) {
           {"alignment", a.align ? "MTB shifts " + shift_text : "none"},
           {"ghosts", a.deghost ? "flagged; longest usable bracket alone" : "flagged; merged as usual"},
           {"flags", "clipped: lower bound (saturated in every bracket); black: nothing recorded; ghost: brackets disagree"}};
-      write_merged_exr((stage / (v.name + ".exr")).string(), m, attrs);
-      staged.push_back({stage / (v.name + ".exr"), out_dir / (v.name + ".exr")});
+      write_merged_exr(file_in_folder(stage, v.name + ".exr").string(), m, attrs);
+      staged.push_back({stage / (v.name + ".exr"), file_in_folder(out_dir, v.name + ".exr")});
       const float stops = a.preview_exposure ? *a.preview_exposure : auto_exposure(m);
       if (!a.no_preview) {
         const cv::Mat png = display_encode(m.radiance, stops);
-        const fs::path p = stage / (v.name + ".png");
+        const fs::path p = file_in_folder(stage, v.name + ".png");
         if (!cv::imwrite(p.string(), png)) throw std::runtime_error(p.string() + ": cannot write the preview");
-        staged.push_back({p, out_dir / (v.name + ".png")});
+        staged.push_back({p, file_in_folder(out_dir, v.name + ".png")});
       }
       const auto t3 = std::chrono::steady_clock::now();
       auto secs = [](auto d) { return std::chrono::duration<double>(d).count(); };

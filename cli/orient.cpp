@@ -8,6 +8,7 @@
 #include "core/atomic_file.h"
 #include "core/lens_model.h"
 #include "core/progress.h"
+#include "core/safe_name.h"
 
 #include <cmath>
 #include <filesystem>
@@ -53,6 +54,7 @@ int run_orient(const OrientArgs& a) {
       views.push_back(read_view_image(a.images[i]));
       const std::string name =
           views.back().name.empty() ? std::filesystem::path(a.images[i]).stem().string() : views.back().name;
+      require_safe_name(name, a.images[i] + ": the view name (from the header's rsibr.view, else the file name)");
       if (!seen.insert(name).second)
         throw std::invalid_argument(a.images[i] + ": view name '" + name + "' is already taken by another image");
       names.push_back(name);

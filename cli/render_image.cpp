@@ -3,6 +3,7 @@
 #include "core/atomic_file.h"
 #include "core/exr_io.h"
 #include "core/map_set.h"
+#include "core/text.h"
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -68,7 +69,7 @@ void write_render_exr(const std::string& path, const cv::Mat& rgba_in, const Cam
     if (n.size() > kMaxAttributeName) throw std::logic_error("attribute name '" + n + "' is too long");
     return n;
   };
-  for (const auto& [key, value] : strings) header.insert(name(key), Imf::StringAttribute(value));
+  for (const auto& [key, value] : strings) header.insert(name(key), Imf::StringAttribute(valid_utf8(value)));
   for (const auto& [key, value] : ints) header.insert(name(key), Imf::IntAttribute(value));
   header.insert(name("eye"), Imf::V3fAttribute(Imath::V3f(float(cam.eye.x()), float(cam.eye.y()), float(cam.eye.z()))));
   header.insert(name("worldFromCam"), Imf::M33fAttribute(m33(cam.world_from_cam)));

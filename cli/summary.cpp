@@ -10,7 +10,8 @@ namespace rsibr::cli {
 
 void write_summary(const std::string& target, const nlohmann::json& summary) {
   if (target.empty()) return;
-  const std::string text = summary.dump(2) + "\n";
+  // Strings from input files may hold bytes that are not UTF-8: replaced (U+FFFD), never fatal.
+  const std::string text = summary.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   if (target == "-") {
     std::cout << text;
     return;

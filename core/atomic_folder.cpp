@@ -1,5 +1,7 @@
 #include "core/atomic_folder.h"
 
+#include "core/text.h"
+
 #include <unistd.h>
 
 #include <fstream>
@@ -31,12 +33,26 @@ void check_output_folder(const std::filesystem::path& folder, const std::vector<
       throw std::invalid_argument(folder.string() + ": output would overwrite the input");
 }
 
+std::filesystem::path file_in_folder(const std::filesystem::path& folder, const std::string& file_name) {
+  namespace fs = std::filesystem;
+  if (file_name.empty() || file_name == "." || file_name == ".." || file_name.find('/') != std::string::npos ||
+      file_name.find('\0') != std::string::npos)
+    throw std::invalid_argument(folder.string() + ": '" + quoted_for_message(file_name) +
+                                "' is not a file name inside the output folder");
+  const fs::path path = folder / file_name;
+  std::error_code ec1, ec2;
+  const fs::path parent = fs::weakly_canonical(normal_folder(path).parent_path(), ec1);
+  const fs::path expected = fs::weakly_canonical(normal_folder(folder), ec2);
+  if (ec1 || ec2 || parent != expected)
+    throw std::invalid_argument(folder.string() + ": '" + quoted_for_message(file_name) + "' lies outside the output folder");
+  return path;
+}
+
 void write_folder_atomically(const std::filesystem::path& folder, const FolderContents& files) {
   namespace fs = std::filesystem;
   check_output_folder(folder);
   for (const auto& [name, bytes] : files)
-    if (name.empty() || fs::path(name).has_parent_path() || name == "." || name == "..")
-      throw std::invalid_argument(folder.string() + ": bad file name " + name);
+    file_in_folder(folder, name);
   const fs::path target = normal_folder(folder);
   std::string staging_name = ".";
   staging_name += target.filename().string();

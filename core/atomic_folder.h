@@ -20,6 +20,13 @@ using FolderContents = std::map<std::string, std::vector<unsigned char>>;
 // target exists but is not a folder, or a file name has a folder part; std::runtime_error on I/O.
 void write_folder_atomically(const std::filesystem::path& folder, const FolderContents& files);
 
+// `folder / file_name` for a file whose name a verb derives from an input (a view's or a ball's
+// name), checked to lie directly in `folder`: `file_name` is one path component (no separator, not
+// "." or "..", no NUL) and the result's parent, with symlinks resolved, is `folder`'s. Throws
+// std::invalid_argument("<folder>: ..."). Every writer renames a finished temporary onto such a
+// path, so an existing symlink of that name is replaced, never written through.
+std::filesystem::path file_in_folder(const std::filesystem::path& folder, const std::string& file_name);
+
 // The checks of write_folder_atomically alone (run them before long work); also refuses a folder
 // that is one of the inputs.
 void check_output_folder(const std::filesystem::path& folder, const std::vector<std::filesystem::path>& inputs = {});

@@ -221,7 +221,7 @@ void write_environment(const std::string& path, const EnvMap& map, const ExrWrit
   for (const auto& [key, value] : map.attributes) {
     const std::string name = "rsibr." + key;
     if (name.size() > kMaxAttributeName) fail(path, "attribute name '" + name + "' is longer than 31 characters");
-    header.insert(name, Imf::StringAttribute(value));
+    header.insert(name, Imf::StringAttribute(valid_utf8(value)));
   }
 
   const char* names1[] = {"Y"};

@@ -4,6 +4,7 @@
 #include "core/atomic_file.h"
 #include "core/colour.h"
 #include "core/exr_io.h"
+#include "core/text.h"
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfChromaticitiesAttribute.h>
@@ -101,9 +102,9 @@ void write_map_set(const std::string& path, const MapSet& set) {
     h.insert("rsibr.worldFromView", Imf::M33fAttribute(m));
     h.insert("rsibr.warp", Imf::StringAttribute(v.warp));
     h.insert("rsibr.source", Imf::StringAttribute(v.source));
-    h.insert("rsibr.material", Imf::StringAttribute(v.material));
+    h.insert("rsibr.material", Imf::StringAttribute(valid_utf8(v.material)));
     if (!v.albedo.empty()) h.insert("rsibr.albedo", Imf::FloatVectorAttribute(v.albedo));
-    for (const auto& [key, value] : v.attributes) h.insert("rsibr." + key, Imf::StringAttribute(value));
+    for (const auto& [key, value] : v.attributes) h.insert("rsibr." + key, Imf::StringAttribute(valid_utf8(value)));
     for (const char* c : {"R", "G", "B"}) h.channels().insert(c, Imf::Channel(Imf::FLOAT));
     if (!v.confidence.empty()) h.channels().insert("confidence", Imf::Channel(Imf::FLOAT));
     headers.push_back(h);

@@ -243,7 +243,7 @@ std::string patch_draco_json(const std::string& text) {
       }
     }
   }
-  return changed ? doc.dump() : text;
+  return changed ? doc.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) : text;
 }
 
 bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,

@@ -1,12 +1,13 @@
 #include "core/photo_set.h"
 
 #include "core/atomic_file.h"
+#include "core/safe_name.h"
+#include "core/text.h"
 #include "core/yaml_spec.h"
 
 #include <cmath>
 #include <fstream>
 #include <limits>
-#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -45,18 +46,18 @@ PhotoSet parse(const YAML::Node& root, const fs::path& folder) {
   if (top.integer("rsibr_photoset") != 1) spec_fail(top.at("rsibr_photoset"), "unsupported version (expected 1)");
   if (top.has("camera")) {
     YamlMap cam(top.get("camera"), top.at("camera"), {"name", "model"});
-    set.camera_name = cam.optional_string("name").value_or("");
+    set.camera_name = valid_utf8(cam.optional_string("name").value_or(""));
     if (cam.has("model")) set.camera_model = resolve(folder, cam.string("model"), cam.at("model"));
   }
   if (top.has("balls")) {
     const YAML::Node balls = top.get("balls");
     if (!balls.IsSequence()) spec_fail(top.at("balls"), "expected a sequence");
-    std::set<std::string> names;
+    DistinctNames names;
     for (std::size_t i = 0; i < balls.size(); ++i) {
       YamlMap b(balls[i], top.at("balls") + "[" + std::to_string(i) + "]", {"name", "kind", "diameter_m"});
       BallSpec spec;
       spec.name = b.string("name");
-      if (!names.insert(spec.name).second) spec_fail(b.at("name"), "duplicate ball name '" + spec.name + "'");
+      names.add(spec.name, b.at("name"), "ball");
       spec.kind = ball_kind(b.choice("kind", {"chrome", "grey", "glossy"}));
       if (b.has("diameter_m")) spec.diameter_m = b.positive("diameter_m");
       set.balls.push_back(spec);
@@ -64,13 +65,12 @@ PhotoSet parse(const YAML::Node& root, const fs::path& folder) {
   }
   const YAML::Node views = top.get("views");
   if (!views.IsSequence() || views.size() == 0) spec_fail(top.at("views"), "expected a non-empty sequence");
-  std::set<std::string> names;
+  DistinctNames names;
   for (std::size_t i = 0; i < views.size(); ++i) {
     YamlMap v(views[i], top.at("views") + "[" + std::to_string(i) + "]", {"name", "brackets"});
     PhotoView view;
     view.name = v.string("name");
-    if (view.name.empty()) spec_fail(v.at("name"), "empty name");
-    if (!names.insert(view.name).second) spec_fail(v.at("name"), "duplicate view name '" + view.name + "'");
+    names.add(view.name, v.at("name"), "view");
     const YAML::Node brackets = v.get("brackets");
     if (!brackets.IsSequence() || brackets.size() == 0) spec_fail(v.at("brackets"), "expected a non-empty sequence");
     for (std::size_t j = 0; j < brackets.size(); ++j) {

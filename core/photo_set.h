@@ -9,7 +9,7 @@
 //     - {name: chrome, kind: chrome, diameter_m: 0.1}
 //     - {name: grey,   kind: grey,   diameter_m: 0.1}
 //   views:
-//     - name: north                          # unique; names output files and map-set parts
+//     - name: north                          # unique; names output files (core/safe_name.h)
 //       brackets:                            # one entry per exposure of this view
 //         - {file: north/0001.png, exposure_s: 0.004, iso: 100, aperture: 8}
 //         - {file: north/0002.png}           # exposure left out: read from EXIF (hdr/)
@@ -20,7 +20,8 @@
 //
 // Paths are relative to the folder holding photoset.yaml (absolute paths are kept as they are).
 // Loading checks the structure strictly (yaml_spec.h: unknown keys, wrong types, non-positive
-// exposures, duplicate view names are errors) and that every listed file exists; errors are
+// exposures are errors; view and ball names must be safe file names, distinct in letter case too:
+// core/safe_name.h; the camera's name is free text, bytes that are not UTF-8 replaced by U+FFFD) and that every listed file exists; errors are
 // std::invalid_argument("<photoset.yaml>: <key path>: <problem>").
 #pragma once
 

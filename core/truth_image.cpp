@@ -1,6 +1,7 @@
 #include "core/truth_image.h"
 
 #include "core/atomic_file.h"
+#include "core/text.h"
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -25,7 +26,7 @@ void write_truth_image(const std::filesystem::path& path, const cv::Mat& image, 
   Imf::Header header(px.cols, px.rows);
   header.compression() = Imf::ZIP_COMPRESSION;
   Imf::addChromaticities(header, Imf::Chromaticities());
-  for (const auto& [k, v] : attributes) header.insert("rsibr." + k, Imf::StringAttribute(v));
+  for (const auto& [k, v] : attributes) header.insert("rsibr." + k, Imf::StringAttribute(valid_utf8(v)));
   if (pose) {
     Imath::M33f m;
     for (int r = 0; r < 3; ++r)

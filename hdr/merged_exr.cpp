@@ -2,6 +2,7 @@
 
 #include "core/atomic_file.h"
 #include "core/exr_io.h"
+#include "core/text.h"
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -52,7 +53,7 @@ void write_merged_exr(const std::string& path, const MergedImage& m, const std::
   for (const auto& [key, value] : attributes) {
     const std::string name = "rsibr." + key;
     if (name.size() > kMaxAttributeName) fail("attribute name '" + name + "' is longer than 31 characters");
-    header.insert(name, Imf::StringAttribute(value));
+    header.insert(name, Imf::StringAttribute(valid_utf8(value)));
   }
   Imf::FrameBuffer fb;
   for (int k = 0; k < kCount; ++k) {

@@ -67,7 +67,7 @@ void save_response(const std::filesystem::path& path, const ResponseCurve& curve
   j["knots"] = {curve.knots[0], curve.knots[1], curve.knots[2]};
   write_atomically(path, [&](const std::string& tmp) {
     std::ofstream f(tmp);
-    f << j.dump(1) << "\n";
+    f << j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";  // the camera name: not always UTF-8
     if (!f) throw std::runtime_error(path.string() + ": cannot write");
   });
 }

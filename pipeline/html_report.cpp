@@ -4,6 +4,7 @@
 #include "core/colour.h"
 #include "core/compare_pictures.h"
 #include "core/exr_io.h"
+#include "core/text.h"
 #include "pipeline/process_pipeline.h"
 #include "pipeline/step_record.h"
 
@@ -44,12 +45,13 @@ std::string base64_encode(const std::vector<unsigned char>& in) {
 
 std::string html_escape(const std::string& text) {
   std::string out;
-  for (char ch : text) {
+  for (char ch : valid_utf8(text)) {
     switch (ch) {
       case '&': out += "&amp;"; break;
       case '<': out += "&lt;"; break;
       case '>': out += "&gt;"; break;
       case '"': out += "&quot;"; break;
+      case '\'': out += "&#39;"; break;
       default: out += ch;
     }
   }
@@ -66,7 +68,7 @@ std::string num(double v, int precision = 4) {
 }
 
 std::string jnum(const nlohmann::json& j, int precision = 4) {
-  return j.is_number() ? num(j.get<double>(), precision) : html_escape(j.is_string() ? j.get<std::string>() : j.dump());
+  return j.is_number() ? num(j.get<double>(), precision) : html_escape(j.is_string() ? j.get<std::string>() : j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
 }
 
 std::string img_tag(const std::vector<unsigned char>& png, const std::string& alt, const std::string& style = "") {
@@ -74,7 +76,14 @@ std::string img_tag(const std::vector<unsigned char>& png, const std::string& al
          " src=\"data:image/png;base64," + base64_encode(png) + "\">";
 }
 
-std::vector<unsigned char> read_bytes(const fs::path& file) {
+// A picture a step record lists, embedded only when it lies inside the run folder `dir` (symlinks
+// resolved): a record copied from elsewhere must not make the report carry files from outside it.
+std::vector<unsigned char> read_bytes(const fs::path& dir, const fs::path& file) {
+  std::error_code ec1, ec2;
+  const fs::path root = fs::weakly_canonical(fs::absolute(dir), ec1), real = fs::weakly_canonical(fs::absolute(file), ec2);
+  const fs::path rel = real.lexically_relative(root);
+  if (ec1 || ec2 || rel.empty() || *rel.begin() == "..")
+    throw std::runtime_error(file.string() + ": listed in a step record but outside the run folder " + dir.string());
   std::ifstream in(file, std::ios::binary);
   if (!in) throw std::runtime_error(file.string() + ": cannot read (listed in a step record)");
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -167,7 +176,9 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
 
   if (rec.count("hdr")) {
     const auto& s = rec["hdr"].summary;
-    h << "<h2>Camera response</h2><p>Model <b>" << html_escape(s.value("model", "")) << "</b>, recovered from view "
+    h << "<h2>Camera response</h2><p>";
+    if (!s.value("camera", "").empty()) h << "Camera <b>" << html_escape(s.value("camera", "")) << "</b>. ";
+    h << "Model <b>" << html_escape(s.value("model", "")) << "</b>, recovered from view "
       << html_escape(s.value("recovered_from", "")) << ".</p>";
     std::vector<PlotSeries> series = {{"R", "#d33", {}, {}}, {"G", "#2a2", {}, {}}, {"B", "#33d", {}, {}}};
     for (const auto& p : s["curve"])
@@ -245,7 +256,7 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
         << jnum(b["overall"]["after"]["relative_rms"]) << "</th><th>" << jnum(b["overall"]["after"]["log_rms_stops"])
         << "</th><th>" << jnum(b["overall"]["after"]["psnr_db"]) << "</th></tr></table>";
       for (const auto& v : b["views"])
-        h << "<p>" << img_tag(read_bytes(fs::path(b["folder"].get<std::string>()) / v["picture"].get<std::string>()),
+        h << "<p>" << img_tag(read_bytes(dir, fs::path(b["folder"].get<std::string>()) / v["picture"].get<std::string>()),
                               v["image"].get<std::string>())
           << "</p>";
     }
@@ -257,7 +268,7 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
       << html_escape(s.value("material", "")) << ", rendered by the runtime from maps baked from the probe; "
       << jnum(s["seconds_per_frame"], 3) << " s per frame.</p><div class=\"frames\">";
     for (const fs::path& f : rec["render"].outputs)
-      if (f.extension() == ".png") h << img_tag(read_bytes(f), f.filename().string());
+      if (f.extension() == ".png") h << img_tag(read_bytes(dir, f), f.filename().string());
     h << "</div>";
   }
   h << "</body></html>\n";

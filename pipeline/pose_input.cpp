@@ -1,5 +1,7 @@
 #include "pipeline/pose_input.h"
 
+#include "core/safe_name.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -41,6 +43,7 @@ PoseSet read_given_poses(const std::string& path) {
   try {
     const YAML::Node views = root["views"];
     if (!views || !views.IsSequence() || views.size() == 0) throw std::invalid_argument("views: expected a list");
+    DistinctNames names;
     for (std::size_t i = 0; i < views.size(); ++i) {
       const std::string where = "views[" + std::to_string(i) + "]";
       if (!views[i]["name"] || !views[i]["world_from_cam"])
@@ -48,7 +51,7 @@ PoseSet read_given_poses(const std::string& path) {
       ViewPose p;
       p.name = views[i]["name"].as<std::string>();
       p.world_from_cam = parse_rows(views[i]["world_from_cam"], where + ".world_from_cam");
-      if (out.find(p.name)) throw std::invalid_argument(where + ": duplicate view name '" + p.name + "'");
+      names.add(p.name, where + ".name", "view");
       out.views.push_back(p);
     }
   } catch (const YAML::Exception& e) {

@@ -9,7 +9,6 @@
 #include "calib/view_image.h"
 #include "calib/view_orientation.h"
 #include "calib/pose_file.h"
-#include "core/photo_set.h"
 #include "core/atomic_file.h"
 #include "core/atomic_folder.h"
 #include "core/camera.h"
@@ -20,6 +19,7 @@
 #include "core/map_compare.h"
 #include "core/map_set.h"
 #include "core/mesh.h"
+#include "core/photo_set.h"
 #include "core/progress.h"
 #include "core/resample.h"
 #include "core/view_set.h"
@@ -111,9 +111,12 @@ void run_step(Context& c, const std::string& step, const nlohmann::json& setting
   c.result.steps.push_back(outcome);
 }
 
+// A view's merged image; view names are safe file names (core/safe_name.h), checked again here.
+fs::path merged_path(const Context& c, const std::string& view) { return file_in_folder(c.dir / "hdr", view + ".exr"); }
+
 std::vector<fs::path> hdr_files(const Context& c) {
   std::vector<fs::path> files;
-  for (const PhotoView& v : c.set.views) files.push_back(c.dir / "hdr" / (v.name + ".exr"));
+  for (const PhotoView& v : c.set.views) files.push_back(merged_path(c, v.name));
   return files;
 }
 
@@ -124,8 +127,8 @@ std::vector<const BallSpec*> balls_of(const Context& c, BallKind kind) {
   return out;
 }
 
-fs::path captured_path(const Context& c, const BallSpec& b) { return c.dir / "maps" / ("captured-" + b.name + ".exr"); }
-fs::path computed_path(const Context& c, const BallSpec& b) { return c.dir / "maps" / ("computed-" + b.name + ".exr"); }
+fs::path captured_path(const Context& c, const BallSpec& b) { return file_in_folder(c.dir / "maps", "captured-" + b.name + ".exr"); }
+fs::path computed_path(const Context& c, const BallSpec& b) { return file_in_folder(c.dir / "maps", "computed-" + b.name + ".exr"); }
 
 // ---- calibrate: the lens model.
 void step_calibrate(Context& c) {
@@ -194,7 +197,7 @@ void step_given_radiance(Context& c) {
       m.radiance = img.radiance;
       m.variance = cv::Mat::zeros(img.radiance.size(), CV_32FC3);
       m.flags = cv::Mat::zeros(img.radiance.size(), CV_8UC1);
-      const fs::path exr = c.dir / "hdr" / (c.set.views[i].name + ".exr");
+      const fs::path exr = merged_path(c, c.set.views[i].name);
       write_merged_exr(exr.string(), m, {{"version", RSIBR_VERSION}, {"view", c.set.views[i].name},
                                           {"source", inputs[i].string()}, {"producer", "rsibr process (given radiance)"}});
       r.outputs.push_back(exr);
@@ -239,7 +242,7 @@ void step_hdr(Context& c) {
       const BracketSet& b = vm.brackets;
       const NoiseModel& noise = vm.noise;
       const MergedImage& m = vm.image;
-      const fs::path exr = c.dir / "hdr" / (v.name + ".exr");
+      const fs::path exr = merged_path(c, v.name);
       write_merged_exr(exr.string(), m,
                        {{"version", RSIBR_VERSION}, {"view", v.name}, {"responseModel", curve.model},
                         {"responseFile", "response.json (next to this file)"}, {"colourSpace", working_space()},
@@ -254,7 +257,7 @@ void step_hdr(Context& c) {
     }
     bar.done();
     r.summary = {{"model", curve.model}, {"recovered_from", richest->name}, {"candidates", cands},
-                 {"curve", plot}, {"max_code", curve.max_code}, {"views", views}};
+                 {"curve", plot}, {"max_code", curve.max_code}, {"views", views}, {"camera", c.set.camera_name}};
   });
 }
 
@@ -285,7 +288,7 @@ void step_orient(Context& c) {
       std::vector<ViewImage> images;
       for (const PhotoView& v : c.set.views) {
         names.push_back(v.name);
-        images.push_back(read_view_image((c.dir / "hdr" / (v.name + ".exr")).string()));
+        images.push_back(read_view_image(merged_path(c, v.name).string()));
       }
       ViewOrientationOptions vo;
       vo.up = c.o.up;
@@ -364,7 +367,7 @@ void step_extract(Context& c) {
     Progress bar("extract", c.o.progress);
     for (std::size_t vi = 0; vi < c.set.views.size(); ++vi) {
       const PhotoView& v = c.set.views[vi];
-      const std::string file = (c.dir / "hdr" / (v.name + ".exr")).string();
+      const std::string file = merged_path(c, v.name).string();
       const ViewImage img = read_view_image(file);
       if (img.radiance.cols != lens.width() || img.radiance.rows != lens.height())
         throw std::invalid_argument(file + ": " + std::to_string(img.radiance.cols) + "x" +

@@ -35,7 +35,7 @@ TEST(PoseFile, RoundTripKeepsRotationsExactAndSigmasToSixDigits) {
   PoseSet p;
   p.gauge = "up";
   p.views.push_back({"north", Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix(), 0.0312345678901});
-  p.views.push_back({"with space: and 'quote'", Eigen::AngleAxisd(-2.9, Vec3(0, 1, 0)).toRotationMatrix(), 0});
+  p.views.push_back({"Side-2.5_b", Eigen::AngleAxisd(-2.9, Vec3(0, 1, 0)).toRotationMatrix(), 0});
   BallCone ball;
   ball.axis = Vec3(0.1, -0.2, 1).normalized();
   ball.half_angle = 0.0998;
@@ -82,6 +82,10 @@ TEST(PoseFile, StrictReadingNamesTheFileAndTheKey) {
       {"rsibr_poses: 1\ngauge: up\nviews: [{name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, 1]}]\n",
        "poses.views[0].sigma_deg: missing"},
       {"rsibr_poses: 1\ngauge: up\nviews: [" + ok_view + ", " + ok_view + "]\n", "duplicate view name 'a'"},
+      {"rsibr_poses: 1\ngauge: up\nviews: [{name: \"../a\", world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], sigma_deg: 0}]\n",
+       "poses.views[0].name: a name starting with '.'"},
+      {"rsibr_poses: 1\ngauge: up\nviews: [{name: \"with space\", world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], sigma_deg: 0}]\n",
+       "poses.views[0].name: a name containing ' '"},
       {"rsibr_poses: 1\ngauge: up\nviews: [{name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, .nan], sigma_deg: 0}]\n",
        "world_from_cam"},
       {"rsibr_poses: 1\ngauge: [up\n", "poses.yaml"},

@@ -134,10 +134,11 @@ TEST(SynthCapture, RefusesANonEmptyOutputAndLeavesNothingOnError) {
   fs::create_directories(dir.path() / "full");
   std::ofstream(dir.path() / "full" / "x") << "x";
   EXPECT_THROW(write_synth_capture(testing::small_scene(), dir.path() / "full"), std::invalid_argument);
-  // A ball name the spec would refuse: its map file cannot be written, after the photos were.
+  // A ball name the spec would refuse (a scene built in code): its map file is refused inside the
+  // truth folder, after the photos were written.
   SynthScene bad = testing::small_scene();
   bad.balls[1].name = "no/such/folder";
-  EXPECT_THROW(write_synth_capture(bad, dir.path() / "new"), std::runtime_error);
+  EXPECT_THROW(write_synth_capture(bad, dir.path() / "new"), std::invalid_argument);
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"full"});
   // A camera inside a ball is refused before any work.
   SynthScene inside = testing::small_scene();

@@ -1,5 +1,7 @@
 #include "core/photo_set.h"
 
+#include "core/text.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -122,6 +124,49 @@ TEST_F(PhotoSetTest, BadInputNamesTheFileAndTheKey) {
     EXPECT_EQ(error.rfind(yaml, 0), 0u) << error;
     EXPECT_NE(error.find(expected), std::string::npos) << "expected '" << expected << "' in: " << error;
   }
+}
+
+TEST_F(PhotoSetTest, ViewAndBallNamesThatAreNotSafeFileNamesAreRefusedNamingTheFileTheKeyAndTheName) {
+  const std::string yaml = (dir_ / "photoset.yaml").string();
+  auto view_named = [](const std::string& name) {
+    return "rsibr_photoset: 1\nviews: [{name: \"" + name + "\", brackets: [{file: v0/a.png}]}]\n";
+  };
+  const std::string long_name(10000, 'a');
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {view_named("../../esc/stolen"), "photoset.views[0].name: a name starting with '.'"},
+      {view_named("v/../../x"), "photoset.views[0].name: a name containing a path separator '/'"},
+      {view_named("/somewhere/escaped"), "photoset.views[0].name: a name starting with a path separator '/'"},
+      {view_named("."), "photoset.views[0].name: a name that is a folder reference"},
+      {view_named(".."), "photoset.views[0].name: a name that is a folder reference"},
+      {view_named(".hidden"), "photoset.views[0].name: a name starting with '.'"},
+      {view_named("-v"), "photoset.views[0].name: a name starting with '-'"},
+      {view_named("a\\\\b"), "photoset.views[0].name: a name containing a path separator '\\'"},
+      {view_named("tab\\there"), "photoset.views[0].name: a name containing a control character"},
+      {view_named("caf\\xe9"), "photoset.views[0].name: a name containing a character that is not ASCII"},
+      {view_named(long_name), "photoset.views[0].name: a name of 10000 characters (at most 64)"},
+      {"rsibr_photoset: 1\nviews: [{name: North, brackets: [{file: v0/a.png}]}, {name: north, brackets: [{file: v0/b.png}]}]\n",
+       "photoset.views[1].name: view name 'north' clashes with 'North' (names must differ in more than letter case)"},
+      {"rsibr_photoset: 1\nballs: [{name: ../chrome, kind: chrome}]\nviews: [{name: v0, brackets: [{file: v0/a.png}]}]\n",
+       "photoset.balls[0].name: a name starting with '.'"},
+      {"rsibr_photoset: 1\nballs: [{name: Grey, kind: grey}, {name: grey, kind: grey}]\nviews: [{name: v0, brackets: [{file: v0/a.png}]}]\n",
+       "photoset.balls[1].name: ball name 'grey' clashes with 'Grey'"},
+  };
+  for (const auto& [text, expected] : cases) {
+    write(text);
+    const std::string error = load_error();
+    EXPECT_EQ(error.rfind(yaml, 0), 0u) << error;
+    EXPECT_NE(error.find(expected), std::string::npos) << "expected '" << expected << "' in: " << error;
+    EXPECT_EQ(error.find('\n'), std::string::npos) << "one line: " << error;
+    EXPECT_LT(error.size(), yaml.size() + 200) << "the name is shortened in the message";
+  }
+}
+
+TEST_F(PhotoSetTest, ACameraNameThatIsNotUtf8IsKeptWithItsBadBytesReplaced) {
+  // A Latin-1 byte (0xE9) in the raw file: not UTF-8.
+  write("rsibr_photoset: 1\ncamera: {name: \"Caf\xE9" " cam\"}\nviews: [{name: v0, brackets: [{file: v0/a.png}]}]\n");
+  const PhotoSet s = load_photo_set(dir_);
+  EXPECT_TRUE(is_utf8(s.camera_name)) << s.camera_name;
+  EXPECT_NE(s.camera_name.find("cam"), std::string::npos);
 }
 
 TEST_F(PhotoSetTest, AMissingFileIsAClearError) {
