@@ -4,26 +4,7 @@
 # Usage: cli_test.sh /path/to/rsibr
 set -u
 rsibr=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-pass=0 fail=0
-check() {  # check NAME CONDITION-COMMAND...
-  local name=$1; shift
-  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAILED: $name"; fi
-}
-# Runs rsibr expecting failure: non-zero exit, exactly one line on stderr that names $2.
-expect_error() {
-  local name=$1 needle=$2; shift 2
-  "$rsibr" "$@" >"$work/out" 2>"$work/err"
-  local rc=$?
-  local lines; lines=$(wc -l <"$work/err")
-  if [ "$rc" -ne 0 ] && [ "$lines" -eq 1 ] && grep -q -- "$needle" "$work/err"; then
-    pass=$((pass + 1))
-  else
-    fail=$((fail + 1)); echo "FAILED: $name (exit $rc, $lines lines):"; cat "$work/err"
-  fi
-}
-no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
+. "$(dirname "$0")/contract_lib.sh"
 
 for verb in convert info pattern blend bake reference render view hdr compare synth extract calibrate probe orient process; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
@@ -206,32 +187,7 @@ else
 fi
 # hdr: a synthetic 8-bit bracket set (gamma 2.2 camera, a radiance ramp with a clipped sun), written
 # by a standard-library PNG writer.
-mkdir -p "$work/shoot/north"
-python3 - "$work/shoot" <<'PY'
-import math, os, random, struct, sys, zlib
-root = sys.argv[1]
-def png(path, w, h, pixel):
-    raw = b"".join(b"\x00" + bytes(v for x in range(w) for v in pixel(x, y)) for y in range(h))
-    chunk = lambda t, d: struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
-    with open(path, "wb") as f:
-        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
-                + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
-rng = random.Random(1)
-W, H = 96, 64
-radiance = [[(10 ** (-3 + 4 * (x + 0.5) / W)) * (1e4 if (x - 80) ** 2 + (y - 12) ** 2 < 16 else 1) for x in range(W)] for y in range(H)]
-times = [1 / 256, 1 / 64, 1 / 16, 1 / 4, 1.0]
-lines = ["rsibr_photoset: 1", "views:", "  - name: north", "    brackets:"]
-for j, t in enumerate(times):
-    def pixel(x, y, t=t):
-        out = []
-        for c, tint in enumerate((0.9, 1.0, 1.1)):
-            X = min(1.0, max(0.0, radiance[y][x] * tint * t * (1 + 0.01 * rng.gauss(0, 1))))
-            out.append(int(round(255 * X ** (1 / 2.2))))
-        return out
-    png(os.path.join(root, "north", "%d.png" % j), W, H, pixel)
-    lines.append("      - {file: north/%d.png, exposure_s: %r}" % (j, t))
-open(os.path.join(root, "photoset.yaml"), "w").write("\n".join(lines) + "\n")
-PY
+python3 "$(dirname "$0")/bracket_shoot.py" "$work/shoot"
 "$rsibr" hdr "$work/shoot" --out "$work/hdr" --json "$work/hdr.json" -q
 check "hdr writes EXR, PNG and the response" test -s "$work/hdr/north.exr" -a -s "$work/hdr/north.png" -a -s "$work/hdr/response.json"
 check "hdr JSON: model chosen by held-out error, sun clipped, no ghosts" python3 -c "
@@ -481,5 +437,4 @@ expect_error "process: missing --probe environment" "noenv.exr" process "$work/p
 check "process: no output after errors" bash -c "! ls -A '$work' | grep -q '^pe[0-9]'"
 check "process: no temporaries" no_temporaries "$work/pout"
 
-echo "cli: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+finish cli
