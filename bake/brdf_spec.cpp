@@ -110,13 +110,7 @@ std::unique_ptr<Brdf> make_brdf(const YAML::Node& spec, const std::string& path)
 }
 
 std::unique_ptr<Brdf> parse_brdf(const std::string& yaml_text) {
-  YAML::Node node;
-  try {
-    node = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw std::invalid_argument("brdf: invalid YAML: " + e.msg);
-  }
-  return make_brdf(node);
+  return make_brdf(parse_yaml(yaml_text, "brdf"));
 }
 
 std::unique_ptr<Brdf> load_brdf(const std::filesystem::path& file) {
@@ -124,13 +118,7 @@ std::unique_ptr<Brdf> load_brdf(const std::filesystem::path& file) {
   if (!in) throw std::invalid_argument(file.string() + ": cannot read BRDF spec");
   std::ostringstream text;
   text << in.rdbuf();
-  YAML::Node node;
-  try {
-    node = YAML::Load(text.str());
-  } catch (const YAML::Exception& e) {
-    throw std::invalid_argument(file.string() + ":" + std::to_string(e.mark.line + 1) + ":" +
-                                std::to_string(e.mark.column + 1) + ": invalid YAML: " + e.msg);
-  }
+  const YAML::Node node = parse_yaml(text.str(), file.string());
   try {
     return make_brdf(node);
   } catch (const std::invalid_argument& e) {

@@ -224,7 +224,7 @@ Vec3 SynthScene::rig_centre() const {
 
 SynthScene parse_synth_scene(const std::string& text, const std::string& what, const std::filesystem::path& folder) {
   try {
-    SynthScene s = parse_root(YAML::Load(text), folder);
+    SynthScene s = parse_root(parse_yaml(text, what), folder);
     s.file = what;
     return s;
   } catch (const YAML::Exception& e) {

@@ -8,6 +8,7 @@
 #include "core/atomic_file.h"
 #include "core/exr_io.h"
 #include "core/map_set.h"
+#include "core/yaml_spec.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -30,7 +31,7 @@ int run_probe(const ProbeArgs& a) {
   std::shared_ptr<const Fresnel> fresnel;
   if (!a.fresnel.empty()) {
     try {
-      fresnel = make_fresnel(YAML::Load(a.fresnel), "--fresnel");
+      fresnel = make_fresnel(parse_yaml(a.fresnel, "--fresnel"), "--fresnel");
     } catch (const std::exception& e) {
       throw std::invalid_argument(std::string("--fresnel: ") + e.what());
     }

@@ -146,17 +146,59 @@ std::string spec_type(const YAML::Node& node, const std::string& path, const std
   return type;
 }
 
+namespace {
+
+// Walks the node graph depth first with the chain of ancestors: a node that is one of its own
+// ancestors (yaml-cpp registers an anchor before its content, so "&a [*a]" contains itself) is a
+// cycle; every visit counts, so aliases that multiply a subtree are bounded by kMaxYamlNodes.
+void check_yaml_graph(const YAML::Node& node, std::vector<YAML::Node>& ancestors, long& visits, const std::string& path,
+                      const std::string& where) {
+  if (++visits > kMaxYamlNodes)
+    throw std::invalid_argument(where + ": more than " + std::to_string(kMaxYamlNodes) + " nodes (aliases expanded)");
+  for (const YAML::Node& a : ancestors)
+    if (a.is(node)) throw std::invalid_argument(where + ": " + path + ": an alias that contains itself (a cycle)");
+  if (int(ancestors.size()) >= kMaxYamlDepth)
+    throw std::invalid_argument(where + ": " + path + ": nested deeper than " + std::to_string(kMaxYamlDepth) + " levels");
+  if (!node.IsMap() && !node.IsSequence()) return;
+  ancestors.push_back(node);
+  std::size_t i = 0;
+  for (const auto& item : node) {
+    if (node.IsSequence()) {
+      check_yaml_graph(item, ancestors, visits, path + "[" + std::to_string(i++) + "]", where);
+    } else {
+      const std::string key = item.first.IsScalar() ? item.first.Scalar() : "?";
+      check_yaml_graph(item.first, ancestors, visits, path + "." + key, where);
+      check_yaml_graph(item.second, ancestors, visits, path + "." + key, where);
+    }
+  }
+  ancestors.pop_back();
+}
+
+}  // namespace
+
+YAML::Node parse_yaml(const std::string& text, const std::string& where) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw std::invalid_argument(where + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                                ": invalid YAML: " + e.msg);
+  }
+  std::vector<YAML::Node> ancestors;
+  long visits = 0;
+  check_yaml_graph(root, ancestors, visits, "document", where);
+  return root;
+}
+
 YAML::Node load_yaml_file(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec))
+    throw std::invalid_argument(file.string() + (std::filesystem::exists(file, ec) ? ": not a regular file" : ": cannot read (no such file)"));
   std::ifstream in(file, std::ios::binary);
   if (!in) throw std::invalid_argument(file.string() + ": cannot read");
   std::ostringstream text;
   text << in.rdbuf();
-  try {
-    return YAML::Load(text.str());
-  } catch (const YAML::Exception& e) {
-    throw std::invalid_argument(file.string() + ":" + std::to_string(e.mark.line + 1) + ":" +
-                                std::to_string(e.mark.column + 1) + ": invalid YAML: " + e.msg);
-  }
+  return parse_yaml(text.str(), file.string());
 }
 
 }  // namespace rsibr

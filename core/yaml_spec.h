@@ -60,7 +60,20 @@ class YamlMap {
 // The "type" of a mapping, read before its other keys are checked.
 std::string spec_type(const YAML::Node& node, const std::string& path, const std::vector<std::string>& types);
 
-// Parses a YAML file; a read or syntax error is std::invalid_argument("<file>:<line>:<col>: ...").
+// Limits on a parsed document: specs are small and hand-written, so deeper nesting or more nodes
+// than this is an attack or an accident (YAML aliases can make a few lines expand to billions of
+// nodes, or point into their own ancestor: a cycle that recursive readers follow forever).
+inline constexpr int kMaxYamlDepth = 64;
+inline constexpr long kMaxYamlNodes = 1'000'000;  // counted with aliases expanded
+
+// Parses YAML text (`where` names it in errors: a file, or an option such as "--fresnel"). A syntax
+// error is std::invalid_argument("<where>:<line>:<col>: invalid YAML: ..."), an alias cycle, nesting
+// deeper than kMaxYamlDepth or more than kMaxYamlNodes nodes is std::invalid_argument("<where>:
+// <key path>: ...").
+YAML::Node parse_yaml(const std::string& text, const std::string& where);
+
+// parse_yaml of a file's text; a file that cannot be read, or is not a regular file (a FIFO, a
+// device, a folder), is std::invalid_argument("<file>: ...").
 YAML::Node load_yaml_file(const std::filesystem::path& file);
 
 }  // namespace rsibr

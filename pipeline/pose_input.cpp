@@ -1,6 +1,7 @@
 #include "pipeline/pose_input.h"
 
 #include "core/safe_name.h"
+#include "core/yaml_spec.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -31,12 +32,7 @@ Mat3 parse_rows(const YAML::Node& node, const std::string& where) {
 
 PoseSet read_given_poses(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw std::invalid_argument(path + ": no such file");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const std::exception& e) {
-    throw std::invalid_argument(path + ": " + e.what());
-  }
+  const YAML::Node root = load_yaml_file(path);
   if (!root.IsMap() || !root["rsibr_synth_truth"]) return read_pose_file(path);  // its own errors
   PoseSet out;
   out.gauge = "up";  // the synthetic world is +Y up

@@ -23,6 +23,7 @@
 #include "core/progress.h"
 #include "core/resample.h"
 #include "core/view_set.h"
+#include "core/yaml_spec.h"
 #include "hdr/bracket_set.h"
 #include "hdr/merge.h"
 #include "hdr/merged_exr.h"
@@ -468,7 +469,7 @@ void step_probe(Context& c) {
     ProbeOptions po;
     po.width = c.o.probe_width;
     std::shared_ptr<const Fresnel> fresnel;
-    if (!c.o.chrome_fresnel.empty()) fresnel = make_fresnel(YAML::Load(c.o.chrome_fresnel), "--chrome-fresnel");
+    if (!c.o.chrome_fresnel.empty()) fresnel = make_fresnel(parse_yaml(c.o.chrome_fresnel, "--chrome-fresnel"), "--chrome-fresnel");
     po.fresnel = fresnel.get();
     Probe p = assemble_probe(all, po);
     p.env.attributes["views"] = std::to_string(all.views.size());
@@ -672,7 +673,7 @@ ProcessResult run_process(const ProcessOptions& o) {
   parse_brdf(o.render_brdf);
   if (!o.chrome_fresnel.empty()) {
     try {
-      make_fresnel(YAML::Load(o.chrome_fresnel), "--chrome-fresnel");
+      make_fresnel(parse_yaml(o.chrome_fresnel, "--chrome-fresnel"), "--chrome-fresnel");
     } catch (const std::exception& e) {
       throw std::invalid_argument(std::string("--chrome-fresnel: ") + e.what());
     }

@@ -71,7 +71,14 @@ TEST(BrdfSpec, SpecParsingRejectsWrongTypes) {
   EXPECT_TRUE(starts_with(error_of("[1, 2]"), "brdf: expected a mapping"));
   EXPECT_TRUE(starts_with(error_of(""), "brdf: expected a mapping"));
   EXPECT_TRUE(starts_with(error_of("{type: [ggx]}"), "brdf.type: expected a string"));
-  EXPECT_TRUE(starts_with(error_of("{type: ggx, roughness: 0.3"), "brdf: invalid YAML"));
+  const std::string syntax = error_of("{type: ggx, roughness: 0.3");
+  EXPECT_TRUE(starts_with(syntax, "brdf:1:") && syntax.find("invalid YAML") != std::string::npos) << syntax;
+}
+
+TEST(BrdfSpec, AliasCyclesInAClearCoatOrALobeAreErrorsNotCrashes) {
+  for (const char* text : {"&c {type: clearcoat, coat: *c}", "&g {type: ggx, roughness: 0.3, fresnel: *g}",
+                           "{type: ggx, roughness: 0.3, fresnel: &f {type: schlick, f0: [*f, 1, 1]}}"})
+    EXPECT_NE(error_of(text).find("cycle"), std::string::npos) << text << " -> " << error_of(text);
 }
 
 TEST(BrdfSpec, SpecParsingRejectsMissingAndOutOfRangeValues) {
