@@ -1,5 +1,6 @@
 #include "calib/view_image.h"
 
+#include "core/input_file.h"
 #include "core/safe_name.h"
 #include "core/truth_image.h"
 #include "hdr/merged_exr.h"
@@ -17,7 +18,7 @@
 namespace rsibr {
 
 ViewImage read_view_image(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw std::runtime_error(path + ": no such file");
+  require_regular_file(path);
   ViewImage v;
   try {
     const MergedImage m = read_merged_exr(path);

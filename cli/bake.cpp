@@ -13,6 +13,7 @@
 #include "bake/integrator.h"
 #include "core/exr_io.h"
 #include "core/map_set.h"
+#include "core/output_plan.h"
 #include "core/progress.h"
 #include "core/view_set.h"
 
@@ -39,7 +40,8 @@ struct BakeArgs {
 int run_bake(const BakeArgs& a) {
   if (std::filesystem::path(a.output).extension() != ".exr")
     throw std::invalid_argument(a.output + ": the output must be an .exr file");
-  check_output_path(a.output, {a.env, a.brdf});
+  OutputPlan outputs({a.env, a.brdf, a.views});
+  const std::string exr = outputs.file(a.output), json = outputs.file(a.json);
   const auto t0 = std::chrono::steady_clock::now();
   const EnvMap env = read_environment_input(a.env, a.layout, a.sanitize);
   // --lobe: the whole BRDF, or one part of it (bake/brdf_lobes.h) with its own central direction.
@@ -92,7 +94,7 @@ int run_bake(const BakeArgs& a) {
   }
   bar.done();
   const auto t2 = std::chrono::steady_clock::now();
-  write_map_set(a.output, set);
+  write_map_set(exr, set);
   const auto t3 = std::chrono::steady_clock::now();
 
   auto secs = [](auto d) { return std::chrono::duration<double>(d).count(); };
@@ -116,7 +118,8 @@ int run_bake(const BakeArgs& a) {
   j["res"] = a.res;
   j["seconds"] = {{"setup", secs(t1 - t0)}, {"integrate", secs(t2 - t1)}, {"write", secs(t3 - t2)},
                   {"per_map", secs(t2 - t1) / double(set.views.size())}};
-  write_summary(a.json, j);
+  write_summary(json, j);
+  outputs.commit();
   return 0;
 }
 

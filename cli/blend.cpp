@@ -6,6 +6,7 @@
 #include "core/atomic_file.h"
 #include "core/colour.h"
 #include "core/map_set.h"
+#include "core/output_plan.h"
 #include "runtime/blend.h"
 #include "runtime/tessellated_warp.h"
 
@@ -28,8 +29,8 @@ struct BlendArgs {
 };
 
 int run_blend(const BlendArgs& a) {
-  check_output_path(a.output, {a.maps});
-  if (!a.preview.empty()) check_output_path(a.preview, {a.maps});
+  OutputPlan outputs({a.maps});
+  const std::string exr = outputs.file(a.output), preview = outputs.file(a.preview), json = outputs.file(a.json);
   const MapSet set = read_map_set(a.maps);
   const ViewSet views = set.view_set();
   const Vec3 view(a.view[0], a.view[1], a.view[2]), up(a.up[0], a.up[1], a.up[2]);
@@ -70,13 +71,9 @@ int run_blend(const BlendArgs& a) {
   mv.rgb = r.rgb;
   mv.confidence = r.weight;
   out.views.push_back(mv);
-  write_map_set(a.output, out);
-  if (!a.preview.empty()) {
-    const cv::Mat png = display_encode(r.rgb, a.preview_exposure);
-    write_atomically(a.preview, [&](const std::string& tmp) {
-      if (!cv::imwrite(tmp, png)) throw std::runtime_error(a.preview + ": cannot write the preview image");
-    });
-  }
+  write_map_set(exr, out);
+  if (!preview.empty() && !cv::imwrite(preview, display_encode(r.rgb, a.preview_exposure)))
+    throw std::runtime_error(a.preview + ": cannot write the preview image");
   nlohmann::json j;
   j["maps"] = a.maps;
   j["output"] = a.output;
@@ -88,7 +85,8 @@ int run_blend(const BlendArgs& a) {
     j["sources"].push_back({{"view", r.located.views[std::size_t(i)]}, {"weight", r.located.weights[std::size_t(i)]}});
   j["warp"] = a.warp;
   j["seconds"] = secs;
-  write_summary(a.json, j);
+  write_summary(json, j);
+  outputs.commit();
   return 0;
 }
 

@@ -4,10 +4,11 @@
 #include "cli/verbs.h"
 
 #include "calib/intrinsics.h"
-#include "pipeline/chessboard_problem.h"
-#include "core/photo_set.h"
 #include "core/atomic_file.h"
+#include "core/output_plan.h"
+#include "core/photo_set.h"
 #include "core/progress.h"
+#include "pipeline/chessboard_problem.h"
 
 #include <Eigen/Eigenvalues>
 
@@ -35,23 +36,21 @@ constexpr double kMinSplineCoverage = 0.6;
 constexpr std::size_t kMinSplineBoards = 8;
 
 // The .cameramodel text mrcal writes, preceded by '#' comment lines (mrcal's reader skips them).
-void write_with_comment(const LensModel& lens, const std::filesystem::path& out, const std::string& comment) {
-  write_atomically(out, [&](const std::string& tmp) {
-    lens.write(tmp);
-    std::ifstream in(tmp, std::ios::binary);
-    std::stringstream text;
-    text << in.rdbuf();
-    in.close();
-    std::ofstream o(tmp, std::ios::binary | std::ios::trunc);
-    o << comment << text.str();
-    if (!o) throw std::runtime_error(out.string() + ": cannot write");
-  });
+void write_with_comment(const LensModel& lens, const std::string& out, const std::string& comment) {
+  lens.write(out);
+  std::ifstream in(out, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  in.close();
+  std::ofstream o(out, std::ios::binary | std::ios::trunc);
+  o << comment << text.str();
+  if (!o) throw std::runtime_error(out + ": cannot write");
 }
 
 int run_calibrate(const CalibrateArgs& a) {
   const PhotoSet set = load_photo_set(a.photoset);
-  check_output_path(a.out, {a.photoset});
-  if (!a.json.empty() && a.json != "-") check_output_path(a.json, {a.photoset});
+  OutputPlan outputs(set.files());
+  const std::string model = outputs.file(a.out), json = outputs.file(a.json);
   std::vector<std::string> missed_files;
   IntrinsicsProblem p;
   {
@@ -111,7 +110,7 @@ int run_calibrate(const CalibrateArgs& a) {
           << p.boards.size() << " boards\n# RMS " << fit.rms_px << " px, corner noise " << fit.noise_sigma_px
           << " px per axis, " << fit.outliers << " outliers\n# projection uncertainty (1 sigma, 3x3 grid over the image): "
           << "worst " << worst_sigma << " px, centre " << points[4]["sigma_px"].get<double>() << " px\n";
-  write_with_comment(fit.lens, a.out, comment.str());
+  write_with_comment(fit.lens, model, comment.str());
 
   // Residual pattern: mean residual vector and RMS per cell of a 4 x 3 grid over the image.
   const int gx = 4, gy = 3;
@@ -169,7 +168,8 @@ int run_calibrate(const CalibrateArgs& a) {
        "shift of the reference frame; for splined models excludes the small rotation that regularisation pins"}};
   j["boards"] = boards;
   j["residual_grid_4x3"] = pattern;
-  write_summary(a.json, j);
+  write_summary(json, j);
+  outputs.commit();
   if (!a.quiet && a.json != "-")
     std::cerr << models[chosen] << ": RMS " << fit.rms_px << " px over " << p.boards.size() << " boards -> " << a.out
               << "\n";

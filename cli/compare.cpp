@@ -9,6 +9,7 @@
 #include "core/compare_pictures.h"
 #include "core/exr_io.h"
 #include "core/map_compare.h"
+#include "core/output_plan.h"
 #include "core/progress.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -59,8 +60,12 @@ std::vector<unsigned char> encode_png(const cv::Mat& bgr, const std::string& nam
 
 int run_compare(const CompareArgs& a) {
   namespace fs = std::filesystem;
-  if (!a.out.empty()) check_output_folder(a.out, {a.a, a.b});
-  if (!a.json.empty() && a.json != "-") check_output_path(a.json, {a.a, a.b});
+  OutputPlan outputs({a.a, a.b});
+  if (!a.out.empty()) {
+    check_output_folder(a.out, {a.a, a.b});
+    outputs.folder(a.out);
+  }
+  const std::string json = outputs.file(a.json);
 
   CompareOptions o;
   o.name_a = a.a;
@@ -185,7 +190,6 @@ int run_compare(const CompareArgs& a) {
   if (!a.out.empty()) {
     files["contact.png"] = encode_png(contact_sheet(panels), (fs::path(a.out) / "contact.png").string());
     j["contact_sheet"] = (fs::path(a.out) / "contact.png").string();
-    write_folder_atomically(a.out, files);
   }
 
   std::ostream& text = a.json == "-" ? std::cerr : std::cout;
@@ -204,7 +208,10 @@ int run_compare(const CompareArgs& a) {
            << c.fit->chroma[1] << " " << c.fit->chroma[2] << (c.fit->converged ? "" : " (not converged)") << "\n";
     if (!a.out.empty()) text << "  pictures in " << a.out << " (heat scale 0.." << heat_max << " stops)\n";
   }
-  write_summary(a.json, j);
+  // The summary is written first, to its temporary: the pictures and the summary appear together.
+  write_summary(json, j);
+  if (!a.out.empty()) write_folder_atomically(a.out, files);
+  outputs.commit();
   if (a.fail_above > 0 && c.after.log_rms_stops > a.fail_above) {
     std::cerr << "rsibr compare: " << a.a << ": log RMS error after the fit " << c.after.log_rms_stops
               << " stops exceeds --fail-above " << a.fail_above << "\n";

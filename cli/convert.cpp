@@ -5,6 +5,7 @@
 #include "core/atomic_file.h"
 #include "core/colour.h"
 #include "core/exr_io.h"
+#include "core/output_plan.h"
 #include "core/progress.h"
 #include "core/resample.h"
 
@@ -47,10 +48,10 @@ std::string command_line_text(const ConvertArgs& a, const Layout& dst) {
 }
 
 int run_convert(const ConvertArgs& a) {
-  check_output_path(a.output, {a.input});
-  if (!a.preview.empty()) check_output_path(a.preview, {a.input});
   if (std::filesystem::path(a.output).extension() != ".exr")
     throw std::invalid_argument(a.output + ": the output must be an .exr file (use --preview for a PNG)");
+  OutputPlan outputs({a.input});
+  const std::string exr = outputs.file(a.output), preview = outputs.file(a.preview), json = outputs.file(a.json);
   const std::optional<LayoutKind> hint =
       a.from_layout.empty() ? std::nullopt : std::optional<LayoutKind>(parse_layout_kind(a.from_layout));
   const LayoutKind to = parse_layout_kind(a.to);
@@ -91,13 +92,9 @@ int run_convert(const ConvertArgs& a) {
   out.attributes["command"] = command_line_text(a, dst);
   ExrWriteOptions wo;
   wo.half = a.half;
-  write_environment(a.output, out, wo);
-  if (!a.preview.empty()) {
-    const cv::Mat png = display_encode(out.pixels, a.preview_exposure);
-    write_atomically(a.preview, [&](const std::string& tmp) {
-      if (!cv::imwrite(tmp, png)) throw std::runtime_error(a.preview + ": cannot write the preview image");
-    });
-  }
+  write_environment(exr, out, wo);
+  if (!preview.empty() && !cv::imwrite(preview, display_encode(out.pixels, a.preview_exposure)))
+    throw std::runtime_error(a.preview + ": cannot write the preview image");
   const auto t3 = std::chrono::steady_clock::now();
 
   const std::vector<double> in_int = integral(src), out_int = integral(out);
@@ -119,7 +116,8 @@ int run_convert(const ConvertArgs& a) {
   j["integral_relative_change"] = rel;
   j["values_sanitized"] = sanitized;
   j["seconds"] = {{"read", secs(t1 - t0)}, {"resample", secs(t2 - t1)}, {"write", secs(t3 - t2)}};
-  write_summary(a.json, j);
+  write_summary(json, j);
+  outputs.commit();
   return 0;
 }
 

@@ -12,6 +12,7 @@
 #include "core/atomic_file.h"
 #include "core/lens_model.h"
 #include "core/map_set.h"
+#include "core/output_plan.h"
 
 #include <algorithm>
 #include <cmath>
@@ -43,8 +44,8 @@ BallGuess parse_ball(const std::string& text) {
 }
 
 int run_extract(const ExtractArgs& a) {
-  check_output_path(a.out, {a.image, a.lens, a.poses});
-  if (!a.json.empty() && a.json != "-") check_output_path(a.json, {a.image, a.lens, a.poses});
+  OutputPlan outputs({a.image, a.lens, a.poses});
+  const std::string exr = outputs.file(a.out), json = outputs.file(a.json);
   if (a.kind != "chrome" && a.kind != "grey")
     throw std::invalid_argument("--kind '" + a.kind + "': expected chrome or grey");
   if (a.indexing != "reflection" && a.indexing != "orthographic")
@@ -125,7 +126,7 @@ int run_extract(const ExtractArgs& a) {
                                                 : "camera (no pose)";
   MapSet set;
   set.views.push_back(std::move(mv));
-  write_map_set(a.out, set);
+  write_map_set(exr, set);
 
   const cv::Mat& conf = set.views.front().confidence;
   nlohmann::json j;
@@ -149,7 +150,8 @@ int run_extract(const ExtractArgs& a) {
   j["ball_from_pose"] = ball_from_pose;
   j["mean_confidence_in_disc"] = cv::mean(conf, conf > 0)[0];
   j["confident_fraction"] = cv::countNonZero(conf > 0.5) / (kPi / 4 * a.size * a.size);
-  write_summary(a.json, j);
+  write_summary(json, j);
+  outputs.commit();
   if (!a.quiet && a.json != "-")
     std::cerr << "ball at (" << loc.centre_px.x() << ", " << loc.centre_px.y() << "), radius " << loc.radius_px
               << " px, outline RMS " << loc.fit.rms_px << " px -> " << a.out << "\n";

@@ -8,6 +8,7 @@
 #include "core/atomic_file.h"
 #include "core/atomic_folder.h"
 #include "core/colour.h"
+#include "core/output_plan.h"
 #include "core/photo_set.h"
 #include "core/progress.h"
 #include "core/text.h"
@@ -135,10 +136,11 @@ int run_hdr(const HdrArgs& a) {
     if (!fs::is_directory(out_dir.parent_path()))
       throw std::invalid_argument(a.out + ": neither it nor its parent folder exists");
   }
-  std::vector<fs::path> inputs;
-  for (const PhotoView& v : set.views)
-    for (const BracketPhoto& b : v.brackets) inputs.push_back(b.file);
+  std::vector<fs::path> inputs = set.files();
   if (!a.response.empty()) inputs.push_back(a.response);
+  OutputPlan outputs(inputs);
+  outputs.folder(a.out);
+  const std::string json = outputs.file(a.json);
   std::vector<std::pair<fs::path, fs::path>> staged;  // (temporary, final)
   const fs::path response_out = out_dir / "response.json";
   for (const PhotoView* v : views)
@@ -147,7 +149,6 @@ int run_hdr(const HdrArgs& a) {
       for (const fs::path& in : inputs) check_not_same_file(in, target);
     }
   for (const fs::path& in : inputs) check_not_same_file(in, response_out);
-  if (!a.json.empty() && a.json != "-") check_output_path(a.json, inputs);
 
   // Everything goes to a staging folder inside the output folder and is renamed into place only
   // when every view has merged: a failure leaves no partial output.
@@ -292,6 +293,7 @@ int run_hdr(const HdrArgs& a) {
     summary["colour_space"] = working;
     summary["radiance_unit"] = "X/e: linear signal normalised to saturation, per unit relative exposure t*iso/100/N^2";
     summary["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    write_summary(json, summary);  // to its temporary: in place with the merged views, or not at all
     for (const auto& [tmp, target] : staged) fs::rename(tmp, target);
     fs::remove_all(stage);
   } catch (...) {
@@ -300,8 +302,8 @@ int run_hdr(const HdrArgs& a) {
     if (created_out) fs::remove(out_dir, ec);
     throw;
   }
+  outputs.commit();
   if (!a.quiet) std::cerr << "rsibr hdr: response model " << summary["response"]["model"].get<std::string>() << "\n";
-  write_summary(a.json, summary);
   return 0;
 }
 

@@ -4,6 +4,7 @@
 
 #include "core/exr_io.h"
 #include "core/map_set.h"
+#include "core/output_plan.h"
 
 #include <algorithm>
 #include <cmath>
@@ -184,7 +185,14 @@ Runner add_info(CLI::App& app) {
   c->add_option("input", a->input, "Environment (.exr, .hdr) or map set (.exr)")->required()->check(CLI::ExistingFile);
   c->add_option("--layout", a->layout, "Layout of an environment whose header and shape do not tell");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
-  return [a] { return is_map_set_file(a->input) ? info_map_set(*a) : info_environment(*a); };
+  return [a] {
+    OutputPlan outputs({a->input});
+    InfoArgs b = *a;
+    b.json = outputs.file(a->json);
+    const int status = is_map_set_file(a->input) ? info_map_set(b) : info_environment(b);
+    outputs.commit();
+    return status;
+  };
 }
 
 }  // namespace rsibr::cli

@@ -7,6 +7,7 @@
 #include "calib/view_orientation.h"
 #include "core/atomic_file.h"
 #include "core/lens_model.h"
+#include "core/output_plan.h"
 #include "core/progress.h"
 #include "core/safe_name.h"
 
@@ -38,8 +39,8 @@ Vec3 parse_up(const std::string& text) {
 int run_orient(const OrientArgs& a) {
   std::vector<std::filesystem::path> inputs(a.images.begin(), a.images.end());
   inputs.push_back(a.lens);
-  check_output_path(a.out, inputs);
-  if (!a.json.empty() && a.json != "-") check_output_path(a.json, inputs);
+  OutputPlan outputs(inputs);
+  const std::string pose_file = outputs.file(a.out), json = outputs.file(a.json);
   ViewOrientationOptions o;
   if (!a.up.empty()) o.up = parse_up(a.up);
   if (a.images.size() < 2)
@@ -72,7 +73,7 @@ int run_orient(const OrientArgs& a) {
       if (what.rfind(names[i] + ": ", 0) == 0) throw std::invalid_argument(a.images[i] + what.substr(names[i].size()));
     throw;
   }
-  write_pose_file(a.out, poses);
+  write_pose_file(pose_file, poses);
 
   nlohmann::json j;
   j["images"] = a.images;
@@ -100,7 +101,8 @@ int run_orient(const OrientArgs& a) {
                   {"ball", {{"centre_px", {b.centre_px.x(), b.centre_px.y()}}, {"radius_px", b.radius_px}, {"rms_px", b.fit.rms_px}}}});
   }
   j["views"] = jv;
-  write_summary(a.json, j);
+  write_summary(json, j);
+  outputs.commit();
   if (!a.quiet && a.json != "-") {
     double worst = 0;
     for (const ViewPose& p : poses.views) worst = std::max(worst, p.sigma_deg);

@@ -5,6 +5,7 @@
 #include "core/atomic_file.h"
 #include "core/exr_io.h"
 #include "core/map_set.h"
+#include "core/output_plan.h"
 #include "core/patterns.h"
 
 #include <cmath>
@@ -23,7 +24,8 @@ struct PatternArgs {
 };
 
 int run_pattern(const PatternArgs& a) {
-  check_output_path(a.output);
+  OutputPlan outputs({a.views});
+  const std::string exr = outputs.file(a.output), json = outputs.file(a.json);
   Radiance f;
   if (a.kind == "direction") {
     f = patterns::direction_coded();
@@ -58,13 +60,14 @@ int run_pattern(const PatternArgs& a) {
       mv.rgb = render_pattern([&](const Vec3& d) { return f(T * d); }, sphere, a.subsamples).pixels;
       maps.views.push_back(std::move(mv));
     }
-    write_map_set(a.output, maps);
+    write_map_set(exr, maps);
     nlohmann::json j;
     j["output"] = a.output;
     j["pattern"] = a.kind;
     j["views"] = maps.views.size();
     j["size"] = a.size;
-    write_summary(a.json, j);
+    write_summary(json, j);
+    outputs.commit();
     return 0;
   }
   const Layout layout = Layout::with_size(parse_layout_kind(a.to), a.size);
@@ -77,7 +80,7 @@ int run_pattern(const PatternArgs& a) {
   EnvMap map = render_pattern(f, layout, m);
   map.attributes["version"] = RSIBR_VERSION;
   map.attributes["command"] = "rsibr pattern " + a.kind + " --to " + a.to + " --size " + std::to_string(a.size);
-  write_environment(a.output, map);
+  write_environment(exr, map);
   const auto integ = integral(map);
   nlohmann::json j;
   j["output"] = a.output;
@@ -86,7 +89,8 @@ int run_pattern(const PatternArgs& a) {
   j["width"] = map.layout.width();
   j["height"] = map.layout.height();
   j["integral_rgb"] = integ;
-  write_summary(a.json, j);
+  write_summary(json, j);
+  outputs.commit();
   return 0;
 }
 

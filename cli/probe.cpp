@@ -8,6 +8,7 @@
 #include "core/atomic_file.h"
 #include "core/exr_io.h"
 #include "core/map_set.h"
+#include "core/output_plan.h"
 #include "core/yaml_spec.h"
 
 #include <yaml-cpp/yaml.h>
@@ -26,8 +27,8 @@ struct ProbeArgs {
 
 int run_probe(const ProbeArgs& a) {
   std::vector<std::filesystem::path> inputs(a.maps.begin(), a.maps.end());
-  check_output_path(a.out, inputs);
-  if (!a.json.empty() && a.json != "-") check_output_path(a.json, inputs);
+  OutputPlan outputs(inputs);
+  const std::string exr = outputs.file(a.out), json = outputs.file(a.json);
   std::shared_ptr<const Fresnel> fresnel;
   if (!a.fresnel.empty()) {
     try {
@@ -64,7 +65,7 @@ int run_probe(const ProbeArgs& a) {
   Probe p = assemble_probe(all, o);
   p.env.attributes["views"] = std::to_string(all.views.size());
   if (fresnel) p.env.attributes["fresnel"] = fresnel->spec();
-  write_environment(a.out, p.env);
+  write_environment(exr, p.env);
   nlohmann::json j;
   j["maps"] = a.maps;
   j["out"] = a.out;
@@ -72,7 +73,8 @@ int run_probe(const ProbeArgs& a) {
   j["width"] = a.width;
   j["covered_fraction"] = p.covered_fraction;
   j["fresnel"] = fresnel ? fresnel->spec() : "none";
-  write_summary(a.json, j);
+  write_summary(json, j);
+  outputs.commit();
   if (!a.quiet && a.json != "-")
     std::cerr << all.views.size() << " views -> " << a.out << " (" << 100 * p.covered_fraction << "% of the sphere)\n";
   return 0;

@@ -5,6 +5,8 @@
 
 #include "core/atomic_file.h"
 #include "core/camera.h"
+#include "core/output_plan.h"
+#include "core/photo_set.h"
 #include "core/progress.h"
 #include "pipeline/process_pipeline.h"
 
@@ -31,7 +33,12 @@ int run_process_verb(ProcessArgs a) {
   else a.o.up = parse_vec3(a.up, "--up");
   a.o.render_width = w;
   a.o.render_height = h;
-  if (!a.json.empty() && a.json != "-") check_output_path(a.json, {a.o.photoset});
+  std::vector<std::filesystem::path> inputs = load_photo_set(a.o.photoset).files();
+  for (const std::string& f : {a.o.lens, a.o.poses, a.o.probe_file, a.o.mesh})
+    if (!f.empty()) inputs.push_back(f);
+  OutputPlan outputs(inputs);
+  outputs.folder(a.o.out.string());
+  const std::string json = outputs.file(a.json);
   a.o.progress = !a.quiet && Progress::stderr_is_terminal();
   if (!a.quiet) a.o.log = [](const std::string& line) { std::cerr << "rsibr process: " << line << "\n"; };
   const ProcessResult r = run_process(a.o);
@@ -45,7 +52,8 @@ int run_process_verb(ProcessArgs a) {
   j["report"] = r.report.string();
   j["steps"] = steps;
   j["results"] = r.summary;
-  write_summary(a.json, j);
+  write_summary(json, j);
+  outputs.commit();
   if (a.json != "-") std::cout << r.report.string() << "\n";
   return 0;
 }

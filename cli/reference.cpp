@@ -11,6 +11,7 @@
 #include "core/colour.h"
 #include "core/exr_io.h"
 #include "core/mesh.h"
+#include "core/output_plan.h"
 #include "core/progress.h"
 #include "core/ray_scene.h"
 
@@ -64,11 +65,13 @@ int run_reference(const ReferenceArgs& a) {
   if (std::filesystem::path(a.output).extension() != ".exr")
     throw std::invalid_argument(a.output + ": the output must be an .exr file");
   const int frames = std::max(1, a.camera.turntable);
-  const std::vector<std::filesystem::path> inputs = {a.mesh, a.env, a.brdf};
+  OutputPlan outputs({a.mesh, a.env, a.brdf});
+  std::vector<std::string> exr_tmp, png_tmp;
   for (int k = 0; k < frames; ++k) {
-    check_output_path(frame_path(a.output, a.camera.turntable, k), inputs);
-    if (!a.preview.empty()) check_output_path(frame_path(a.preview, a.camera.turntable, k), inputs);
+    exr_tmp.push_back(outputs.file(frame_path(a.output, a.camera.turntable, k)));
+    if (!a.preview.empty()) png_tmp.push_back(outputs.file(frame_path(a.preview, a.camera.turntable, k)));
   }
+  const std::string json = outputs.file(a.json);
   ReferenceOptions o;
   o.spp = a.spp;
   o.light_samples = a.light_samples;
@@ -105,14 +108,9 @@ int run_reference(const ReferenceArgs& a) {
     });
     const auto r1 = std::chrono::steady_clock::now();
     const std::string out = frame_path(a.output, a.camera.turntable, k);
-    write_render(out, im, cam, strings, o);
-    if (!a.preview.empty()) {
-      const std::string png_path = frame_path(a.preview, a.camera.turntable, k);
-      const cv::Mat png = display_encode(im.rgb, a.preview_exposure);
-      write_atomically(png_path, [&](const std::string& tmp) {
-        if (!cv::imwrite(tmp, png)) throw std::runtime_error(png_path + ": cannot write the preview image");
-      });
-    }
+    write_render(exr_tmp[std::size_t(k)], im, cam, strings, o);
+    if (!a.preview.empty() && !cv::imwrite(png_tmp[std::size_t(k)], display_encode(im.rgb, a.preview_exposure)))
+      throw std::runtime_error(frame_path(a.preview, a.camera.turntable, k) + ": cannot write the preview image");
     const auto r2 = std::chrono::steady_clock::now();
     render_s += std::chrono::duration<double>(r1 - r0).count();
     write_s += std::chrono::duration<double>(r2 - r1).count();
@@ -156,7 +154,8 @@ int run_reference(const ReferenceArgs& a) {
   j["shadow_rays"] = shadow_rays;
   j["bounce_rays"] = bounce_rays;
   j["seconds"] = {{"load", secs(t1 - t0)}, {"scene", secs(t2 - t1)}, {"render", render_s}, {"write", write_s}};
-  write_summary(a.json, j);
+  write_summary(json, j);
+  outputs.commit();
   return 0;
 }
 

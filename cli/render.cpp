@@ -11,6 +11,7 @@
 #include "core/exr_io.h"
 #include "core/map_set.h"
 #include "core/mesh.h"
+#include "core/output_plan.h"
 #include "core/progress.h"
 #include "core/text.h"
 #include "runtime/renderer.h"
@@ -74,8 +75,10 @@ int run_render(const RenderArgs& a) {
   inputs.emplace_back(a.mesh);
   if (!a.env.empty()) inputs.emplace_back(a.env);
   const int frames = std::max(1, a.camera.turntable);
-  for (int k = 0; k < frames; ++k) check_output_path(frame_path(a.output, a.camera.turntable, k), inputs);
-  if (!a.json.empty() && a.json != "-") check_output_path(a.json, inputs);
+  OutputPlan outputs(inputs);
+  std::vector<std::string> frame_tmp;
+  for (int k = 0; k < frames; ++k) frame_tmp.push_back(outputs.file(frame_path(a.output, a.camera.turntable, k)));
+  const std::string json = outputs.file(a.json);
 
   const auto t_load = std::chrono::steady_clock::now();
   MeshLoadReport mesh_report;
@@ -129,8 +132,8 @@ int run_render(const RenderArgs& a) {
     const std::string path = frame_path(a.output, a.camera.turntable, k);
     auto p = provenance;
     if (a.camera.turntable > 0) p["frame"] = std::to_string(k) + "/" + std::to_string(a.camera.turntable);
-    if (ext == ".exr") write_render_exr(path, image, cam, p);
-    else write_rgba_png(path, image, a.exposure);
+    if (ext == ".exr") write_render_exr(frame_tmp[std::size_t(k)], image, cam, p);
+    else write_rgba_png(frame_tmp[std::size_t(k)], image, a.exposure);
     jframes.push_back({{"path", path},
                        {"seconds", stats.seconds},
                        {"seconds_blend", stats.seconds_blend},
@@ -157,7 +160,8 @@ int run_render(const RenderArgs& a) {
   j["render_seconds_per_frame"] = render_total / frames;
   j["fps"] = render_total > 0 ? frames / render_total : 0.0;
   j["hits"] = hits_total;
-  write_summary(a.json, j);
+  write_summary(json, j);
+  outputs.commit();
   return 0;
 }
 

@@ -5,6 +5,7 @@
 
 #include "capture/synth_capture.h"
 #include "capture/synth_scene.h"
+#include "core/output_plan.h"
 #include "core/progress.h"
 
 #include <iostream>
@@ -22,6 +23,9 @@ struct SynthArgs {
 
 int run_synth(const SynthArgs& a) {
   SynthScene scene = load_synth_scene(a.scene);
+  OutputPlan outputs({a.scene});
+  outputs.folder(a.out);
+  const std::string json = outputs.file(a.json);
   if (a.seed) scene.seed = *a.seed;
   Progress bar("synth", !a.quiet && Progress::stderr_is_terminal());
   const SynthReport r = write_synth_capture(scene, a.out, [&](double f) { bar.update(f); });
@@ -47,7 +51,8 @@ int run_synth(const SynthArgs& a) {
   j["samples_traced"] = r.pixels_rendered;
   j["seconds"] = {{"render", r.seconds_render}, {"brackets", r.seconds_brackets}, {"truth", r.seconds_truth},
                   {"total", r.seconds_total}};
-  write_summary(a.json, j);
+  write_summary(json, j);
+  outputs.commit();
   return 0;
 }
 

@@ -11,6 +11,7 @@
 #include "core/atomic_file.h"
 #include "core/map_set.h"
 #include "core/mesh.h"
+#include "core/output_plan.h"
 #include "core/progress.h"
 #include "core/text.h"
 #include "runtime/renderer.h"
@@ -73,11 +74,13 @@ int run_view(const ViewArgs& a) {
   // Every output is checked before any work (numbered like rsibr render --turntable N).
   std::vector<std::filesystem::path> inputs{a.maps, a.mesh};
   if (!a.maps2.empty()) inputs.emplace_back(a.maps2);
+  OutputPlan outputs(inputs);
+  std::vector<std::string> png_tmp, exr_tmp;
   for (int k = 0; k < std::max(1, a.orbit); ++k) {
-    if (!a.screenshot.empty()) check_output_path(frame_path(a.screenshot, a.orbit, k), inputs);
-    if (!a.exr.empty()) check_output_path(frame_path(a.exr, a.orbit, k), inputs);
+    if (!a.screenshot.empty()) png_tmp.push_back(outputs.file(frame_path(a.screenshot, a.orbit, k)));
+    if (!a.exr.empty()) exr_tmp.push_back(outputs.file(frame_path(a.exr, a.orbit, k)));
   }
-  if (!a.json.empty() && a.json != "-") check_output_path(a.json, inputs);
+  const std::string json = outputs.file(a.json);
 
   MeshLoadReport mesh_report;
   const Mesh mesh = load_mesh(a.mesh, &mesh_report);
@@ -135,12 +138,12 @@ int run_view(const ViewArgs& a) {
         p["frame"] = std::to_string(f.index) + "/" + std::to_string(a.orbit);
         if (!a.screenshot.empty()) {
           const std::string path = frame_path(a.screenshot, a.orbit, f.index);
-          write_rgba_png(path, f.rgba, a.exposure, a.display, a.view);
+          write_rgba_png(png_tmp.at(std::size_t(f.index)), f.rgba, a.exposure, a.display, a.view);
           jf["screenshot"] = path;
         }
         if (!a.exr.empty()) {
           const std::string path = frame_path(a.exr, a.orbit, f.index);
-          write_render_exr(path, f.rgba, f.camera, p);
+          write_render_exr(exr_tmp.at(std::size_t(f.index)), f.rgba, f.camera, p);
           jf["exr"] = path;
         }
         if (a.benchmark) std::printf("frame %d %.3f ms\n", f.index, 1e3 * f.seconds);
@@ -169,7 +172,8 @@ int run_view(const ViewArgs& a) {
   j["frames"] = jframes;
   j["median_frame_seconds"] = median;
   j["fps"] = median > 0 ? 1.0 / median : 0.0;
-  write_summary(a.json, j);
+  write_summary(json, j);
+  outputs.commit();
   return 0;
 #endif
 }

@@ -2,6 +2,7 @@
 
 #include "core/atomic_file.h"
 #include "core/colour.h"
+#include "core/input_file.h"
 #include "core/text.h"
 
 #include <OpenEXR/ImfChannelList.h>
@@ -169,8 +170,7 @@ EnvMap read_hdr(const std::string& path, std::optional<LayoutKind> hint, EnvRead
 
 EnvMap read_environment(const std::string& path, std::optional<LayoutKind> hint, EnvReadReport* report_out) {
   EnvReadReport report;
-  if (!std::filesystem::exists(path)) fail(path, "no such file");
-  if (std::filesystem::is_directory(path)) fail(path, "is a folder, not an image");
+  require_regular_file(path);
   std::ifstream probe(path, std::ios::binary);
   unsigned char magic[4] = {0, 0, 0, 0};
   probe.read(reinterpret_cast<char*>(magic), 4);

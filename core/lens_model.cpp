@@ -2,6 +2,7 @@
 #include "core/lens_model.h"
 
 #include "core/atomic_file.h"
+#include "core/input_file.h"
 
 extern "C" {
 #include <mrcal/mrcal.h>
@@ -94,6 +95,7 @@ LensModel LensModel::parse(const std::string& text, const std::string& what) {
 }
 
 LensModel LensModel::read(const std::filesystem::path& file) {
+  require_regular_file(file);
   std::ifstream in(file, std::ios::binary);
   if (!in) throw std::invalid_argument(file.string() + ": cannot read");
   std::stringstream ss;

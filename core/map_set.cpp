@@ -4,6 +4,7 @@
 #include "core/atomic_file.h"
 #include "core/colour.h"
 #include "core/exr_io.h"
+#include "core/input_file.h"
 #include "core/text.h"
 
 #include <OpenEXR/ImfChannelList.h>
@@ -134,6 +135,8 @@ void write_map_set(const std::string& path, const MapSet& set) {
 }
 
 bool is_map_set_file(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return false;
   try {
     Imf::MultiPartInputFile file(path.c_str());
     return file.parts() >= 1 && file.header(0).hasName() && file.header(0).name() == "view.000";
@@ -143,6 +146,7 @@ bool is_map_set_file(const std::string& path) {
 }
 
 MapSet read_map_set(const std::string& path) {
+  require_regular_file(path);
   MapSet set;
   try {
     Imf::MultiPartInputFile file(path.c_str());

@@ -23,7 +23,8 @@ fs::path resolve(const fs::path& folder, const std::string& p, const std::string
   if (p.empty()) spec_fail(key, "empty path");
   const fs::path full = fs::path(p).is_absolute() ? fs::path(p) : folder / p;
   std::error_code ec;
-  if (!fs::is_regular_file(full, ec)) spec_fail(key, "no such file '" + full.string() + "'");
+  if (!fs::exists(full, ec)) spec_fail(key, "no such file '" + full.string() + "'");
+  if (!fs::is_regular_file(full, ec)) spec_fail(key, "'" + full.string() + "' is not a regular file");
   return fs::absolute(full).lexically_normal();
 }
 
@@ -142,7 +143,16 @@ const char* to_string(BallKind k) {
 const PhotoView& PhotoSet::view(const std::string& name) const {
   for (const PhotoView& v : views)
     if (v.name == name) return v;
-  throw std::out_of_range("photo set has no view '" + name + "'");
+  throw std::out_of_range("photo set has no view '" + quoted_for_message(name) + "'");
+}
+
+std::vector<fs::path> PhotoSet::files() const {
+  std::vector<fs::path> out = {folder / "photoset.yaml"};
+  if (camera_model) out.push_back(*camera_model);
+  for (const PhotoView& v : views)
+    for (const BracketPhoto& b : v.brackets) out.push_back(b.file);
+  if (chessboards) out.insert(out.end(), chessboards->files.begin(), chessboards->files.end());
+  return out;
 }
 
 PhotoSet load_photo_set(const fs::path& path) {

@@ -73,6 +73,9 @@ struct PhotoSet {
   std::optional<ChessboardSet> chessboards;
 
   const PhotoView& view(const std::string& name) const;  // throws std::out_of_range
+  // Every file the set names (photoset.yaml, the brackets, the chessboards, the camera model):
+  // what a verb reading the set must never overwrite.
+  std::vector<std::filesystem::path> files() const;
 };
 
 // `path` is photoset.yaml or the folder holding it.

@@ -1,5 +1,7 @@
 #include "core/yaml_spec.h"
 
+#include "core/input_file.h"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -191,9 +193,7 @@ YAML::Node parse_yaml(const std::string& text, const std::string& where) {
 }
 
 YAML::Node load_yaml_file(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec))
-    throw std::invalid_argument(file.string() + (std::filesystem::exists(file, ec) ? ": not a regular file" : ": cannot read (no such file)"));
+  require_regular_file(file);
   std::ifstream in(file, std::ios::binary);
   if (!in) throw std::invalid_argument(file.string() + ": cannot read");
   std::ostringstream text;

@@ -1,6 +1,7 @@
 #include "hdr/response_curve.h"
 
 #include "core/atomic_file.h"
+#include "core/input_file.h"
 
 #include <algorithm>
 #include <cmath>
@@ -73,6 +74,7 @@ void save_response(const std::filesystem::path& path, const ResponseCurve& curve
 }
 
 ResponseCurve load_response(const std::filesystem::path& path) {
+  require_regular_file(path);
   std::ifstream f(path);
   if (!f) throw std::runtime_error(path.string() + ": cannot open the response curve");
   try {

@@ -1,0 +1,108 @@
+#include "core/output_plan.h"
+
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+namespace fs = std::filesystem;
+namespace rsibr {
+namespace {
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p);
+  return std::string((std::istreambuf_iterator<char>(in)), {});
+}
+
+class OutputPlanTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("rsibr_output_plan_" + std::to_string(std::random_device{}()));
+    fs::create_directories(dir_ / "sub");
+    std::ofstream(dir_ / "in.exr") << "input";
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::size_t entries() const { return std::size_t(std::distance(fs::directory_iterator(dir_), fs::directory_iterator())); }
+  fs::path dir_;
+};
+
+TEST_F(OutputPlanTest, CommittedOutputsAppearTogetherAndNothingElseRemains) {
+  {
+    OutputPlan plan({dir_ / "in.exr"});
+    const std::string a = plan.file((dir_ / "out.exr").string()), j = plan.file((dir_ / "out.json").string());
+    EXPECT_EQ(fs::path(a).parent_path(), dir_);
+    EXPECT_EQ(fs::path(a).extension(), ".exr") << "writers that pick the format by the extension still can";
+    std::ofstream(a) << "map";
+    std::ofstream(j) << "{}";
+    EXPECT_FALSE(fs::exists(dir_ / "out.exr")) << "nothing is in place before the commit";
+    plan.commit();
+  }
+  EXPECT_EQ(read(dir_ / "out.exr"), "map");
+  EXPECT_EQ(read(dir_ / "out.json"), "{}");
+  EXPECT_EQ(entries(), 4u) << "in.exr, sub, out.exr, out.json and no temporary";
+}
+
+TEST_F(OutputPlanTest, AFailureBeforeTheCommitLeavesNothing) {
+  {
+    OutputPlan plan;
+    std::ofstream(plan.file((dir_ / "out.exr").string())) << "half";
+    plan.file((dir_ / "out.json").string());
+    // ... the verb throws here ...
+  }
+  EXPECT_EQ(entries(), 2u);
+}
+
+TEST_F(OutputPlanTest, AnOutputThatIsAnInputIsRefusedByIdentityNotSpelling) {
+  fs::create_hard_link(dir_ / "in.exr", dir_ / "hard.exr");
+  fs::create_symlink(dir_ / "in.exr", dir_ / "link.exr");
+  for (const fs::path& out : {dir_ / "in.exr", dir_ / "sub" / ".." / "in.exr", dir_ / "hard.exr", dir_ / "link.exr"}) {
+    OutputPlan plan({dir_ / "in.exr"});
+    EXPECT_NE(error_of([&] { plan.file(out.string()); }).find("output would overwrite the input"), std::string::npos)
+        << out;
+  }
+  EXPECT_EQ(read(dir_ / "in.exr"), "input");
+}
+
+TEST_F(OutputPlanTest, TwoOutputsThatAreOneFileAreRefused) {
+  OutputPlan plan;
+  plan.file((dir_ / "a.json").string());
+  EXPECT_NE(error_of([&] { plan.file((dir_ / "sub" / ".." / "a.json").string()); }).find("named twice"), std::string::npos);
+  plan.folder((dir_ / "pictures").string());
+  EXPECT_NE(error_of([&] { plan.file((dir_ / "pictures").string()); }).find("named twice"), std::string::npos);
+}
+
+TEST_F(OutputPlanTest, MissingFoldersFoldersAndFifosAreRefusedBeforeAnyWork) {
+  OutputPlan plan;
+  EXPECT_NE(error_of([&] { plan.file((dir_ / "nofolder" / "a.json").string()); }).find("does not exist"), std::string::npos);
+  EXPECT_NE(error_of([&] { plan.file((dir_ / "sub").string()); }).find("is a folder"), std::string::npos);
+  ASSERT_EQ(::mkfifo((dir_ / "pipe.json").c_str(), 0600), 0);
+  EXPECT_NE(error_of([&] { plan.file((dir_ / "pipe.json").string()); }).find("not a regular file"), std::string::npos);
+  std::ofstream(dir_ / "file") << "x";
+  EXPECT_NE(error_of([&] { plan.folder((dir_ / "file").string()); }).find("is not a folder"), std::string::npos);
+  EXPECT_EQ(plan.file(""), "");
+  EXPECT_EQ(plan.file("-"), "-");
+}
+
+TEST_F(OutputPlanTest, ACommitOfAnOutputThatWasNeverWrittenIsAnError) {
+  OutputPlan plan;
+  plan.file((dir_ / "out.exr").string());
+  EXPECT_THROW(plan.commit(), std::logic_error);
+}
+
+}  // namespace
+}  // namespace rsibr
