@@ -1,5 +1,6 @@
 // rsibr bake: a computed map set, the lighting integral of a BRDF against an environment, one
 // sphere map per view (bake/integrator.h for what a texel holds).
+#include "cli/option_checks.h"
 #include "cli/render_image.h"
 #include "cli/summary.h"
 #include "cli/verbs.h"
@@ -151,7 +152,7 @@ Runner add_bake(CLI::App& app) {
   c->add_option("--method", a->method, "reference, mis, fis or sh")
       ->check(CLI::IsMember({"reference", "mis", "fis", "sh"}));
   c->add_option("--samples", a->samples, "mis, fis: samples per texel")->check(CLI::Range(1, 1 << 20));
-  c->add_option("--seed", a->seed, "Random seed (mis, fis)");
+  c->add_option("--seed", a->seed, "Random seed (mis, fis)")->check(seed_check());
   c->add_option("--reference-width", a->reference_width,
                 "reference: integrate over the MIP level at most this wide (0: the full environment)")
       ->check(CLI::Range(0, 1 << 20));

@@ -26,12 +26,14 @@ struct BlendArgs {
   int rings = 16;
   double rim_fade = 0.4;
   float preview_exposure = 0.f;
+  bool sanitize = false;
 };
 
 int run_blend(const BlendArgs& a) {
   OutputPlan outputs({a.maps});
   const std::string exr = outputs.file(a.output), preview = outputs.file(a.preview), json = outputs.file(a.json);
-  const MapSet set = read_map_set(a.maps);
+  long sanitized = 0;
+  const MapSet set = read_map_set(a.maps, a.sanitize ? BadTexels::zero : BadTexels::refuse, &sanitized);
   const ViewSet views = set.view_set();
   const Vec3 view(a.view[0], a.view[1], a.view[2]), up(a.up[0], a.up[1], a.up[2]);
   if (!view.allFinite() || !(view.norm() > 0)) throw std::invalid_argument("--view must be a non-zero direction");
@@ -50,7 +52,12 @@ int run_blend(const BlendArgs& a) {
   }
   options.warp = warp.get();
   const auto t0 = std::chrono::steady_clock::now();
-  const BlendResult r = blend(set, views, view, up, options);
+  BlendResult r;
+  try {
+    r = blend(set, views, view, up, options);
+  } catch (const std::invalid_argument& e) {  // a property of the map set (its size, its views)
+    throw std::invalid_argument(a.maps + ": " + e.what());
+  }
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   MapSet out;
@@ -85,6 +92,7 @@ int run_blend(const BlendArgs& a) {
     j["sources"].push_back({{"view", r.located.views[std::size_t(i)]}, {"weight", r.located.weights[std::size_t(i)]}});
   j["warp"] = a.warp;
   j["seconds"] = secs;
+  j["values_sanitized"] = sanitized;
   write_summary(json, j);
   outputs.commit();
   return 0;
@@ -111,6 +119,8 @@ Runner add_blend(CLI::App& app) {
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--preview", a->preview, "Also write a display-encoded PNG");
   c->add_option("--preview-exposure", a->preview_exposure, "Exposure of the preview in stops");
+  c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
+                                         "confidences to [0, 1]) instead of failing; the JSON counts them");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   return [a] { return run_blend(*a); };
 }

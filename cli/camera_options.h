@@ -14,6 +14,9 @@
 
 namespace rsibr::cli {
 
+// More frames than this is a typo (each frame is a file).
+inline constexpr int kMaxTurntableFrames = 100000;
+
 struct CameraArgs {
   std::string size = "1280x720";
   double fov = 40;

@@ -26,7 +26,7 @@ namespace {
 
 struct CompareArgs {
   std::string a, b, out, json, layout;
-  bool no_fit = false, quiet = false;
+  bool no_fit = false, quiet = false, sanitize = false;
   double log_eps = 1e-2, psnr_peak = 0, view_tolerance = 0.5, loss_scale = 0.1, heat_max = 0, fail_above = 0;
   float exposure = NAN;
   long fit_texels = 1 << 17;
@@ -83,15 +83,24 @@ int run_compare(const CompareArgs& a) {
                                 " is a map set; compare a map set with a map set, an environment with an environment");
   Comparison c;
   std::string kind;
+  long sanitized = 0;
   if (set_a) {
     kind = "map set";
-    c = compare_map_sets(read_map_set(a.a), read_map_set(a.b), o);
+    const BadTexels bad = a.sanitize ? BadTexels::zero : BadTexels::refuse;
+    long za = 0, zb = 0;
+    const MapSet ma = read_map_set(a.a, bad, &za), mb = read_map_set(a.b, bad, &zb);
+    sanitized = za + zb;
+    c = compare_map_sets(ma, mb, o);
   } else {
     kind = "environment";
     const std::optional<LayoutKind> hint =
         a.layout.empty() ? std::nullopt : std::optional<LayoutKind>(parse_layout_kind(a.layout));
-    EnvReadReport ra, rb;
-    const EnvMap ea = read_environment(a.a, hint, &ra), eb = read_environment(a.b, hint, &rb);
+    EnvMap ea = read_environment(a.a, hint), eb = read_environment(a.b, hint);
+    for (auto [path, env] : {std::pair<const std::string*, EnvMap*>{&a.a, &ea}, {&a.b, &eb}}) {
+      const TexelAudit audit = audit_texels(env->pixels);
+      if (audit.bad() && !a.sanitize) throw std::runtime_error(*path + ": " + audit.describe() + "; pass --sanitize to zero them");
+      if (a.sanitize) sanitized += sanitize_texels(env->pixels);
+    }
     c = compare_environments(ea, eb, o);
   }
 
@@ -109,6 +118,7 @@ int run_compare(const CompareArgs& a) {
 
   nlohmann::json j;
   j["a"] = a.a;
+  j["values_sanitized"] = sanitized;
   j["b"] = a.b;
   j["kind"] = kind;
   j["settings"] = {{"log_epsilon", c.settings.log_epsilon},
@@ -260,6 +270,8 @@ Runner add_compare(CLI::App& app) {
   c->add_option("--layout", a->layout, "Layout of environments whose header and shape do not tell");
   c->add_option("--fail-above", a->fail_above, "Exit with status 3 when the overall log RMS after the fit exceeds this (stops)")
       ->check(CLI::PositiveNumber);
+  c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
+                                         "confidences to [0, 1]) instead of failing; the JSON counts them");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or report");
   return [a] { return run_compare(*a); };
 }

@@ -60,19 +60,9 @@ int run_convert(const ConvertArgs& a) {
   EnvReadReport report;
   EnvMap src = read_environment(a.input, hint, &report);
   if (!a.input_colour_space.empty()) convert_colour_space(src.pixels, a.input_colour_space, working_space());
-  long sanitized = 0;
-  if (report.nan_values || report.inf_values) {
-    if (!a.sanitize)
-      throw std::runtime_error(a.input + ": " + std::to_string(report.nan_values) + " NaN and " +
-                               std::to_string(report.inf_values) + " Inf values; pass --sanitize to zero them");
-  }
-  if (a.sanitize) {
-    src.pixels.forEach<cv::Vec3f>([&](cv::Vec3f& p, const int*) {
-      for (int k = 0; k < 3; ++k)
-        if (!std::isfinite(p[k]) || p[k] < 0) p[k] = 0.f;
-    });
-    sanitized = report.nan_values + report.inf_values + report.negative_values;
-  }
+  if (report.texels.bad() && !a.sanitize)
+    throw std::runtime_error(a.input + ": " + report.texels.describe() + "; pass --sanitize to zero them");
+  const long sanitized = a.sanitize ? sanitize_texels(src.pixels) : 0;
   const auto t1 = std::chrono::steady_clock::now();
 
   const int size = a.size > 0 ? a.size : matching_size(to, src.layout.texel_count());

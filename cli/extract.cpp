@@ -73,6 +73,13 @@ int run_extract(const ExtractArgs& a) {
   BallGuess guess;
   int candidates = 0;
   if (given) {
+    // A ball must overlap the image and be no larger than it (the outline search scales with R).
+    const double w = view.radiance.cols, h = view.radiance.rows;
+    if (given->radius_px > std::hypot(w, h) || given->centre_px.x() < -given->radius_px ||
+        given->centre_px.y() < -given->radius_px || given->centre_px.x() > w + given->radius_px ||
+        given->centre_px.y() > h + given->radius_px)
+      throw std::invalid_argument("--ball '" + a.ball + "': the ball does not fit the " + std::to_string(int(w)) + "x" +
+                                  std::to_string(int(h)) + " image");
     guess = *given;
   } else {
     const double m = std::min(lens.width(), lens.height());

@@ -93,9 +93,10 @@ int info_environment(const InfoArgs& a) {
   j["colour"] = rep.chromaticities_converted ? "converted from the file's chromaticities to linear Rec.709 D65"
                                              : "linear Rec.709 D65";
   j["values"] = channel_stats(env.pixels);
-  j["nan"] = rep.nan_values;
-  j["inf"] = rep.inf_values;
-  j["negative"] = rep.negative_values;
+  j["nan"] = rep.texels.nan;
+  j["inf"] = rep.texels.inf;
+  j["huge"] = rep.texels.huge;
+  j["negative"] = rep.texels.negative;
   j["integral_rgb"] = integ;
   j["mean_radiance_rgb"] = {integ[0] / (4 * kPi), integ[1] / (4 * kPi), integ[2] / (4 * kPi)};
   j["peak"] = {{"luminance", peak}, {"pixel", {pc, pr}}, {"direction", {peak_dir.x(), peak_dir.y(), peak_dir.z()}},
@@ -118,8 +119,9 @@ int info_environment(const InfoArgs& a) {
             << "  peak luminance " << peak << " at pixel (" << pc << ", " << pr << "), direction (" << peak_dir.x()
             << ", " << peak_dir.y() << ", " << peak_dir.z() << "); median " << median << "; dynamic range "
             << j["dynamic_range"].get<double>() << "\n"
-            << "  suspicious values: " << rep.nan_values << " NaN, " << rep.inf_values << " Inf, " << rep.negative_values
-            << " negative" << (rep.negative_values ? " (lossy-compression ringing? see --sanitize in convert)" : "")
+            << "  suspicious values: " << rep.texels.nan << " NaN, " << rep.texels.inf << " Inf, " << rep.texels.huge
+            << " beyond " << kMaxRadiance << ", " << rep.texels.negative << " negative"
+            << (rep.texels.negative ? " (lossy-compression ringing? see --sanitize in convert)" : "")
             << "\n";
   for (const auto& [k, v] : env.attributes) text << "  rsibr." << k << ": " << v << "\n";
   write_summary(a.json, j);
@@ -127,11 +129,14 @@ int info_environment(const InfoArgs& a) {
 }
 
 int info_map_set(const InfoArgs& a) {
-  const MapSet set = read_map_set(a.input);
+  // info describes what is there: unusable values are counted (read as --sanitize would), not refused.
+  long unusable = 0;
+  const MapSet set = read_map_set(a.input, BadTexels::zero, &unusable);
   const ViewSet vs = set.view_set();
   nlohmann::json j;
   j["file"] = a.input;
   j["kind"] = "map set";
+  j["unusable_values"] = unusable;
   j["views"] = set.views.size();
   j["width"] = set.width();
   j["height"] = set.height();
@@ -142,6 +147,10 @@ int info_map_set(const InfoArgs& a) {
   text << a.input << ": map set, " << set.views.size() << " views of " << set.width() << "x" << set.height()
             << ", linear Rec.709 D65, " << vs.triangles().size() << " triangles, "
             << (vs.surrounds() ? "surrounds the sphere" : "does not surround the sphere") << "\n";
+  if (unusable)
+    text << "  " << unusable << " values that are NaN, Inf, beyond " << kMaxRadiance
+         << ", negative, or confidences outside [0, 1]: --sanitize zeroes them (the other verbs refuse the "
+            "non-finite, huge and out-of-range ones without it)\n";
   nlohmann::json views = nlohmann::json::array();
   for (std::size_t i = 0; i < set.views.size(); ++i) {
     const MapView& v = set.views[i];

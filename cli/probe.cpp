@@ -22,7 +22,7 @@ struct ProbeArgs {
   std::vector<std::string> maps;
   std::string out, fresnel, json;
   int width = 512;
-  bool quiet = false;
+  bool quiet = false, sanitize = false;
 };
 
 int run_probe(const ProbeArgs& a) {
@@ -38,8 +38,11 @@ int run_probe(const ProbeArgs& a) {
     }
   }
   MapSet all;
+  long sanitized = 0;
   for (const std::string& path : a.maps) {
-    const MapSet s = read_map_set(path);
+    long zeroed = 0;
+    const MapSet s = read_map_set(path, a.sanitize ? BadTexels::zero : BadTexels::refuse, &zeroed);
+    sanitized += zeroed;
     for (std::size_t v = 0; v < s.views.size(); ++v) {
       const MapView& mv = s.views[v];
       if (mv.confidence.empty() || mv.source != "captured")
@@ -72,6 +75,7 @@ int run_probe(const ProbeArgs& a) {
   j["views"] = all.views.size();
   j["width"] = a.width;
   j["covered_fraction"] = p.covered_fraction;
+  j["values_sanitized"] = sanitized;
   j["fresnel"] = fresnel ? fresnel->spec() : "none";
   write_summary(json, j);
   outputs.commit();
@@ -96,6 +100,8 @@ Runner add_probe(CLI::App& app) {
   c->add_option("--width", a->width, "Lat-long width (height = width / 2)")->check(CLI::Range(4, 16384));
   c->add_option("--fresnel", a->fresnel, "The ball's Fresnel spec (divided out)");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
+  c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
+                                         "confidences to [0, 1]) instead of failing; the JSON counts them");
   c->add_flag("-q,--quiet", a->quiet, "No report line");
   return [a] { return run_probe(*a); };
 }

@@ -1,5 +1,6 @@
 // rsibr process: the whole job, a photo set to probe, captured and computed maps, their comparison,
 // a turntable and an HTML report (pipeline/process_pipeline.h), resumable step by step.
+#include "cli/option_checks.h"
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
@@ -87,7 +88,7 @@ Runner add_process(CLI::App& app) {
   c->add_option("--grey-albedo", a->o.grey_albedo, "The grey ball's albedo")->check(CLI::Range(0.001, 1.0));
   c->add_option("--bake-method", a->o.bake_method, "Integrator of the computed maps: mis, fis, sh, reference");
   c->add_option("--bake-samples", a->o.bake_samples, "Samples per texel (mis, fis)")->check(CLI::Range(1, 1 << 20));
-  c->add_option("--seed", a->o.seed, "Seed of every stochastic step");
+  c->add_option("--seed", a->o.seed, "Seed of every stochastic step")->check(seed_check());
   c->add_option("--render-brdf", a->o.render_brdf, "BRDF spec (YAML text) of the turntable's material");
   c->add_option("--turntable", a->o.turntable, "Turntable frames")->check(CLI::Range(1, 360));
   c->add_option("--size", a->size, "Turntable frame size WxH");

@@ -1,6 +1,7 @@
 // rsibr reference: the ground-truth render of a mesh with a BRDF under an environment, seen by a
 // perspective camera (bake/reference_renderer.h for what a pixel holds).
 #include "cli/camera_options.h"
+#include "cli/option_checks.h"
 #include "cli/render_image.h"
 #include "cli/summary.h"
 #include "cli/verbs.h"
@@ -185,7 +186,7 @@ Runner add_reference(CLI::App& app) {
                 "Environment and BRDF samples per surface interaction (each)")
       ->capture_default_str()
       ->check(CLI::Range(1, 1 << 12));
-  c->add_option("--seed", a->seed, "Random seed")->capture_default_str();
+  c->add_option("--seed", a->seed, "Random seed")->capture_default_str()->check(seed_check());
   c->add_flag("--shadows,!--no-shadows", a->shadows,
               "Self-shadowing (default on); --no-shadows: the baked-map contract (no occlusion, no bounces)");
   c->add_option("--bounces", a->bounces, "Surface interactions per path, with shadows (1: direct light only)")

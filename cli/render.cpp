@@ -43,7 +43,7 @@ struct RenderArgs {
   int map_size = 0, rings = 16, spp = 1;
   double rim_fade = 0.4;
   float exposure = 0.f;
-  bool quiet = false;
+  bool quiet = false, sanitize = false;
 };
 
 std::string extension_of(const std::string& path) {
@@ -85,8 +85,11 @@ int run_render(const RenderArgs& a) {
   const Mesh mesh = load_mesh(a.mesh, &mesh_report);
   std::vector<MapSet> sets;
   sets.reserve(a.maps.size());
+  long sanitized = 0;
   for (const std::string& m : a.maps) {
-    sets.push_back(read_map_set(m));
+    long zeroed = 0;
+    sets.push_back(read_map_set(m, a.sanitize ? BadTexels::zero : BadTexels::refuse, &zeroed));
+    sanitized += zeroed;
     try {
       validate(sets.back());
     } catch (const std::exception& e) {
@@ -95,7 +98,7 @@ int run_render(const RenderArgs& a) {
   }
   EnvMap env;
   if (!a.env.empty()) {
-    env = read_environment(a.env);
+    env = read_environment_input(a.env, "", a.sanitize);
     options.environment = &env;
   }
   std::vector<const MapSet*> set_ptrs;
@@ -160,6 +163,7 @@ int run_render(const RenderArgs& a) {
   j["render_seconds_per_frame"] = render_total / frames;
   j["fps"] = render_total > 0 ? frames / render_total : 0.0;
   j["hits"] = hits_total;
+  j["values_sanitized"] = sanitized;
   write_summary(json, j);
   outputs.commit();
   return 0;
@@ -195,6 +199,8 @@ Runner add_render(CLI::App& app) {
   c->add_option("--env", a->env, "Environment map shown where rays miss (alpha 1)")->check(CLI::ExistingFile);
   c->add_option("--exposure", a->exposure, "PNG: exposure in stops before the display transform");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
+  c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
+                                         "confidences to [0, 1]) instead of failing; the JSON counts them");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar");
   return [a] { return run_render(*a); };
 }

@@ -21,29 +21,15 @@
 
 namespace rsibr::cli {
 
-long sanitize_environment(EnvMap& env) {
-  long changed = 0;
-  const int ch = env.channels();
-  for (int r = 0; r < env.pixels.rows; ++r) {
-    float* row = env.pixels.ptr<float>(r);
-    for (int i = 0; i < env.pixels.cols * ch; ++i)
-      if (!std::isfinite(row[i]) || row[i] < 0) {
-        row[i] = 0.f;
-        ++changed;
-      }
-  }
-  return changed;
-}
 
 EnvMap read_environment_input(const std::string& path, const std::string& layout, bool sanitize) {
   const std::optional<LayoutKind> hint =
       layout.empty() ? std::nullopt : std::optional<LayoutKind>(parse_layout_kind(layout));
   EnvReadReport report;
   EnvMap env = read_environment(path, hint, &report);
-  if ((report.nan_values || report.inf_values) && !sanitize)
-    throw std::runtime_error(path + ": " + std::to_string(report.nan_values) + " NaN and " +
-                             std::to_string(report.inf_values) + " Inf values; pass --sanitize to zero them");
-  if (sanitize) sanitize_environment(env);
+  if (report.texels.bad() && !sanitize)
+    throw std::runtime_error(path + ": " + report.texels.describe() + "; pass --sanitize to zero them");
+  if (sanitize) sanitize_texels(env.pixels);
   return env;
 }
 

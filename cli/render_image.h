@@ -12,12 +12,10 @@
 
 namespace rsibr::cli {
 
-// Reads an environment (layout: a --layout value or empty). NaN or Inf values are an error naming
-// the file unless `sanitize`, which zeroes them and negative values (lossy-compression ringing).
+// Reads an environment (layout: a --layout value or empty). NaN, Inf or absurd values
+// (core/texel_audit.h) are an error naming the file, the counts and the first texel unless
+// `sanitize`, which zeroes them and negative values (lossy-compression ringing).
 EnvMap read_environment_input(const std::string& path, const std::string& layout, bool sanitize);
-
-// Zeroes NaN, Inf and negative values in place; returns how many values changed.
-long sanitize_environment(EnvMap& env);
 
 // rgba: CV_32FC4 (R, G, B, A). ZIP, Rec.709 chromaticities, the camera as rsibr.eye (V3f),
 // rsibr.worldFromCam (M33f, columns camera x right, y down, z forward in world) and

@@ -1,5 +1,6 @@
 // rsibr synth: a synthetic capture (photo set) of a ball rig with its ground truth
 // (capture/synth_capture.h; the scene spec is documented in datasets-synthetic/README.md).
+#include "cli/option_checks.h"
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
@@ -67,7 +68,7 @@ Runner add_synth(CLI::App& app) {
             "bytes.");
   c->add_option("scene", a->scene, "Scene spec (YAML)")->required();
   c->add_option("--out", a->out, "Output folder (must not exist, or be empty)")->required();
-  c->add_option("--seed", a->seed, "Random seed (overrides the spec's seed)");
+  c->add_option("--seed", a->seed, "Random seed (overrides the spec's seed)")->check(seed_check());
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or summary line");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   return [a] { return run_synth(*a); };

@@ -36,13 +36,13 @@ struct ViewArgs {
   int map_size = 0, rings = 16, orbit = 0;
   double rim_fade = 0.4, wipe = 0.5;
   float exposure = 0.f;
-  bool weights = false, benchmark = false, quiet = false;
+  bool weights = false, benchmark = false, quiet = false, sanitize = false;
 };
 
 #if RSIBR_HAVE_VIEWER
 
-MapSet load_maps(const std::string& path) {
-  MapSet set = read_map_set(path);
+MapSet load_maps(const std::string& path, bool sanitize) {
+  MapSet set = read_map_set(path, sanitize ? BadTexels::zero : BadTexels::refuse);
   try {
     validate(set);
   } catch (const std::exception& e) {
@@ -86,8 +86,8 @@ int run_view(const ViewArgs& a) {
   const Mesh mesh = load_mesh(a.mesh, &mesh_report);
   std::vector<MapSet> sets;
   sets.reserve(2);
-  sets.push_back(load_maps(a.maps));
-  if (!a.maps2.empty()) sets.push_back(load_maps(a.maps2));
+  sets.push_back(load_maps(a.maps, a.sanitize));
+  if (!a.maps2.empty()) sets.push_back(load_maps(a.maps2, a.sanitize));
 
   viewer::ViewerScene scene;
   scene.mesh = &mesh;
@@ -220,6 +220,8 @@ Runner add_view(CLI::App& app) {
   c->add_option("--exr", a->exr, "Scripted: write each frame as RGBA float EXR (numbered when N > 1)");
   c->add_flag("--benchmark", a->benchmark, "Scripted: print each frame's time and the median frame rate");
   c->add_option("--json", a->json, "Scripted: write a JSON summary to FILE ('-' for stdout)");
+  c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
+                                         "confidences to [0, 1]) instead of failing; the JSON counts them");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar");
   return [a] { return run_view(*a); };
 }

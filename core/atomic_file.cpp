@@ -30,12 +30,4 @@ void check_not_same_file(const std::filesystem::path& input, const std::filesyst
     throw std::invalid_argument(output.string() + ": output would overwrite the input");
 }
 
-void check_output_path(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs) {
-  const std::filesystem::path folder = output.has_parent_path() ? output.parent_path() : std::filesystem::path(".");
-  std::error_code ec;
-  if (!std::filesystem::is_directory(folder, ec))
-    throw std::invalid_argument(output.string() + ": the folder " + folder.string() + " does not exist");
-  for (const auto& input : inputs) check_not_same_file(input, output);
-}
-
 }  // namespace rsibr

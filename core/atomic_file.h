@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <functional>
 #include <string>
-#include <vector>
 
 namespace rsibr {
 
@@ -17,8 +16,6 @@ void write_atomically(const std::filesystem::path& target,
 // overwritten).
 void check_not_same_file(const std::filesystem::path& input, const std::filesystem::path& output);
 
-// Checks an output path before long work starts: its folder exists and it names none of the
-// inputs. Throws std::invalid_argument("<output>: <problem>").
-void check_output_path(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs = {});
+// Checking every output of a verb before its work: core/output_plan.h.
 
 }  // namespace rsibr

@@ -75,7 +75,11 @@ EnvMap read_exr(const std::string& path, std::optional<LayoutKind> hint, EnvRead
   Imf::InputFile file(path.c_str());
   const Imf::Header& h = file.header();
   const Imath::Box2i dw = h.dataWindow();
-  const int W = dw.max.x - dw.min.x + 1, H = dw.max.y - dw.min.y + 1;
+  const long long W64 = (long long)dw.max.x - dw.min.x + 1, H64 = (long long)dw.max.y - dw.min.y + 1;
+  // A corrupt or hostile header must not size an allocation: at most 2^28 pixels (3 GiB of float RGB).
+  if (W64 < 1 || H64 < 1 || W64 > 65536 || H64 > 65536 || W64 * H64 > (1LL << 28))
+    fail(path, "a data window of " + std::to_string(W64) + "x" + std::to_string(H64) + " pixels (corrupt, or too large)");
+  const int W = int(W64), H = int(H64);
   report.format = "exr";
   report.compression = compression_name(h.compression());
 
@@ -194,14 +198,7 @@ EnvMap read_environment(const std::string& path, std::optional<LayoutKind> hint,
     std::replace(msg.begin(), msg.end(), '\n', ' ');
     fail(path, msg);
   }
-  for (int r = 0; r < map.pixels.rows; ++r) {
-    const float* p = map.pixels.ptr<float>(r);
-    for (int i = 0; i < map.pixels.cols * map.pixels.channels(); ++i) {
-      if (std::isnan(p[i])) ++report.nan_values;
-      else if (std::isinf(p[i])) ++report.inf_values;
-      else if (p[i] < 0) ++report.negative_values;
-    }
-  }
+  report.texels = audit_texels(map.pixels);
   if (report_out) *report_out = report;
   return map;
 }

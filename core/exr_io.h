@@ -8,6 +8,7 @@
 #pragma once
 
 #include "core/env_map.h"
+#include "core/texel_audit.h"
 
 #include <optional>
 #include <string>
@@ -20,7 +21,7 @@ struct EnvReadReport {
   std::string compression;       // EXR compression name
   std::string layout_source;     // "envmap attribute", "rsibr.layout attribute", "--layout", "shape"
   bool chromaticities_converted = false;
-  long nan_values = 0, inf_values = 0, negative_values = 0;  // counted over all channels
+  TexelAudit texels;             // NaN, Inf, huge and negative values, over all channels
 };
 
 // Throws std::runtime_error("<path>: <problem>") on any failure.

@@ -5,6 +5,7 @@
 #include "core/colour.h"
 #include "core/exr_io.h"
 #include "core/input_file.h"
+#include "core/texel_audit.h"
 #include "core/text.h"
 
 #include <OpenEXR/ImfChannelList.h>
@@ -22,11 +23,16 @@
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfVecAttribute.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
 namespace rsibr {
 namespace {
+
+// A sphere map wider than this is a corrupt or hostile header, not a map (8192^2 RGB float is 0.8 GB).
+constexpr long long kMaxMapSize = 16384;
 
 std::string part_name(std::size_t i) {
   char buf[32];
@@ -145,9 +151,10 @@ bool is_map_set_file(const std::string& path) {
   }
 }
 
-MapSet read_map_set(const std::string& path) {
+MapSet read_map_set(const std::string& path, BadTexels bad, long* zeroed) {
   require_regular_file(path);
   MapSet set;
+  long changed = 0;
   try {
     Imf::MultiPartInputFile file(path.c_str());
     for (int i = 0; i < file.parts(); ++i) {
@@ -181,7 +188,11 @@ MapSet read_map_set(const std::string& path) {
         if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) v.attributes[key] = s->value();
       }
       const Imath::Box2i dw = h.dataWindow();
-      const int W = dw.max.x - dw.min.x + 1, H = dw.max.y - dw.min.y + 1;
+      const long long W64 = (long long)dw.max.x - dw.min.x + 1, H64 = (long long)dw.max.y - dw.min.y + 1;
+      if (W64 < 1 || H64 < 1 || W64 > kMaxMapSize || H64 > kMaxMapSize)
+        throw std::runtime_error(who + "a data window of " + std::to_string(W64) + "x" + std::to_string(H64) +
+                                 " texels (at most " + std::to_string(kMaxMapSize) + " a side)");
+      const int W = int(W64), H = int(H64);
       v.rgb = cv::Mat(H, W, CV_32FC3);
       Imf::FrameBuffer fb;
       char* base = reinterpret_cast<char*>(v.rgb.data);
@@ -208,9 +219,30 @@ MapSet read_map_set(const std::string& path) {
           });
         }
       }
+      // Values no computation can use: refused, or zeroed on request.
+      const TexelAudit rgb = audit_texels(v.rgb);
+      long outside = 0;  // confidences that are not finite or not in [0, 1]
+      for (int r = 0; r < v.confidence.rows; ++r) {
+        float* w = v.confidence.ptr<float>(r);
+        for (int x = 0; x < v.confidence.cols; ++x) {
+          if (std::isfinite(w[x]) && w[x] >= 0 && w[x] <= 1) continue;
+          ++outside;
+          if (bad == BadTexels::zero) w[x] = std::isnan(w[x]) ? 0.f : std::clamp(w[x], 0.f, 1.f);
+        }
+      }
+      if (bad == BadTexels::refuse) {
+        if (rgb.bad()) throw std::runtime_error(part_name(std::size_t(i)) + ": " + rgb.describe() + " in R, G, B");
+        if (outside)
+          throw std::runtime_error(part_name(std::size_t(i)) + ": " + std::to_string(outside) +
+                                   " confidence values that are not in [0, 1]");
+      } else {
+        changed += sanitize_texels(v.rgb) + outside;
+      }
       set.views.push_back(std::move(v));
     }
+    if (zeroed) *zeroed = changed;
     validate(set);
+    set.view_set();  // views that coincide cannot be triangulated: refused here, naming the file
   } catch (const std::exception& e) {
     throw std::runtime_error(path + ": " + e.what());
   }

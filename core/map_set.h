@@ -53,9 +53,17 @@ struct MapSet {
 // view and the problem.
 void validate(const MapSet& set);
 
-// Both throw std::runtime_error("<path>: <problem>"). Writing is atomic.
+// What a reader does with NaN, Inf and absurd values (core/texel_audit.h) in a file's maps, and
+// with confidences that are not finite or outside [0, 1].
+enum class BadTexels {
+  refuse,  // an error naming the view, the counts and the first texel
+  zero,    // colour values zeroed (negative ones too), confidences clamped to [0, 1] (NaN: 0)
+};
+
+// Both throw std::runtime_error("<path>: <problem>"). Writing is atomic. `zeroed`, if given,
+// receives how many values BadTexels::zero changed.
 void write_map_set(const std::string& path, const MapSet& set);
-MapSet read_map_set(const std::string& path);
+MapSet read_map_set(const std::string& path, BadTexels bad = BadTexels::refuse, long* zeroed = nullptr);
 
 // True when the file is a multi-part EXR whose first part is named "view.000".
 bool is_map_set_file(const std::string& path);

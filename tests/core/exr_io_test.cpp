@@ -465,20 +465,20 @@ TEST(ExrIo, NanAndInfAreCountedInTheReport) {
   write_environment(path, map);
   EnvReadReport report;
   read_environment(path, std::nullopt, &report);
-  EXPECT_EQ(report.nan_values, 3);
-  EXPECT_EQ(report.inf_values, 3);
-  EXPECT_EQ(report.negative_values, 3);
+  EXPECT_EQ(report.texels.nan, 3);
+  EXPECT_EQ(report.texels.inf, 3);
+  EXPECT_EQ(report.texels.negative, 3);
   // Half output keeps NaN and Inf (they are not overflow) and the counts survive.
   write_environment(path, map, {.half = true});
   read_environment(path, std::nullopt, &report);
-  EXPECT_EQ(report.nan_values, 3);
-  EXPECT_EQ(report.inf_values, 3);
-  EXPECT_EQ(report.negative_values, 3);
+  EXPECT_EQ(report.texels.nan, 3);
+  EXPECT_EQ(report.texels.inf, 3);
+  EXPECT_EQ(report.texels.negative, 3);
   // A clean file counts nothing.
   map.pixels = cv::Mat(4, 8, CV_32FC3, cv::Scalar(1, 2, 3));
   write_environment(path, map);
   read_environment(path, std::nullopt, &report);
-  EXPECT_EQ(report.nan_values + report.inf_values + report.negative_values, 0);
+  EXPECT_EQ(report.texels.nan + report.texels.inf + report.texels.negative, 0);
 }
 
 }  // namespace

@@ -1,0 +1,30 @@
+// Values a reader takes from a file are audited before any work uses them. NaN, +-Inf and absurd
+// magnitudes (beyond kMaxRadiance: 10^8 such values still sum to a finite float) would make every
+// blend, bake, resample or comparison that touches them NaN or Inf, so readers refuse them with
+// the count and the first position, or zero them when the user asks (--sanitize).
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <string>
+
+namespace rsibr {
+
+inline constexpr float kMaxRadiance = 1e30f;
+
+struct TexelAudit {
+  long nan = 0, inf = 0, huge = 0;  // values (not texels), over every channel
+  long negative = 0;                // finite values below zero (lossy-compression ringing)
+  int first_row = -1, first_col = -1;  // the first NaN, Inf or huge value's texel
+  bool bad() const { return nan > 0 || inf > 0 || huge > 0; }
+  // "2 NaN, 1 Inf and 3 values beyond 1e+30 (the first at texel (column 4, row 7))".
+  std::string describe() const;
+};
+
+// m: a float image (CV_32F, any channel count), rows in order.
+TexelAudit audit_texels(const cv::Mat& m);
+
+// Zeroes every NaN, Inf, huge and negative value of m (CV_32F) and returns how many it changed.
+long sanitize_texels(cv::Mat& m);
+
+}  // namespace rsibr
