@@ -12,18 +12,13 @@
 #include <string>
 #include <vector>
 
+#include "error_message.h"
+
 namespace fs = std::filesystem;
 namespace rsibr {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
-}
+using test_support::error_of;
 
 TEST(SafeName, NamesOfLettersDigitsDotsDashesAndUnderscoresAreSafe) {
   for (const std::string name : {std::string("north"), std::string("view00"), std::string("Grey_ball-2"),

@@ -11,17 +11,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "error_message.h"
+
 namespace rsibr {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
-}
+using test_support::error_of;
 
 TEST(ParseYaml, AnAliasInsideItsOwnAnchorIsACycleNamedWithItsKeyPath) {
   for (const char* text : {"a: &x [1, *x]", "lobe: &l {type: ggx, inner: *l}", "&r {self: *r}"}) {

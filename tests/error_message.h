@@ -1,0 +1,19 @@
+#pragma once
+// The message of the std::invalid_argument a call throws, or "" when it throws none: tests of
+// refusals compare against the one line a user would read.
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+namespace rsibr::test_support {
+
+inline std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace rsibr::test_support
