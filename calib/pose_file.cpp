@@ -115,11 +115,7 @@ void write_pose_file(const std::string& path, const PoseSet& poses) {
           << "], half_angle_deg: " << v.ball->half_angle * 180 / kPi << "}\n";
     }
   }
-  write_atomically(path, [&](const std::string& tmp) {
-    std::ofstream f(tmp, std::ios::binary);
-    f << out.str();
-    if (!f.flush()) throw std::runtime_error(path + ": cannot write");
-  });
+  write_text_atomically(path, out.str());
 }
 
 }  // namespace rsibr

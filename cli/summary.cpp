@@ -16,11 +16,7 @@ void write_summary(const std::string& target, const nlohmann::json& summary) {
     std::cout << text;
     return;
   }
-  write_atomically(target, [&](const std::string& tmp) {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out) throw std::runtime_error(target + ": cannot write the summary");
-  });
+  write_text_atomically(target, text);
 }
 
 }  // namespace rsibr::cli

@@ -3,6 +3,9 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
 #include <stdexcept>
 
 namespace rsibr {
@@ -22,6 +25,15 @@ void write_atomically(const std::filesystem::path& target,
     std::filesystem::remove(tmp, ec);
     throw;
   }
+}
+
+void write_text_atomically(const std::filesystem::path& target, const std::string& text) {
+  write_atomically(target, [&](const std::string& tmp) {
+    std::ofstream f(tmp, std::ios::binary);
+    f.write(text.data(), std::streamsize(text.size()));
+    f.close();
+    if (!f) throw std::runtime_error(target.string() + ": cannot write: " + std::strerror(errno));
+  });
 }
 
 void check_not_same_file(const std::filesystem::path& input, const std::filesystem::path& output) {

@@ -210,11 +210,7 @@ fs::path save_photo_set(const PhotoSet& set) {
   }
   out << YAML::EndMap;
   const fs::path target = folder / "photoset.yaml";
-  write_atomically(target, [&](const std::string& tmp) {
-    std::ofstream f(tmp, std::ios::binary);
-    f << "# rsibr photo set (core/photo_set.h describes the format)\n" << out.c_str() << "\n";
-    if (!f) throw std::runtime_error(target.string() + ": cannot write");
-  });
+  write_text_atomically(target, std::string("# rsibr photo set (core/photo_set.h describes the format)\n") + out.c_str() + "\n");
   return target;
 }
 

@@ -66,11 +66,8 @@ void save_response(const std::filesystem::path& path, const ResponseCurve& curve
   j["parameters"] = curve.parameters;
   j["max_code"] = curve.max_code;
   j["knots"] = {curve.knots[0], curve.knots[1], curve.knots[2]};
-  write_atomically(path, [&](const std::string& tmp) {
-    std::ofstream f(tmp);
-    f << j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";  // the camera name: not always UTF-8
-    if (!f) throw std::runtime_error(path.string() + ": cannot write");
-  });
+  // The camera name is not always UTF-8: bad bytes are replaced.
+  write_text_atomically(path, j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 ResponseCurve load_response(const std::filesystem::path& path) {

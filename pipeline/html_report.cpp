@@ -272,12 +272,7 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
     h << "</div>";
   }
   h << "</body></html>\n";
-  const std::string text = h.str();
-  write_atomically(out, [&](const std::string& tmp) {
-    std::ofstream o(tmp, std::ios::binary);
-    o << text;
-    if (!o) throw std::runtime_error(tmp + ": cannot write");
-  });
+  write_text_atomically(out, h.str());
 }
 
 }  // namespace rsibr

@@ -92,11 +92,8 @@ void write_step_record(const fs::path& dir, const StepRecord& r) {
   j["seconds"] = r.seconds;
   j["summary"] = r.summary;
   fs::create_directories(dir / "steps");
-  write_atomically(step_record_path(dir, r.step), [&](const std::string& tmp) {
-    std::ofstream out(tmp);
-    out << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";  // input text: not always UTF-8
-    if (!out) throw std::runtime_error(tmp + ": cannot write");
-  });
+  // Input text (names, the camera) is not always UTF-8: bad bytes are replaced.
+  write_text_atomically(step_record_path(dir, r.step), j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 }  // namespace rsibr
