@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <mutex>
 #include <stdexcept>
 
 namespace rsibr {
@@ -11,6 +12,21 @@ namespace rsibr {
 namespace fs = std::filesystem;
 
 namespace {
+
+// Every temporary handed out in this process, with its target (a handful per run): errors are
+// reported after the plan that made them is gone.
+std::vector<std::pair<std::string, std::string>>& temporaries() {
+  static std::vector<std::pair<std::string, std::string>> names;
+  return names;
+}
+std::mutex& temporaries_mutex() {
+  static std::mutex m;
+  return m;
+}
+void remember_temporary(const std::string& tmp, const std::string& target) {
+  const std::lock_guard<std::mutex> lock(temporaries_mutex());
+  temporaries().emplace_back(tmp, target);
+}
 
 // The path with symlinks resolved as far as it exists ("out/./a.json" and "out/a.json" are one).
 fs::path identity(const fs::path& p) {
@@ -75,6 +91,7 @@ std::string OutputPlan::file(const std::string& path) {
   tmp.replace_filename("." + p.stem().string() + ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++) +
                        p.extension().string());
   staged_.emplace_back(tmp, p);
+  remember_temporary(tmp.string(), path);
   return tmp.string();
 }
 
@@ -85,6 +102,13 @@ void OutputPlan::folder(const std::string& path) {
   std::error_code ec;
   if (fs::exists(p, ec) && !fs::is_directory(p, ec)) throw std::invalid_argument(path + ": exists and is not a folder");
   check_distinct(p, "a folder");
+}
+
+std::string OutputPlan::naming_targets(std::string message) {
+  const std::lock_guard<std::mutex> lock(temporaries_mutex());
+  for (const auto& [tmp, target] : temporaries())
+    for (std::size_t at; (at = message.find(tmp)) != std::string::npos;) message.replace(at, tmp.size(), target);
+  return message;
 }
 
 void OutputPlan::commit() {

@@ -43,6 +43,10 @@ class OutputPlan {
   // was never written is a std::logic_error (a verb that registers an output must write it).
   void commit();
 
+  // `message` with every temporary this process's plans handed out replaced by its target: an
+  // error raised while writing a temporary names the file the user asked for.
+  static std::string naming_targets(std::string message);
+
  private:
   void check_distinct(const std::filesystem::path& path, const std::string& kind);
   std::vector<std::filesystem::path> inputs_;

@@ -251,6 +251,21 @@ ln "$in/env-good.exr" "$work/hardlink.exr"
 refused "convert: the output is a hard link to the input" "output would overwrite the input" convert "$in/env-good.exr" "$work/hardlink.exr" --to cube --size 8
 rm "$work/hardlink.exr"
 
+# ---- a full file system (a 64 KiB tmpfs, when this machine lets root mount one)
+full="$work/full"
+mkdir -p "$full"
+if mount -t tmpfs -o size=64k tmpfs "$full" 2>/dev/null; then
+  trap 'umount "$full" 2>/dev/null; rm -rf "$work"' EXIT
+  head -c 40000 /dev/zero >"$full/ballast"
+  refused "convert: the output's disk is full" "big.exr" convert "$in/env-good.exr" "$full/big.exr" --to cube --size 128
+  head -c 20000 /dev/zero >"$full/ballast2"  # one 4 KiB page left: the preview fits, the summary does not
+  refused "convert: the summary's disk is full" "s.json" convert "$in/env-good.exr" "$out/ok.exr" --to cube --size 8 --preview "$full/p.png" --json "$full/s.json" --quiet
+  check "a full disk leaves no temporaries" test "$(ls -A "$full" | tr '\n' ' ')" = "ballast ballast2 "
+  umount "$full"
+else
+  echo "bad-input-battery: cannot mount a tmpfs here; the full-disk cases are skipped"
+fi
+
 find "$in" -type f -exec sha256sum {} + | sort >"$work/inputs-after.sha"
 check "every input is byte-identical" diff "$work/inputs.sha" "$work/inputs-after.sha"
 finish bad-input-battery

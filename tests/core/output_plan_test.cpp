@@ -11,20 +11,15 @@
 #include <stdexcept>
 #include <string>
 
+#include "error_message.h"
+
 namespace fs = std::filesystem;
 namespace rsibr {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
-}
+using test_support::error_of;
 
-std::string read(const fs::path& p) {
+std::string contents_of(const fs::path& p) {
   std::ifstream in(p);
   return std::string((std::istreambuf_iterator<char>(in)), {});
 }
@@ -52,8 +47,8 @@ TEST_F(OutputPlanTest, CommittedOutputsAppearTogetherAndNothingElseRemains) {
     EXPECT_FALSE(fs::exists(dir_ / "out.exr")) << "nothing is in place before the commit";
     plan.commit();
   }
-  EXPECT_EQ(read(dir_ / "out.exr"), "map");
-  EXPECT_EQ(read(dir_ / "out.json"), "{}");
+  EXPECT_EQ(contents_of(dir_ / "out.exr"), "map");
+  EXPECT_EQ(contents_of(dir_ / "out.json"), "{}");
   EXPECT_EQ(entries(), 4u) << "in.exr, sub, out.exr, out.json and no temporary";
 }
 
@@ -75,7 +70,7 @@ TEST_F(OutputPlanTest, AnOutputThatIsAnInputIsRefusedByIdentityNotSpelling) {
     EXPECT_NE(error_of([&] { plan.file(out.string()); }).find("output would overwrite the input"), std::string::npos)
         << out;
   }
-  EXPECT_EQ(read(dir_ / "in.exr"), "input");
+  EXPECT_EQ(contents_of(dir_ / "in.exr"), "input");
 }
 
 TEST_F(OutputPlanTest, TwoOutputsThatAreOneFileAreRefused) {
@@ -96,6 +91,18 @@ TEST_F(OutputPlanTest, MissingFoldersFoldersAndFifosAreRefusedBeforeAnyWork) {
   EXPECT_NE(error_of([&] { plan.folder((dir_ / "file").string()); }).find("is not a folder"), std::string::npos);
   EXPECT_EQ(plan.file(""), "");
   EXPECT_EQ(plan.file("-"), "-");
+}
+
+TEST_F(OutputPlanTest, AnErrorAboutATemporaryNamesTheTargetEvenAfterThePlanIsGone) {
+  std::string message;
+  {
+    OutputPlan out;
+    const std::string tmp = out.file((dir_ / "map.exr").string());
+    message = tmp + ": No space left on device (writing " + tmp + ")";
+  }
+  const std::string target = (dir_ / "map.exr").string();
+  EXPECT_EQ(OutputPlan::naming_targets(message), target + ": No space left on device (writing " + target + ")");
+  EXPECT_EQ(OutputPlan::naming_targets("unrelated: message"), "unrelated: message");
 }
 
 TEST_F(OutputPlanTest, ACommitOfAnOutputThatWasNeverWrittenIsAnError) {
