@@ -1,5 +1,6 @@
 #include "calib/view_image.h"
 
+#include "core/exr_io.h"
 #include "core/input_file.h"
 #include "core/safe_name.h"
 #include "core/truth_image.h"
@@ -31,6 +32,7 @@ ViewImage read_view_image(const std::string& path) {
     v.radiance = img;
   }
   try {
+    check_exr_before_reading(path);
     Imf::InputFile file(path.c_str());
     if (const auto* a = file.header().findTypedAttribute<Imf::StringAttribute>("rsibr.view")) v.name = a->value();
     if (const auto* a = file.header().findTypedAttribute<Imf::M33fAttribute>("rsibr.worldFromCam")) {

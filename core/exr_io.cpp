@@ -22,8 +22,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 
@@ -72,14 +74,11 @@ LayoutKind layout_from_shape(const std::string& path, int w, int h) {
 }
 
 EnvMap read_exr(const std::string& path, std::optional<LayoutKind> hint, EnvReadReport& report) {
+  check_exr_before_reading(path);
   Imf::InputFile file(path.c_str());
   const Imf::Header& h = file.header();
   const Imath::Box2i dw = h.dataWindow();
-  const long long W64 = (long long)dw.max.x - dw.min.x + 1, H64 = (long long)dw.max.y - dw.min.y + 1;
-  // A corrupt or hostile header must not size an allocation: at most 2^28 pixels (3 GiB of float RGB).
-  if (W64 < 1 || H64 < 1 || W64 > 65536 || H64 > 65536 || W64 * H64 > (1LL << 28))
-    fail(path, "a data window of " + std::to_string(W64) + "x" + std::to_string(H64) + " pixels (corrupt, or too large)");
-  const int W = int(W64), H = int(H64);
+  const auto [W, H] = checked_data_window(dw, path);
   report.format = "exr";
   report.compression = compression_name(h.compression());
 
@@ -151,7 +150,25 @@ EnvMap read_exr(const std::string& path, std::optional<LayoutKind> hint, EnvRead
   return map;
 }
 
+// The image size a Radiance .hdr header claims (its resolution line, "-Y H +X W" after the first
+// empty line), checked before OpenCV allocates it: a hostile header must not size an allocation.
+void check_hdr_size(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (int lines = 0; std::getline(in, line) && !line.empty(); ++lines)
+    if (lines > 1000 || line.size() > 4096) fail(path, "a Radiance header without its end");
+  std::getline(in, line);
+  std::istringstream res(line);
+  std::string ay, ax;
+  long long h = 0, w = 0;
+  if (!(res >> ay >> h >> ax >> w) || ay.size() != 2 || ax.size() != 2 || (ay[1] != 'Y' && ay[1] != 'X'))
+    fail(path, "no Radiance resolution line (\"-Y H +X W\")");
+  if (w < 1 || h < 1 || w > 65536 || h > 65536 || w * h > (1LL << 27))
+    fail(path, "a resolution of " + std::to_string(w) + "x" + std::to_string(h) + " (corrupt, or too large)");
+}
+
 EnvMap read_hdr(const std::string& path, std::optional<LayoutKind> hint, EnvReadReport& report) {
+  check_hdr_size(path);
   cv::Mat bgr = cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
   if (bgr.empty()) fail(path, "not a readable Radiance .hdr file");
   if (bgr.type() != CV_32FC3) bgr.convertTo(bgr, CV_32FC3);
@@ -172,9 +189,67 @@ EnvMap read_hdr(const std::string& path, std::optional<LayoutKind> hint, EnvRead
 
 }  // namespace
 
+std::pair<int, int> checked_data_window(const Imath::Box2i& dw, const std::string& path) {
+  const long long w = (long long)dw.max.x - dw.min.x + 1, h = (long long)dw.max.y - dw.min.y + 1;
+  if (w < 1 || h < 1 || w > 65536 || h > 65536 || w * h > (1LL << 27))
+    fail(path, "a data window of " + std::to_string(w) + "x" + std::to_string(h) + " pixels (corrupt, or too large)");
+  return {int(w), int(h)};
+}
+
+void check_exr_before_reading(const std::string& path) {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    Imf::Header::setMaxImageSize(65536, 65536);
+    Imf::Header::setMaxTileSize(8192, 8192);
+  });
+  //   file   := magic(4) version(4) header+ [0]        (one header, or several ended by an empty one)
+  //   header := attribute* 0;  attribute := name 0 type 0 size(int32 LE) value(size bytes)
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(0, std::ios::end);
+  const long long file_size = in.tellg();
+  in.seekg(0);
+  unsigned char head[8] = {};
+  in.read(reinterpret_cast<char*>(head), 8);
+  if (!in || head[0] != 0x76 || head[1] != 0x2f || head[2] != 0x31 || head[3] != 0x01) fail(path, "not an OpenEXR file");
+  const bool multipart = (head[5] & 0x10) != 0;
+  auto read_string = [&](const char* what) {
+    std::string s;
+    for (char c; in.get(c) && c != '\0';) {
+      s += c;
+      if (s.size() > 255) fail(path, std::string("a header ") + what + " longer than 255 bytes");
+    }
+    if (!in) fail(path, "the header ends before the pixels (truncated?)");
+    return s;
+  };
+  for (int part = 0;; ++part) {
+    if (part >= 1024) fail(path, "more than 1024 parts");
+    int attributes = 0;
+    for (;; ++attributes) {
+      if (attributes > 1024) fail(path, "more than 1024 header attributes");
+      const std::string name = read_string("attribute name");
+      if (name.empty()) break;
+      read_string("type name");
+      unsigned char b[4];
+      in.read(reinterpret_cast<char*>(b), 4);
+      const long long size = std::int32_t(std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 | std::uint32_t(b[2]) << 16 |
+                                          std::uint32_t(b[3]) << 24);
+      if (!in || size < 0 || size > file_size - (long long)in.tellg())
+        fail(path, "header attribute '" + quoted_for_message(name) + "' claims " + std::to_string(size) +
+                       " bytes, more than the file holds (corrupt or truncated)");
+      in.seekg(size, std::ios::cur);
+    }
+    if (!multipart) break;
+    if (attributes == 0) break;  // the empty header that ends a multi-part file's headers
+  }
+}
+
 EnvMap read_environment(const std::string& path, std::optional<LayoutKind> hint, EnvReadReport* report_out) {
   EnvReadReport report;
-  require_regular_file(path);
+  try {
+    require_regular_file(path);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(e.what());  // this reader's errors are runtime_error, whatever the cause
+  }
   std::ifstream probe(path, std::ios::binary);
   unsigned char magic[4] = {0, 0, 0, 0};
   probe.read(reinterpret_cast<char*>(magic), 4);
@@ -250,14 +325,20 @@ void write_environment(const std::string& path, const EnvMap& map, const ExrWrit
   Imf::FrameBuffer fb;
   for (int k = 0; k < ch; ++k)
     fb.insert(names[k], Imf::Slice(type, base + k * elem, ch * elem, ch * elem * std::size_t(W)));
+  std::string temporary;
   try {
     write_atomically(path, [&](const std::string& tmp) {
+      temporary = tmp;
       Imf::OutputFile out(tmp.c_str(), header);
       out.setFrameBuffer(fb);
       out.writePixels(H);
     });
   } catch (const std::exception& e) {
-    fail(path, e.what());
+    // OpenEXR names the temporary, which never outlives the failure: the user is told `path`.
+    std::string what = e.what();
+    for (const std::string& name : {" \"" + temporary + "\"", " " + temporary})
+      for (std::size_t at; !temporary.empty() && (at = what.find(name)) != std::string::npos;) what.erase(at, name.size());
+    fail(path, what);
   }
 }
 

@@ -22,6 +22,110 @@ extern "C" {
 namespace rsibr {
 namespace {
 
+// The .cameramodel syntax, checked before mrcal sees the text: mrcal 2.2's parser reads past the
+// end of some malformed texts (found by fuzz/fuzz_camera_model), so only well-formed ones reach it.
+//   model  := '{' [ string ':' value { ',' string ':' value } [','] ] '}'
+//   value  := string | number | '[' [ value { ',' value } [','] ] ']'
+//   string := '...' or "..." on one line;  number := [+-] digits [. digits] [(e|E) [+-] digits]
+// with blanks and '#' comments (to the end of the line) between tokens, and nothing after '}'.
+class CameraModelSyntax {
+ public:
+  explicit CameraModelSyntax(const std::string& text) : s_(text) {}
+
+  // "" when the text is well formed, else what is wrong and where.
+  std::string problem() {
+    try {
+      expect('{');
+      if (!accept('}')) {
+        do {
+          if (peek() == '}') break;
+          string();
+          expect(':');
+          value(1);
+        } while (accept(','));
+        expect('}');
+      }
+      skip();
+      if (i_ != s_.size()) fail("text after the closing '}'");
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& what) {
+    std::size_t line = 1;
+    for (std::size_t k = 0; k < i_ && k < s_.size(); ++k) line += s_[k] == '\n';
+    throw std::invalid_argument("line " + std::to_string(line) + ": " + what);
+  }
+  void skip() {
+    while (i_ < s_.size()) {
+      if (s_[i_] == '#') {
+        while (i_ < s_.size() && s_[i_] != '\n') ++i_;
+      } else if (s_[i_] == ' ' || s_[i_] == '\t' || s_[i_] == '\n' || s_[i_] == '\r') {
+        ++i_;
+      } else {
+        break;
+      }
+    }
+  }
+  char peek() {
+    skip();
+    return i_ < s_.size() ? s_[i_] : '\0';
+  }
+  bool accept(char c) {
+    if (peek() != c) return false;
+    ++i_;
+    return true;
+  }
+  void expect(char c) {
+    if (!accept(c)) fail(std::string("expected '") + c + "'");
+  }
+  void string() {
+    const char q = peek();
+    if (q != '\'' && q != '"') fail("expected a quoted key or string");
+    for (++i_; i_ < s_.size() && s_[i_] != q; ++i_)
+      if (s_[i_] == '\n' || s_[i_] == '\\') fail("a string that spans lines or holds a backslash");
+    if (i_ >= s_.size()) fail("a string without its closing quote");
+    ++i_;
+  }
+  void digits() {
+    const std::size_t start = i_;
+    while (i_ < s_.size() && s_[i_] >= '0' && s_[i_] <= '9') ++i_;
+    if (i_ == start) fail("expected a number");
+  }
+  void number() {
+    skip();
+    if (i_ < s_.size() && (s_[i_] == '+' || s_[i_] == '-')) ++i_;
+    digits();
+    if (i_ < s_.size() && s_[i_] == '.') {
+      ++i_;
+      while (i_ < s_.size() && s_[i_] >= '0' && s_[i_] <= '9') ++i_;
+    }
+    if (i_ < s_.size() && (s_[i_] == 'e' || s_[i_] == 'E')) {
+      ++i_;
+      if (i_ < s_.size() && (s_[i_] == '+' || s_[i_] == '-')) ++i_;
+      digits();
+    }
+  }
+  void value(int depth) {
+    if (depth > 4) fail("lists nested too deep");
+    const char c = peek();
+    if (c == '\'' || c == '"') return string();
+    if (c != '[') return number();
+    ++i_;
+    if (accept(']')) return;
+    do {
+      if (peek() == ']') break;
+      value(depth + 1);
+    } while (accept(','));
+    expect(']');
+  }
+  const std::string& s_;
+  std::size_t i_ = 0;
+};
+
 mrcal_lensmodel_t lensmodel_of(const std::string& name) {
   mrcal_lensmodel_t m;
   if (!mrcal_lensmodel_from_name(&m, name.c_str()) || !mrcal_lensmodel_type_is_valid(m.type))
@@ -59,6 +163,8 @@ LensModel LensModel::pinhole(double f, int width, int height) {
 }
 
 LensModel LensModel::parse(const std::string& text, const std::string& what) {
+  if (const std::string problem = CameraModelSyntax(text).problem(); !problem.empty())
+    throw std::invalid_argument(what + ": not a valid mrcal .cameramodel (" + problem + ")");
   // mrcal's parser reports problems on stderr; catch that line so the error stays one line that
   // names the file (the CLI contract).
   std::string diagnostic;

@@ -31,8 +31,9 @@
 namespace rsibr {
 namespace {
 
-// A sphere map wider than this is a corrupt or hostile header, not a map (8192^2 RGB float is 0.8 GB).
-constexpr long long kMaxMapSize = 16384;
+// A sphere map wider than this is a corrupt or hostile header, not a map (rsibr bake --res stops
+// there too; 8192^2 RGB float is 0.8 GB).
+constexpr long long kMaxMapSize = 8192;
 
 std::string part_name(std::size_t i) {
   char buf[32];
@@ -144,6 +145,7 @@ bool is_map_set_file(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) return false;
   try {
+    check_exr_before_reading(path);
     Imf::MultiPartInputFile file(path.c_str());
     return file.parts() >= 1 && file.header(0).hasName() && file.header(0).name() == "view.000";
   } catch (...) {
@@ -152,10 +154,11 @@ bool is_map_set_file(const std::string& path) {
 }
 
 MapSet read_map_set(const std::string& path, BadTexels bad, long* zeroed) {
-  require_regular_file(path);
   MapSet set;
   long changed = 0;
   try {
+    require_regular_file(path);
+    check_exr_before_reading(path);
     Imf::MultiPartInputFile file(path.c_str());
     for (int i = 0; i < file.parts(); ++i) {
       const Imf::Header& h = file.header(i);
@@ -244,7 +247,9 @@ MapSet read_map_set(const std::string& path, BadTexels bad, long* zeroed) {
     validate(set);
     set.view_set();  // views that coincide cannot be triangulated: refused here, naming the file
   } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
+    const std::string what = e.what();
+    if (what.rfind(path + ": ", 0) == 0) throw std::runtime_error(what);
+    throw std::runtime_error(path + ": " + what);
   }
   return set;
 }

@@ -1,6 +1,7 @@
 #include "core/truth_image.h"
 
 #include "core/atomic_file.h"
+#include "core/exr_io.h"
 #include "core/text.h"
 
 #include <OpenEXR/ImfChannelList.h>
@@ -57,9 +58,10 @@ void write_truth_image(const std::filesystem::path& path, const cv::Mat& image, 
 
 cv::Mat read_truth_image(const std::filesystem::path& path) {
   try {
+    check_exr_before_reading(path.string());
     Imf::InputFile in(path.c_str());
     const Imath::Box2i dw = in.header().dataWindow();
-    const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
+    const auto [w, h] = checked_data_window(dw, path.string());
     const bool grey = in.header().channels().findChannel("Y") != nullptr;
     const int ch = grey ? 1 : 3;
     cv::Mat out(h, w, CV_32FC(ch));

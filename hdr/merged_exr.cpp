@@ -74,9 +74,10 @@ void write_merged_exr(const std::string& path, const MergedImage& m, const std::
 
 MergedImage read_merged_exr(const std::string& path, std::map<std::string, std::string>* attributes) {
   try {
+    check_exr_before_reading(path);
     Imf::InputFile in(path.c_str());
     const Imath::Box2i dw = in.header().dataWindow();
-    const int W = dw.max.x - dw.min.x + 1, H = dw.max.y - dw.min.y + 1;
+    const auto [W, H] = checked_data_window(dw, path);
     for (int k = 0; k < kCount; ++k)
       if (!in.header().channels().findChannel(kChannels[k]))
         throw std::runtime_error(std::string("no channel ") + kChannels[k] + " (not a merged view)");

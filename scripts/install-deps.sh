@@ -18,8 +18,8 @@ packages=(
   libsuitesparse-dev  # calib/intrinsics.cpp: cholmod (mrcal's Jacobian for the intrinsics covariance)
   # viewer (runtime/viewer; optional at build time) and its CI test under Xvfb (Mesa llvmpipe)
   libglfw3-dev libimgui-dev libepoxy-dev xvfb xauth libgl1-mesa-dri
-  # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev
+  # tests and benchmarks; clang's libFuzzer for the fuzz targets (fuzz/)
+  libgtest-dev libgmock-dev libbenchmark-dev clang-14 libclang-rt-14-dev
   # real-data fetch (npm registry) and docs plots
   python3 python3-numpy python3-matplotlib
 )

@@ -5,8 +5,10 @@
 #      message when the npm registry cannot be reached),
 #   3. builds and tests the release preset, then the address+undefined sanitizer preset (which skips
 #      ten long numerical sweeps, listed in CMakePresets.json's asan test preset: their code paths are
-#      run under the sanitizers by shorter tests, and the release run keeps CI under 30 minutes with them).
-# Options: --fast skips the sanitizer build.
+#      run under the sanitizers by shorter tests, and the release run keeps CI under 30 minutes with them),
+#   4. builds the libFuzzer targets of the file readers with clang (fuzz preset) and runs each for a
+#      bounded time from its seed corpus (fuzz/README.md); any finding fails the run.
+# Options: --fast skips the sanitizer and fuzz builds.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -23,7 +25,7 @@ bash scripts/fetch-assets.sh || echo "test.sh: real-world data unavailable; the 
 
 jobs=$(nproc)
 presets=(release)
-((fast)) || presets+=(asan)
+((fast)) || presets+=(asan fuzz)
 # Unity builds: each target is compiled as a few large translation units, which halves a
 # from-scratch build (the headers of Eigen, OpenCV, nlohmann and the standard library are parsed once
 # per batch, not once per file). Day-to-day incremental builds with the presets stay per-file; a

@@ -94,6 +94,31 @@ TEST(LensModel, BadInputIsAnErrorNamingTheProblem) {
   }
 }
 
+TEST(LensModel, MalformedTextsThatMrcalReadsPastTheirEndAreRefusedBeforeMrcalSeesThem) {
+  // Found by fuzz/fuzz_camera_model (fuzz/regressions/): mrcal 2.2's parser read past the end of
+  // these and crashed; they are refused with the line at fault.
+  const std::pair<std::string, std::string> cases[] = {
+      {"{\n    'lensmodel':  'LENSMODEL_PINHOLE',\n    'intrinsics': [ 100, 100, 47.5, 31.5 ],\n"
+       "    'imagersize': [ 96, 64 ],\n    'extrinsic 0, 0, 0, 0, 0 ],\n# generated for the",
+       "line 5: a string that spans lines"},
+      {"# a comment\n{\n    'lensmodel':  'LENSMODEL_OPENCV8',\n    'intrinsics':# comment  [ 7t0", "line 4: expected a number"},
+      {"{ 'lensmodel': 'LENSMODEL_PINHOLE', # x", "expected a quoted key"},
+      {"{ 'lensmodel': 'LENSMODEL_PINHOLE' } trailing", "text after the closing '}'"},
+      {"{ 'a': [[[[[1]]]]] }", "nested too deep"},
+  };
+  for (const auto& [text, expected] : cases) {
+    try {
+      LensModel::parse(text, "m.cameramodel");
+      FAIL() << "no error for: " << text;
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind("m.cameramodel: not a valid mrcal .cameramodel (", 0), 0u) << what;
+      EXPECT_NE(what.find(expected), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
+}
+
 TEST(RayTable, InterpolatedRaysReprojectToTheirPixels) {
   for (const LensModel& lens : {LensModel::pinhole(800, 640, 480), wide_opencv8()}) {
     const RayTable table(lens, 8);

@@ -244,6 +244,32 @@ TEST(MapSet, ReadingANonMapSetFileIsAClearError) {
   EXPECT_TRUE(is_map_set_file(maps));
 }
 
+TEST(MapSet, AHeaderAttributeClaimingMoreBytesThanTheFileIsRefusedBeforeOpenExrAllocatesIt) {
+  // OpenEXR 3.1 allocated (and cleared) the claimed size of a string attribute before finding the
+  // file too short: 2 GB for a 4 KB file (fuzz/regressions/fuzz_map_set/).
+  TempDir dir;
+  const std::string maps = dir.file("maps.exr");
+  write_map_set(maps, make_set(4, 4));
+  std::ifstream in(maps, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  const std::string key = std::string("rsibr.warp") + '\0' + "string" + '\0';
+  const std::size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos);
+  for (int k = 0; k < 4; ++k) bytes[at + key.size() + std::size_t(k)] = k == 3 ? '\x7f' : '\xff';  // 2^31 - 1
+  const std::string bad = dir.file("claims-2gb.exr");
+  std::ofstream(bad, std::ios::binary) << bytes;
+  try {
+    read_map_set(bad);
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind(bad + ": ", 0), 0u) << msg;
+    EXPECT_NE(msg.find("'rsibr.warp' claims 2147483647 bytes"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find(bad, 1), std::string::npos) << "the path is named once: " << msg;
+  }
+  EXPECT_FALSE(is_map_set_file(bad));
+}
+
 TEST(MapSet, PartsAreNamedInOrder) {
   TempDir dir;
   const MapSet set = make_set(5, 6);
