@@ -7,6 +7,16 @@
 // g_mirror_inv(r) (core/sphere_map.h), RGB and confidence bilinear. A chrome map holds F(cos) L(w)
 // with cos = n.v = sqrt((1 + r.z) / 2) (the half angle); `fresnel`, when given, is divided out so the
 // probe holds L. Texels whose summed confidence is below min_weight are 0 (no view saw them).
+//
+// Energy: a probe texel is the mean of k x k lookups over its cell, k = clamp(ceil(texel angle /
+// map texel angle), 1, 4) (a map texel spans 4 / size radians: the sphere map is equal-area, 4 sr
+// per unit of disc area), so a probe coarser than the maps still sums their energy; a finer one
+// reads the maps' bilinear reconstruction, which keeps it.
+//
+// Clipped light: where no view has an unclipped tap but some view has a clipped one (the map's
+// `clipped` channel, core/map_set.h), the probe texel is 0 and `clipped` holds the summed weight
+// of those taps (the direction was clipped in every bracket of every chrome view that saw it),
+// `lower_bound` the largest of the views' values there (each a lower bound of F L, F divided out).
 #pragma once
 
 #include "bake/fresnel.h"
@@ -14,6 +24,12 @@
 #include "core/map_set.h"
 
 namespace rsibr {
+
+// The chrome ball's reflectance when the user states none (rsibr probe --fresnel, rsibr process
+// --chrome-fresnel): a conductor with chromium-like optical constants, n = 2.9 / 2.9 / 2.6 and
+// k = 3.4 / 3.4 / 3.2 (R / G / B), about 57% at normal incidence and rising to 1 at grazing, as
+// chrome-plated steel balls measure (55-65% across the visible). "none" keeps F L in the probe.
+inline constexpr const char* kDefaultChromeFresnel = "{type: conductor, eta: [2.9, 2.9, 2.6], k: [3.4, 3.4, 3.2]}";
 
 struct ProbeOptions {
   int width = 256;                  // lat-long width (height = width / 2)
@@ -24,7 +40,10 @@ struct ProbeOptions {
 struct Probe {
   EnvMap env;               // lat-long, RGB
   cv::Mat weight;           // CV_32FC1, summed confidence per texel
+  cv::Mat clipped;          // CV_32FC1, summed weight of clipped taps where no unclipped one exists
+  cv::Mat lower_bound;      // CV_32FC3, the largest lower bound of L seen there (0 elsewhere)
   double covered_fraction = 0;  // solid-angle fraction with weight >= min_weight
+  double clipped_fraction = 0;  // solid-angle fraction of texels clipped in every view that saw them
 };
 
 // Throws std::invalid_argument when the set is empty or has no confidence channel (not captured).
