@@ -20,6 +20,8 @@ struct Lookup {
   double clipped = 0, clipped_weight = 0;
 };
 
+double luminance(const Vec3& c) { return 0.2126 * c.x() + 0.7152 * c.y() + 0.0722 * c.z(); }
+
 Lookup look_up(const MapView& mv, const Vec3& r) {
   Lookup out;
   const Vec2 px = sphere_map::pixel_from_disc(sphere_map::g_mirror_inv(r), mv.rgb.cols, mv.rgb.rows);
@@ -111,6 +113,9 @@ Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
           }
         }
       wsum /= k * k, csum /= k * k, sum /= k * k;
+      // A trusted estimate below a lower bound some view saw there contradicts it (a sun smeared
+      // over the stretched rim of a view that saw it unclipped): the lower bound wins.
+      if (wsum >= options.min_weight && csum >= options.min_weight && luminance(sum / wsum) < luminance(bound)) wsum = 0;
       if (wsum < options.min_weight) {
         if (csum >= options.min_weight) {
           probe.clipped.at<float>(row, col) = static_cast<float>(csum);

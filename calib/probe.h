@@ -13,10 +13,14 @@
 // per unit of disc area), so a probe coarser than the maps still sums their energy; a finer one
 // reads the maps' bilinear reconstruction, which keeps it.
 //
-// Clipped light: where no view has an unclipped tap but some view has a clipped one (the map's
-// `clipped` channel, core/map_set.h), the probe texel is 0 and `clipped` holds the summed weight
-// of those taps (the direction was clipped in every bracket of every chrome view that saw it),
-// `lower_bound` the largest of the views' values there (each a lower bound of F L, F divided out).
+// Clipped light: a view's lookup with a clipped tap (the map's `clipped` channel, core/map_set.h)
+// counts as clipped as a whole (the tap's value is a lower bound; renormalising over its trusted
+// neighbours would fill a sun with sky). Where no view has an unclipped lookup but some view a
+// clipped one, or the unclipped views' blend is darker than the largest lower bound (it
+// contradicts it: a sun smeared over the stretched rim of a view that saw it unclipped), the probe
+// texel is 0, `clipped` holds the summed weight of the clipped lookups (the direction counts as
+// clipped in every bracket of every chrome view that saw it) and `lower_bound` the largest of
+// their values (each a lower bound of F L, F divided out).
 #pragma once
 
 #include "bake/fresnel.h"
@@ -40,7 +44,7 @@ struct ProbeOptions {
 struct Probe {
   EnvMap env;               // lat-long, RGB
   cv::Mat weight;           // CV_32FC1, summed confidence per texel
-  cv::Mat clipped;          // CV_32FC1, summed weight of clipped taps where no unclipped one exists
+  cv::Mat clipped;          // CV_32FC1, summed weight of the clipped lookups at clipped texels (0 elsewhere)
   cv::Mat lower_bound;      // CV_32FC3, the largest lower bound of L seen there (0 elsewhere)
   double covered_fraction = 0;  // solid-angle fraction with weight >= min_weight
   double clipped_fraction = 0;  // solid-angle fraction of texels clipped in every view that saw them

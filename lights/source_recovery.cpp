@@ -37,6 +37,8 @@ struct Texel {
   int ball = 0;    // index over grey then glossy balls
   int view = 0;    // index over distinct image names
   const Brdf* brdf = nullptr;  // glossy only
+  Vec3 mirror = Vec3::Zero();  // glossy: the mirror direction of v about n
+  double lobe = 0;             // glossy: the lobe's width (rad, bake/brdf.h), 0 for a normal lobe
 };
 
 // A source's direction as a bounded offset in the tangent plane of its region's centroid:
@@ -66,11 +68,14 @@ Vec3 direction_of(const Frame& f, const double* x) {
 
 // The glossy ball's kernel: the mean over the cap of eval (cosine included), per channel.
 Vec3 glossy_kernel(const Texel& t, const Vec3& d, double rho) {
+  // A mirror lobe far from the disc (more than 4 lobe widths past its edge): its tail, below 1e-3
+  // of the highlight for the BRDFs of bake/, is left out.
+  if (t.lobe > 0 && angle_between(t.mirror, d) > rho + 4 * t.lobe) return Vec3::Zero();
   const Mat3 frame = shading::frame_around(t.n);
   const Vec3 wo = frame.transpose() * t.v;
   if (!(wo.z() > 0)) return Vec3::Zero();
-  const double lobe = std::max(t.brdf->lobe_width(wo), 1e-4);
-  const int rings = std::clamp(int(std::ceil(3 * rho / lobe)), 1, 6);
+  const double lobe = std::max(t.lobe > 0 ? t.lobe : t.brdf->lobe_width(wo), 1e-4);
+  const int rings = std::clamp(int(std::ceil(2 * rho / lobe)), 1, 4);
   const std::vector<Vec3> pts = light_kernels::cap_points(d, rho, rings);
   Vec3 sum = Vec3::Zero();
   for (const Vec3& w : pts) {
@@ -197,7 +202,8 @@ struct Fit {
 
 // The joint Ceres refinement from x (directions within their bounds, P >= 0, rho when fitted).
 Fit refine(const std::vector<Texel>& texels, const std::vector<Frame>& frames, std::vector<std::array<double, kBlock>> x,
-           double delta, bool move_directions, bool fit_radius, bool want_covariance, const std::vector<char>& use) {
+           double delta, bool move_directions, bool fit_radius, bool want_covariance, const std::vector<char>& use,
+           int iterations = 50) {
   Fit fit;
   const int S = int(frames.size());
   ceres::Problem::Options po;
@@ -205,8 +211,17 @@ Fit refine(const std::vector<Texel>& texels, const std::vector<Frame>& frames, s
   std::vector<double*> blocks;
   for (int s = 0; s < S; ++s) blocks.push_back(x[std::size_t(s)].data());
   long used = 0;
+  // A glossy texel whose mirror direction lies more than two lobe widths beyond the reach of every
+  // source (its region and largest radius) sees only the lobe's tail of it: left out of the
+  // problem (most of a glossy ball, and most of the cost); the linear solves keep it.
+  auto reachable = [&](const Texel& t) {
+    if (!t.brdf || !(t.lobe > 0)) return true;
+    for (const Frame& f : frames)
+      if (angle_between(t.mirror, f.d0) <= f.max_radius + f.max_radius + 2 * t.lobe) return true;
+    return false;
+  };
   for (std::size_t i = 0; i < texels.size(); ++i) {
-    if (!use.empty() && !use[i]) continue;
+    if ((!use.empty() && !use[i]) || !reachable(texels[i])) continue;
     ceres::CostFunction* cost = nullptr;
     if (texels[i].brdf) {
       auto* c = new ceres::DynamicNumericDiffCostFunction<GlossyCost>(new GlossyCost{&texels[i], &frames});
@@ -243,7 +258,7 @@ Fit refine(const std::vector<Texel>& texels, const std::vector<Frame>& frames, s
   }
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = 50;
+  so.max_num_iterations = iterations;
   so.function_tolerance = 1e-10;
   so.parameter_tolerance = 1e-10;
   so.num_threads = 1;  // deterministic
@@ -268,7 +283,7 @@ Fit refine(const std::vector<Texel>& texels, const std::vector<Frame>& frames, s
   // texel count over that effective count of independent observations.
   std::map<std::pair<int, int>, std::pair<long, bool>> group;  // (ball, view) -> (texels, glossy)
   for (std::size_t i = 0; i < texels.size(); ++i)
-    if (use.empty() || use[i]) {
+    if ((use.empty() || use[i]) && reachable(texels[i])) {
       auto& g = group[{texels[i].ball, texels[i].view}];
       ++g.first;
       g.second = texels[i].brdf != nullptr;
@@ -363,7 +378,6 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
       const MapView& mv = maps.views[v];
       if (mv.confidence.empty() || mv.rgb.type() != CV_32FC3)
         throw std::invalid_argument("sources: " + name + " view." + std::to_string(v) + " has no confidence (not captured)");
-      if (mv.warp != "normal") throw std::invalid_argument("sources: " + name + " view." + std::to_string(v) + " is not a normal-warp map");
       const std::string image = image_of(mv, v);
       const auto [it, fresh] = view_index.emplace(image, int(view_names.size()));
       if (fresh) view_names.push_back(image);
@@ -396,6 +410,11 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
             t.known = Vec3(g[0], g[1], g[2]);
             t.gain = Vec3::Ones();
             t.brdf = brdf;
+            t.mirror = 2 * t.n.dot(t.v) * t.n - t.v;
+            if (brdf->central_direction() == Lobe::Mirror) {
+              const Mat3 frame = shading::frame_around(t.n);
+              t.lobe = brdf->lobe_width(frame.transpose() * t.v);
+            }
           } else {
             t.gain = albedo / kPi;
             t.known = t.gain.cwiseProduct(irradiance(t.n));
@@ -538,7 +557,8 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
           if (!t.brdf) t.known = t.gain.cwiseProduct(fold_irradiance(t.n));
         });
       }
-      folds.push_back(refine(refolded.empty() ? texels : refolded, frames, x, delta, options.refine, fit_radius, false, use).x);
+      // From the full solution, which a fold moves little: a few iterations.
+      folds.push_back(refine(refolded.empty() ? texels : refolded, frames, x, delta, options.refine, fit_radius, false, use, 8).x);
     }
   }
   ball_residuals(x, true);

@@ -48,13 +48,13 @@ namespace rsibr {
 
 struct GreyBallMaps {
   std::string name;
-  const MapSet* maps = nullptr;  // captured, normal warp, world frame
+  const MapSet* maps = nullptr;  // captured (confidence), world frame; texel p holds the ball's point of normal T g_normal(p)
   Vec3 albedo = Vec3::Constant(0.18);
 };
 
 struct GlossyBallMaps {
   std::string name;
-  const MapSet* maps = nullptr;  // captured, normal warp, world frame
+  const MapSet* maps = nullptr;  // as for the grey ball
   const Brdf* brdf = nullptr;
 };
 
@@ -90,8 +90,8 @@ struct SourceRecovery {
 };
 
 // `known`: the probe without the clipped texels (they are 0), lat-long, L (the chrome ball's
-// Fresnel divided out). Throws std::invalid_argument for maps without confidence or of the wrong
-// warp; never returns a non-finite value.
+// Fresnel divided out). Throws std::invalid_argument for maps without confidence; never returns a
+// non-finite value.
 SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedRegion>& regions,
                                const std::vector<GreyBallMaps>& grey, const std::vector<GlossyBallMaps>& glossy,
                                const SourceRecoveryOptions& options = {},

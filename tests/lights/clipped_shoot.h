@@ -13,6 +13,7 @@
 
 #include "bake/brdf_spec.h"
 #include "calib/probe.h"
+#include "lights/clipped_regions.h"
 #include "capture/irradiance.h"
 #include "capture/true_sphere_map.h"
 #include "core/exr_io.h"
@@ -67,7 +68,7 @@ inline Vec3 direction_at(double azimuth_deg, double elevation_deg) {
 inline const char* kChrome = "{type: conductor, eta: [2.9, 2.9, 2.6], k: [3.4, 3.4, 3.2]}";
 
 struct ClippedShoot {
-  MapSet chrome, grey;
+  MapSet chrome, grey, glossy;  // glossy: empty unless a BRDF is given
 };
 
 inline double rim_fade(double cos_nv) {
@@ -75,8 +76,11 @@ inline double rim_fade(double cos_nv) {
   return t * t * (3 - 2 * t);
 }
 
+// glossy: also a glossy ball of this BRDF spec (its true map: bake/'s MIS integral, 64 samples,
+// the lights by exact quadrature), with the grey ball's noise and rim fade.
 inline ClippedShoot clipped_shoot(const EnvMap& env, double clip, int views = 6, double elevation_deg = 10,
-                                  double azimuth0_deg = 15, double noise = 0.005, int size = 64, std::uint64_t seed = 1) {
+                                  double azimuth0_deg = 15, double noise = 0.005, int size = 64, std::uint64_t seed = 1,
+                                  const std::string& glossy = "") {
   ClippedShoot shoot;
   const auto fresnel = make_fresnel(YAML::Load(kChrome));
   SynthBall grey;
@@ -86,6 +90,7 @@ inline ClippedShoot clipped_shoot(const EnvMap& env, double clip, int views = 6,
   const IrradianceQuadrature irradiance(env);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> gauss(0, 1);
+  std::unique_ptr<Integrator> mis;
   for (int v = 0; v < views; ++v) {
     const Vec3 view = direction_at(azimuth0_deg + 360.0 * v / views, elevation_deg);
     MapView c;
@@ -126,19 +131,33 @@ inline ClippedShoot clipped_shoot(const EnvMap& env, double clip, int views = 6,
       }
     shoot.chrome.views.push_back(std::move(c));
 
-    MapView g = true_sphere_map(grey, 10 * view, env, size, &irradiance);
-    g.source = "captured";
-    g.attributes["image"] = "view" + std::to_string(v);
-    g.confidence = cv::Mat(size, size, CV_32FC1, cv::Scalar(0));
-    for (int r = 0; r < size; ++r)
-      for (int col = 0; col < size; ++col) {
-        const Vec2 xy = sphere_map::disc_from_pixel(Vec2(col, r), size, size);
-        if (xy.squaredNorm() >= 1) continue;
-        cv::Vec3f& p = g.rgb.at<cv::Vec3f>(r, col);
-        for (int k = 0; k < 3; ++k) p[k] = float(p[k] * (1 + noise * gauss(rng)));
-        g.confidence.at<float>(r, col) = float(rim_fade(sphere_map::g_normal(xy).z()));
-      }
-    shoot.grey.views.push_back(std::move(g));
+    auto captured = [&](MapView g) {
+      g.source = "captured";
+      g.warp = "normal";
+      g.attributes["image"] = "view" + std::to_string(v);
+      g.confidence = cv::Mat(size, size, CV_32FC1, cv::Scalar(0));
+      for (int r = 0; r < size; ++r)
+        for (int col = 0; col < size; ++col) {
+          const Vec2 xy = sphere_map::disc_from_pixel(Vec2(col, r), size, size);
+          if (xy.squaredNorm() >= 1) continue;
+          cv::Vec3f& p = g.rgb.at<cv::Vec3f>(r, col);
+          for (int k = 0; k < 3; ++k) p[k] = float(p[k] * (1 + noise * gauss(rng)));
+          g.confidence.at<float>(r, col) = float(rim_fade(sphere_map::g_normal(xy).z()));
+        }
+      return g;
+    };
+    shoot.grey.views.push_back(captured(true_sphere_map(grey, 10 * view, env, size, &irradiance)));
+    if (!glossy.empty()) {
+      // bake/'s MIS integral: the bright texels (the lights) by exact quadrature, the sky sampled.
+      if (!mis) mis = make_integrator("mis", env);
+      MapView g;
+      g.view = view;
+      g.world_from_view = world_from_view_for(view);
+      IntegratorOptions io;
+      io.samples = 64;
+      g.rgb = mis->radiance_map(*parse_brdf(glossy), view, g.world_from_view, size, io);
+      shoot.glossy.views.push_back(captured(g));
+    }
   }
   return shoot;
 }
@@ -153,27 +172,26 @@ inline ProbeOptions probe_options(int width = 256) {
 }
 inline Probe shoot_probe(const ClippedShoot& shoot, int width = 256) { return assemble_probe(shoot.chrome, probe_options(width)); }
 
-// The truth inside a set of probe texels: the power (RGB) of the environment's texels whose
-// direction falls in them (nearest texel), and its power-weighted centroid.
-inline std::pair<Vec3, Vec3> truth_in(const EnvMap& env, const Layout& probe, const std::vector<long>& texels) {
-  std::vector<char> in(std::size_t(probe.width()) * probe.height(), 0);
-  for (long t : texels) in[std::size_t(t)] = 1;
+// What a recovered source had to supply (its truth): inside a cap around a clipped region (its
+// radius + 2 degrees), the environment's power minus the measured probe's (the probe holds what
+// the views saw unclipped at the source's edge); and the source's true direction, the
+// power-weighted centroid of the environment's texels in the cap brighter than 10 x its mean.
+inline std::pair<Vec3, Vec3> truth_needed(const EnvMap& env, const EnvMap& measured, const ClippedRegion& region) {
+  const double cap = region.radius + 2 * kPi / 180;
+  const std::vector<double> total = integral(env);
+  const double mean = (total[0] + total[1] + total[2]) / (3 * 4 * kPi);
   Vec3 power = Vec3::Zero(), centroid = Vec3::Zero();
-  for (int r = 0; r < env.layout.height(); ++r)
-    for (int c = 0; c < env.layout.width(); ++c) {
-      const Vec3 w = env.layout.texel_direction(c, r)->normalized();
-      const Vec2 p = probe.pixel(w);
-      int pc = std::clamp(int(std::lround(p.x())), 0, probe.width() - 1), pr = std::clamp(int(std::lround(p.y())), 0, probe.height() - 1);
-      bool hit = in[std::size_t(pr) * probe.width() + pc];
-      if (pc == 0) hit = hit || in[std::size_t(pr) * probe.width() + probe.width() - 1];
-      if (pc == probe.width() - 1) hit = hit || in[std::size_t(pr) * probe.width()];
-      if (!hit) continue;
-      const float* L = env.pixels.ptr<float>(r) + c * env.channels();
-      const double om = env.layout.texel_solid_angle(c, r);
-      power += om * Vec3(L[0], L[1], L[2]);
-      centroid += om * (L[0] + L[1] + L[2]) * w;
-    }
-  return {power, centroid.norm() > 0 ? Vec3(centroid.normalized()) : Vec3::UnitY()};
+  for (const EnvMap* e : {&env, &measured})
+    for (int r = 0; r < e->layout.height(); ++r)
+      for (int c = 0; c < e->layout.width(); ++c) {
+        const Vec3 w = e->layout.texel_direction(c, r)->normalized();
+        if (angle_between(w, region.direction) > cap) continue;
+        const float* L = e->pixels.ptr<float>(r) + c * e->channels();
+        const double om = e->layout.texel_solid_angle(c, r);
+        power += (e == &env ? om : -om) * Vec3(L[0], L[1], L[2]);
+        if (e == &env && (L[0] + L[1] + L[2]) / 3 > 10 * mean) centroid += om * (L[0] + L[1] + L[2]) * w;
+      }
+  return {power, centroid.norm() > 0 ? Vec3(centroid.normalized()) : region.direction};
 }
 
 }  // namespace rsibr::testing
