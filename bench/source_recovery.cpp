@@ -14,11 +14,12 @@
 //   computed_vs_truth       computed grey maps / u against the true grey maps: relative RMS after
 //                           the global gain fit (core/map_compare.h) and without it (calibrated)
 //   sun                     the truth's brightest source (its power-weighted centroid within 3
-//                           degrees of the brightest texel) and the recovered source nearest to it:
-//                           angle (degrees); `needed`, the truth inside a cap around the sun (3
-//                           degrees, or the region's radius + 1) minus what the measured probe holds
-//                           there (u_c units): what the source had to supply; power_ratio =
-//                           recovered / needed per channel; error_over_sigma = (recovered - needed) / sigma
+//                           degrees of the brightest texel; `power` there) and the most powerful
+//                           recovered source: angle (degrees) and its sigma; `needed`, the truth's
+//                           integral minus the measured probe's (what the sources had to supply: the
+//                           probe keeps the unclipped edges of a light); `recovered`, the sources'
+//                           summed power and its sigma; power_ratio = recovered / needed per channel;
+//                           error_over_sigma = (recovered - needed) / sigma
 #include "capture/synth_capture.h"
 #include "capture/synth_scene.h"
 #include "core/exr_io.h"
@@ -167,63 +168,38 @@ int main(int argc, char** argv) {
     power = power.cwiseProduct(chrome_unit);
     nlohmann::json sun = {{"direction", {centroid.normalized().x(), centroid.normalized().y(), centroid.normalized().z()}},
                           {"power", {power[0], power[1], power[2]}}};
+    // The recovered sources against what they had to supply: the truth's integral minus the measured
+    // probe's (the probe keeps the unclipped edges of a light), per channel, summed over sources;
+    // the direction of the most powerful source against the sun's.
     const fs::path record = process / "steps" / "sources.json";
-    if (fs::exists(record)) {
+    if (fs::exists(record) && fs::exists(process / "probe-measured.exr")) {
       std::ifstream in(record);
       const nlohmann::json rec = nlohmann::json::parse(in);
       const auto& sources = rec["summary"]["sources"];
-      double nearest = 1e9;
-      for (const auto& s : sources) {
-        const Vec3 d(s["direction"][0].get<double>(), s["direction"][1].get<double>(), s["direction"][2].get<double>());
-        const double a = angle_between(d, centroid.normalized()) * 180 / kPi;
-        if (a >= nearest) continue;
-        nearest = a;
-        sun["angle_deg"] = a;
-        sun["direction_sigma_deg"] = s["direction_sigma_deg"];
-        nlohmann::json pr = nlohmann::json::array(), z = nlohmann::json::array();
-        for (int k = 0; k < 3; ++k) {
-          const double p = s["power"][std::size_t(k)].get<double>(), sg = s["power_sigma"][std::size_t(k)].get<double>();
-          pr.push_back(p / power[k]);
-          z.push_back(sg > 0 ? (p - power[k]) / sg : 0.0);
-        }
-        sun["power_ratio"] = pr;
+      const Vec3 need = truth_integral - integral3(read_environment((process / "probe-measured.exr").string()));
+      Vec3 total = Vec3::Zero(), variance = Vec3::Zero();
+      double strongest = -1;
+      for (const auto& src : sources) {
+        Vec3 p, sg;
+        for (int k = 0; k < 3; ++k) p[k] = src["power"][std::size_t(k)].get<double>(), sg[k] = src["power_sigma"][std::size_t(k)].get<double>();
+        total += p, variance += sg.cwiseAbs2();
+        if (p.sum() <= strongest) continue;
+        strongest = p.sum();
+        const Vec3 d(src["direction"][0].get<double>(), src["direction"][1].get<double>(), src["direction"][2].get<double>());
+        sun["angle_deg"] = angle_between(d, centroid.normalized()) * 180 / kPi;
+        sun["direction_sigma_deg"] = src["direction_sigma_deg"];
+      }
+      sun["needed"] = {need[0], need[1], need[2]};
+      sun["recovered"] = {total[0], total[1], total[2]};
+      sun["recovered_sigma"] = {std::sqrt(variance[0]), std::sqrt(variance[1]), std::sqrt(variance[2])};
+      if (!sources.empty()) {
+        sun["power_ratio"] = {total[0] / need[0], total[1] / need[1], total[2] / need[2]};
+        nlohmann::json z = nlohmann::json::array();
+        for (int k = 0; k < 3; ++k) z.push_back(variance[k] > 0 ? (total[k] - need[k]) / std::sqrt(variance[k]) : 0.0);
         sun["error_over_sigma"] = z;
-        sun["recovered"] = s["power"];
-        sun["recovered_sigma"] = s["power_sigma"];
       }
       out["sources"] = sources.size();
       out["regions"] = rec["summary"]["regions"].size();
-    }
-    // What the source had to supply: inside a cap around the true sun (radius: 3 degrees, or the
-    // nearest region's radius + 1 degree when larger), the truth minus what the measured probe holds.
-    if (fs::exists(process / "probe-measured.exr") && fs::exists(record)) {
-      std::ifstream in(record);
-      const nlohmann::json rec = nlohmann::json::parse(in);
-      double cap = 3 * kPi / 180;
-      for (const auto& rg : rec["summary"]["regions"]) {
-        const Vec3 d(rg["direction"][0].get<double>(), rg["direction"][1].get<double>(), rg["direction"][2].get<double>());
-        if (angle_between(d, centroid) < 10 * kPi / 180) cap = std::max(cap, (rg["radius_deg"].get<double>() + 1) * kPi / 180);
-      }
-      auto cap_power = [&](const EnvMap& e, const Vec3& scale) {
-        Vec3 p = Vec3::Zero();
-        for (int r = 0; r < e.layout.height(); ++r)
-          for (int c = 0; c < e.layout.width(); ++c) {
-            if (angle_between(*e.layout.texel_direction(c, r), centroid) > cap) continue;
-            const float* v = e.pixels.ptr<float>(r) + c * e.channels();
-            p += e.layout.texel_solid_angle(c, r) * Vec3(v[0], v[1], v[2]).cwiseProduct(scale);
-          }
-        return p;
-      };
-      const Vec3 need = cap_power(env, chrome_unit) - cap_power(read_environment((process / "probe-measured.exr").string()), Vec3::Ones());
-      sun["cap_deg"] = cap * 180 / kPi;
-      sun["needed"] = {need[0], need[1], need[2]};
-      if (sun.contains("power_ratio")) {
-        for (int k = 0; k < 3; ++k) {
-          const double p = sun["recovered"][std::size_t(k)].get<double>(), sg = sun["recovered_sigma"][std::size_t(k)].get<double>();
-          sun["power_ratio"][std::size_t(k)] = p / need[k];
-          sun["error_over_sigma"][std::size_t(k)] = sg > 0 ? (p - need[k]) / sg : 0.0;
-        }
-      }
     }
     out["sun"] = sun;
     std::cout << out.dump(1) << "\n";

@@ -113,9 +113,11 @@ Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
           }
         }
       wsum /= k * k, csum /= k * k, sum /= k * k;
-      // A trusted estimate below a lower bound some view saw there contradicts it (a sun smeared
-      // over the stretched rim of a view that saw it unclipped): the lower bound wins.
-      if (wsum >= options.min_weight && csum >= options.min_weight && luminance(sum / wsum) < luminance(bound)) wsum = 0;
+      // A trusted estimate below a lower bound other views saw there contradicts them (a sun smeared
+      // over the stretched rim of a view that saw it unclipped): the lower bound wins when its
+      // views outweigh the trusted ones (else one view's misregistered clipped pixels would clip
+      // the sky the others saw).
+      if (wsum >= options.min_weight && csum > wsum && luminance(sum / wsum) < luminance(bound)) wsum = 0;
       if (wsum < options.min_weight) {
         if (csum >= options.min_weight) {
           probe.clipped.at<float>(row, col) = static_cast<float>(csum);

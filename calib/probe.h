@@ -16,8 +16,9 @@
 // Clipped light: a view's lookup with a clipped tap (the map's `clipped` channel, core/map_set.h)
 // counts as clipped as a whole (the tap's value is a lower bound; renormalising over its trusted
 // neighbours would fill a sun with sky). Where no view has an unclipped lookup but some view a
-// clipped one, or the unclipped views' blend is darker than the largest lower bound (it
-// contradicts it: a sun smeared over the stretched rim of a view that saw it unclipped), the probe
+// clipped one, or the clipped lookups outweigh the unclipped ones and the unclipped blend is darker
+// than the largest lower bound (it contradicts them: a sun smeared over the stretched rim of a view
+// that saw it unclipped), the probe
 // texel is 0, `clipped` holds the summed weight of the clipped lookups (the direction counts as
 // clipped in every bracket of every chrome view that saw it) and `lower_bound` the largest of
 // their values (each a lower bound of F L, F divided out).

@@ -23,7 +23,7 @@ struct UnionFind {
 
 }  // namespace
 
-std::vector<ClippedRegion> find_clipped_regions(const Probe& probe) {
+std::vector<ClippedRegion> find_clipped_regions(const Probe& probe, double merge_deg) {
   const Layout& layout = probe.env.layout;
   const int W = layout.width(), H = layout.height();
   if (probe.clipped.empty() || probe.clipped.rows != H || probe.clipped.cols != W) return {};
@@ -71,18 +71,44 @@ std::vector<ClippedRegion> find_clipped_regions(const Probe& probe) {
       g.weight += probe.clipped.at<float>(r, c);
       sums[std::size_t(idx)] += omega * w;
     }
-  for (std::size_t i = 0; i < regions.size(); ++i) {
-    ClippedRegion& g = regions[i];
-    g.direction = sums[i].norm() > 0 ? sums[i].normalized() : layout.texel_direction(int(g.texels[0] % W), int(g.texels[0] / W))->normalized();
+  auto finish = [&](ClippedRegion& g, const Vec3& sum) {
+    g.direction = sum.norm() > 0 ? sum.normalized() : layout.texel_direction(int(g.texels[0] % W), int(g.texels[0] / W))->normalized();
     double rad = 0;
     for (long t : g.texels) rad = std::max(rad, angle_between(g.direction, *layout.texel_direction(int(t % W), int(t / W))));
     g.radius = rad + half_diagonal;
-  }
-  std::stable_sort(regions.begin(), regions.end(), [](const ClippedRegion& a, const ClippedRegion& b) {
+  };
+  for (std::size_t i = 0; i < regions.size(); ++i) finish(regions[i], sums[i]);
+  auto by_bound = [](const ClippedRegion& a, const ClippedRegion& b) {
     const double la = a.lower_bound.sum(), lb = b.lower_bound.sum();
     return la != lb ? la > lb : a.texels.front() < b.texels.front();
-  });
-  return regions;
+  };
+  // Merge: each component, largest lower bound first, joins the first merged region whose
+  // centroid (as merged so far) is within merge_deg of its own.
+  std::vector<std::size_t> order(regions.size());
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return by_bound(regions[a], regions[b]); });
+  std::vector<ClippedRegion> merged;
+  std::vector<Vec3> merged_sums;
+  const double cos_merge = std::cos(merge_deg * kPi / 180);
+  for (std::size_t i : order) {
+    std::size_t j = 0;
+    while (j < merged.size() && !(merged[j].direction.dot(regions[i].direction) >= cos_merge)) ++j;
+    if (j == merged.size()) {
+      merged.push_back(regions[i]);
+      merged_sums.push_back(sums[i]);
+      continue;
+    }
+    ClippedRegion& m = merged[j];
+    m.texels.insert(m.texels.end(), regions[i].texels.begin(), regions[i].texels.end());
+    std::sort(m.texels.begin(), m.texels.end());
+    m.solid_angle += regions[i].solid_angle;
+    m.lower_bound += regions[i].lower_bound;
+    m.weight += regions[i].weight;
+    merged_sums[j] += sums[i];
+    finish(m, merged_sums[j]);
+  }
+  std::stable_sort(merged.begin(), merged.end(), by_bound);
+  return merged;
 }
 
 }  // namespace rsibr

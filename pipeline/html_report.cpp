@@ -236,6 +236,12 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
     if (rec.count("sources")) h << light_sources_warning(rec["sources"].summary);
     for (const auto& b : s["balls"]) {
       h << "<h3>" << html_escape(b["ball"].get<std::string>()) << "</h3>";
+      if (b.contains("untrusted_views") && !b["untrusted_views"].empty()) {
+        h << "<p class=\"warn\">Left out (the ball has no trusted texel there: hidden behind another ball, or not found):";
+        for (const auto& v : b["untrusted_views"]) h << " " << html_escape(v.get<std::string>());
+        h << ".</p>";
+      }
+      if (!b.contains("overall")) continue;
       if (b.contains("fit"))
         h << "<p>Fitted gains R, G, B: " << jnum(b["fit"]["gains"][0]) << ", " << jnum(b["fit"]["gains"][1]) << ", "
           << jnum(b["fit"]["gains"][2]) << " (" << jnum(b["fit"]["exposure_stops"], 3) << " stops).</p>";

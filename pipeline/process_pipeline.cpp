@@ -578,8 +578,28 @@ void step_compare(Context& c) {
   run_step(c, "compare", nlohmann::json::object(), inputs, [&](StepRecord& r) {
     nlohmann::json balls = nlohmann::json::array();
     for (const BallSpec* b : greys) {
-      const MapSet captured = read_map_set(captured_path(c, *b).string());
-      const MapSet computed = read_map_set(computed_path(c, *b).string());
+      MapSet captured = read_map_set(captured_path(c, *b).string());
+      MapSet computed = read_map_set(computed_path(c, *b).string());
+      // Views whose ball has no trusted texel (hidden behind another ball, or not found) cannot be
+      // compared: left out and listed (the bake made one computed view per captured one, in order).
+      std::vector<std::string> untrusted;
+      if (captured.views.size() == computed.views.size()) {
+        MapSet a, bset;
+        for (std::size_t i = 0; i < captured.views.size(); ++i) {
+          if (cv::countNonZero(captured.views[i].confidence > 0) == 0) {
+            untrusted.push_back(captured.views[i].attributes.count("image") ? captured.views[i].attributes.at("image")
+                                                                             : "view." + std::to_string(i));
+            continue;
+          }
+          a.views.push_back(std::move(captured.views[i]));
+          bset.views.push_back(std::move(computed.views[i]));
+        }
+        if (a.views.empty()) {
+          balls.push_back({{"ball", b->name}, {"views", nlohmann::json::array()}, {"untrusted_views", untrusted}});
+          continue;
+        }
+        captured = std::move(a), computed = std::move(bset);
+      }
       CompareOptions co;
       co.name_a = captured_path(c, *b).string();
       co.name_b = computed_path(c, *b).string();
@@ -619,7 +639,7 @@ void step_compare(Context& c) {
       fs::create_directories(folder.parent_path());
       write_folder_atomically(folder, files);
       for (const auto& [name, bytes] : files) r.outputs.push_back(folder / name);
-      nlohmann::json bj = {{"ball", b->name}, {"folder", folder.string()}, {"views", views},
+      nlohmann::json bj = {{"ball", b->name}, {"folder", folder.string()}, {"views", views}, {"untrusted_views", untrusted},
                            {"overall", {{"before", metrics_json(cmp.before)}, {"after", metrics_json(cmp.after)}}},
                            {"heat_max_stops", heat_max}, {"log_epsilon", cmp.settings.log_epsilon}};
       if (cmp.fit)
