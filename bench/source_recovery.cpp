@@ -130,6 +130,21 @@ int main(int argc, char** argv) {
           for (int k = 0; k < 3; ++k) p[k] = float(p[k] / u[k]);
         });
       }
+      // Views whose ball was not found where the truth has it (the extracted view more than 2
+      // degrees off: a wrong detection) are left out and counted.
+      int dropped = 0;
+      for (MapSet* set : {&c, &cap}) {
+        MapSet kept;
+        for (MapView& mv : set->views) {
+          bool near = false;
+          for (const MapView& tv : t.views) near = near || angle_between(mv.view, tv.view) < 2 * kPi / 180;
+          if (near) kept.views.push_back(std::move(mv));
+          else if (set == &c) ++dropped;
+        }
+        *set = std::move(kept);
+      }
+      out["views_left_out"][ball] = dropped;
+      if (c.views.empty() || cap.views.empty()) continue;
       CompareOptions co;
       co.view_tolerance_deg = 2.0;
       const Comparison fit = compare_map_sets(c, t, co);
