@@ -15,9 +15,11 @@
 //                           the global gain fit (core/map_compare.h) and without it (calibrated)
 //   sun                     the truth's brightest source (its power-weighted centroid within 3
 //                           degrees of the brightest texel; `power` there) and the most powerful
-//                           recovered source: angle (degrees) and its sigma; `needed`, the truth's
-//                           integral minus the measured probe's (what the sources had to supply: the
-//                           probe keeps the unclipped edges of a light); `recovered`, the sources'
+//                           recovered source: angle (degrees) and its sigma; `needed`, the truth
+//                           minus the measured probe inside caps around the clipped regions (their
+//                           radius + 2 degrees): what the sources had to supply (the probe keeps the
+//                           unclipped edges of a light; its holes elsewhere, under the stand, are no
+//                           source's to fill); `recovered`, the sources'
 //                           summed power and its sigma; power_ratio = recovered / needed per channel;
 //                           error_over_sigma = (recovered - needed) / sigma
 #include "capture/synth_capture.h"
@@ -183,15 +185,33 @@ int main(int argc, char** argv) {
     power = power.cwiseProduct(chrome_unit);
     nlohmann::json sun = {{"direction", {centroid.normalized().x(), centroid.normalized().y(), centroid.normalized().z()}},
                           {"power", {power[0], power[1], power[2]}}};
-    // The recovered sources against what they had to supply: the truth's integral minus the measured
-    // probe's (the probe keeps the unclipped edges of a light), per channel, summed over sources;
-    // the direction of the most powerful source against the sun's.
+    // The recovered sources, summed, against what they had to supply; the direction of the most
+    // powerful source against the sun's.
     const fs::path record = process / "steps" / "sources.json";
     if (fs::exists(record) && fs::exists(process / "probe-measured.exr")) {
       std::ifstream in(record);
       const nlohmann::json rec = nlohmann::json::parse(in);
       const auto& sources = rec["summary"]["sources"];
-      const Vec3 need = truth_integral - integral3(read_environment((process / "probe-measured.exr").string()));
+      // Inside caps around the clipped regions (each its radius + 2 degrees): far from them the
+      // measured probe's own holes (the stand's directions) are no source's to fill.
+      std::vector<std::pair<Vec3, double>> caps;
+      for (const auto& rg : rec["summary"]["regions"])
+        caps.push_back({Vec3(rg["direction"][0].get<double>(), rg["direction"][1].get<double>(), rg["direction"][2].get<double>()),
+                        (rg["radius_deg"].get<double>() + 2) * kPi / 180});
+      auto in_caps = [&](const EnvMap& e, const Vec3& scale) {
+        Vec3 p = Vec3::Zero();
+        for (int r = 0; r < e.layout.height(); ++r)
+          for (int c = 0; c < e.layout.width(); ++c) {
+            const Vec3 w = *e.layout.texel_direction(c, r);
+            bool in = false;
+            for (const auto& [d, radius] : caps) in = in || angle_between(w, d) <= radius;
+            if (!in) continue;
+            const float* v = e.pixels.ptr<float>(r) + c * e.channels();
+            p += e.layout.texel_solid_angle(c, r) * Vec3(v[0], v[1], v[2]).cwiseProduct(scale);
+          }
+        return p;
+      };
+      const Vec3 need = in_caps(env, chrome_unit) - in_caps(read_environment((process / "probe-measured.exr").string()), Vec3::Ones());
       Vec3 total = Vec3::Zero(), variance = Vec3::Zero();
       double strongest = -1;
       for (const auto& src : sources) {

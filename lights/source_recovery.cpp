@@ -603,6 +603,33 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
       sd = std::max(sd, std::sqrt(k * jd));
       sr = std::max(sr, std::sqrt(k * jr));
     }
+    // The model's misfit as a floor: on the texels this source lights, the fit's relative RMS
+    // residual r (per channel) is an error of the model M = K + P G the sources cannot be known
+    // better than; it moves P by r M / G, i.e. sigma >= r P / f with f the source's mean share of M
+    // there. (The errors the views share, e.g. the probe's known part near the source, escape the
+    // covariance and the jackknife; this is where they show.)
+    {
+      Vec3 num = Vec3::Zero(), den = Vec3::Zero(), share = Vec3::Zero();
+      double count = 0;
+      for (const Texel& t : texels) {
+        const Vec3 g = kernel(t, src.direction, xs[5]);
+        if (t.brdf || light_kernels::mean_clamped_cosine(t.n.dot(src.direction), 0.0) <= options.min_lit_kernel) continue;
+        Vec3 m = t.known;
+        for (int q = 0; q < S; ++q)
+          m += kernel(t, direction_of(frames[std::size_t(q)], x[std::size_t(q)].data()), x[std::size_t(q)][5])
+                   .cwiseProduct(Vec3(x[std::size_t(q)][2], x[std::size_t(q)][3], x[std::size_t(q)][4]));
+        const double w = t.sqrt_w * t.sqrt_w;
+        for (int ch = 0; ch < 3; ++ch) {
+          if (!(m[ch] > 0)) continue;
+          num[ch] += w * (t.obs[ch] - m[ch]) * (t.obs[ch] - m[ch]);
+          den[ch] += w * m[ch] * m[ch];
+          share[ch] += w * g[ch] * src.power[ch] / m[ch];
+        }
+        count += w;
+      }
+      for (int ch = 0; ch < 3 && count > 0; ++ch)
+        if (den[ch] > 0 && share[ch] > 0) sp[ch] = std::max(sp[ch], std::sqrt(num[ch] / den[ch]) * src.power[ch] / (share[ch] / count));
+    }
     src.power_sigma = sp;
     src.direction_sigma = sd;
     src.radius_sigma = fit_radius ? sr : 0;

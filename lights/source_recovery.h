@@ -26,7 +26,9 @@
 // residuals' variance and by the texel count over the effective count of independent observations,
 // the model's errors being smooth over a ball) and the spread of leave-one-view-out solves
 // (jackknife; with `known_without`, the probe's known part of each fold is the probe assembled
-// without that view's chrome map, so errors the probe shares across the grey views show too).
+// without that view's chrome map, so errors the probe shares across the grey views show too), and
+// at least the fit's relative residual on the texels the source lights over the source's share
+// of the light there (the model's misfit: errors every view shares show only there).
 //
 // A region is not recovered (a note says why, and the probe keeps it as it was) when the balls
 // have fewer than `min_lit_texels` trusted texels it lights (kernel above `min_lit_kernel`): no
