@@ -13,6 +13,9 @@ namespace rsibr {
 
 namespace {
 
+// Samples this close to 0 (radiance units) do not count as a feature against the texel's others.
+constexpr double kSampleFloor = 1e-12;
+
 double smoothstep(double e0, double e1, double x) {
   const double t = std::clamp((x - e0) / (e1 - e0), 0.0, 1.0);
   return t * t * (3 - 2 * t);
@@ -101,53 +104,138 @@ MapView extract_sphere_map(const cv::Mat& image, const cv::Mat& flags, const Len
   mv.attributes["indexing"] = options.indexing == SphereIndexing::reflection ? "reflection" : "orthographic";
   mv.rgb = cv::Mat(size, size, CV_32FC3, cv::Scalar::all(0));
   mv.confidence = cv::Mat(size, size, CV_32FC1, cv::Scalar(0));
+  if (!flags.empty()) mv.clipped = cv::Mat(size, size, CV_32FC1, cv::Scalar(0));
+
+  // One sample: the disc point's surface normal (start: the guess for the reflection solve), its
+  // image point, and the incidence cosine; false when it has none (outside the disc or the image,
+  // facing away, no reflection solution).
+  struct Sample {
+    Vec3 n, reflected;
+    Vec2 px;
+    double cos_i = 0;
+  };
+  auto sample_at = [&](const Vec2& xy, const Vec3* start, Sample* out) {
+    if (xy.squaredNorm() >= 1.0) return false;
+    Vec3 n = cam_from_view * sphere_map::g_normal(xy);
+    Vec3 reflected;  // the direction the point reflects the camera ray into (camera frame)
+    if (options.indexing == SphereIndexing::reflection) {
+      const Vec3 r = cam_from_view * sphere_map::g_mirror(xy);
+      const auto solved = reflection_normal(centre, r, start ? *start : n);
+      if (!solved) return false;
+      n = *solved;
+      reflected = r;
+    }
+    const Vec3 p = centre + n;
+    const Vec3 w = -p.normalized();  // toward the camera
+    const double cos_i = w.dot(n);
+    if (!(cos_i > 0)) return false;
+    if (options.indexing == SphereIndexing::orthographic) reflected = 2 * cos_i * n - w;
+    const Vec2 px = lens.project(p);
+    if (!px.allFinite() || !lens.in_image(px, 0.5)) return false;
+    *out = {n, reflected, px, cos_i};
+    return true;
+  };
+  // Bilinear taps (pixel centres at integers): the value, and whether a tap is clipped.
+  auto read = [&](const Vec2& px, Vec3* value) {
+    const int x0 = std::clamp(static_cast<int>(std::floor(px.x())), 0, image.cols - 2);
+    const int y0 = std::clamp(static_cast<int>(std::floor(px.y())), 0, image.rows - 2);
+    const double fx = std::clamp(px.x() - x0, 0.0, 1.0), fy = std::clamp(px.y() - y0, 0.0, 1.0);
+    bool clipped = false;
+    if (!flags.empty()) {
+      const unsigned char f = flags.at<unsigned char>(y0, x0) | flags.at<unsigned char>(y0, x0 + 1) |
+                              flags.at<unsigned char>(y0 + 1, x0) | flags.at<unsigned char>(y0 + 1, x0 + 1);
+      clipped = (f & options.clipped_mask) != 0;
+    }
+    const cv::Vec3f a = image.at<cv::Vec3f>(y0, x0), b = image.at<cv::Vec3f>(y0, x0 + 1);
+    const cv::Vec3f c = image.at<cv::Vec3f>(y0 + 1, x0), d = image.at<cv::Vec3f>(y0 + 1, x0 + 1);
+    for (int k = 0; k < 3; ++k)
+      (*value)[k] = (1 - fy) * ((1 - fx) * a[k] + fx * b[k]) + fy * ((1 - fx) * c[k] + fx * d[k]);
+    return clipped;
+  };
+
+  // Balls nearer the camera than this one (distances in this ball's radii: R' / sin(alpha')), as
+  // cones widened by the margin.
+  struct Hider {
+    Vec3 axis;
+    double cos_half;
+  };
+  std::vector<Hider> hiders;
+  for (const ExtractOptions::HidingBall& h : options.hiding) {
+    if (!(h.cone.half_angle > 0 && h.cone.half_angle < kPi / 2) || !h.cone.axis.allFinite() || !(h.radius_ratio > 0)) continue;
+    if (h.radius_ratio / std::sin(h.cone.half_angle) >= 1 / std::sin(cone.half_angle)) continue;  // farther: it cannot hide this one
+    hiders.push_back({h.cone.axis.normalized(), std::cos(h.cone.half_angle + options.hidden_margin_px / limb_scale)});
+  }
+
+  // Texel centres first (their image points give each texel's footprint).
+  std::vector<Sample> centres(std::size_t(size) * std::size_t(size));
+  std::vector<char> valid(centres.size(), 0);
+  parallel_for_rows(size, [&](int row) {
+    for (int col = 0; col < size; ++col) {
+      const std::size_t i = std::size_t(row) * std::size_t(size) + std::size_t(col);
+      valid[i] = sample_at(sphere_map::disc_from_pixel(Vec2(col, row), size, size), nullptr, &centres[i]);
+    }
+  });
+  auto footprint_px = [&](int row, int col) {
+    const std::size_t i = std::size_t(row) * std::size_t(size) + std::size_t(col);
+    double f = 0;
+    for (const auto& [dr, dc] : {std::pair{0, 1}, {1, 0}, {0, -1}, {-1, 0}}) {
+      const int r2 = row + dr, c2 = col + dc;
+      if (r2 < 0 || c2 < 0 || r2 >= size || c2 >= size) continue;
+      const std::size_t j = std::size_t(r2) * std::size_t(size) + std::size_t(c2);
+      if (valid[j]) f = std::max(f, (centres[j].px - centres[i].px).norm());
+    }
+    return f;
+  };
 
   parallel_for_rows(size, [&](int row) {
     for (int col = 0; col < size; ++col) {
-      const Vec2 xy = sphere_map::disc_from_pixel(Vec2(col, row), size, size);
-      if (xy.squaredNorm() >= 1.0) continue;
-      Vec3 n = cam_from_view * sphere_map::g_normal(xy);
-      Vec3 reflected;  // the direction the point reflects the camera ray into (camera frame)
-      if (options.indexing == SphereIndexing::reflection) {
-        const Vec3 r = cam_from_view * sphere_map::g_mirror(xy);
-        const auto solved = reflection_normal(centre, r, n);
-        if (!solved) continue;
-        n = *solved;
-        reflected = r;
-      }
-      const Vec3 p = centre + n;
-      const Vec3 w = -p.normalized();  // toward the camera
-      const double cos_i = w.dot(n);
-      if (!(cos_i > 0)) continue;
-      if (options.indexing == SphereIndexing::orthographic) reflected = 2 * cos_i * n - w;
-      const Vec2 px = lens.project(p);
-      if (!px.allFinite() || !lens.in_image(px, 0.5)) continue;
-      double conf = smoothstep(cos_rim_zero, cos_rim_full, cos_i);
+      const std::size_t i = std::size_t(row) * std::size_t(size) + std::size_t(col);
+      if (!valid[i]) continue;
+      const Sample& s = centres[i];
+      const Vec3 p = centre + s.n;
+      double conf = smoothstep(cos_rim_zero, cos_rim_full, s.cos_i);
       const double limb_px = (cone.half_angle - angle_between(p, axis)) * limb_scale;
       conf *= smoothstep(options.limb_margin_px / 3, options.limb_margin_px, limb_px);
       if (options.mirror && options.camera_mask_deg > 0)
-        conf *= smoothstep(cos_cam_zero, cos_cam_full, reflected.dot(to_camera));
+        conf *= smoothstep(cos_cam_zero, cos_cam_full, s.reflected.dot(to_camera));
+      for (const Hider& h : hiders)
+        if (p.normalized().dot(h.axis) > h.cos_half) conf = 0;
       if (options.down) {
-        const Vec3 dir = options.mirror ? reflected : n;
+        const Vec3 dir = options.mirror ? s.reflected : s.n;
         conf *= smoothstep(cos_stand_zero, cos_stand_full, dir.dot(options.down->normalized()));
       }
-      // Bilinear taps (pixel centres at integers).
-      const int x0 = std::clamp(static_cast<int>(std::floor(px.x())), 0, image.cols - 2);
-      const int y0 = std::clamp(static_cast<int>(std::floor(px.y())), 0, image.rows - 2);
-      const double fx = std::clamp(px.x() - x0, 0.0, 1.0), fy = std::clamp(px.y() - y0, 0.0, 1.0);
-      if (!flags.empty()) {
-        const unsigned char f = flags.at<unsigned char>(y0, x0) | flags.at<unsigned char>(y0, x0 + 1) |
-                                flags.at<unsigned char>(y0 + 1, x0) | flags.at<unsigned char>(y0 + 1, x0 + 1);
-        if (f & options.clipped_mask) conf = 0;
+      int k = 1;
+      if (options.mirror && options.supersample_spacing_px > 0)
+        k = std::clamp(int(std::ceil(footprint_px(row, col) / options.supersample_spacing_px)), 1,
+                       std::max(1, options.max_supersample));
+      Vec3 v;
+      bool clipped = read(s.px, &v);
+      if (k > 1) {
+        Vec3 sum = Vec3::Zero(), value;
+        double lo = INFINITY, hi = 0;
+        int count = 0;
+        for (int a = 0; a < k; ++a)
+          for (int b = 0; b < k; ++b) {
+            const Vec2 q(col - 0.5 + (b + 0.5) / k, row - 0.5 + (a + 0.5) / k);
+            Sample t;
+            if (!sample_at(sphere_map::disc_from_pixel(q, size, size), &s.n, &t)) continue;
+            // Samples whose taps reach past the outline read the background: left out.
+            if ((cone.half_angle - angle_between(centre + t.n, axis)) * limb_scale < options.limb_margin_px) continue;
+            clipped = read(t.px, &value) || clipped;
+            sum += value;
+            const double y = 0.2126 * value[0] + 0.7152 * value[1] + 0.0722 * value[2];
+            lo = std::min(lo, y), hi = std::max(hi, y);
+            ++count;
+          }
+        // A feature smaller than the texel (the samples differ by more than 2x): their mean, which
+        // keeps its energy. Elsewhere the centre's value, the point the texel stands for (the mean
+        // of smooth content differs from it at second order, by the curvature over the texel).
+        if (count > 0 && hi > 2 * lo + kSampleFloor) v = sum / count;
       }
-      const cv::Vec3f a = image.at<cv::Vec3f>(y0, x0), b = image.at<cv::Vec3f>(y0, x0 + 1);
-      const cv::Vec3f c = image.at<cv::Vec3f>(y0 + 1, x0), d = image.at<cv::Vec3f>(y0 + 1, x0 + 1);
-      cv::Vec3f v;
-      for (int k = 0; k < 3; ++k)
-        v[k] = static_cast<float>((1 - fy) * ((1 - fx) * a[k] + fx * b[k]) + fy * ((1 - fx) * c[k] + fx * d[k]));
-      if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]))) continue;
-      mv.rgb.at<cv::Vec3f>(row, col) = v;
-      mv.confidence.at<float>(row, col) = static_cast<float>(conf);
+      if (!v.allFinite()) continue;
+      mv.rgb.at<cv::Vec3f>(row, col) = cv::Vec3f(float(v[0]), float(v[1]), float(v[2]));
+      mv.confidence.at<float>(row, col) = clipped ? 0.f : static_cast<float>(conf);
+      if (clipped) mv.clipped.at<float>(row, col) = static_cast<float>(conf);
     }
   });
   return mv;

@@ -29,7 +29,26 @@
 //                  camera_ramp_deg beyond
 //   stand          0 where the texel's direction (reflected for mirror maps, the normal otherwise) is
 //                  within stand_mask_deg of `down` (camera frame), ramping over stand_ramp_deg
-//   clipped        0 where any bilinear tap has a flag in `flags` & clipped_mask (hdr/merge.h: clipped)
+//   hidden         0 where the camera ray to the texel's surface point passes within
+//                  hidden_margin_px of one of `hiding` (another ball nearer the camera: it hides
+//                  this one there, and the texel would show that ball)
+//   clipped        0 where any bilinear tap of any of the texel's samples has a flag in
+//                  `flags` & clipped_mask (hdr/merge.h: clipped in every bracket); the confidence the
+//                  texel would have had goes to the map's `clipped` channel (core/map_set.h), which
+//                  is written only when `flags` is given
+// Samples (energy of small sources; mirror maps): a texel is its centre's image point read bilinearly, unless
+// k x k samples on a regular grid over its cell in disc coordinates (each mapped to the image
+// through the same indexing) differ by more than a factor of 2 in luminance: a feature smaller than
+// the texel (a sun one pixel wide, a lamp, an edge), where the texel is their mean. The sphere map
+// is equal-area in its central direction (dw = 4 dx dy for mirror maps), so the mean is over the
+// texel's solid angle; samples at most half a pixel apart in the image sum the tent-reconstructed
+// image closely enough to keep the feature's integral (the tent's spectrum, sinc^2, is 0 at the
+// sampling frequency 2 / pixel and small around it: at spacing s the aliased error is about
+// sinc^2(1 / s) per axis, 4% at 0.75 pixel, under 2% at 0.5), where the centre alone
+// would read it or miss it by the sub-pixel phase (a sun's energy per view varied 40x). Smooth
+// content keeps the centre's value: the texel stands for that point, and the mean differs from it
+// by the curvature over the texel. k = clamp(ceil(footprint / supersample_spacing_px), 1,
+// max_supersample), the footprint being the image distance to the neighbouring texels' centres.
 #pragma once
 
 #include "calib/ball_cone.h"
@@ -40,6 +59,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace rsibr {
 
@@ -55,6 +75,18 @@ struct ExtractOptions {
   std::optional<Vec3> down;          // camera frame; none: no stand mask
   double stand_mask_deg = 8, stand_ramp_deg = 4;
   unsigned char clipped_mask = 1;    // hdr/merge.h kClipped
+  // Other balls of the view (their cones and radii over this ball's): those nearer the camera
+  // hide this one where their cones (widened by hidden_margin_px) cover it.
+  struct HidingBall {
+    BallCone cone;
+    double radius_ratio = 1;
+  };
+  std::vector<HidingBall> hiding;
+  double hidden_margin_px = 2.0;
+  // Mirror maps only (a grey or glossy ball's shading has no feature smaller than a texel);
+  // <= 0: the centre alone.
+  double supersample_spacing_px = 0.5;
+  int max_supersample = 16;
   std::string material;              // the map's rsibr.material
 };
 

@@ -21,7 +21,7 @@ namespace {
 struct ProcessArgs {
   ProcessOptions o;
   std::string size = "320x240", json, up = "0,-1,0";
-  bool quiet = false;
+  bool quiet = false, no_sources = false;
 };
 
 int run_process_verb(ProcessArgs a) {
@@ -32,6 +32,7 @@ int run_process_verb(ProcessArgs a) {
     throw std::invalid_argument("--size '" + a.size + "': expected WxH, 16..8192 each");
   if (a.up == "none") a.o.up.reset();
   else a.o.up = parse_vec3(a.up, "--up");
+  a.o.recover_sources = !a.no_sources;
   a.o.render_width = w;
   a.o.render_height = h;
   std::vector<std::filesystem::path> inputs = load_photo_set(a.o.photoset).files();
@@ -68,7 +69,8 @@ Runner add_process(CLI::App& app) {
       "Steps (each skipped when its outputs are newer than its inputs and its settings are unchanged; records in "
       "DIR/steps/<step>.json): calibrate (chessboards, or --lens) -> hdr (response + merge per view) -> orient "
       "(solved from the chrome ball's features, or --poses) -> extract (every ball of every view; chrome by reflection indexing, grey orthographic) -> probe "
-      "(chrome maps blended) -> bake (grey balls from the probe, Lambert) -> compare (captured vs computed, gains "
+      "(chrome maps blended) -> sources (light clipped in every chrome view recovered from the grey and glossy balls, "
+      "written into the probe; --no-sources: not) -> bake (grey balls from the probe, Lambert) -> compare (captured vs computed, gains "
       "fitted) -> render (turntable of --mesh or a torus lit by the probe) -> report (DIR/report.html, "
       "self-contained). Prints the report's path.\n"
       "Example: rsibr process shoot/photoset.yaml --out shoot/out --poses shoot/poses.yaml");
@@ -84,7 +86,12 @@ Runner add_process(CLI::App& app) {
   c->add_option("--force", a->o.force, "Re-run this step even if up to date (repeatable; 'all')");
   c->add_option("--map-size", a->o.map_size, "Sphere maps' size in texels")->check(CLI::Range(8, 2048));
   c->add_option("--probe-width", a->o.probe_width, "Lat-long probe width")->check(CLI::Range(8, 16384));
-  c->add_option("--chrome-fresnel", a->o.chrome_fresnel, "The chrome ball's Fresnel spec, divided out of the probe");
+  c->add_option("--chrome-fresnel", a->o.chrome_fresnel,
+                "The chrome ball's Fresnel spec, divided out of the probe ('none': the probe holds F L)")
+      ->capture_default_str();
+  c->add_flag("--no-sources", a->no_sources,
+              "Do not recover light clipped in every chrome view from the grey and glossy balls (probe.exr is the measured probe)");
+  c->add_option("--glossy-brdf", a->o.glossy_brdf, "The glossy balls' BRDF spec (YAML text): they then constrain the recovered sources");
   c->add_option("--grey-albedo", a->o.grey_albedo, "The grey ball's albedo")->check(CLI::Range(0.001, 1.0));
   c->add_option("--bake-method", a->o.bake_method, "Integrator of the computed maps: mis, fis, sh, reference");
   c->add_option("--bake-samples", a->o.bake_samples, "Samples per texel (mis, fis)")->check(CLI::Range(1, 1 << 20));

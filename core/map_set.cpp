@@ -60,6 +60,8 @@ void validate(const MapSet& set) {
     if (v.rgb.size() != set.views.front().rgb.size()) throw std::invalid_argument(who + "size differs from view.000");
     if (!v.confidence.empty() && (v.confidence.type() != CV_32FC1 || v.confidence.size() != v.rgb.size()))
       throw std::invalid_argument(who + "confidence must be one float channel of the map's size");
+    if (!v.clipped.empty() && (v.clipped.type() != CV_32FC1 || v.clipped.size() != v.rgb.size()))
+      throw std::invalid_argument(who + "clipped must be one float channel of the map's size");
     if (!v.view.allFinite() || std::abs(v.view.norm() - 1.0) > 1e-5)
       throw std::invalid_argument(who + "view direction is not a unit vector");
     const Mat3& T = v.world_from_view;
@@ -115,6 +117,7 @@ void write_map_set(const std::string& path, const MapSet& set) {
     for (const auto& [key, value] : v.attributes) h.insert("rsibr." + key, Imf::StringAttribute(valid_utf8(value)));
     for (const char* c : {"R", "G", "B"}) h.channels().insert(c, Imf::Channel(Imf::FLOAT));
     if (!v.confidence.empty()) h.channels().insert("confidence", Imf::Channel(Imf::FLOAT));
+    if (!v.clipped.empty()) h.channels().insert("clipped", Imf::Channel(Imf::FLOAT));
     headers.push_back(h);
   }
   try {
@@ -124,6 +127,7 @@ void write_map_set(const std::string& path, const MapSet& set) {
         const MapView& v = set.views[i];
         const cv::Mat rgb = v.rgb.isContinuous() ? v.rgb : v.rgb.clone();
         const cv::Mat conf = v.confidence.empty() || v.confidence.isContinuous() ? v.confidence : v.confidence.clone();
+        const cv::Mat clip = v.clipped.empty() || v.clipped.isContinuous() ? v.clipped : v.clipped.clone();
         Imf::FrameBuffer fb;
         char* base = reinterpret_cast<char*>(rgb.data);
         const char* names[] = {"R", "G", "B"};
@@ -131,6 +135,8 @@ void write_map_set(const std::string& path, const MapSet& set) {
           fb.insert(names[k], Imf::Slice(Imf::FLOAT, base + k * sizeof(float), 3 * sizeof(float), 3 * sizeof(float) * std::size_t(W)));
         if (!conf.empty())
           fb.insert("confidence", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(conf.data), sizeof(float), sizeof(float) * std::size_t(W)));
+        if (!clip.empty())
+          fb.insert("clipped", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(clip.data), sizeof(float), sizeof(float) * std::size_t(W)));
         Imf::OutputPart part(file, int(i));
         part.setFrameBuffer(fb);
         part.writePixels(H);
@@ -205,6 +211,10 @@ MapSet read_map_set(const std::string& path, BadTexels bad, long* zeroed) {
       if (h.channels().findChannel("confidence")) {
         v.confidence = cv::Mat(H, W, CV_32FC1);
         fb.insert("confidence", Imf::Slice::Make(Imf::FLOAT, v.confidence.data, dw, sizeof(float), sizeof(float) * std::size_t(W)));
+      }
+      if (h.channels().findChannel("clipped")) {
+        v.clipped = cv::Mat(H, W, CV_32FC1);
+        fb.insert("clipped", Imf::Slice::Make(Imf::FLOAT, v.clipped.data, dw, sizeof(float), sizeof(float) * std::size_t(W)));
       }
       Imf::InputPart part(file, i);
       part.setFrameBuffer(fb);

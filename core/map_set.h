@@ -10,7 +10,8 @@
 //                        A's table as core/albedo_normalisation.h lays it out; the same for every view
 //   rsibr.<key>          provenance strings (MapView::attributes)
 //   chromaticities       Rec.709 / D65 (the working space)
-// Channels R, G, B (float32), plus "confidence" for captured maps. Texel p of view v holds the
+// Channels R, G, B (float32), plus "confidence" for captured maps and, for captured maps whose
+// image had pixels clipped in every bracket, "clipped" (see MapView::clipped). Texel p of view v holds the
 // radiance leaving a surface with normal world_from_view * g_normal(p) toward a viewer at infinity
 // along v (core/sphere_map.h).
 #pragma once
@@ -37,6 +38,10 @@ struct MapView {
   std::map<std::string, std::string> attributes;  // provenance, written as rsibr.<key>
   cv::Mat rgb;                        // CV_32FC3, RGB order, sphere-map layout (square or not)
   cv::Mat confidence;                 // empty, or CV_32FC1 of the same size
+  // Empty, or CV_32FC1 of the same size: where some of the texel's image samples were clipped in
+  // every bracket (their radiance is a lower bound), the confidence the texel would have had without
+  // them (its confidence is then 0); 0 elsewhere. "Seen" = confidence > 0 or clipped > 0.
+  cv::Mat clipped;
 };
 
 struct MapSet {

@@ -5,6 +5,7 @@
 #include "core/compare_pictures.h"
 #include "core/exr_io.h"
 #include "core/text.h"
+#include "pipeline/light_sources_report.h"
 #include "pipeline/process_pipeline.h"
 #include "pipeline/step_record.h"
 
@@ -222,27 +223,36 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
     std::vector<unsigned char> png;
     cv::imencode(".png", display_encode(probe.pixels, auto_exposure(mean[0], mean[1], mean[2])), png);
     h << "<h2>Light probe</h2><p>" << jnum(s["views"]) << " chrome views blended, "
-      << num(100 * s["covered_fraction"].get<double>(), 3) << "% of the sphere seen (lat-long, tone-mapped).</p>"
-      << img_tag(png, "probe");
+      << num(100 * s["covered_fraction"].get<double>(), 3) << "% of the sphere seen (lat-long, tone-mapped";
+    const bool sources = rec.count("sources") && !rec["sources"].summary.value("sources", nlohmann::json::array()).empty();
+    if (sources && fs::is_regular_file(dir / "probe-measured.exr")) {
+      // Before (as measured) and after (with the recovered sources), at the final probe's exposure.
+      const EnvMap measured = read_environment((dir / "probe-measured.exr").string());
+      std::vector<unsigned char> before;
+      cv::imencode(".png", display_encode(measured.pixels, auto_exposure(mean[0], mean[1], mean[2])), before);
+      h << "; as measured, then with the recovered sources).</p>" << img_tag(before, "probe as measured") << img_tag(png, "probe");
+    } else {
+      h << ").</p>" << img_tag(png, "probe");
+    }
   }
+  if (rec.count("sources")) h << light_sources_section(dir, rec["sources"].summary);
 
   if (rec.count("compare")) {
     const auto& s = rec["compare"].summary;
     h << "<h2>Captured vs computed</h2><p>Captured grey-ball maps against maps baked from the probe (Lambert). "
          "Errors after the global exposure / white-balance fit are errors of shape; the fitted gains are the "
          "calibration offset. Heat maps: log2 error (stops).</p>";
-    // Pixels clipped in every bracket hold lower bounds; in the chrome views they are left out of
-    // the probe, so light from there (a sun) is missing from the computed maps.
-    long clipped = 0;
-    if (rec.count("hdr"))
-      for (const auto& v : rec["hdr"].summary["views"]) clipped = std::max(clipped, v.value("clipped_pixels", 0L));
-    if (clipped > 0)
-      h << "<p class=\"warn\"><b>Clipped pixels:</b> up to " << clipped
-        << " pixel(s) of a view saturated in every bracket (lower bounds, left out of the probe). A sun "
-           "reflected in a chrome ball covers a pixel or two and holds most of the light: if it is among them, "
-           "the computed maps are too dark on the side it lights. Shoot shorter brackets.</p>";
+    // Light clipped in every chrome view (a sun): what the sources step recovered, or how much is
+    // missing; nothing when nothing was clipped.
+    if (rec.count("sources")) h << light_sources_warning(rec["sources"].summary);
     for (const auto& b : s["balls"]) {
       h << "<h3>" << html_escape(b["ball"].get<std::string>()) << "</h3>";
+      if (b.contains("untrusted_views") && !b["untrusted_views"].empty()) {
+        h << "<p class=\"warn\">Left out (the ball has no trusted texel there: hidden behind another ball, or not found):";
+        for (const auto& v : b["untrusted_views"]) h << " " << html_escape(v.get<std::string>());
+        h << ".</p>";
+      }
+      if (!b.contains("overall")) continue;
       if (b.contains("fit"))
         h << "<p>Fitted gains R, G, B: " << jnum(b["fit"]["gains"][0]) << ", " << jnum(b["fit"]["gains"][1]) << ", "
           << jnum(b["fit"]["gains"][2]) << " (" << jnum(b["fit"]["exposure_stops"], 3) << " stops).</p>";

@@ -30,8 +30,10 @@
 #include "hdr/noise_model.h"
 #include "hdr/photo_set_merge.h"
 #include "hdr/response_recovery.h"
+#include "lights/recovered_probe.h"
 #include "pipeline/chessboard_problem.h"
 #include "pipeline/html_report.h"
+#include "pipeline/light_sources_step.h"
 #include "pipeline/pose_input.h"
 #include "pipeline/step_record.h"
 #include "pipeline/torus_mesh.h"
@@ -416,6 +418,13 @@ void step_extract(Context& c) {
         eo.material = eo.mirror ? "{type: mirror}" : "{type: lambert}";
         // The chrome ball as refined with the orientations (the outline lies inside its limb).
         const BallCone cone = eo.mirror ? extraction_cone(loc, pose, lens) : loc.fit.cone;
+        // The view's other balls, which hide this one where they are nearer the camera.
+        for (std::size_t k2 = 0; k2 < by_kind.size(); ++k2) {
+          if (k2 == k) continue;
+          const BallSpec& other = c.set.balls[by_kind[k2]];
+          const double ratio = other.diameter_m && ball.diameter_m ? *other.diameter_m / *ball.diameter_m : 1.0;
+          eo.hiding.push_back({located[by_score[k2]].fit.cone, ratio});
+        }
         MapView mv = extract_sphere_map(img.radiance, img.flags, lens, cone, world_from_cam, eo);
         mv.attributes["image"] = v.name;
         mv.attributes["ball"] = ball.name;
@@ -455,7 +464,7 @@ void step_probe(Context& c) {
     run_step(c, "probe", {{"width", c.o.probe_width}, {"given", c.o.probe_file}}, {c.o.probe_file}, [&](StepRecord& r) {
       EnvMap env = resample(read_environment(c.o.probe_file), Layout(LayoutKind::LatLong, c.o.probe_width, c.o.probe_width / 2));
       env.attributes["producer"] = "rsibr process (given probe " + fs::path(c.o.probe_file).filename().string() + ")";
-      const fs::path out = c.dir / "probe.exr";
+      const fs::path out = c.dir / "probe-measured.exr";
       write_environment(out.string(), env);
       r.outputs = {out};
       r.summary = {{"views", 0}, {"width", c.o.probe_width}, {"covered_fraction", 1.0}, {"fresnel", "given: " + c.o.probe_file}};
@@ -468,18 +477,57 @@ void step_probe(Context& c) {
       for (MapView& v : read_map_set(p.string()).views) all.views.push_back(std::move(v));
     ProbeOptions po;
     po.width = c.o.probe_width;
-    std::shared_ptr<const Fresnel> fresnel;
-    if (!c.o.chrome_fresnel.empty()) fresnel = make_fresnel(parse_yaml(c.o.chrome_fresnel, "--chrome-fresnel"), "--chrome-fresnel");
+    const auto fresnel = chrome_fresnel_from_spec(c.o.chrome_fresnel, "--chrome-fresnel");
     po.fresnel = fresnel.get();
     Probe p = assemble_probe(all, po);
     p.env.attributes["views"] = std::to_string(all.views.size());
     p.env.attributes["producer"] = "rsibr process (probe step)";
     p.env.attributes["version"] = RSIBR_VERSION;
-    const fs::path out = c.dir / "probe.exr";
+    if (fresnel) p.env.attributes["fresnel"] = fresnel->spec();
+    const fs::path out = c.dir / "probe-measured.exr";
     write_environment(out.string(), p.env);
     r.outputs = {out};
     r.summary = {{"views", all.views.size()}, {"width", c.o.probe_width}, {"covered_fraction", p.covered_fraction},
+                 {"clipped_fraction", p.clipped_fraction},
                  {"fresnel", fresnel ? fresnel->spec() : "none (the probe holds F L)"}};
+  });
+}
+
+// ---- sources: the clipped light recovered from the grey and glossy balls -> DIR/probe.exr.
+void step_sources(Context& c) {
+  LightSourcesStep s;
+  std::vector<fs::path> inputs = {c.dir / "probe-measured.exr"};
+  for (const BallSpec* b : balls_of(c, BallKind::chrome)) s.chrome.push_back(captured_path(c, *b));
+  for (const BallSpec* b : balls_of(c, BallKind::grey)) s.grey.push_back({b->name, captured_path(c, *b)});
+  for (const BallSpec* b : balls_of(c, BallKind::glossy)) s.glossy.push_back({b->name, captured_path(c, *b)});
+  s.given_probe = !c.o.probe_file.empty();
+  // The balls' maps and settings matter only when the probe step found light clipped in every view.
+  const nlohmann::json& probe = c.result.summary["probe"];
+  const bool clipped = !s.given_probe && probe.is_object() && probe.value("clipped_fraction", 1.0) > 0;
+  if (!s.given_probe) inputs.insert(inputs.end(), s.chrome.begin(), s.chrome.end());
+  if (clipped) {
+    for (const auto& g : s.grey) inputs.push_back(g.second);
+    if (!c.o.glossy_brdf.empty())
+      for (const auto& g : s.glossy) inputs.push_back(g.second);
+  }
+  s.glossy_brdf = c.o.glossy_brdf;
+  s.measured = c.dir / "probe-measured.exr";
+  s.out = c.dir / "probe.exr";
+  s.probe_width = c.o.probe_width;
+  s.chrome_fresnel = c.o.chrome_fresnel;
+  s.grey_albedo = c.o.grey_albedo;
+  s.recover = c.o.recover_sources;
+  s.seed = c.o.seed;
+  nlohmann::json settings = {{"recover", s.recover}, {"width", s.probe_width}, {"fresnel", s.chrome_fresnel},
+                             {"given", s.given_probe}, {"clipped", clipped}};
+  if (clipped) settings.update({{"albedo", s.grey_albedo}, {"glossy_brdf", s.glossy_brdf}, {"seed", s.seed}});
+  run_step(c, "sources", settings, inputs, [&](StepRecord& r) {
+    r.summary = run_light_sources_step(s);
+    r.outputs = {s.out};
+    if (c.o.log) {
+      const std::string line = light_sources_line(r.summary);
+      if (!line.empty()) c.o.log("sources: " + line);
+    }
   });
 }
 
@@ -534,8 +582,28 @@ void step_compare(Context& c) {
   run_step(c, "compare", nlohmann::json::object(), inputs, [&](StepRecord& r) {
     nlohmann::json balls = nlohmann::json::array();
     for (const BallSpec* b : greys) {
-      const MapSet captured = read_map_set(captured_path(c, *b).string());
-      const MapSet computed = read_map_set(computed_path(c, *b).string());
+      MapSet captured = read_map_set(captured_path(c, *b).string());
+      MapSet computed = read_map_set(computed_path(c, *b).string());
+      // Views whose ball has no trusted texel (hidden behind another ball, or not found) cannot be
+      // compared: left out and listed (the bake made one computed view per captured one, in order).
+      std::vector<std::string> untrusted;
+      if (captured.views.size() == computed.views.size()) {
+        MapSet a, bset;
+        for (std::size_t i = 0; i < captured.views.size(); ++i) {
+          if (cv::countNonZero(captured.views[i].confidence > 0) == 0) {
+            untrusted.push_back(captured.views[i].attributes.count("image") ? captured.views[i].attributes.at("image")
+                                                                             : "view." + std::to_string(i));
+            continue;
+          }
+          a.views.push_back(std::move(captured.views[i]));
+          bset.views.push_back(std::move(computed.views[i]));
+        }
+        if (a.views.empty()) {
+          balls.push_back({{"ball", b->name}, {"views", nlohmann::json::array()}, {"untrusted_views", untrusted}});
+          continue;
+        }
+        captured = std::move(a), computed = std::move(bset);
+      }
       CompareOptions co;
       co.name_a = captured_path(c, *b).string();
       co.name_b = computed_path(c, *b).string();
@@ -575,7 +643,7 @@ void step_compare(Context& c) {
       fs::create_directories(folder.parent_path());
       write_folder_atomically(folder, files);
       for (const auto& [name, bytes] : files) r.outputs.push_back(folder / name);
-      nlohmann::json bj = {{"ball", b->name}, {"folder", folder.string()}, {"views", views},
+      nlohmann::json bj = {{"ball", b->name}, {"folder", folder.string()}, {"views", views}, {"untrusted_views", untrusted},
                            {"overall", {{"before", metrics_json(cmp.before)}, {"after", metrics_json(cmp.after)}}},
                            {"heat_max_stops", heat_max}, {"log_epsilon", cmp.settings.log_epsilon}};
       if (cmp.fit)
@@ -653,16 +721,16 @@ void step_render(Context& c) {
 }  // namespace
 
 const std::vector<std::string>& process_steps() {
-  static const std::vector<std::string> steps = {"calibrate", "hdr",  "orient", "extract", "probe",
-                                                 "bake",      "compare", "render", "report"};
+  static const std::vector<std::string> steps = {"calibrate", "hdr",     "orient", "extract", "probe",
+                                                 "sources",   "bake",    "compare", "render", "report"};
   return steps;
 }
 
 ProcessResult run_process(const ProcessOptions& o) {
   for (const std::string& f : o.force)
     if (f != "all" && std::find(process_steps().begin(), process_steps().end(), f) == process_steps().end())
-      throw std::invalid_argument("--force '" + f + "': not a step (calibrate, hdr, orient, extract, probe, bake, "
-                                  "compare, render, report, all)");
+      throw std::invalid_argument("--force '" + f + "': not a step (calibrate, hdr, orient, extract, probe, sources, "
+                                  "bake, compare, render, report, all)");
   if (!o.lens.empty() && !fs::is_regular_file(o.lens)) throw std::invalid_argument(o.lens + ": no such file");
   if (!o.mesh.empty() && !fs::is_regular_file(o.mesh)) throw std::invalid_argument(o.mesh + ": no such file");
   if (!o.probe_file.empty() && !fs::is_regular_file(o.probe_file)) throw std::invalid_argument(o.probe_file + ": no such file");
@@ -671,11 +739,12 @@ ProcessResult run_process(const ProcessOptions& o) {
   if (!o.poses.empty()) read_given_poses(o.poses);  // errors before any work
   if (o.up && !(o.up->norm() > 0 && o.up->allFinite())) throw std::invalid_argument("--up: expected a non-zero direction");
   parse_brdf(o.render_brdf);
-  if (!o.chrome_fresnel.empty()) {
+  chrome_fresnel_from_spec(o.chrome_fresnel, "--chrome-fresnel");  // errors before any work
+  if (!o.glossy_brdf.empty()) {
     try {
-      make_fresnel(parse_yaml(o.chrome_fresnel, "--chrome-fresnel"), "--chrome-fresnel");
+      parse_brdf(o.glossy_brdf);
     } catch (const std::exception& e) {
-      throw std::invalid_argument(std::string("--chrome-fresnel: ") + e.what());
+      throw std::invalid_argument(std::string("--glossy-brdf: ") + e.what());
     }
   }
   ProcessResult result;
@@ -694,6 +763,7 @@ ProcessResult run_process(const ProcessOptions& o) {
   step_orient(c);
   step_extract(c);
   step_probe(c);
+  step_sources(c);
   step_bake(c);
   step_compare(c);
   step_render(c);

@@ -7,7 +7,9 @@
 //              calib/view_orientation.h, world +Y up given the up of the first camera; or --poses)
 //   extract    every ball of every view -> DIR/maps/captured-<ball>.exr, one part per view in the
 //              world frame (chrome: reflection indexing, mirror warp; grey/glossy: orthographic)
-//   probe      chrome maps -> DIR/probe.exr (lat-long, confidence-weighted blend)
+//   probe      chrome maps -> DIR/probe-measured.exr (lat-long, confidence-weighted blend)
+//   sources    the light clipped in every chrome view, recovered from the grey (and glossy) balls
+//              (pipeline/light_sources_step.h) -> DIR/probe.exr, the probe the later steps use
 //   bake       probe -> DIR/maps/computed-<ball>.exr for every grey ball, Lambert of albedo
 //              grey_albedo, at the captured views' directions and frames
 //   compare    captured vs computed per grey ball -> DIR/compare/<ball>.json + side-by-side PNGs
@@ -19,6 +21,7 @@
 // atomically and then its record. Frames: world +Y up (the gauge of the poses).
 #pragma once
 
+#include "calib/probe.h"
 #include "core/vec.h"
 
 #include <nlohmann/json.hpp>
@@ -45,7 +48,10 @@ struct ProcessOptions {
   std::vector<std::string> force;  // steps to re-run ("all" for every step)
   int map_size = 64;         // extracted and computed sphere maps (texels a side)
   int probe_width = 256;     // lat-long probe width
-  std::string chrome_fresnel;  // the chrome ball's Fresnel spec (YAML text), divided out of the probe; empty: none
+  // The chrome ball's Fresnel spec (YAML text), divided out of the probe; "" or "none": none (F L).
+  std::string chrome_fresnel = kDefaultChromeFresnel;
+  bool recover_sources = true;  // sources step: false writes the measured probe unchanged
+  std::string glossy_brdf;      // the glossy balls' BRDF spec (YAML text); empty: they are not used
   double grey_albedo = 0.18; // the grey ball's Lambert albedo (compare fits a gain anyway)
   std::string bake_method = "mis";
   int bake_samples = 128;

@@ -363,6 +363,11 @@ check "probe: three views cover the sphere" python3 -c "import json; j = json.lo
 expect_error "probe: a view without a pose" "camera's frame" probe "$work/pc0.exr" "$work/pc1.exr" --out "$work/probe-e1.exr"
 expect_error "probe: computed maps" "not a captured map" probe "$work/syn1/truth/maps/chrome.exr" --out "$work/probe-e2.exr"
 expect_error "probe: bad Fresnel" "--fresnel" probe "$work/pv0.exr" --out "$work/probe-e3.exr" --fresnel '{type: glass}'
+expect_error "probe: glossy maps without their BRDF" "--glossy-brdf" probe "$work/pv0.exr" --out "$work/probe-e4.exr" --glossy "$work/pv1.exr"
+expect_error "probe: chrome maps given as the grey ball's" "not a captured grey or glossy map" probe "$work/pv0.exr" --out "$work/probe-e5.exr" --grey "$work/pv1.exr"
+"$rsibr" probe "$work/pv0.exr" "$work/pv1.exr" "$work/pv2.exr" --out "$work/probe-fl.exr" --width 64 --fresnel none --json "$work/probe-fl.json" -q
+check "probe: --fresnel none keeps F L, no clipped light in the minimal spec" python3 -c "
+import json; j = json.load(open('$work/probe-fl.json')); assert j['fresnel'] == 'none' and j['light_sources']['regions'] == [], j"
 check "probe: no output after errors" bash -c "! ls -A '$work' | grep -q '^probe-e'"
 
 # --- orient (calib/view_orientation.h): three views 20 degrees apart of a chrome ball in a real
@@ -428,7 +433,10 @@ b = j['results']['compare']['balls'][0]; assert b['ball'] == 'grey' and b['overa
   --map-size 32 --turntable 2 --size 64x48 --json "$work/p2.json" -q >/dev/null
 check "process: a second run skips every step" python3 -c "
 import json; j = json.load(open('$work/p2.json')); assert not any(s['ran'] for s in j['steps']), j['steps']"
+check "process: nothing clipped in minimal-grey, so probe.exr is the measured probe" python3 -c "
+import json; j = json.load(open('$work/p1.json')); s = j['results']['sources']; assert s['regions'] == [] and s['sources'] == [], s"
 expect_error "process: missing photo set" "nothere" process "$work/nothere" --out "$work/pe1" -q
+expect_error "process: bad --glossy-brdf" "--glossy-brdf" process "$work/psyn/photos" --out "$work/pe7" --glossy-brdf '{type: velvet}' -q
 expect_error "process: unknown --force step" "--force 'merge'" process "$work/psyn/photos" --out "$work/pe2" --force merge -q
 expect_error "process: missing poses file" "noposes.yaml" process "$work/psyn/photos" --out "$work/pe3" --poses "$work/noposes.yaml" -q
 expect_error "process: output parent missing" "nofolder" process "$work/psyn/photos" --out "$work/nofolder/pe4" --poses "$work/psyn/truth/truth.yaml" -q
