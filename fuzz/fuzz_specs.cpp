@@ -1,7 +1,8 @@
 // libFuzzer target: the YAML specs a user hands rsibr: any YAML (anchors, aliases, nesting),
-// BRDF specs, photo sets and pose files. Every input must parse or be a std::exception.
+// BRDF specs, photo sets, pose files and synthetic scene specs. Every input must parse or be a std::exception.
 #include "bake/brdf_spec.h"
 #include "calib/pose_file.h"
+#include "capture/synth_scene.h"
 #include "core/photo_set.h"
 #include "core/yaml_spec.h"
 #include "fuzz/fuzz_input.h"
@@ -18,6 +19,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   try {
     (void)rsibr::parse_brdf(text);
+  } catch (const std::exception&) {
+  }
+  try {
+    (void)rsibr::parse_synth_scene(text, "scene.yaml", std::filesystem::temp_directory_path());
   } catch (const std::exception&) {
   }
   const std::string yaml = rsibr::fuzz::input_file(data, size, ".yaml");
