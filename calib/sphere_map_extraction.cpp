@@ -127,6 +127,11 @@ MapView extract_sphere_map(const cv::Mat& image, const cv::Mat& flags, const Len
       conf *= smoothstep(options.limb_margin_px / 3, options.limb_margin_px, limb_px);
       if (options.mirror && options.camera_mask_deg > 0)
         conf *= smoothstep(cos_cam_zero, cos_cam_full, reflected.dot(to_camera));
+      for (const Occluder& occ : options.in_front)
+        if (ray_hits(occ, Vec3::Zero(), -w, p.norm())) conf = 0;
+      if (options.mirror)
+        for (const Occluder& occ : options.occluders)
+          if (ray_hits(occ, p, reflected.normalized())) conf = 0;
       if (options.down) {
         const Vec3 dir = options.mirror ? reflected : n;
         conf *= smoothstep(cos_stand_zero, cos_stand_full, dir.dot(options.down->normalized()));

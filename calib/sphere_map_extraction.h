@@ -30,9 +30,14 @@
 //   stand          0 where the texel's direction (reflected for mirror maps, the normal otherwise) is
 //                  within stand_mask_deg of `down` (camera frame), ramping over stand_ramp_deg
 //   clipped        0 where any bilinear tap has a flag in `flags` & clipped_mask (hdr/merge.h: clipped)
+//   occluders      mirror maps: 0 where the reflected ray from the texel's surface point meets one of
+//                  `occluders` (calib/occluders.h: the other balls, the stands, the photographer)
+//   in front       0 where the camera's ray to the texel's surface point meets one of `in_front`
+//                  first (another ball nearer the camera hides that part of this one)
 #pragma once
 
 #include "calib/ball_cone.h"
+#include "calib/occluders.h"
 #include "core/lens_model.h"
 #include "core/map_set.h"
 
@@ -40,6 +45,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace rsibr {
 
@@ -55,6 +61,8 @@ struct ExtractOptions {
   std::optional<Vec3> down;          // camera frame; none: no stand mask
   double stand_mask_deg = 8, stand_ramp_deg = 4;
   unsigned char clipped_mask = 1;    // hdr/merge.h kClipped
+  std::vector<Occluder> occluders;   // camera frame, this ball's radii (mirror maps only)
+  std::vector<Occluder> in_front;    // camera frame, this ball's radii (any map)
   std::string material;              // the map's rsibr.material
 };
 

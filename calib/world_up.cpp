@@ -1,0 +1,92 @@
+#include "calib/world_up.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace rsibr {
+
+namespace {
+
+constexpr double kDeg = kPi / 180;
+
+struct Solve {
+  Vec3 u;
+  Eigen::Matrix2d information;
+};
+
+Solve gauss_newton(const std::vector<Vec3>& x, double sigma_roll, const std::vector<VerticalLine>& lines, const Vec3& u0,
+                   double sigma_prior, Vec3 u) {
+  Eigen::Matrix2d jtj = Eigen::Matrix2d::Identity();
+  for (int it = 0; it < 20; ++it) {
+    const Vec3 t1 = u.unitOrthogonal(), t2 = u.cross(t1);
+    jtj.setZero();
+    Eigen::Vector2d jtr = Eigen::Vector2d::Zero();
+    auto add = [&](const Vec3& a, double sigma, double r) {  // residual r = a . u / sigma (a . u linearised)
+      const Eigen::Vector2d j(a.dot(t1) / sigma, a.dot(t2) / sigma);
+      jtj += j * j.transpose();
+      jtr += j * r;
+    };
+    for (const Vec3& xi : x) add(xi, sigma_roll, xi.dot(u) / sigma_roll);
+    for (const VerticalLine& l : lines) {
+      const double s = l.sigma_deg * kDeg;
+      add(l.plane_normal, s, l.plane_normal.dot(u) / s);
+    }
+    // Prior on the tangent components of u - u0.
+    const Vec3 d = u - u0;
+    add(t1, sigma_prior, d.dot(t1) / sigma_prior);
+    add(t2, sigma_prior, d.dot(t2) / sigma_prior);
+    const Eigen::Vector2d step = jtj.ldlt().solve(-jtr);
+    if (!step.allFinite()) break;
+    u = (u + step[0] * t1 + step[1] * t2).normalized();
+    if (step.norm() < 1e-13) break;
+  }
+  return {u, jtj};
+}
+
+}  // namespace
+
+WorldUp estimate_world_up(const std::vector<Mat3>& world_from_cam, const std::vector<VerticalLine>& lines,
+                          const WorldUpOptions& o) {
+  if (world_from_cam.empty()) throw std::invalid_argument("world up: no cameras");
+  std::vector<Vec3> x;
+  Vec3 u0 = Vec3::Zero();
+  for (const Mat3& r : world_from_cam) {
+    if (!r.allFinite()) throw std::invalid_argument("world up: a non-finite rotation");
+    x.push_back(r.col(0).normalized());
+    u0 -= r.col(1).normalized();
+  }
+  if (!(u0.norm() > 1e-9)) u0 = -world_from_cam.front().col(1);
+  u0.normalize();
+  // Start: the smallest eigenvector of the cue scatter, signed toward the upright prior.
+  double sigma_roll = o.roll_sigma_deg * kDeg;
+  Mat3 s = Mat3::Zero();
+  for (const Vec3& xi : x) s += xi * xi.transpose() / (sigma_roll * sigma_roll);
+  for (const VerticalLine& l : lines) s += l.plane_normal * l.plane_normal.transpose() / std::pow(l.sigma_deg * kDeg, 2);
+  s += (Mat3::Identity() - u0 * u0.transpose()) / std::pow(o.prior_sigma_deg * kDeg, 2);
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(s);
+  Vec3 start = eig.eigenvectors().col(0);
+  if (start.dot(u0) < 0) start = -start;
+  const double sigma_prior = o.prior_sigma_deg * kDeg;
+  Solve sol = gauss_newton(x, sigma_roll, lines, u0, sigma_prior, start);
+  WorldUp out;
+  if (x.size() >= 4) {
+    double s2 = 0;
+    for (const Vec3& xi : x) s2 += std::pow(std::asin(std::clamp(xi.dot(sol.u), -1.0, 1.0)), 2);
+    sigma_roll = std::max(std::sqrt(s2 / double(x.size() - 2)), o.min_roll_sigma_deg * kDeg);
+    sol = gauss_newton(x, sigma_roll, lines, u0, sigma_prior, sol.u);
+    out.roll_sigma_estimated = true;
+  }
+  out.up = sol.u;
+  out.roll_sigma_deg = sigma_roll / kDeg;
+  const Eigen::Matrix2d cov = sol.information.inverse();
+  out.sigma_deg = std::sqrt(std::max(0.0, cov.trace())) / kDeg;
+  for (const Vec3& xi : x) out.roll_deg.push_back(std::asin(std::clamp(xi.dot(sol.u), -1.0, 1.0)) / kDeg);
+  out.lines = int(lines.size());
+  out.tilt_from_first_deg = angle_between(sol.u, -world_from_cam.front().col(1)) / kDeg;
+  return out;
+}
+
+}  // namespace rsibr
