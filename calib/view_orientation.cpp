@@ -130,6 +130,11 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
     names.push_back(all_names[v]);
     if (!options.known_world_from_cam.empty()) known.push_back(options.known_world_from_cam[v]);
   }
+  if (!options.known_world_from_cam.empty() && names.empty()) {
+    // Known rotations: nothing to refine; the views without a chrome ball keep no ball.
+    if (report) *report = rep;
+    return PoseSet{};
+  }
   if (names.size() < 2 && known.empty()) {
     std::string why = "orient: a chrome ball was found in " + std::to_string(names.size()) + " of " + std::to_string(all_views.size()) +
                       " views, need at least 2";

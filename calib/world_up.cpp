@@ -17,19 +17,19 @@ struct Solve {
   Eigen::Matrix2d information;
 };
 
-Solve gauss_newton(const std::vector<Vec3>& x, double sigma_roll, const std::vector<VerticalLine>& lines, const Vec3& u0,
-                   double sigma_prior, Vec3 u) {
+Solve gauss_newton(const std::vector<Vec3>& x, const std::vector<double>& weight, double sigma_roll,
+                   const std::vector<VerticalLine>& lines, const Vec3& u0, double sigma_prior, Vec3 u) {
   Eigen::Matrix2d jtj = Eigen::Matrix2d::Identity();
   for (int it = 0; it < 20; ++it) {
     const Vec3 t1 = u.unitOrthogonal(), t2 = u.cross(t1);
     jtj.setZero();
     Eigen::Vector2d jtr = Eigen::Vector2d::Zero();
-    auto add = [&](const Vec3& a, double sigma, double r) {  // residual r = a . u / sigma (a . u linearised)
+    auto add = [&](const Vec3& a, double sigma, double r, double w = 1) {  // residual r = a . u / sigma (linearised)
       const Eigen::Vector2d j(a.dot(t1) / sigma, a.dot(t2) / sigma);
-      jtj += j * j.transpose();
-      jtr += j * r;
+      jtj += w * j * j.transpose();
+      jtr += w * j * r;
     };
-    for (const Vec3& xi : x) add(xi, sigma_roll, xi.dot(u) / sigma_roll);
+    for (std::size_t i = 0; i < x.size(); ++i) add(x[i], sigma_roll, x[i].dot(u) / sigma_roll, weight[i]);
     for (const VerticalLine& l : lines) {
       const double s = l.sigma_deg * kDeg;
       add(l.plane_normal, s, l.plane_normal.dot(u) / s);
@@ -70,13 +70,24 @@ WorldUp estimate_world_up(const std::vector<Mat3>& world_from_cam, const std::ve
   Vec3 start = eig.eigenvectors().col(0);
   if (start.dot(u0) < 0) start = -start;
   const double sigma_prior = o.prior_sigma_deg * kDeg;
-  Solve sol = gauss_newton(x, sigma_roll, lines, u0, sigma_prior, start);
+  std::vector<double> weight(x.size(), 1.0);
+  Solve sol = gauss_newton(x, weight, sigma_roll, lines, u0, sigma_prior, start);
   WorldUp out;
   if (x.size() >= 4) {
-    double s2 = 0;
-    for (const Vec3& xi : x) s2 += std::pow(std::asin(std::clamp(xi.dot(sol.u), -1.0, 1.0)), 2);
-    sigma_roll = std::max(std::sqrt(s2 / double(x.size() - 2)), o.min_roll_sigma_deg * kDeg);
-    sol = gauss_newton(x, sigma_roll, lines, u0, sigma_prior, sol.u);
+    // The roll scatter from the residuals (robustly: 1.4826 MAD), and Cauchy weights at 2.5 of it,
+    // so that a camera turned about its own tilted axis (its x out of the horizontal) does not pull
+    // the level of the others; repeated as the residuals settle.
+    for (int it = 0; it < 6; ++it) {
+      std::vector<double> a;
+      for (const Vec3& xi : x) a.push_back(std::abs(std::asin(std::clamp(xi.dot(sol.u), -1.0, 1.0))));
+      std::vector<double> sorted = a;
+      std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
+      // MAD about zero of n - 2 free residuals: scaled so that a Gaussian scatter gives its sigma.
+      const double mad = 1.4826 * sorted[sorted.size() / 2] * std::sqrt(double(x.size()) / double(x.size() - 2));
+      sigma_roll = std::max(mad, o.min_roll_sigma_deg * kDeg);
+      for (std::size_t i = 0; i < x.size(); ++i) weight[i] = 1 / (1 + std::pow(a[i] / (2.5 * sigma_roll), 2));
+      sol = gauss_newton(x, weight, sigma_roll, lines, u0, sigma_prior, sol.u);
+    }
     out.roll_sigma_estimated = true;
   }
   out.up = sol.u;

@@ -12,9 +12,11 @@
 // what the cameras cannot: with every x axis parallel (all views from one side) the tilt about that
 // axis. Start: the eigenvector of sum x_i x_i^T / sigma_roll^2 + sum m_j m_j^T / sigma_j^2 with
 // the smallest eigenvalue, signed toward u0; then Gauss-Newton on u's tangent plane. sigma_roll is
-// the cameras' roll scatter: from the roll residuals asin(x_i . u) (degrees of freedom n - 2) when
-// there are at least 4 cameras, never below `min_roll_sigma_deg`; else `roll_sigma_deg`. The std dev
-// of u (degrees, both tangent axes together) is from the inverse of the normal equations.
+// the cameras' roll scatter: with at least 4 cameras, 1.4826 times the median |asin(x_i . u)|
+// (scaled for the n - 2 degrees of freedom), never below `min_roll_sigma_deg`, and each camera
+// weighted by a Cauchy loss at 2.5 sigma_roll (a camera turned about its own tilted axis, its x
+// out of the horizontal, does not pull the others); else `roll_sigma_deg`, unweighted. The std dev
+// of u (degrees, both tangent axes together) is from the inverse of the weighted normal equations.
 // Frames: whatever frame the rotations are in (the orientation solve's), u in that frame.
 #pragma once
 

@@ -150,10 +150,11 @@ void write_balls_section(std::ostringstream& h, const nlohmann::json& s, const f
   for (const auto& v : s["views"])
     for (const auto& b : v["balls"])
       if (b.contains("mask")) {
-        if (!any) h << "<h3>Chrome masks</h3><p>Each view's chrome map (left) and its confidence (right): red is left out of "
-                       "the probe (the camera and photographer, the stands, the other balls, clipped pixels, the rim).</p>";
+        if (!any) h << "<h3>Masks</h3><p>Each view's map of each ball (left) and its confidence (right): red is left out "
+                       "(chrome: the camera and photographer, the stands, the other balls; grey: what this view alone sees "
+                       "differently, a shadow of the photographer; both: a ball in front, clipped pixels, the rim).</p>";
         any = true;
-        h << "<p>" << html_escape(v["name"].get<std::string>()) << "<br>"
+        h << "<p>" << html_escape(v["name"].get<std::string>() + " " + b["ball"].get<std::string>()) << "<br>"
           << img_tag(read_bytes(dir / b["mask"].get<std::string>()), v["name"].get<std::string>()) << "</p>";
       }
 }

@@ -5,6 +5,7 @@
 #include "calib/ball_identification.h"
 #include "calib/ball_locator.h"
 #include "calib/intrinsics.h"
+#include "calib/lambert_consensus.h"
 #include "calib/occluders.h"
 #include "calib/probe.h"
 #include "calib/sphere_map_extraction.h"
@@ -415,7 +416,7 @@ void step_extract(Context& c) {
   nlohmann::json balls = nlohmann::json::array(), given = nlohmann::json::array();
   for (const BallSpec& b : c.set.balls) balls.push_back({b.name, to_string(b.kind), b.diameter_m.value_or(0.0)});
   for (const BallOverride& o : overrides) given.push_back({o.view, o.ball, o.guess.centre_px.x(), o.guess.centre_px.y(), o.guess.radius_px});
-  const nlohmann::json settings = {{"map_size", c.o.map_size}, {"balls", balls}, {"given", given}, {"identification", 2}};
+  const nlohmann::json settings = {{"map_size", c.o.map_size}, {"balls", balls}, {"given", given}, {"identification", 4}};
   run_step(c, "extract", settings, inputs, [&](StepRecord& r) {
     if (c.set.balls.empty()) throw std::invalid_argument(c.o.photoset + ": balls: the photo set lists no ball");
     const LensModel lens = LensModel::read(c.dir / "camera.cameramodel");
@@ -543,15 +544,10 @@ void step_extract(Context& c) {
         mv.attributes["identified"] = found[b].status;
         const cv::Mat& conf = mv.confidence;
         bj["confident_fraction"] = cv::countNonZero(conf > 0.5) / (kPiD / 4 * c.o.map_size * c.o.map_size);
-        if (eo.mirror && int(b) == chrome_index) {
-          const cv::Scalar mean = cv::mean(mv.rgb);
-          const std::string name = v.name + ".png";
-          masks[name] = png_bytes(mask_picture(mv, auto_exposure(mean[0], mean[1], mean[2])), name);
-          bj["mask"] = "masks/" + name;
-          nlohmann::json occ = nlohmann::json::array();
-          for (const Occluder& o : eo.occluders) occ.push_back(o.what);
-          bj["masked"] = occ;
-        }
+        nlohmann::json occ = nlohmann::json::array();
+        for (const Occluder& o : eo.occluders) occ.push_back(o.what);
+        for (const Occluder& o : eo.in_front) occ.push_back(o.what);
+        bj["masked"] = occ;
         vj["balls"].push_back(bj);
         sets[b].views.push_back(std::move(mv));
       }
@@ -559,6 +555,48 @@ void step_extract(Context& c) {
       bar.update(double(vb.size() + k + 1) / steps);
     }
     bar.done();
+    // Grey balls: what one view alone sees differently (the photographer's shadow) is masked, a view
+    // mostly so is left out (calib/lambert_consensus.h).
+    auto ball_entry = [&](const std::string& view, const std::string& ball) -> nlohmann::json* {
+      for (auto& vj : views)
+        if (vj["name"] == view)
+          for (auto& bj : vj["balls"])
+            if (bj["ball"] == ball) return &bj;
+      return nullptr;
+    };
+    for (std::size_t b = 0; b < listed.size(); ++b) {
+      if (listed[b].kind != BallKind::grey) continue;
+      const std::vector<LambertConsensusView> cons = mask_lambert_inconsistencies(sets[b].views);
+      std::vector<MapView> kept;
+      for (std::size_t k = 0; k < cons.size(); ++k) {
+        MapView& mv = sets[b].views[k];
+        nlohmann::json* bj = ball_entry(mv.attributes["image"], listed[b].name);
+        if (bj) {
+          (*bj)["consensus"] = {{"judged", cons[k].judged}, {"masked", cons[k].masked}, {"median_stops", cons[k].median_stops}};
+          (*bj)["confident_fraction"] = cv::countNonZero(mv.confidence > 0.5) / (kPiD / 4 * c.o.map_size * c.o.map_size);
+        }
+        if (cons[k].left_out) {
+          if (bj) {
+            (*bj)["status"] = "left out: inconsistent with the other views";
+            (*bj)["note"] = std::to_string(cons[k].masked) + " of " + std::to_string(cons[k].judged) +
+                            " texels differ from the other views' median by more than 0.12 stops (median " +
+                            std::to_string(cons[k].median_stops).substr(0, 5) + "): a shadow or occluder of this view alone";
+          }
+          continue;
+        }
+        kept.push_back(std::move(mv));
+      }
+      sets[b].views = std::move(kept);
+    }
+    // Each map's mask for the report.
+    for (std::size_t b = 0; b < listed.size(); ++b)
+      for (const MapView& mv : sets[b].views) {
+        const cv::Scalar mean = cv::mean(mv.rgb);
+        const std::string image = mv.attributes.at("image");
+        const std::string name = int(b) == chrome_index ? image + ".png" : image + "-" + listed[b].name + ".png";
+        masks[name] = png_bytes(mask_picture(mv, auto_exposure(mean[0], mean[1], mean[2])), name);
+        if (nlohmann::json* bj = ball_entry(image, listed[b].name)) (*bj)["mask"] = "masks/" + name;
+      }
     for (std::size_t b = 0; b < listed.size(); ++b)
       if (sets[b].views.empty())
         throw std::runtime_error("ball '" + listed[b].name + "' was found in no view (see the balls' notes with --json; "

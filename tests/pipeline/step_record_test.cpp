@@ -105,7 +105,7 @@ TEST_F(StepRecordTest, ACopiedRunFolderWithMovedPhotosIsUpToDate) {
   r.outputs = {run / "maps" / "m.exr"};
   const RecordRoots roots{run, photos};
   write_step_record(run, r, roots);
-  ASSERT_EQ(step_stale_reason(run, "extract", {}, r.inputs, roots), "");
+  ASSERT_EQ(step_stale_reason(run, "extract", nlohmann::json::object(), r.inputs, roots), "");
   // Copy (new times: a copy made later) and move the photos.
   const fs::path run2 = dir / "elsewhere" / "run", photos2 = dir / "moved" / "photos";
   fs::create_directories(run2.parent_path());
@@ -116,18 +116,18 @@ TEST_F(StepRecordTest, ACopiedRunFolderWithMovedPhotosIsUpToDate) {
     fs::last_write_time(p, fs::last_write_time(p) + std::chrono::seconds(7));
   const RecordRoots roots2{run2, photos2};
   const std::vector<fs::path> inputs2 = {photos2 / "v0" / "b0.png", run2 / "camera.cameramodel"};
-  EXPECT_EQ(step_stale_reason(run2, "extract", {}, inputs2, roots2), "");
+  EXPECT_EQ(step_stale_reason(run2, "extract", nlohmann::json::object(), inputs2, roots2), "");
   const StepRecord back = read_step_record(run2, "extract", roots2);
   ASSERT_EQ(back.outputs.size(), 1u);
   EXPECT_EQ(back.outputs[0], fs::absolute(run2 / "maps" / "m.exr").lexically_normal());
   EXPECT_EQ(back.inputs[0], fs::absolute(photos2 / "v0" / "b0.png").lexically_normal());
   // The copy is independent: an edited input in it is a change there only.
   write(photos2 / "v0" / "b0.png", "other bytes");
-  EXPECT_NE(step_stale_reason(run2, "extract", {}, inputs2, roots2).find("b0.png changed"), std::string::npos);
+  EXPECT_NE(step_stale_reason(run2, "extract", nlohmann::json::object(), inputs2, roots2).find("b0.png changed"), std::string::npos);
   // Another file in the input's place (another name) is a change even with the same contents.
   write(run2 / "lens2.cameramodel", "lens");
   write(photos2 / "v0" / "b0.png", "photo bytes");
-  EXPECT_EQ(step_stale_reason(run2, "extract", {}, {photos2 / "v0" / "b0.png", run2 / "lens2.cameramodel"}, roots2),
+  EXPECT_EQ(step_stale_reason(run2, "extract", nlohmann::json::object(), {photos2 / "v0" / "b0.png", run2 / "lens2.cameramodel"}, roots2),
             (run2 / "lens2.cameramodel").string() + " changed");
 }
 
