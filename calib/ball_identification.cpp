@@ -235,7 +235,23 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
     }
   }
   // A circle inside a mirror's disc is something the mirror reflects, not a ball (a circle inside a
-  // large smooth circle, a lamp or a plate behind the rig, may well be a ball).
+  // large smooth circle, a lamp or a plate behind the rig, may well be a ball). A larger circle that
+  // looks like a mirror only for the ball in front of it (a sphere or a target behind the chrome
+  // ball) is measured again without that ball's disc: if it no longer looks like one, it is the
+  // thing behind, and the ball inside stays.
+  for (std::size_t k = 0; k < balls.size(); ++k) {
+    if (!looks_like(balls[k], BallKind::chrome)) continue;
+    for (std::size_t i = 0; i < balls.size(); ++i) {
+      if (i == k || !inside_disc(balls[i], balls[k]) || !looks_like(balls[i], BallKind::chrome)) continue;
+      if (!(balls[i].inlier_fraction >= 0.8 && balls[i].loc.fit.rms_px <= 0.5)) continue;  // a clean outline of its own
+      const BallCandidate without = measure(image, lens, balls[k].loc, {{balls[i].loc.centre_px, balls[i].loc.radius_px}});
+      if (!looks_like(without, BallKind::chrome)) {
+        balls[k].texture = without.texture, balls[k].rim_texture = without.rim_texture;
+        balls[k].mirror_score = without.mirror_score, balls[k].diffuse_residual = without.diffuse_residual;
+        break;
+      }
+    }
+  }
   std::vector<BallCandidate> out;
   for (std::size_t i = 0; i < balls.size(); ++i) {
     bool inside = false;

@@ -173,7 +173,7 @@ SynthClutter parse_clutter(const YAML::Node& node, const std::string& path) {
 SynthViewPlan parse_plan(const YAML::Node& node, const std::string& path) {
   const YamlMap m(node, path,
                   {"plan", "count", "azimuths_deg", "azimuth0_deg", "elevation_deg", "min_elevation_deg",
-                   "distance_m", "look_at", "roll_deg", "yaw_deg", "jitter_m", "jitter_deg"});
+                   "distance_m", "look_at", "roll_deg", "yaw_deg", "pan_deg", "jitter_m", "jitter_deg"});
   SynthViewPlan p;
   p.plan = m.choice("plan", {"ring", "icosa", "handheld"});
   auto only = [&](const char* key, std::initializer_list<const char*> plans) {
@@ -196,6 +196,7 @@ SynthViewPlan parse_plan(const YAML::Node& node, const std::string& path) {
   if (m.has("look_at")) p.look_at = m.vec3("look_at");
   if (m.has("roll_deg")) p.roll_deg = m.number_in("roll_deg", -180, false, 180, false);
   if (m.has("yaw_deg")) p.yaw_deg = m.number_in("yaw_deg", -89, false, 89, false);
+  if (m.has("pan_deg")) p.pan_deg = m.number_in("pan_deg", -89, false, 89, false);
   if (only("jitter_m", {"handheld"})) p.jitter_m = m.number_in("jitter_m", 0, false, 10, false);
   if (only("jitter_deg", {"handheld"})) p.jitter_deg = m.number_in("jitter_deg", 0, false, 45, false);
   return p;

@@ -67,6 +67,9 @@ struct SynthViewPlan {
   std::optional<Vec3> look_at;      // default: the centre of the balls
   double roll_deg = 0;
   double yaw_deg = 0;               // after aiming: turn the camera right by this (the target moves left)
+                                    // about its own y axis (aimed up or down, that tilts the horizon)
+  double pan_deg = 0;               // after aiming: turn right about the world's vertical (a person turning:
+                                    // the horizon stays level)
   double jitter_m = 0.03, jitter_deg = 1.5;  // handheld: position and orientation jitter (std dev)
 };
 

@@ -36,7 +36,7 @@ clutter:
 camera: {width: 400, height: 300, lens: {model: LENSMODEL_PINHOLE, focal_px: 500}}
 views:
   - {plan: ring, azimuths_deg: [15, 90, 165, 270, 320], elevation_deg: 10, distance_m: 0.9}
-  - {plan: ring, azimuths_deg: [200], elevation_deg: 10, distance_m: 0.9, yaw_deg: 17}
+  - {plan: ring, azimuths_deg: [200], elevation_deg: 10, distance_m: 0.9, pan_deg: 17}
 )";
   return parse_synth_scene(text, "clutter.yaml", ".");
 }

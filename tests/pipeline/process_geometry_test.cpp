@@ -56,8 +56,8 @@ camera:
 exposure: {middle_s: 0.05, count: 5, step_ev: 2, iso: 400, aperture: 5.6}
 views:
   - {plan: handheld, count: 6, elevation_deg: 25, distance_m: 0.55, jitter_m: 0.01, jitter_deg: 1.0}
-  - {plan: ring, azimuths_deg: [100], elevation_deg: 20, distance_m: 0.55, look_at: [0, 1.42, 0], yaw_deg: 14}
-  - {plan: ring, azimuths_deg: [250], elevation_deg: 15, distance_m: 0.55, yaw_deg: 18}
+  - {plan: ring, azimuths_deg: [100], elevation_deg: 20, distance_m: 0.55, look_at: [0, 1.42, 0], pan_deg: 14}
+  - {plan: ring, azimuths_deg: [250], elevation_deg: 15, distance_m: 0.55, pan_deg: 18}
 chessboards: {count: 6, corners: 10, spacing_m: 0.02}
 truth_map_size: 48
 )";
