@@ -2,7 +2,7 @@
 // runs held-out shoots through synth and process and writes the docs/tradeoffs.md section "Robust
 // geometry (rsibr process on shoots)").
 //
-//   rsibr_geometry_robustness SYNTH_DIR RUN_DIR
+//   rsibr_geometry_robustness SYNTH_DIR RUN_DIR [REFERENCE_RUN_DIR]
 //
 // JSON on stdout:
 //   balls        per listed ball: found, wrong (centre farther than a fifth of its radius from the
@@ -14,6 +14,10 @@
 //   grey         per view: log RMS (stops) of the captured grey map against the true one after the
 //                global gain fit, the map moved into the truth's world through the view's true
 //                rotation; and the worst
+//   reference    with REFERENCE_RUN_DIR (the same shoot processed from the true scene radiance, poses and
+//                lens: every physical effect on the grey ball, the photographer's and the other balls'
+//                occlusion included, and none of the pipeline's errors): the grey maps against that
+//                run's, per view after the gain fit: the pipeline's own error
 #include "calib/pose_file.h"
 #include "core/map_compare.h"
 #include "core/map_set.h"
@@ -33,8 +37,8 @@ namespace fs = std::filesystem;
 using namespace rsibr;
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    std::cerr << "usage: rsibr_geometry_robustness SYNTH_DIR RUN_DIR\n";
+  if (argc != 3 && argc != 4) {
+    std::cerr << "usage: rsibr_geometry_robustness SYNTH_DIR RUN_DIR [REFERENCE_RUN_DIR]\n";
     return 2;
   }
   const fs::path syn = argv[1], run = argv[2];
@@ -125,6 +129,17 @@ int main(int argc, char** argv) {
         worst = std::max(worst, p.after.log_rms_stops);
       }
       out["grey_overall_stops"] = c.after.log_rms_stops;
+      if (argc == 4) {
+        const MapSet ref = read_map_set((fs::path(argv[3]) / "maps" / ("captured-" + name + ".exr")).string());
+        const Comparison r = compare_map_sets(m, ref, co);
+        nlohmann::json per = nlohmann::json::array();
+        double rw = 0;
+        for (const PairComparison& p : r.pairs) {
+          per.push_back({{"view", m.views[p.index_a].attributes.at("image")}, {"stops", p.after.log_rms_stops}});
+          rw = std::max(rw, p.after.log_rms_stops);
+        }
+        out["reference"] = {{"ball", name}, {"views", per}, {"worst_stops", rw}, {"overall_stops", r.after.log_rms_stops}};
+      }
     }
     out["grey"] = grey;
     out["grey_worst_stops"] = worst;

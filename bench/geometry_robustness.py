@@ -11,7 +11,8 @@ was developed on; these are not those):
   vignetting    a lens 1.6 stops dark at the corner, the rig turned toward corners, CC0 `apartment`
   cut           handheld views in the CC0 `workshop`, two of them turned so the frame cuts a ball
 Each: rsibr synth, then rsibr process on the photos as a user would run it (the lens from the
-chessboards, the orientations solved, world up estimated, vignetting from the chessboards), then
+chessboards, the orientations solved, world up estimated, vignetting from the chessboards), and once
+from the true scene radiance, poses and lens (the physical reference), then
 build/release/rsibr_geometry_robustness against the truth. Reported: balls found / wrong /
 missing, cut balls flagged, views oriented, the probe's tilt against the true up and the sigma the
 run reports, the vignetting at the corner (estimated and true), and the captured grey maps against
@@ -20,7 +21,7 @@ ball, so the photographer's own shadow and body count as error where the consens
 
 Writes the section "Robust geometry (rsibr process on shoots)" of docs/tradeoffs.md.
 
-  python3 bench/geometry_robustness.py [--build build/release] [--work /tmp/rsibr-geometry] [--keep]
+  python3 bench/geometry_robustness.py [--build build/release] [--work /tmp/rsibr-geometry] [--keep] [--only NAME...]
 """
 import argparse
 import json
@@ -159,7 +160,18 @@ def main():
         run(rsibr, "process", os.path.join(folder, "syn", "photos"), "--out", os.path.join(folder, "run"),
             "--chrome-fresnel", FRESNEL, "-q")
         t2 = time.time()
-        m = json.loads(run(measure, os.path.join(folder, "syn"), os.path.join(folder, "run")))
+        # The physical reference: the true scene radiance (before vignetting), poses and lens, so its
+        # grey maps hold every physical effect (the photographer, the other balls) and no pipeline error.
+        scene_dir = os.path.join(folder, "scene")
+        os.makedirs(scene_dir)
+        views = os.path.join(folder, "syn", "truth", "views")
+        for f in os.listdir(views):
+            if f.endswith("_scene.exr"):
+                os.symlink(os.path.join(views, f), os.path.join(scene_dir, f.replace("_scene.exr", ".exr")))
+        run(rsibr, "process", os.path.join(folder, "syn", "photos"), "--out", os.path.join(folder, "ref"),
+            "--radiance", scene_dir, "--poses", os.path.join(folder, "syn", "truth", "truth.yaml"),
+            "--lens", os.path.join(folder, "syn", "truth", "camera.cameramodel"), "--chrome-fresnel", FRESNEL, "-q")
+        m = json.loads(run(measure, os.path.join(folder, "syn"), os.path.join(folder, "run"), os.path.join(folder, "ref")))
         m["name"], m["seconds_synth"], m["seconds_process"] = name, t1 - t0, t2 - t1
         rows.append(m)
         print("%s: %s" % (name, json.dumps({k: m[k] for k in ("balls", "tilt_deg", "grey_worst_stops")})), flush=True)
@@ -174,11 +186,14 @@ def main():
         "runs it (lens from the chessboards, orientations solved, world up estimated, vignetting from the chessboards),",
         "then `rsibr_geometry_robustness` against the truth. A ball is wrong when its centre is farther than a fifth of",
         "its radius from the truth's. Tilt: the run's +Y against the true up; sigma: the run's own. Grey: the captured",
-        "grey maps against the true (unoccluded) ones after the global gain fit, log RMS per view; the photographer",
-        "is in these scenes, and what his shadow or body leave after the cross-view consensus counts as error.",
+        "grey maps against the true (unoccluded) ones after the global gain fit, log RMS per view: the photographer",
+        "and the chrome ball beside the grey one are in these scenes, and what their shadows and bodies do to the",
+        "grey ball's light (real light, which the truth maps leave out) counts as error there. The last column holds",
+        "the pipeline's own error: the grey maps against those of the same shoot processed from the true scene",
+        "radiance (before vignetting), poses and lens, which have every physical effect and no pipeline error.",
         "",
-        "| shoot | views oriented | balls found / wrong | missing | cut flagged / cut | tilt (deg) | sigma (deg) | vignetting corner est / true (stops) | grey per view (stops) | worst |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "| shoot | views oriented | balls found / wrong | missing | cut flagged / cut | tilt (deg) | sigma (deg) | vignetting corner est / true (stops) | grey vs truth per view (stops) | worst | grey vs physical reference, worst (stops) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for m in rows:
         found = sum(b["found"] for k, b in m["balls"].items() if k != "*")
@@ -188,10 +203,10 @@ def main():
         cut_t = sum(b.get("cut_true", 0) for b in m["balls"].values())
         grey = " ".join("%.3f" % g["stops"] for g in m["grey"])
         sigma = "%.2f" % m["sigma_deg"] if m.get("sigma_deg") is not None else "-"
-        lines.append("| %s | %d / %d | %d / %d | %d | %d / %d | %.2f | %s | %.2f / %.2f | %s | %.3f |" % (
+        lines.append("| %s | %d / %d | %d / %d | %d | %d / %d | %.2f | %s | %.2f / %.2f | %s | %.3f | %.3f |" % (
             m["name"], m["views"]["oriented"], m["views"]["listed"], found, wrong, missing, cut_f, cut_t,
             m["tilt_deg"], sigma, m["vignetting"]["estimated_corner_stops"], m["vignetting"]["true_corner_stops"],
-            grey, m["grey_worst_stops"]))
+            grey, m["grey_worst_stops"], m["reference"]["worst_stops"]))
     notes = []
     for m in rows:
         for k, b in m["balls"].items():

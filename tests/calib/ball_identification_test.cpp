@@ -67,6 +67,22 @@ bool visible(const testing::RenderedView& v, int ball) {
   return angle_between(a, b) > 0.7 * (ra + rb) || a.norm() < b.norm();
 }
 
+// The views as the cross-view stage sees them, with the true rotations and (where it shows) the
+// true chrome ball as the anchor.
+std::vector<ViewBalls> with_true_rotations(const Views& r) {
+  std::vector<ViewBalls> vb;
+  for (std::size_t i = 0; i < r.views.size(); ++i) {
+    ViewBalls v;
+    v.name = "view" + std::to_string(i);
+    v.candidates = r.candidates[i];
+    v.world_from_cam = r.views[i].pose.world_from_cam;
+    const Vec3 c = testing::ball_centre_cam(r.views[i], 0);
+    if (visible(r.views[i], 0)) v.chrome = BallCone{c.normalized(), std::asin(0.05 / c.norm())};
+    vb.push_back(v);
+  }
+  return vb;
+}
+
 // Per view, without the rotations: the chrome ball as the orientation step picks it is the true
 // chrome ball in every view where it shows.
 TEST(BallIdentification, TheChromeBallIsFoundAmongBackgroundCirclesInEveryView) {
@@ -94,16 +110,7 @@ TEST(BallIdentification, TheChromeBallIsFoundAmongBackgroundCirclesInEveryView) 
 TEST(BallIdentification, AcrossViewsEveryBallIsFoundAndNothingElseIsTaken) {
   if (!fs::exists(kLobby)) GTEST_SKIP() << kLobby << " missing (scripts/fetch-assets.sh)";
   const Views& r = rendered();
-  std::vector<ViewBalls> vb;
-  for (std::size_t i = 0; i < r.views.size(); ++i) {
-    ViewBalls v;
-    v.name = "view" + std::to_string(i);
-    v.candidates = r.candidates[i];
-    v.world_from_cam = r.views[i].pose.world_from_cam;
-    const Vec3 c = testing::ball_centre_cam(r.views[i], 0);
-    if (visible(r.views[i], 0)) v.chrome = BallCone{c.normalized(), std::asin(0.05 / c.norm())};
-    vb.push_back(v);
-  }
+  const std::vector<ViewBalls> vb = with_true_rotations(r);
   const std::vector<RigMember> rig = fit_ball_rig(vb, r.listed);
   ASSERT_TRUE(rig[1].known);
   EXPECT_TRUE(rig[1].scale_given);
@@ -146,15 +153,7 @@ TEST(BallIdentification, AcrossViewsEveryBallIsFoundAndNothingElseIsTaken) {
 TEST(BallIdentification, WithoutDiametersTheRigEstimatesTheBallsRelativeSize) {
   if (!fs::exists(kLobby)) GTEST_SKIP() << kLobby << " missing (scripts/fetch-assets.sh)";
   const Views& r = rendered();
-  std::vector<ViewBalls> vb;
-  for (std::size_t i = 0; i < r.views.size(); ++i) {
-    ViewBalls v;
-    v.candidates = r.candidates[i];
-    v.world_from_cam = r.views[i].pose.world_from_cam;
-    const Vec3 c = testing::ball_centre_cam(r.views[i], 0);
-    if (visible(r.views[i], 0)) v.chrome = BallCone{c.normalized(), std::asin(0.05 / c.norm())};
-    vb.push_back(v);
-  }
+  const std::vector<ViewBalls> vb = with_true_rotations(r);
   const std::vector<ListedBall> listed = {{"chrome", BallKind::chrome, {}}, {"grey", BallKind::grey, {}}};
   const std::vector<RigMember> rig = fit_ball_rig(vb, listed);
   ASSERT_TRUE(rig[1].known);

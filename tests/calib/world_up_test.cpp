@@ -99,14 +99,20 @@ TEST(WorldUp, UncertaintyGrowsWithTheRollScatter) {
   EXPECT_GT(large.roll_sigma_deg, 2 * small.roll_sigma_deg);
 }
 
-// Cameras all on one side (x axes parallel) cannot fix the tilt about that axis: the upright prior
-// (the cameras' mean -y) decides it, and the sigma says so.
-TEST(WorldUp, ViewsFromOneSideFallBackToTheUprightPriorAndSayItIsUncertain) {
+// Three cameras looking along -Z, aimed 15 degrees down, 2 degrees apart in azimuth.
+std::vector<Mat3> from_one_side() {
   std::vector<Mat3> r;
   for (double yaw : {-2.0, 0.0, 2.0})
     r.push_back(Eigen::AngleAxisd(yaw * kDeg, Vec3::UnitY()).toRotationMatrix() *
                 Eigen::AngleAxisd(-15 * kDeg, Vec3::UnitX()).toRotationMatrix() *
                 (Mat3() << 1, 0, 0, 0, -1, 0, 0, 0, -1).finished());
+  return r;
+}
+
+// Cameras all on one side (x axes parallel) cannot fix the tilt about that axis: the upright prior
+// (the cameras' mean -y) decides it, and the sigma says so.
+TEST(WorldUp, ViewsFromOneSideFallBackToTheUprightPriorAndSayItIsUncertain) {
+  const std::vector<Mat3> r = from_one_side();
   const WorldUp w = estimate_world_up(r);
   EXPECT_TRUE(w.up.allFinite());
   EXPECT_GT(w.sigma_deg, 5.0);
@@ -115,11 +121,7 @@ TEST(WorldUp, ViewsFromOneSideFallBackToTheUprightPriorAndSayItIsUncertain) {
 
 // A vertical line (the stand) fixes up where the rolls cannot; its plane normals are exact here.
 TEST(WorldUp, AVerticalLineAddsWhatTheRollsCannotFix) {
-  std::vector<Mat3> r;
-  for (double yaw : {-2.0, 0.0, 2.0})
-    r.push_back(Eigen::AngleAxisd(yaw * kDeg, Vec3::UnitY()).toRotationMatrix() *
-                Eigen::AngleAxisd(-15 * kDeg, Vec3::UnitX()).toRotationMatrix() *
-                (Mat3() << 1, 0, 0, 0, -1, 0, 0, 0, -1).finished());
+  const std::vector<Mat3> r = from_one_side();
   // A plane containing +Y seen by the views: normal (0, 0, 1) (the line through the ball, in x = 0).
   const WorldUp w = estimate_world_up(r, {{Vec3(0, 0, 1), 0.2, "stand"}});
   EXPECT_LT(angle_between(w.up, Vec3(0, 1, 0)) / kDeg, 0.01);
