@@ -17,9 +17,11 @@
 #include "pipeline/step_record.h"
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <unistd.h>
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -154,6 +156,17 @@ TEST_F(ProcessEndToEnd, ACopiedRunFolderResumesWithoutRedoingAStep) {
   EXPECT_TRUE(ran["bake"]);
   EXPECT_FALSE(ran["extract"]);
   for (const StepOutcome& s : run_process(options()).steps) EXPECT_FALSE(s.ran) << s.step;
+  // --ball VIEW:BALL=X,Y,R (a rough guess, 3 px and 10% off the truth) overrides that detection.
+  const YAML::Node truth = YAML::LoadFile((root_ / "syn" / "truth" / "truth.yaml").string());
+  const YAML::Node grey = truth["views"][1]["balls"][1];
+  ASSERT_EQ(grey["name"].as<std::string>(), "grey");
+  const double x = grey["centre_px"][0].as<double>(), y = grey["centre_px"][1].as<double>();
+  const double r = 700 * 0.05 / grey["distance_m"].as<double>();
+  o.ball_overrides = {"view01:grey=" + std::to_string(x + 3) + "," + std::to_string(y - 2) + "," + std::to_string(1.1 * r)};
+  const ProcessResult given = run_process(o);
+  const auto& balls = given.summary["extract"]["views"][1]["balls"];
+  EXPECT_EQ(balls[1]["status"], "given");
+  EXPECT_LT(std::hypot(balls[1]["centre_px"][0].get<double>() - x, balls[1]["centre_px"][1].get<double>() - y), 1.0);
 }
 
 // Truth poses carry no balls: the orient step refines each view's chrome ball with the rotations
