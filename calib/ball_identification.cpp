@@ -522,6 +522,30 @@ std::vector<RigMember> fit_ball_rig(const std::vector<ViewBalls>& views, const s
   return rig;
 }
 
+BallLocation refit_outline_excluding(const BallLocation& ball, const LensModel& lens, const std::vector<BallLocation>& others) {
+  std::vector<Vec3> rays;
+  std::vector<Vec2> kept;
+  for (const Vec2& p : ball.outline_px) {
+    bool on_other = false;
+    for (const BallLocation& o : others) on_other |= (p - o.centre_px).norm() <= o.radius_px + std::max(2.0, 0.05 * o.radius_px);
+    if (!on_other) rays.push_back(lens.unproject(p)), kept.push_back(p);
+  }
+  if (kept.size() == ball.outline_px.size() || kept.size() < 16) return ball;
+  BallLocation out = ball;
+  try {
+    out.fit = fit_cone(rays, lens);
+  } catch (const std::invalid_argument&) {
+    return ball;
+  }
+  out.outline_px = kept;
+  out.centre_px = lens.project(out.fit.cone.axis);
+  double sum = 0;
+  const std::vector<Vec2> outline = cone_outline(out.fit.cone, lens, 64);
+  for (const Vec2& q : outline) sum += (q - out.centre_px).norm();
+  out.radius_px = sum / double(outline.size());
+  return out;
+}
+
 BallCandidate given_ball(const cv::Mat& image, const LensModel& lens, const BallGuess& guess) {
   return measure_ball(image, lens, locate_ball(image, lens, guess));
 }

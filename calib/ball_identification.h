@@ -138,6 +138,10 @@ std::vector<BallFinding> identify_view_balls(const ViewBalls& view, const std::v
 // The cone of a ball at `offset` (world, chrome radii) and radius `scale` from the chrome cone of a view.
 BallCone predicted_cone(const BallCone& chrome, const Mat3& world_from_cam, const Vec3& offset, double scale);
 
+// The ball's cone fitted again without its outline points on or inside `others` (balls in front of
+// it, whose edges are not its own): the located ball unchanged when no point goes or too few stay.
+BallLocation refit_outline_excluding(const BallLocation& ball, const LensModel& lens, const std::vector<BallLocation>& others);
+
 // A ball given by hand: located at the guess (calib/ball_locator.h) and measured.
 BallCandidate given_ball(const cv::Mat& image, const LensModel& lens, const BallGuess& guess);
 

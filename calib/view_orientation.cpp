@@ -44,11 +44,11 @@ Mat3 gauge_world_from_first_cam(const std::optional<Vec3>& up) {
   return cam_from_world.transpose();
 }
 
-WorldUp level_pose_set(PoseSet& poses, const WorldUpOptions& options) {
+WorldUp level_pose_set(PoseSet& poses, const WorldUpOptions& options, const std::vector<VerticalLine>& lines) {
   if (poses.views.empty()) throw std::invalid_argument("level: no views");
   std::vector<Mat3> r;
   for (const ViewPose& v : poses.views) r.push_back(v.world_from_cam);
-  WorldUp wu = estimate_world_up(r, {}, options);
+  WorldUp wu = estimate_world_up(r, lines, options);
   // Up in the first camera's frame; the new world from the first camera is the gauge's.
   const Mat3 first_from_world = r.front().transpose();
   wu.up = (first_from_world * wu.up).normalized();
@@ -65,14 +65,39 @@ BallCone extraction_cone(const BallLocation& located, const ViewPose& pose, cons
 }
 
 std::optional<BallCandidate> find_chrome_ball(const cv::Mat& image, const LensModel& lens,
-                                              const std::vector<ListedBall>& listed, const BallSearchOptions& search) {
+                                              const std::vector<ListedBall>& listed, const BallSearchOptions& search,
+                                              std::vector<BallLocation>* overlapping) {
   const std::vector<ListedBall> balls = listed.empty() ? std::vector<ListedBall>{{"chrome", BallKind::chrome, {}}} : listed;
   const std::vector<BallCandidate> cands = find_ball_candidates(image, lens, search);
   const std::vector<int> pick = assign_balls_in_view(cands, balls);
   for (std::size_t b = 0; b < balls.size(); ++b)
-    if (balls[b].kind == BallKind::chrome && pick[b] >= 0) return cands[std::size_t(pick[b])];
+    if (balls[b].kind == BallKind::chrome && pick[b] >= 0) {
+      const BallCandidate& chrome = cands[std::size_t(pick[b])];
+      if (overlapping)
+        for (std::size_t k = 0; k < cands.size(); ++k) {
+          const BallLocation& o = cands[k].loc;
+          if (int(k) != pick[b] && (o.centre_px - chrome.loc.centre_px).norm() < o.radius_px + chrome.loc.radius_px &&
+              o.radius_px > 0.5 * chrome.loc.radius_px && o.radius_px < 2 * chrome.loc.radius_px)
+            overlapping->push_back(o);
+        }
+      return chrome;
+    }
   return std::nullopt;
 }
+
+namespace {
+
+// `flags` with the clipped bit set over the discs of `balls` (another ball in front of the chrome
+// one shows itself, not the world: its pixels must give no features).
+cv::Mat masked_flags(const cv::Mat& flags, const cv::Size& size, const std::vector<BallLocation>& balls) {
+  cv::Mat out = flags.empty() ? cv::Mat::zeros(size, CV_8UC1) : flags.clone();
+  for (const BallLocation& b : balls)
+    cv::circle(out, cv::Point(int(std::lround(b.centre_px.x())), int(std::lround(b.centre_px.y()))),
+               int(std::ceil(b.radius_px + std::max(2.0, 0.05 * b.radius_px))), cv::Scalar(1), cv::FILLED);
+  return out;
+}
+
+}  // namespace
 
 PoseSet orient_views(const std::vector<std::string>& all_names, const std::vector<ViewImage>& all_views, const LensModel& lens,
                      const ViewOrientationOptions& options, ViewOrientationReport* report) {
@@ -99,6 +124,7 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
                                   " float RGB expected of the lens model's size " + std::to_string(lens.width()) + "x" +
                                   std::to_string(lens.height()));
     std::optional<BallCandidate> found;
+    std::vector<BallLocation> overlapping;
     const std::optional<BallGuess> guess = !options.given_chrome.empty() && options.given_chrome[v]
                                                ? options.given_chrome[v]
                                                : (!options.balls.empty() ? std::optional<BallGuess>(options.balls[v]) : std::nullopt);
@@ -109,15 +135,19 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
         throw std::invalid_argument(all_names[v] + ": no ball found (" + e.what() + ")");
       }
     } else {
-      found = find_chrome_ball(img, lens, options.listed, options.search);
+      found = find_chrome_ball(img, lens, options.listed, options.search, &overlapping);
     }
     if (!found) {
       rep.left_out.push_back(all_names[v] + ": no chrome ball found (no candidate with a clean outline that looks like a mirror)");
       continue;
     }
+    // Another ball overlapping the chrome one may be in front: its edge is no part of the chrome
+    // ball's outline.
+    if (!overlapping.empty()) found->loc = refit_outline_excluding(found->loc, lens, overlapping);
     const BallLocation& loc = found->loc;
     if (options.domain == FeatureDomain::cube) {
-      sets.push_back(ball_cube_feature_set(img, all_views[v].flags, lens, loc.fit.cone, options.features, options.cube));
+      const cv::Mat flags = overlapping.empty() ? all_views[v].flags : masked_flags(all_views[v].flags, img.size(), overlapping);
+      sets.push_back(ball_cube_feature_set(img, flags, lens, loc.fit.cone, options.features, options.cube));
       feats.push_back(sets.back().features);
       if (!options.refine_tracks) sets.back().faces.clear();
     } else {
@@ -239,8 +269,20 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
     out.views.push_back({names[v], s.world_from_cam[v], s.sigma_deg[v], std::nullopt});
     if (options.refine_balls) out.views.back().ball = rep.balls[v].fit.cone;
   }
-  // The solve's world is the first oriented camera's frame: levelled by the estimated up.
-  if (known.empty() && !options.up && options.estimate_up) rep.world_up = level_pose_set(out, options.up_options);
+  // The solve's world is the first oriented camera's frame: levelled by the estimated up, with the
+  // stands under the chrome balls as vertical lines where they show.
+  if (known.empty() && !options.up && options.estimate_up) {
+    std::vector<VerticalLine> lines;
+    for (std::size_t v = 0; v < n && options.stand_lines; ++v) {
+      const std::size_t i = std::size_t(std::find(all_names.begin(), all_names.end(), names[v]) - all_names.begin());
+      if (const auto line = find_stand_line(all_views[i].radiance, lens, rep.balls[v].fit.cone, options.stand))
+        lines.push_back({s.world_from_cam[v] * line->plane_normal, line->sigma_deg, names[v] + ": stand"});
+    }
+    // One stand seen from every view: its tilt is common to all its lines.
+    for (VerticalLine& l : lines)
+      l.sigma_deg = std::max(l.sigma_deg, options.stand.verticality_deg * std::sqrt(double(lines.size())));
+    rep.world_up = level_pose_set(out, options.up_options, lines);
+  }
   if (report) *report = rep;
   return out;
 }

@@ -22,6 +22,7 @@
 #include "calib/ball_locator.h"
 #include "calib/orientation_solve.h"
 #include "calib/pose_file.h"
+#include "calib/stand_line.h"
 #include "calib/track_refinement.h"
 #include "calib/view_image.h"
 #include "calib/world_up.h"
@@ -45,6 +46,8 @@ struct ViewOrientationOptions {
   std::optional<Vec3> up;              // camera frame of the first view; none: the first-view gauge
   bool estimate_up = false;            // without `up`: estimated from the views (gauge "estimated-up")
   WorldUpOptions up_options;
+  bool stand_lines = true;             // with estimate_up: the stand under each chrome ball as a vertical line (calib/stand_line.h)
+  StandLineOptions stand;
   std::vector<BallGuess> balls;        // per view, or empty: detected
   std::vector<std::optional<BallGuess>> given_chrome;  // per view or empty: a given chrome ball (--ball)
   std::vector<ListedBall> listed;      // the photo set's balls (empty: one chrome ball)
@@ -92,11 +95,12 @@ struct ViewOrientationReport {
 // std::invalid_argument for a zero or non-finite up.
 Mat3 gauge_world_from_first_cam(const std::optional<Vec3>& up);
 
-// Levels a pose set: world up estimated from its rotations (calib/world_up.h) and the world turned
+// Levels a pose set: world up estimated from its rotations and `lines` (world frame of the set;
+// calib/world_up.h), and the world turned
 // so that it is +Y and the first view's forward axis, made horizontal, is +Z (the "up" gauge with
 // the estimated up); gauge becomes "estimated-up". Returns the estimate, up in the first view's
 // camera frame. Throws std::invalid_argument for an empty set.
-WorldUp level_pose_set(PoseSet& poses, const WorldUpOptions& options = {});
+WorldUp level_pose_set(PoseSet& poses, const WorldUpOptions& options = {}, const std::vector<VerticalLine>& lines = {});
 
 // The cone to extract a located ball with: the pose's refined chrome ball (ViewPose::ball) when it is
 // the same ball (its centre's pixel within half the located radius of the located centre), else the
@@ -104,9 +108,11 @@ WorldUp level_pose_set(PoseSet& poses, const WorldUpOptions& options = {});
 BallCone extraction_cone(const BallLocation& located, const ViewPose& pose, const LensModel& lens);
 
 // The chrome ball of one view: candidates (calib/ball_identification.h) matched to the listed balls;
-// nullopt when none looks like a chrome ball.
+// nullopt when none looks like a chrome ball. `overlapping`, when given, gets the ball-sized
+// candidates whose discs overlap it (their pixels give no features: one may be in front).
 std::optional<BallCandidate> find_chrome_ball(const cv::Mat& image, const LensModel& lens,
-                                              const std::vector<ListedBall>& listed, const BallSearchOptions& search);
+                                              const std::vector<ListedBall>& listed, const BallSearchOptions& search,
+                                              std::vector<BallLocation>* overlapping = nullptr);
 
 // `names` and `views` parallel, >= 2 views, all of the lens's size. Throws std::invalid_argument
 // with a message naming the view ("<name>: no ball found", "orient: view '<name>' shares 0

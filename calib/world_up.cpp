@@ -18,7 +18,8 @@ struct Solve {
 };
 
 Solve gauss_newton(const std::vector<Vec3>& x, const std::vector<double>& weight, double sigma_roll,
-                   const std::vector<VerticalLine>& lines, const Vec3& u0, double sigma_prior, Vec3 u) {
+                   const std::vector<VerticalLine>& lines, const std::vector<double>& line_weight, const Vec3& u0,
+                   double sigma_prior, Vec3 u) {
   Eigen::Matrix2d jtj = Eigen::Matrix2d::Identity();
   for (int it = 0; it < 20; ++it) {
     const Vec3 t1 = u.unitOrthogonal(), t2 = u.cross(t1);
@@ -30,9 +31,9 @@ Solve gauss_newton(const std::vector<Vec3>& x, const std::vector<double>& weight
       jtr += w * j * r;
     };
     for (std::size_t i = 0; i < x.size(); ++i) add(x[i], sigma_roll, x[i].dot(u) / sigma_roll, weight[i]);
-    for (const VerticalLine& l : lines) {
-      const double s = l.sigma_deg * kDeg;
-      add(l.plane_normal, s, l.plane_normal.dot(u) / s);
+    for (std::size_t j = 0; j < lines.size(); ++j) {
+      const double s = lines[j].sigma_deg * kDeg;
+      add(lines[j].plane_normal, s, lines[j].plane_normal.dot(u) / s, line_weight[j]);
     }
     // Prior on the tangent components of u - u0.
     const Vec3 d = u - u0;
@@ -70,8 +71,8 @@ WorldUp estimate_world_up(const std::vector<Mat3>& world_from_cam, const std::ve
   Vec3 start = eig.eigenvectors().col(0);
   if (start.dot(u0) < 0) start = -start;
   const double sigma_prior = o.prior_sigma_deg * kDeg;
-  std::vector<double> weight(x.size(), 1.0);
-  Solve sol = gauss_newton(x, weight, sigma_roll, lines, u0, sigma_prior, start);
+  std::vector<double> weight(x.size(), 1.0), line_weight(lines.size(), 1.0);
+  Solve sol = gauss_newton(x, weight, sigma_roll, lines, line_weight, u0, sigma_prior, start);
   WorldUp out;
   if (x.size() >= 4) {
     // The roll scatter from the residuals (robustly: 1.4826 MAD), and Cauchy weights at 2.5 of it,
@@ -86,9 +87,17 @@ WorldUp estimate_world_up(const std::vector<Mat3>& world_from_cam, const std::ve
       const double mad = 1.4826 * sorted[sorted.size() / 2] * std::sqrt(double(x.size()) / double(x.size() - 2));
       sigma_roll = std::max(mad, o.min_roll_sigma_deg * kDeg);
       for (std::size_t i = 0; i < x.size(); ++i) weight[i] = 1 / (1 + std::pow(a[i] / (2.5 * sigma_roll), 2));
-      sol = gauss_newton(x, weight, sigma_roll, lines, u0, sigma_prior, sol.u);
+      for (std::size_t j = 0; j < lines.size(); ++j)
+        line_weight[j] = 1 / (1 + std::pow(lines[j].plane_normal.dot(sol.u) / (3 * lines[j].sigma_deg * kDeg), 2));
+      sol = gauss_newton(x, weight, sigma_roll, lines, line_weight, u0, sigma_prior, sol.u);
     }
     out.roll_sigma_estimated = true;
+  } else if (!lines.empty()) {
+    for (int it = 0; it < 4; ++it) {
+      for (std::size_t j = 0; j < lines.size(); ++j)
+        line_weight[j] = 1 / (1 + std::pow(lines[j].plane_normal.dot(sol.u) / (3 * lines[j].sigma_deg * kDeg), 2));
+      sol = gauss_newton(x, weight, sigma_roll, lines, line_weight, u0, sigma_prior, sol.u);
+    }
   }
   out.up = sol.u;
   out.roll_sigma_deg = sigma_roll / kDeg;

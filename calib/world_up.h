@@ -15,7 +15,8 @@
 // the cameras' roll scatter: with at least 4 cameras, 1.4826 times the median |asin(x_i . u)|
 // (scaled for the n - 2 degrees of freedom), never below `min_roll_sigma_deg`, and each camera
 // weighted by a Cauchy loss at 2.5 sigma_roll (a camera turned about its own tilted axis, its x
-// out of the horizontal, does not pull the others); else `roll_sigma_deg`, unweighted. The std dev
+// out of the horizontal, does not pull the others); else `roll_sigma_deg`, unweighted. Lines are
+// Cauchy-weighted at 3 of their own sigmas (a line that is not vertical gives way). The std dev
 // of u (degrees, both tangent axes together) is from the inverse of the weighted normal equations.
 // Frames: whatever frame the rotations are in (the orientation solve's), u in that frame.
 #pragma once

@@ -301,13 +301,13 @@ void step_orient(Context& c) {
   const std::vector<ListedBall> listed = listed_balls(c.set);
   std::vector<std::optional<BallGuess>> given_chrome;
   nlohmann::json chrome_overrides = nlohmann::json::array();
+  // The chrome ball given by hand in a view (the first listed chrome ball's --ball).
   for (const PhotoView& v : c.set.views) {
-    given_chrome.push_back(std::nullopt);
+    std::optional<BallGuess> g;
     for (const BallSpec& b : c.set.balls)
-      if (b.kind == BallKind::chrome && !given_chrome.back())
-        if ((given_chrome.back() = find_override(overrides, v.name, b.name)))
-          chrome_overrides.push_back({v.name, given_chrome.back()->centre_px.x(), given_chrome.back()->centre_px.y(),
-                                      given_chrome.back()->radius_px});
+      if (b.kind == BallKind::chrome && !g) g = find_override(overrides, v.name, b.name);
+    if (g) chrome_overrides.push_back({v.name, g->centre_px.x(), g->centre_px.y(), g->radius_px});
+    given_chrome.push_back(g);
   }
   nlohmann::json balls = nlohmann::json::array();
   for (const BallSpec& b : c.set.balls) balls.push_back({b.name, to_string(b.kind), b.diameter_m.value_or(0.0)});
