@@ -182,7 +182,8 @@ BallLocation locate_ball(const cv::Mat& image, const LensModel& lens, const Ball
   return loc;
 }
 
-std::vector<BallGuess> detect_balls(const cv::Mat& image, double min_radius_px, double max_radius_px, int max_count) {
+std::vector<BallGuess> detect_balls(const cv::Mat& image, double min_radius_px, double max_radius_px, int max_count,
+                                    int per_band) {
   const cv::Mat lum = luminance(image);
   // Tone map: log luminance stretched between its 1st and 99th percentiles to 8 bits.
   cv::Mat lg;
@@ -194,13 +195,23 @@ std::vector<BallGuess> detect_balls(const cv::Mat& image, double min_radius_px, 
   cv::Mat u8;
   lg.convertTo(u8, CV_8U, 255.0 / std::max(hi - lo, 1e-6), -lo * 255.0 / std::max(hi - lo, 1e-6));
   cv::GaussianBlur(u8, u8, cv::Size(5, 5), 1.2);
-  std::vector<cv::Vec3f> circles;
-  cv::HoughCircles(u8, circles, cv::HOUGH_GRADIENT, 1.0, std::max(2.0 * min_radius_px, 4.0), 100, 20,
-                   static_cast<int>(std::floor(min_radius_px)), static_cast<int>(std::ceil(max_radius_px)));
+  std::vector<std::pair<double, double>> bands;
+  if (per_band > 0) {
+    for (double r0 = min_radius_px; r0 < max_radius_px; r0 *= 2) bands.push_back({r0, std::min(2.1 * r0, max_radius_px)});
+  } else {
+    bands.push_back({min_radius_px, max_radius_px});
+  }
   std::vector<BallGuess> out;
-  for (const auto& c : circles) {
-    if (static_cast<int>(out.size()) >= max_count) break;
-    out.push_back({Vec2(c[0], c[1]), c[2]});
+  for (const auto& [r0, r1] : bands) {
+    std::vector<cv::Vec3f> circles;
+    cv::HoughCircles(u8, circles, cv::HOUGH_GRADIENT, 1.0, std::max(2.0 * r0, 4.0), 100, 20,
+                     static_cast<int>(std::floor(r0)), static_cast<int>(std::ceil(r1)));
+    int kept = 0;
+    for (const auto& c : circles) {
+      if (static_cast<int>(out.size()) >= max_count || (per_band > 0 && kept >= per_band)) break;
+      out.push_back({Vec2(c[0], c[1]), c[2]});
+      ++kept;
+    }
   }
   return out;
 }

@@ -48,6 +48,10 @@ BallLocation locate_ball(const cv::Mat& image, const LensModel& lens, const Ball
 
 // Candidate balls (strongest first, at most `max_count`) from a Hough circle transform of the
 // tone-mapped log luminance, with radii in [min_radius_px, max_radius_px]: guesses for locate_ball.
-std::vector<BallGuess> detect_balls(const cv::Mat& image, double min_radius_px, double max_radius_px, int max_count);
+// With per_band > 0 the range is split into bands a factor 2 apart and each band keeps its
+// per_band strongest circles (band by band, smallest radii first; max_count then caps the total),
+// so large background circles cannot crowd out a ball's.
+std::vector<BallGuess> detect_balls(const cv::Mat& image, double min_radius_px, double max_radius_px, int max_count,
+                                    int per_band = 0);
 
 }  // namespace rsibr

@@ -47,6 +47,9 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
         throw std::invalid_argument("orientation: invalid ball prior");
   }
   for (const auto& o : obs) seen[o.view][o.feature] = o.direction;
+  const bool fixed = !options.fixed_world_from_cam.empty();
+  if (fixed && static_cast<int>(options.fixed_world_from_cam.size()) != views)
+    throw std::invalid_argument("orientation: fixed rotations must be given for every view or none");
 
   // Start: place views one by one against the world directions known so far (view 0 is the gauge).
   std::vector<Mat3> r(views, Mat3::Identity());
@@ -58,23 +61,40 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
     for (const auto& [f, o] : seen[v]) sum[f] += r[v] * o;
   };
   add_view(0);
+  if (fixed) {
+    r = options.fixed_world_from_cam;
+    std::fill(sum.begin(), sum.end(), Vec3::Zero());
+    for (int v = 0; v < views; ++v) placed[v] = 1, add_view(v);
+  }
   std::mt19937_64 rng(options.seed);
   const double cos_in = std::cos(options.inlier_deg * kPi / 180);
-  for (int round = 1; round < views; ++round) {
+  std::vector<char> dropped(views, 0);
+  std::vector<std::string> left_out(views);
+  for (int round = 1; round < views && !fixed; ++round) {
     // The unplaced view sharing the most features with the placed ones.
     int best_v = -1;
     std::vector<int> best_shared;
     for (int v = 0; v < views; ++v) {
-      if (placed[v]) continue;
+      if (placed[v] || dropped[v]) continue;
       std::vector<int> shared;
       for (const auto& [f, o] : seen[v])
         if (sum[f].squaredNorm() > 0) shared.push_back(f);
       if (best_v < 0 || shared.size() > best_shared.size()) best_v = v, best_shared = shared;
     }
-    if (best_shared.size() < 3)
-      throw std::invalid_argument("orientation: view " + std::to_string(best_v) + " shares " +
-                                  std::to_string(best_shared.size()) +
-                                  " feature(s) with the other views; need at least 3 to orient it");
+    if (best_v < 0) break;
+    if (best_shared.size() < 3) {
+      const std::string why = "orientation: view " + std::to_string(best_v) + " shares " +
+                              std::to_string(best_shared.size()) +
+                              " feature(s) with the other views; need at least 3 to orient it";
+      if (!options.leave_out_unplaced) throw std::invalid_argument(why);
+      // The view sharing the most cannot be placed: neither can the rest.
+      for (int v = 0; v < views; ++v)
+        if (!placed[v] && !dropped[v]) {
+          dropped[v] = 1;
+          left_out[v] = "shares fewer than 3 features with the oriented views";
+        }
+      break;
+    }
     const int v = best_v;
     std::vector<Vec3> a, b;
     for (int f : best_shared) a.push_back(seen[v].at(f)), b.push_back(sum[f].normalized());
@@ -89,9 +109,13 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
         if ((rr * a[k]).dot(b[k]) > cos_in) in.push_back(k);
       if (in.size() > best_in.size()) best_in = in;
     }
-    if (best_in.size() < 3)
-      throw std::invalid_argument("orientation: view " + std::to_string(v) +
-                                  ": no rotation agrees with 3 or more shared features");
+    if (best_in.size() < 3) {
+      const std::string why = "no rotation agrees with 3 or more shared features";
+      if (!options.leave_out_unplaced) throw std::invalid_argument("orientation: view " + std::to_string(v) + ": " + why);
+      dropped[v] = 1;
+      left_out[v] = why;
+      continue;
+    }
     std::vector<Vec3> ai, bi;
     for (int k : best_in) ai.push_back(a[k]), bi.push_back(b[k]);
     r[v] = kabsch(ai, bi);
@@ -111,6 +135,7 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
   std::vector<double> sines;
   for (const BallPrior& b : options.balls) axes.push_back(b.axis), sines.push_back(std::sin(b.half_angle));
   for (const auto& o : obs) {
+    if (dropped[o.view]) continue;
     if (refine_balls && o.ray.squaredNorm() > 0) {
       auto* cost = new ceres::AutoDiffCostFunction<BallReflectionResidual, 3, 4, 3, 1, 3>(
           new BallReflectionResidual(o.ray.normalized(), o.sigma));
@@ -136,10 +161,13 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
       problem.SetParameterBlockConstant(&sines[v]);
     }
   }
-  for (int v = 0; v < views; ++v) problem.SetManifold(q[v].coeffs().data(), new ceres::EigenQuaternionManifold);
+  for (int v = 0; v < views; ++v)
+    if (problem.HasParameterBlock(q[v].coeffs().data()))
+      problem.SetManifold(q[v].coeffs().data(), new ceres::EigenQuaternionManifold);
   for (int f = 0; f < features; ++f)
     if (problem.HasParameterBlock(d[f].data())) problem.SetManifold(d[f].data(), new ceres::SphereManifold<3>);
-  problem.SetParameterBlockConstant(q[0].coeffs().data());
+  for (int v = 0; v < (fixed ? views : 1); ++v)
+    if (problem.HasParameterBlock(q[v].coeffs().data())) problem.SetParameterBlockConstant(q[v].coeffs().data());
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::SPARSE_SCHUR;
   so.max_num_iterations = 100;
@@ -151,6 +179,8 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
   if (!summary.IsSolutionUsable()) throw std::runtime_error("orientation: Ceres failed: " + summary.message);
 
   OrientationSolution out;
+  for (int v = 0; v < views; ++v) out.oriented.push_back(dropped[v] ? 0 : 1);
+  out.left_out = left_out;
   out.world_from_cam.resize(views);
   for (int v = 0; v < views; ++v) out.world_from_cam[v] = q[v].normalized().toRotationMatrix();
   out.feature_directions = d;
@@ -159,6 +189,7 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
   for (double sv : sines) out.ball_half_angles.push_back(std::asin(sv));
   double sum2 = 0;
   for (const auto& o : obs) {
+    if (dropped[o.view]) continue;
     const Vec3 dir = refine_balls && o.ray.squaredNorm() > 0
                          ? reflect_off_ball<double>(o.ray.normalized(), axes[o.view], sines[o.view]).normalized()
                          : o.direction;
@@ -168,22 +199,26 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
   }
   out.rms_sigmas = out.inliers ? std::sqrt(sum2 / out.inliers) : 0;
 
+  out.sigma_deg.assign(views, 0.0);
+  if (fixed) return out;
   // Covariance of each free view's rotation, in the manifold's tangent space (3 x 3).
   ceres::Covariance::Options co;
   co.algorithm_type = ceres::SPARSE_QR;
   co.num_threads = 1;
   ceres::Covariance cov(co);
   std::vector<std::pair<const double*, const double*>> blocks;
-  for (int v = 1; v < views; ++v) blocks.emplace_back(q[v].coeffs().data(), q[v].coeffs().data());
-  out.sigma_deg.assign(views, 0.0);
+  for (int v = 1; v < views; ++v)
+    if (!dropped[v]) blocks.emplace_back(q[v].coeffs().data(), q[v].coeffs().data());
   if (cov.Compute(blocks, &problem)) {
     for (int v = 1; v < views; ++v) {
+      if (dropped[v]) continue;
       double c[9];  // 3 x 3, row-major
       cov.GetCovarianceBlockInTangentSpace(q[v].coeffs().data(), q[v].coeffs().data(), c);
       out.sigma_deg[v] = 2 * std::sqrt(std::max(0.0, c[0] + c[4] + c[8])) * 180 / kPi;
     }
   } else {
-    for (int v = 1; v < views; ++v) out.sigma_deg[v] = std::numeric_limits<double>::infinity();
+    for (int v = 1; v < views; ++v)
+      if (!dropped[v]) out.sigma_deg[v] = std::numeric_limits<double>::infinity();
   }
   return out;
 }

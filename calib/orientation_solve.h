@@ -57,10 +57,18 @@ struct OrientationOptions {
   // (s_v - sin half_angle) / (sigma_half_angle cos half_angle)): an outline found a pixel inside the
   // limb scales the rim's directions radially, which no rotation absorbs.
   std::vector<BallPrior> balls;
+  // Per view, or empty: the rotations are known (a pose file) and held at these; the solve then
+  // refines only the feature directions and, with `balls`, the balls (sigma_deg is 0 for every view).
+  std::vector<Mat3> fixed_world_from_cam;
+  // A view that cannot be placed (fewer than 3 features shared with the placed views, or no
+  // rotation agreeing with 3) is left out (OrientationSolution::oriented) instead of an error.
+  bool leave_out_unplaced = false;
 };
 
 struct OrientationSolution {
-  std::vector<Mat3> world_from_cam;     // per view
+  std::vector<char> oriented;           // per view: 1, or 0 when left out (leave_out_unplaced)
+  std::vector<std::string> left_out;    // per view: why it was left out ("" when oriented)
+  std::vector<Mat3> world_from_cam;     // per view (identity for a view left out)
   std::vector<double> sigma_deg;        // per view: rotation std dev, all axes together (0 for the gauge view)
   std::vector<Vec3> feature_directions; // per feature, world, unit (zero for unobserved features)
   std::vector<Vec3> ball_axes;          // per view, the refined ball axes (camera frame; with balls only)

@@ -27,7 +27,8 @@ Mat3 checked_rotation(const Mat3& m, const std::string& key) {
 }
 
 void check(const PoseSet& p) {
-  if (p.gauge != "first-view" && p.gauge != "up") spec_fail("poses.gauge", "expected first-view or up, got '" + p.gauge + "'");
+  if (p.gauge != "first-view" && p.gauge != "up" && p.gauge != "estimated-up")
+    spec_fail("poses.gauge", "expected first-view, up or estimated-up, got '" + p.gauge + "'");
   if (p.views.empty()) spec_fail("poses.views", "expected a non-empty sequence");
   DistinctNames names;
   for (std::size_t i = 0; i < p.views.size(); ++i) {
@@ -59,7 +60,7 @@ PoseSet read_pose_file(const std::string& path) {
     YamlMap top(root, "poses", {"rsibr_poses", "gauge", "views"});
     if (top.integer("rsibr_poses") != 1) spec_fail(top.at("rsibr_poses"), "unsupported version (expected 1)");
     PoseSet p;
-    p.gauge = top.choice("gauge", {"first-view", "up"});
+    p.gauge = top.choice("gauge", {"first-view", "up", "estimated-up"});
     const YAML::Node views = top.get("views");
     if (!views.IsSequence() || views.size() == 0) spec_fail(top.at("views"), "expected a non-empty sequence");
     for (std::size_t i = 0; i < views.size(); ++i) {

@@ -2,7 +2,7 @@
 // `rsibr extract --poses` and `rsibr process`:
 //
 //   rsibr_poses: 1
-//   gauge: first-view            # or "up": how the world frame was fixed (calib/view_orientation.h)
+//   gauge: first-view            # "up" or "estimated-up": how the world frame was fixed (calib/view_orientation.h)
 //   views:
 //     - {name: north, world_from_cam: [9 numbers, row-major], sigma_deg: 0.03,
 //        ball: {axis: [x, y, z], half_angle_deg: 5.7}}     # optional
@@ -33,7 +33,7 @@ struct ViewPose {
 };
 
 struct PoseSet {
-  std::string gauge = "first-view";  // "first-view" or "up"
+  std::string gauge = "first-view";  // "first-view", "up" or "estimated-up" (+Y up in both)
   std::vector<ViewPose> views;
 
   // The view named `name`, or nullptr.

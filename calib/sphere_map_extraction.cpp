@@ -153,19 +153,6 @@ MapView extract_sphere_map(const cv::Mat& image, const cv::Mat& flags, const Len
     return clipped;
   };
 
-  // Balls nearer the camera than this one (distances in this ball's radii: R' / sin(alpha')), as
-  // cones widened by the margin.
-  struct Hider {
-    Vec3 axis;
-    double cos_half;
-  };
-  std::vector<Hider> hiders;
-  for (const ExtractOptions::HidingBall& h : options.hiding) {
-    if (!(h.cone.half_angle > 0 && h.cone.half_angle < kPi / 2) || !h.cone.axis.allFinite() || !(h.radius_ratio > 0)) continue;
-    if (h.radius_ratio / std::sin(h.cone.half_angle) >= 1 / std::sin(cone.half_angle)) continue;  // farther: it cannot hide this one
-    hiders.push_back({h.cone.axis.normalized(), std::cos(h.cone.half_angle + options.hidden_margin_px / limb_scale)});
-  }
-
   // Texel centres first (their image points give each texel's footprint).
   std::vector<Sample> centres(std::size_t(size) * std::size_t(size));
   std::vector<char> valid(centres.size(), 0);
@@ -198,8 +185,11 @@ MapView extract_sphere_map(const cv::Mat& image, const cv::Mat& flags, const Len
       conf *= smoothstep(options.limb_margin_px / 3, options.limb_margin_px, limb_px);
       if (options.mirror && options.camera_mask_deg > 0)
         conf *= smoothstep(cos_cam_zero, cos_cam_full, s.reflected.dot(to_camera));
-      for (const Hider& h : hiders)
-        if (p.normalized().dot(h.axis) > h.cos_half) conf = 0;
+      for (const Occluder& occ : options.in_front)
+        if (ray_hits(occ, Vec3::Zero(), p.normalized(), p.norm())) conf = 0;
+      if (options.mirror)
+        for (const Occluder& occ : options.occluders)
+          if (ray_hits(occ, p, s.reflected.normalized())) conf = 0;
       if (options.down) {
         const Vec3 dir = options.mirror ? s.reflected : s.n;
         conf *= smoothstep(cos_stand_zero, cos_stand_full, dir.dot(options.down->normalized()));

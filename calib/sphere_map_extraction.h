@@ -29,9 +29,10 @@
 //                  camera_ramp_deg beyond
 //   stand          0 where the texel's direction (reflected for mirror maps, the normal otherwise) is
 //                  within stand_mask_deg of `down` (camera frame), ramping over stand_ramp_deg
-//   hidden         0 where the camera ray to the texel's surface point passes within
-//                  hidden_margin_px of one of `hiding` (another ball nearer the camera: it hides
-//                  this one there, and the texel would show that ball)
+//   occluders      mirror maps: 0 where the reflected ray from the texel's surface point meets one of
+//                  `occluders` (calib/occluders.h: the other balls, the stands, the photographer)
+//   in front       0 where the camera's ray to the texel's surface point meets one of `in_front`
+//                  first (another ball nearer the camera hides that part of this one)
 //   clipped        0 where any bilinear tap of any of the texel's samples has a flag in
 //                  `flags` & clipped_mask (hdr/merge.h: clipped in every bracket); the confidence the
 //                  texel would have had goes to the map's `clipped` channel (core/map_set.h), which
@@ -52,6 +53,7 @@
 #pragma once
 
 #include "calib/ball_cone.h"
+#include "calib/occluders.h"
 #include "core/lens_model.h"
 #include "core/map_set.h"
 
@@ -75,14 +77,8 @@ struct ExtractOptions {
   std::optional<Vec3> down;          // camera frame; none: no stand mask
   double stand_mask_deg = 8, stand_ramp_deg = 4;
   unsigned char clipped_mask = 1;    // hdr/merge.h kClipped
-  // Other balls of the view (their cones and radii over this ball's): those nearer the camera
-  // hide this one where their cones (widened by hidden_margin_px) cover it.
-  struct HidingBall {
-    BallCone cone;
-    double radius_ratio = 1;
-  };
-  std::vector<HidingBall> hiding;
-  double hidden_margin_px = 2.0;
+  std::vector<Occluder> occluders;   // camera frame, this ball's radii (mirror maps only)
+  std::vector<Occluder> in_front;    // camera frame, this ball's radii (any map)
   // Mirror maps only (a grey or glossy ball's shading has no feature smaller than a texel);
   // <= 0: the centre alone.
   double supersample_spacing_px = 0.5;

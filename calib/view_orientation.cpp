@@ -11,77 +11,6 @@ namespace rsibr {
 
 namespace {
 
-// Texture inside a candidate's disc (its inner 80%): the mean absolute difference of the log
-// luminance between neighbouring pixels. A chrome ball reflects the whole world, edges compressed
-// toward its rim; a grey ball shows a smooth shading, whose log range may be as large (sun and
-// shadow) but changes slowly, so the pixel-to-pixel difference, not the spread, tells them apart.
-double disc_texture(const cv::Mat& image, const BallGuess& g) {
-  const double r = 0.8 * g.radius_px;
-  auto log_lum = [&](int x, int y) {
-    const cv::Vec3f p = image.at<cv::Vec3f>(y, x);
-    return std::log(std::max(1e-6, (double(p[0]) + p[1] + p[2]) / 3));
-  };
-  double s = 0;
-  int n = 0;
-  const int x0 = std::max(0, int(g.centre_px.x() - r)), x1 = std::min(image.cols - 2, int(g.centre_px.x() + r));
-  const int y0 = std::max(0, int(g.centre_px.y() - r)), y1 = std::min(image.rows - 2, int(g.centre_px.y() + r));
-  for (int y = y0; y <= y1; ++y)
-    for (int x = x0; x <= x1; ++x) {
-      if ((Vec2(x + 0.5, y + 0.5) - g.centre_px).norm() > r - 1) continue;
-      const double v = log_lum(x, y);
-      s += std::abs(log_lum(x + 1, y) - v) + std::abs(log_lum(x, y + 1) - v), n += 2;
-    }
-  return n > 0 ? s / n : 0;
-}
-
-// The chrome ball among the Hough candidates: each candidate (and its radius scaled by 0.8 and 1.25,
-// as Hough radii in a textured scene are rough) is located (calib/ball_locator.h); a fit counts when
-// most of its outline points agree (inlier fraction >= 0.6, RMS <= 0.5 px) and its radius and centre
-// are plausible (within the detection range, in the image). Fits whose centres lie
-// within half a radius of each other are one ball, represented by its fit with the most inliers;
-// a circle inside another ball's disc is dropped (a reflection in a chrome ball); among the balls
-// the most textured disc wins (a chrome ball reflects the whole world; a grey ball
-// beside it often has the cleaner outline, so the outline alone would pick it).
-BallLocation find_chrome_ball(const cv::Mat& img, const LensModel& lens, double rmin, double rmax, const std::string& name) {
-  const std::vector<BallGuess> found = detect_balls(img, rmin, rmax, 8);
-  std::vector<BallLocation> balls;
-  for (const BallGuess& g : found)
-    for (double scale : {1.0, 0.8, 1.25}) {
-      BallLocation loc;
-      try {
-        loc = locate_ball(img, lens, {g.centre_px, g.radius_px * scale});
-      } catch (const std::invalid_argument&) {
-        continue;
-      }
-      const double fraction = loc.outline_px.empty() ? 0 : double(loc.fit.inliers) / loc.outline_px.size();
-      if (fraction < 0.6 || !(loc.fit.rms_px <= 0.5)) continue;
-      // A straight edge fits a huge circle: the radius must stay near the detection range and the
-      // centre in the image.
-      if (!(loc.radius_px >= rmin / 1.25 && loc.radius_px <= 1.25 * rmax) || !lens.in_image(loc.centre_px)) continue;
-      auto same = std::find_if(balls.begin(), balls.end(), [&](const BallLocation& b) {
-        return (b.centre_px - loc.centre_px).norm() < 0.5 * std::min(b.radius_px, loc.radius_px);
-      });
-      if (same == balls.end()) balls.push_back(loc);
-      else if (loc.fit.inliers > same->fit.inliers) *same = loc;
-    }
-  if (balls.empty()) throw std::invalid_argument(name + ": no ball found");
-  // A circle inside another ball's disc is something the ball reflects, not a ball.
-  auto inside_another = [&](std::size_t i) {
-    for (std::size_t k = 0; k < balls.size(); ++k)
-      if (k != i && (balls[i].centre_px - balls[k].centre_px).norm() + balls[i].radius_px <= 1.05 * balls[k].radius_px)
-        return true;
-    return false;
-  };
-  std::size_t best = 0;
-  double best_texture = -1;
-  for (std::size_t i = 0; i < balls.size(); ++i) {
-    if (inside_another(i)) continue;
-    const double t = disc_texture(img, {balls[i].centre_px, balls[i].radius_px});
-    if (t > best_texture) best = i, best_texture = t;
-  }
-  return balls[best];
-}
-
 // "view 3" in the solver's messages -> "view 'name'".
 std::string with_names(const std::string& what, const std::vector<std::string>& names) {
   std::string out;
@@ -115,44 +44,110 @@ Mat3 gauge_world_from_first_cam(const std::optional<Vec3>& up) {
   return cam_from_world.transpose();
 }
 
+WorldUp level_pose_set(PoseSet& poses, const WorldUpOptions& options, const std::vector<VerticalLine>& lines) {
+  if (poses.views.empty()) throw std::invalid_argument("level: no views");
+  std::vector<Mat3> r;
+  for (const ViewPose& v : poses.views) r.push_back(v.world_from_cam);
+  WorldUp wu = estimate_world_up(r, lines, options);
+  // Up in the first camera's frame; the new world from the first camera is the gauge's.
+  const Mat3 first_from_world = r.front().transpose();
+  wu.up = (first_from_world * wu.up).normalized();
+  const Mat3 new_from_old = gauge_world_from_first_cam(wu.up) * first_from_world;
+  for (ViewPose& v : poses.views) v.world_from_cam = new_from_old * v.world_from_cam;
+  poses.gauge = "estimated-up";
+  return wu;
+}
+
 BallCone extraction_cone(const BallLocation& located, const ViewPose& pose, const LensModel& lens) {
   if (!pose.ball) return located.fit.cone;
   const Vec2 c = lens.project(pose.ball->axis);
   return c.allFinite() && (c - located.centre_px).norm() < 0.5 * located.radius_px ? *pose.ball : located.fit.cone;
 }
 
-PoseSet orient_views(const std::vector<std::string>& names, const std::vector<ViewImage>& views, const LensModel& lens,
+std::optional<BallCandidate> find_chrome_ball(const cv::Mat& image, const LensModel& lens,
+                                              const std::vector<ListedBall>& listed, const BallSearchOptions& search,
+                                              std::vector<BallLocation>* overlapping) {
+  const std::vector<ListedBall> balls = listed.empty() ? std::vector<ListedBall>{{"chrome", BallKind::chrome, {}}} : listed;
+  const std::vector<BallCandidate> cands = find_ball_candidates(image, lens, search);
+  const std::vector<int> pick = assign_balls_in_view(cands, balls);
+  for (std::size_t b = 0; b < balls.size(); ++b)
+    if (balls[b].kind == BallKind::chrome && pick[b] >= 0) {
+      const BallCandidate& chrome = cands[std::size_t(pick[b])];
+      if (overlapping)
+        for (std::size_t k = 0; k < cands.size(); ++k) {
+          const BallLocation& o = cands[k].loc;
+          if (int(k) != pick[b] && (o.centre_px - chrome.loc.centre_px).norm() < o.radius_px + chrome.loc.radius_px &&
+              o.radius_px > 0.5 * chrome.loc.radius_px && o.radius_px < 2 * chrome.loc.radius_px)
+            overlapping->push_back(o);
+        }
+      return chrome;
+    }
+  return std::nullopt;
+}
+
+namespace {
+
+// `flags` with the clipped bit set over the discs of `balls` (another ball in front of the chrome
+// one shows itself, not the world: its pixels must give no features).
+cv::Mat masked_flags(const cv::Mat& flags, const cv::Size& size, const std::vector<BallLocation>& balls) {
+  cv::Mat out = flags.empty() ? cv::Mat::zeros(size, CV_8UC1) : flags.clone();
+  for (const BallLocation& b : balls)
+    cv::circle(out, cv::Point(int(std::lround(b.centre_px.x())), int(std::lround(b.centre_px.y()))),
+               int(std::ceil(b.radius_px + std::max(2.0, 0.05 * b.radius_px))), cv::Scalar(1), cv::FILLED);
+  return out;
+}
+
+}  // namespace
+
+PoseSet orient_views(const std::vector<std::string>& all_names, const std::vector<ViewImage>& all_views, const LensModel& lens,
                      const ViewOrientationOptions& options, ViewOrientationReport* report) {
-  if (names.size() != views.size()) throw std::invalid_argument("orient: names and views differ in number");
-  if (views.size() < 2) throw std::invalid_argument("orient: " + std::to_string(views.size()) + " view(s), need at least 2");
-  if (!options.balls.empty() && options.balls.size() != views.size())
+  if (all_names.size() != all_views.size()) throw std::invalid_argument("orient: names and views differ in number");
+  if (all_views.size() < 2 && options.known_world_from_cam.empty())
+    throw std::invalid_argument("orient: " + std::to_string(all_views.size()) + " view(s), need at least 2");
+  if (!options.balls.empty() && options.balls.size() != all_views.size())
     throw std::invalid_argument("orient: ball guesses must be given for every view or none");
+  if (!options.given_chrome.empty() && options.given_chrome.size() != all_views.size())
+    throw std::invalid_argument("orient: given chrome balls must be listed for every view or none");
+  if (!options.known_world_from_cam.empty() && options.known_world_from_cam.size() != all_views.size())
+    throw std::invalid_argument("orient: known rotations must be given for every view or none");
   const Mat3 gauge = gauge_world_from_first_cam(options.up);
-  const double m = std::min(lens.width(), lens.height());
-  const double rmin = options.min_radius_px > 0 ? options.min_radius_px : std::max(4.0, m / 40);
-  const double rmax = options.max_radius_px > 0 ? options.max_radius_px : m / 2;
   ViewOrientationReport rep;
   std::vector<BallFeatures> feats;
   std::vector<CubeFeatureSet> sets;  // cube domain, for re-locating the tracks
   std::vector<BallCone> detected_cones;
-  for (std::size_t v = 0; v < views.size(); ++v) {
-    const cv::Mat& img = views[v].radiance;
+  std::vector<std::string> names;
+  std::vector<Mat3> known;
+  for (std::size_t v = 0; v < all_views.size(); ++v) {
+    const cv::Mat& img = all_views[v].radiance;
     if (img.type() != CV_32FC3 || img.cols != lens.width() || img.rows != lens.height())
-      throw std::invalid_argument(names[v] + ": " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
+      throw std::invalid_argument(all_names[v] + ": " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
                                   " float RGB expected of the lens model's size " + std::to_string(lens.width()) + "x" +
                                   std::to_string(lens.height()));
-    BallLocation loc;
-    if (!options.balls.empty()) {
+    std::optional<BallCandidate> found;
+    std::vector<BallLocation> overlapping;
+    const std::optional<BallGuess> guess = !options.given_chrome.empty() && options.given_chrome[v]
+                                               ? options.given_chrome[v]
+                                               : (!options.balls.empty() ? std::optional<BallGuess>(options.balls[v]) : std::nullopt);
+    if (guess) {
       try {
-        loc = locate_ball(img, lens, options.balls[v]);
+        found = given_ball(img, lens, *guess);
       } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument(names[v] + ": no ball found (" + e.what() + ")");
+        throw std::invalid_argument(all_names[v] + ": no ball found (" + e.what() + ")");
       }
     } else {
-      loc = find_chrome_ball(img, lens, rmin, rmax, names[v]);
+      found = find_chrome_ball(img, lens, options.listed, options.search, &overlapping);
     }
+    if (!found) {
+      rep.left_out.push_back(all_names[v] + ": no chrome ball found (no candidate with a clean outline that looks like a mirror)");
+      continue;
+    }
+    // Another ball overlapping the chrome one may be in front: its edge is no part of the chrome
+    // ball's outline.
+    if (!overlapping.empty()) found->loc = refit_outline_excluding(found->loc, lens, overlapping);
+    const BallLocation& loc = found->loc;
     if (options.domain == FeatureDomain::cube) {
-      sets.push_back(ball_cube_feature_set(img, views[v].flags, lens, loc.fit.cone, options.features, options.cube));
+      const cv::Mat flags = overlapping.empty() ? all_views[v].flags : masked_flags(all_views[v].flags, img.size(), overlapping);
+      sets.push_back(ball_cube_feature_set(img, flags, lens, loc.fit.cone, options.features, options.cube));
       feats.push_back(sets.back().features);
       if (!options.refine_tracks) sets.back().faces.clear();
     } else {
@@ -160,16 +155,30 @@ PoseSet orient_views(const std::vector<std::string>& names, const std::vector<Vi
     }
     detected_cones.push_back(loc.fit.cone);
     rep.balls.push_back(loc);
+    rep.measured.push_back(*found);
     rep.features.push_back(static_cast<int>(feats.back().directions.size()));
+    names.push_back(all_names[v]);
+    if (!options.known_world_from_cam.empty()) known.push_back(options.known_world_from_cam[v]);
   }
-  int tracks = 0;
-  const std::vector<DirectionObservation> obs = match_ball_features(feats, &tracks);
+  if (!options.known_world_from_cam.empty() && names.empty()) {
+    // Known rotations: nothing to refine; the views without a chrome ball keep no ball.
+    if (report) *report = rep;
+    return PoseSet{};
+  }
+  if (names.size() < 2 && known.empty()) {
+    std::string why = "orient: a chrome ball was found in " + std::to_string(names.size()) + " of " + std::to_string(all_views.size()) +
+                      " views, need at least 2";
+    if (!rep.left_out.empty()) why += " (" + rep.left_out.front() + ")";
+    throw std::invalid_argument(why);
+  }
+  if (names.empty()) throw std::invalid_argument("orient: " + rep.left_out.front());
   OrientationOptions so = options.solve;
-  so.first_world_from_cam = gauge;
-  if (options.refine_balls) {
+  so.first_world_from_cam = known.empty() ? gauge : known.front();
+  auto ball_priors = [&] {
     // Prior: the ball centre known to the outline points' scatter (their errors are correlated along
     // the outline, so the fit's formal std dev, RMS / sqrt(points), would be far too small).
     so.balls.clear();
+    if (!options.refine_balls) return;
     for (const BallLocation& b : rep.balls) {
       const Vec3 a = b.fit.cone.axis.normalized();
       const Vec3 t = a.unitOrthogonal();
@@ -178,43 +187,103 @@ PoseSet orient_views(const std::vector<std::string>& names, const std::vector<Vi
       so.balls.push_back({a, b.fit.cone.half_angle, std::max(b.fit.rms_px, options.ball_prior_px) / px_per_rad,
                           options.ball_radius_prior_px / px_per_rad});
     }
+  };
+  // Views the features cannot place are left out (reported), and the rest solved again.
+  int tracks = 0;
+  std::vector<DirectionObservation> obs;
+  std::optional<OrientationSolution> solved;  // the first solve, when every view was placed
+  for (;;) {
+    obs = match_ball_features(feats, &tracks);
+    so.fixed_world_from_cam = known;
+    ball_priors();
+    if (!known.empty() || names.size() < 2) break;
+    OrientationOptions probe = so;
+    probe.leave_out_unplaced = true;
+    OrientationSolution first;
+    try {
+      first = solve_orientations(static_cast<int>(names.size()), tracks, obs, probe);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(with_names(e.what(), names));
+    }
+    std::vector<char> keep = first.oriented;
+    if (std::count(keep.begin(), keep.end(), 1) == static_cast<long>(keep.size())) {
+      solved = std::move(first);
+      break;
+    }
+    for (std::size_t v = 0; v < keep.size(); ++v)
+      if (!keep[v]) rep.left_out.push_back(names[v] + ": its chrome ball " + first.left_out[v]);
+    auto filter = [&](auto& vec) {
+      std::size_t w = 0;
+      for (std::size_t v = 0; v < keep.size(); ++v)
+        if (keep[v]) vec[w++] = std::move(vec[v]);
+      vec.resize(w);
+    };
+    filter(feats), filter(detected_cones), filter(rep.balls), filter(rep.measured), filter(rep.features), filter(names);
+    if (!sets.empty()) filter(sets);
+    if (names.size() < 2)
+      throw std::invalid_argument("orient: only " + std::to_string(names.size()) + " view(s) could be oriented (" +
+                                  rep.left_out.back() + ")");
   }
+  const std::size_t n = names.size();
   OrientationSolution s;
+  const int nv = static_cast<int>(n);
   try {
-    s = solve_orientations(static_cast<int>(views.size()), tracks, obs, so);
-    if (options.domain == FeatureDomain::cube && options.refine_tracks) {
-      std::vector<BallCone> refined_cones = detected_cones;
-      if (options.refine_balls)
-        for (std::size_t v = 0; v < views.size(); ++v) refined_cones[v] = {s.ball_axes[v], s.ball_half_angles[v]};
-      const std::vector<DirectionObservation> refined =
-          refine_tracks(sets, detected_cones, refined_cones, lens, options.features, s.world_from_cam, obs,
-                        options.tracks, &rep.track_refinement);
-      s = solve_orientations(static_cast<int>(views.size()), tracks, refined, so);
+    if (n == 1 || (!known.empty() && obs.empty())) {
+      // Known rotations and nothing matched (or one view): the balls stay as located.
+      s.world_from_cam = known;
+      s.sigma_deg.assign(n, 0.0);
+      for (const BallLocation& b : rep.balls) s.ball_axes.push_back(b.fit.cone.axis), s.ball_half_angles.push_back(b.fit.cone.half_angle);
+    } else {
+      s = solved ? *solved : solve_orientations(nv, tracks, obs, so);
+      if (options.domain == FeatureDomain::cube && options.refine_tracks) {
+        std::vector<BallCone> refined_cones = detected_cones;
+        if (options.refine_balls)
+          for (std::size_t v = 0; v < n; ++v) refined_cones[v] = {s.ball_axes[v], s.ball_half_angles[v]};
+        const std::vector<DirectionObservation> refined =
+            refine_tracks(sets, detected_cones, refined_cones, lens, options.features, s.world_from_cam, obs,
+                          options.tracks, &rep.track_refinement);
+        s = solve_orientations(nv, tracks, refined, so);
+      }
     }
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(with_names(e.what(), names));
   }
   if (options.refine_balls)
-    for (std::size_t v = 0; v < views.size(); ++v) {
+    for (std::size_t v = 0; v < n; ++v) {
       rep.balls[v].radius_px *= std::tan(s.ball_half_angles[v]) / std::tan(rep.balls[v].fit.cone.half_angle);
       rep.balls[v].fit.cone.axis = s.ball_axes[v];
       rep.balls[v].fit.cone.half_angle = s.ball_half_angles[v];
       rep.balls[v].centre_px = lens.project(s.ball_axes[v]);
     }
+  for (std::size_t v = 0; v < n; ++v)
+    if (!std::isfinite(s.sigma_deg[v]))
+      throw std::runtime_error("orient: the orientations are not determined by the features (singular covariance)");
+  rep.names = names;
   rep.tracks = tracks;
   rep.observations = s.observations;
   rep.inliers = s.inliers;
   rep.rms_sigmas = s.rms_sigmas;
-  if (report) *report = rep;
-  for (std::size_t v = 0; v < views.size(); ++v)
-    if (!std::isfinite(s.sigma_deg[v]))
-      throw std::runtime_error("orient: the orientations are not determined by the features (singular covariance)");
   PoseSet out;
   out.gauge = options.up ? "up" : "first-view";
-  for (std::size_t v = 0; v < views.size(); ++v) {
+  for (std::size_t v = 0; v < n; ++v) {
     out.views.push_back({names[v], s.world_from_cam[v], s.sigma_deg[v], std::nullopt});
     if (options.refine_balls) out.views.back().ball = rep.balls[v].fit.cone;
   }
+  // The solve's world is the first oriented camera's frame: levelled by the estimated up, with the
+  // stands under the chrome balls as vertical lines where they show.
+  if (known.empty() && !options.up && options.estimate_up) {
+    std::vector<VerticalLine> lines;
+    for (std::size_t v = 0; v < n && options.stand_lines; ++v) {
+      const std::size_t i = std::size_t(std::find(all_names.begin(), all_names.end(), names[v]) - all_names.begin());
+      if (const auto line = find_stand_line(all_views[i].radiance, lens, rep.balls[v].fit.cone, options.stand))
+        lines.push_back({s.world_from_cam[v] * line->plane_normal, line->sigma_deg, names[v] + ": stand"});
+    }
+    // One stand seen from every view: its tilt is common to all its lines.
+    for (VerticalLine& l : lines)
+      l.sigma_deg = std::max(l.sigma_deg, options.stand.verticality_deg * std::sqrt(double(lines.size())));
+    rep.world_up = level_pose_set(out, options.up_options, lines);
+  }
+  if (report) *report = rep;
   return out;
 }
 

@@ -1,5 +1,5 @@
-// Every view's orientation from its image of the chrome ball: the ball found in each view (Hough
-// candidates -> calib/ball_locator.h; the chrome ball is the candidate with the most texture), SIFT
+// Every view's orientation from its image of the chrome ball: the ball found in each view (the
+// candidates and the listed balls matched by appearance and size, calib/ball_identification.h), SIFT
 // features of the world it reflects, detected on cube faces (calib/ball_cube_features.h; or in the
 // image itself, calib/ball_features.h) as reflected directions, matched across views and
 // solved in one Ceres problem (calib/orientation_solve.h). The result is a pose file's content
@@ -11,15 +11,21 @@
 //               normalising; e.g. (0, -1, 0) for a camera levelled on a tripod, whose y axis points
 //               down); the world's +Z is the first camera's forward axis made horizontal (or its
 //               -y axis when it looks straight up or down), X = Y x Z.
+//   estimated   estimate_up: the first-view solve, then up estimated from the cameras' x axes
+//               (calib/world_up.h) and used as `up` (gauge "estimated-up").
+// A view without a chrome ball found is left out (reported) while two or more remain.
 #pragma once
 
 #include "calib/ball_cube_features.h"
 #include "calib/ball_features.h"
+#include "calib/ball_identification.h"
 #include "calib/ball_locator.h"
 #include "calib/orientation_solve.h"
 #include "calib/pose_file.h"
+#include "calib/stand_line.h"
 #include "calib/track_refinement.h"
 #include "calib/view_image.h"
+#include "calib/world_up.h"
 #include "core/lens_model.h"
 
 #include <optional>
@@ -38,9 +44,16 @@ enum class FeatureDomain { cube, image };
 
 struct ViewOrientationOptions {
   std::optional<Vec3> up;              // camera frame of the first view; none: the first-view gauge
+  bool estimate_up = false;            // without `up`: estimated from the views (gauge "estimated-up")
+  WorldUpOptions up_options;
+  bool stand_lines = true;             // with estimate_up: the stand under each chrome ball as a vertical line (calib/stand_line.h)
+  StandLineOptions stand;
   std::vector<BallGuess> balls;        // per view, or empty: detected
-  double min_radius_px = 0;            // detection range; 0: min(width, height) / 40
-  double max_radius_px = 0;            // 0: min(width, height) / 2
+  std::vector<std::optional<BallGuess>> given_chrome;  // per view or empty: a given chrome ball (--ball)
+  std::vector<ListedBall> listed;      // the photo set's balls (empty: one chrome ball)
+  BallSearchOptions search;            // min/max radius 0: min(width, height) / 40 and / 2
+  // Known rotations (a pose file without balls), per view: the features refine only the balls.
+  std::vector<Mat3> known_world_from_cam;
   // Denser than BallFeatureOptions' defaults: weaker SIFT features (contrast 0.01) and out to 0.95 of
   // the ball's angular radius. The rim's features are what separates a ball-centre error from a
   // rotation; on rendered views (bench/orientation_accuracy) this halves the mean error (0.96 -> 0.53
@@ -67,7 +80,11 @@ struct ViewOrientationOptions {
 
 // What orient_views saw, for reports (--json).
 struct ViewOrientationReport {
-  std::vector<BallLocation> balls;      // per view (centre_px and the cone's axis refined when refine_balls)
+  std::vector<std::string> names;       // the views oriented (the rest were left out)
+  std::vector<std::string> left_out;    // "<view>: <why>"
+  std::vector<BallLocation> balls;      // per view oriented (centre_px and the cone's axis refined when refine_balls)
+  std::vector<BallCandidate> measured;  // per view oriented: the chrome ball as found (before refinement)
+  std::optional<WorldUp> world_up;      // estimated up (in the first view's camera frame)
   std::vector<int> features;            // per view: features in the ball
   int tracks = 0, observations = 0, inliers = 0;
   double rms_sigmas = 0;
@@ -78,10 +95,24 @@ struct ViewOrientationReport {
 // std::invalid_argument for a zero or non-finite up.
 Mat3 gauge_world_from_first_cam(const std::optional<Vec3>& up);
 
+// Levels a pose set: world up estimated from its rotations and `lines` (world frame of the set;
+// calib/world_up.h), and the world turned
+// so that it is +Y and the first view's forward axis, made horizontal, is +Z (the "up" gauge with
+// the estimated up); gauge becomes "estimated-up". Returns the estimate, up in the first view's
+// camera frame. Throws std::invalid_argument for an empty set.
+WorldUp level_pose_set(PoseSet& poses, const WorldUpOptions& options = {}, const std::vector<VerticalLine>& lines = {});
+
 // The cone to extract a located ball with: the pose's refined chrome ball (ViewPose::ball) when it is
 // the same ball (its centre's pixel within half the located radius of the located centre), else the
 // located outline's.
 BallCone extraction_cone(const BallLocation& located, const ViewPose& pose, const LensModel& lens);
+
+// The chrome ball of one view: candidates (calib/ball_identification.h) matched to the listed balls;
+// nullopt when none looks like a chrome ball. `overlapping`, when given, gets the ball-sized
+// candidates whose discs overlap it (their pixels give no features: one may be in front).
+std::optional<BallCandidate> find_chrome_ball(const cv::Mat& image, const LensModel& lens,
+                                              const std::vector<ListedBall>& listed, const BallSearchOptions& search,
+                                              std::vector<BallLocation>* overlapping = nullptr);
 
 // `names` and `views` parallel, >= 2 views, all of the lens's size. Throws std::invalid_argument
 // with a message naming the view ("<name>: no ball found", "orient: view '<name>' shares 0

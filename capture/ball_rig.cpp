@@ -57,6 +57,42 @@ void add_pole(RigMesh& out, double x, double z, double y0, double y1, double rad
   }
 }
 
+// A flat disc (centre c, normal n) as `rings` concentric annuli of alternating albedo, 96 segments.
+void add_disc(RigMesh& out, const SynthClutter& d, const Vec3& normal) {
+  const int segments = 96;
+  const Vec3 u = normal.unitOrthogonal(), v = normal.cross(u);
+  for (int k = 0; k < d.rings; ++k) {
+    const double r0 = d.radius_m * k / d.rings, r1 = d.radius_m * (k + 1) / d.rings;
+    const Vec3& albedo = k % 2 == 0 ? d.albedo : d.ring_albedo;
+    for (int i = 0; i < segments; ++i) {
+      const double a0 = 2 * kPi * i / segments, a1 = 2 * kPi * (i + 1) / segments;
+      const Vec3 e0 = std::cos(a0) * u + std::sin(a0) * v, e1 = std::cos(a1) * u + std::sin(a1) * v;
+      // Counter-clockwise about the normal.
+      add_quad(out, d.centre + r0 * e0, d.centre + r1 * e0, d.centre + r1 * e1, d.centre + r0 * e1, albedo);
+    }
+  }
+}
+
+// A UV sphere, 64 x 128 segments, smooth (exact) vertex normals.
+void add_sphere(RigMesh& out, const SynthClutter& s) {
+  const int rows = 64, cols = 128;
+  const auto base = std::uint32_t(out.mesh.positions.size());
+  for (int i = 0; i <= rows; ++i)
+    for (int j = 0; j <= cols; ++j) {
+      const double th = kPi * i / rows, ph = 2 * kPi * j / cols;
+      const Vec3 n(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
+      out.mesh.positions.push_back(Vec3(s.centre + s.radius_m * n).cast<float>());
+      out.mesh.normals.push_back(n.cast<float>());
+    }
+  auto at = [&](int i, int j) { return base + std::uint32_t(i * (cols + 1) + j); };
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) {
+      if (i > 0) out.mesh.triangles.push_back({at(i, j), at(i, j + 1), at(i + 1, j)}), out.albedo.push_back(s.albedo);
+      if (i + 1 < rows)
+        out.mesh.triangles.push_back({at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)}), out.albedo.push_back(s.albedo);
+    }
+}
+
 }  // namespace
 
 RigMesh build_rig_mesh(const SynthScene& scene, const CameraPose* pose) {
@@ -68,6 +104,15 @@ RigMesh build_rig_mesh(const SynthScene& scene, const CameraPose* pose) {
       if (bottom > 0) add_pole(out, b.centre.x(), b.centre.z(), 0.0, bottom + 0.2 * b.diameter_m, kStandRadius,
                                Vec3::Constant(kStandAlbedo));
     }
+  for (const SynthClutter& c : scene.clutter) {
+    if (c.shape == "sphere") {
+      add_sphere(out, c);
+    } else {
+      Vec3 n = c.normal.value_or(scene.rig_centre() - c.centre);
+      if (!(n.norm() > 0)) n = Vec3::UnitZ();
+      add_disc(out, c, n.normalized());
+    }
+  }
   if (pose && scene.photographer) {
     const Mat3& R = pose->world_from_cam;
     add_box(out, R, pose->eye, Vec3(-0.07, -0.05, -0.09), Vec3(0.07, 0.05, -0.01), Vec3::Constant(kCameraBodyAlbedo));

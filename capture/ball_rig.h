@@ -26,7 +26,8 @@ struct RigMesh {
 inline constexpr double kCameraBodyAlbedo = 0.04, kPhotographerAlbedo = 0.25, kStandAlbedo = 0.08;
 inline constexpr double kStandRadius = 0.012;
 
-// The stand (when scene.stand) and, when `pose` is given and scene.photographer, its proxy.
+// The stand (when scene.stand), the clutter (scene.clutter) and, when `pose` is given and
+// scene.photographer, its proxy.
 RigMesh build_rig_mesh(const SynthScene& scene, const CameraPose* pose);
 
 // Nearest t > t_min where the ray o + t d (d unit) meets the sphere (centre c, radius r), computed

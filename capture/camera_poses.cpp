@@ -12,10 +12,12 @@ namespace {
 
 constexpr double kDeg = kPi / 180;
 
-// Look at `at` with world up, turn right by yaw about the camera's y axis (down), then roll about z.
-Mat3 aim(const Vec3& eye, const Vec3& at, double roll_deg, double yaw_deg) {
+// Look at `at` with world up, turn right by pan about the world's vertical (a rotation of -pan about
+// +Y), by yaw about the camera's y axis (down), then roll about z.
+Mat3 aim(const Vec3& eye, const Vec3& at, double roll_deg, double yaw_deg, double pan_deg = 0) {
   const Camera c = look_at(eye, at, Vec3(0, 1, 0), 60, 64, 64);
-  return c.world_from_cam * Eigen::AngleAxisd(yaw_deg * kDeg, Vec3::UnitY()).toRotationMatrix() *
+  return Eigen::AngleAxisd(-pan_deg * kDeg, Vec3::UnitY()).toRotationMatrix() * c.world_from_cam *
+         Eigen::AngleAxisd(yaw_deg * kDeg, Vec3::UnitY()).toRotationMatrix() *
          Eigen::AngleAxisd(roll_deg * kDeg, Vec3::UnitZ()).toRotationMatrix();
 }
 
@@ -45,7 +47,7 @@ std::vector<CameraPose> plan_camera_poses(const SynthScene& scene) {
     for (std::size_t i = 0; i < dirs.size(); ++i) {
       CameraPose pose;
       pose.eye = at + plan.distance_m * dirs[i];
-      pose.world_from_cam = aim(pose.eye, at, plan.roll_deg, plan.yaw_deg);
+      pose.world_from_cam = aim(pose.eye, at, plan.roll_deg, plan.yaw_deg, plan.pan_deg);
       if (plan.plan == "handheld") {
         NoiseRng rng(scene.seed, 0x4A17ull << 32 | (p << 16) | i);
         const Vec3 dp(sample_normal(rng), sample_normal(rng), sample_normal(rng));
@@ -53,7 +55,8 @@ std::vector<CameraPose> plan_camera_poses(const SynthScene& scene) {
         axis = axis.norm() > 0 ? axis.normalized() : Vec3::UnitY();
         const double angle = plan.jitter_deg * kDeg * sample_normal(rng);
         pose.eye += plan.jitter_m * dp;
-        pose.world_from_cam = Eigen::AngleAxisd(angle, axis).toRotationMatrix() * aim(pose.eye, at, plan.roll_deg, plan.yaw_deg);
+        pose.world_from_cam =
+            Eigen::AngleAxisd(angle, axis).toRotationMatrix() * aim(pose.eye, at, plan.roll_deg, plan.yaw_deg, plan.pan_deg);
       }
       char name[32];
       std::snprintf(name, sizeof name, "view%02zu", out.size());

@@ -7,8 +7,9 @@
 //             std dev `jitter_deg` about a random axis) are jittered, seeded
 //
 // Azimuth 0 is +Z, 90 is +X; elevation is above the horizontal plane through look_at. Cameras look
-// at look_at (default: the rig centre) with world +Y up in the image, turn right by yaw_deg (the
-// target moves toward the left edge), then roll about their axis.
+// at look_at (default: the rig centre) with world +Y up in the image, turn right by pan_deg about the
+// world's vertical and by yaw_deg about their own y axis (the target moves toward the left edge),
+// then roll about their axis.
 #pragma once
 
 #include "capture/synth_scene.h"

@@ -11,7 +11,8 @@
 //   glossy ball      its true sphere map for this view (capture/true_sphere_map.h: bake/'s FIS
 //                    integral of the BRDF) read at the normal: exact where n = v, elsewhere the view
 //                    direction is taken as v (ball centre -> camera), off by up to asin(R / D)
-//   stand, proxies   albedo * E(n) / pi                         Lambert, n facing the ray
+//   stand, proxies,  albedo * E(n) / pi                         Lambert, n facing the ray
+//   clutter
 // E(n) = int L_env(w) max(0, n.w) dw is the unoccluded irradiance: read bilinearly from a
 // 256 x 128 lat-long irradiance map whose texels are capture/irradiance.h's quadrature (bright texels
 // at full resolution, the rest on a 128-wide MIP level). Measured accuracy against brute force over

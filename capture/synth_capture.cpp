@@ -77,8 +77,10 @@ YAML::Node mat(const Mat3& m) {
   return n;
 }
 
-// v(p) = 1 - a (|p - c| / |corner - c|)^2, c the principal point (image centre without a core).
-cv::Mat vignetting_field(const LensModel& lens, double a) {
+// v(p) = 1 - a r^2, or 1 + k1 r^2 + k2 r^4 + k3 r^6 with `poly`; r = |p - c| / |corner - c|, c the
+// principal point (image centre without a core).
+cv::Mat vignetting_field(const LensModel& lens, double a, const std::optional<Vec3>& poly) {
+  const Vec3 k = poly.value_or(Vec3(-a, 0, 0));
   const auto& in = lens.intrinsics();
   const Vec2 c = in.size() >= 4 ? Vec2(in[2], in[3]) : Vec2(0.5 * (lens.width() - 1), 0.5 * (lens.height() - 1));
   double r2max = 0;
@@ -87,7 +89,10 @@ cv::Mat vignetting_field(const LensModel& lens, double a) {
     r2max = std::max(r2max, (k - c).squaredNorm());
   cv::Mat v(lens.height(), lens.width(), CV_32FC1);
   for (int y = 0; y < v.rows; ++y)
-    for (int x = 0; x < v.cols; ++x) v.at<float>(y, x) = float(1 - a * (Vec2(x, y) - c).squaredNorm() / r2max);
+    for (int x = 0; x < v.cols; ++x) {
+      const double r2 = (Vec2(x, y) - c).squaredNorm() / r2max;
+      v.at<float>(y, x) = float(1 + r2 * (k[0] + r2 * (k[1] + r2 * k[2])));
+    }
   return v;
 }
 
@@ -187,7 +192,7 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
 
   SynthReport report;
   SensorNoise noise{1.0, cam.full_well, cam.read_noise};
-  const cv::Mat vignette = vignetting_field(cam.lens, cam.vignetting);
+  const cv::Mat vignette = vignetting_field(cam.lens, cam.vignetting, cam.vignetting_poly);
   RigRenderOptions ropt;
   ropt.supersampling = cam.supersampling;
   ropt.seed = scene.seed;
@@ -215,6 +220,7 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
   tc["shot_normalised"] = 1.0 / cam.full_well;
   tc["read_variance_normalised"] = (cam.read_noise / cam.full_well) * (cam.read_noise / cam.full_well);
   tc["vignetting"] = cam.vignetting;
+  if (cam.vignetting_poly) tc["vignetting"] = vec(*cam.vignetting_poly);
   tc["white_balance"] = vec(cam.white_balance);
   tc["supersampling"] = cam.supersampling;
   tc["convention"] = "X = L e k electrons (L after vignetting and white balance, e = t*iso/100/N^2); "
@@ -337,23 +343,27 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
     ChessboardSet cs;
     cs.corners_x = cs.corners_y = scene.chessboards.corners;
     cs.spacing_m = scene.chessboards.spacing_m;
+    // The camera's own response, format and white balance (boards are photographed with it), so a
+    // vignetting estimate from the boards sees what the brackets see.
     const SensorNoise board_noise{0.7 * cam.full_well / 0.9, cam.full_well, cam.read_noise};
-    const CameraResponse board_response("srgb");
+    const std::string board_ext = "." + ext_of(cam.format);
     for (int i = 0; i < scene.chessboards.count; ++i) {
       const ChessboardShot shot = render_chessboard(cam.lens, rays, scene.chessboards, i, scene.seed, cam.supersampling);
-      cv::Mat lit = shot.reflectance.mul(vignette);
-      const cv::Mat codes = expose_bracket(lit, 1.0, board_noise, board_response, 255, scene.seed, 0xB0000 + std::uint64_t(i));
+      const cv::Mat lit1 = shot.reflectance.mul(vignette);
+      cv::Mat lit;
+      cv::merge(std::vector<cv::Mat>{lit1 * cam.white_balance[0], lit1 * cam.white_balance[1], lit1 * cam.white_balance[2]}, lit);
+      const cv::Mat codes = expose_bracket(lit, 1.0, board_noise, response, max_code, scene.seed, 0xB0000 + std::uint64_t(i));
       char name[32];
       std::snprintf(name, sizeof name, "board%02d", i);
-      write_codes(photos / "chessboards" / (std::string(name) + ".png"), codes, "png");
-      cs.files.push_back(photos / "chessboards" / (std::string(name) + ".png"));
+      write_codes(photos / "chessboards" / (std::string(name) + board_ext), codes, cam.format);
+      cs.files.push_back(photos / "chessboards" / (std::string(name) + board_ext));
       std::ofstream corners(truth / "chessboards" / (std::string(name) + ".txt"));
       corners.precision(10);
       corners << "# true pixel positions of the inner corners, row-major (j outer, i inner); mrcal pixel convention\n";
       for (const Vec2& p : shot.corners) corners << p.x() << " " << p.y() << "\n";
       if (!corners) throw std::runtime_error((truth / "chessboards" / name).string() + ".txt: cannot write");
       YAML::Node tb;
-      tb["file"] = std::string("chessboards/") + name + ".png";
+      tb["file"] = std::string("chessboards/") + name + board_ext;
       tb["corners"] = std::string("chessboards/") + name + ".txt";
       tb["cam_from_board"] = mat(shot.cam_from_board);
       tb["board_centre_cam"] = vec(shot.board_centre_cam);

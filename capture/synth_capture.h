@@ -2,7 +2,7 @@
 //
 //   DIR/photos/   a photo set (photoset.yaml, core/photo_set.h): per view <view>/<view>_bNN.<ext>
 //                 (one file per exposure, shortest first, exposure_s/iso/aperture in the YAML) and
-//                 chessboards/boardNN.png
+//                 chessboards/boardNN.<ext> (the same camera: response, format, white balance)
 //   DIR/truth/    truth.yaml (the exposure convention's gain k, full well, read noise, response,
 //                 vignetting, white balance, per view the pose, per bracket its exposure and clipped
 //                 fraction, per ball its centre and image position, per board its pose),

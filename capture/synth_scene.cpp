@@ -123,7 +123,19 @@ SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const 
   if (m.has("format")) c.format = m.choice("format", {"png", "jpeg", "tiff"});
   if (m.has("supersampling"))
     c.supersampling = int(spec_in_range(double(m.integer("supersampling")), m.at("supersampling"), 1, false, 16, false));
-  if (m.has("vignetting")) c.vignetting = m.number_in("vignetting", 0, false, 1, true);
+  if (m.has("vignetting")) {
+    if (m.get("vignetting").IsSequence()) {
+      const Vec3 k = m.vec3("vignetting");
+      // v must stay in (0.02, 1.5] from the centre to the corner.
+      for (int i = 0; i <= 100; ++i) {
+        const double r2 = i / 100.0, v = 1 + k[0] * r2 + k[1] * r2 * r2 + k[2] * r2 * r2 * r2;
+        if (!(v > 0.02 && v <= 1.5)) spec_fail(m.at("vignetting"), "the polynomial leaves (0.02, 1.5] inside the image");
+      }
+      c.vignetting_poly = k;
+    } else {
+      c.vignetting = m.number_in("vignetting", 0, false, 1, true);
+    }
+  }
   if (m.has("white_balance")) c.white_balance = vec3_in(m, "white_balance", 0, true);
   if (m.has("full_well")) c.full_well = m.number_in("full_well", 1, false, 1e9, false);
   if (m.has("read_noise")) c.read_noise = m.number_in("read_noise", 0, false, 1e6, false);
@@ -131,10 +143,35 @@ SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const 
   return c;
 }
 
+SynthClutter parse_clutter(const YAML::Node& node, const std::string& path) {
+  const YamlMap m(node, path, {"shape", "centre", "radius_m", "normal", "albedo", "rings", "ring_albedo"});
+  SynthClutter c;
+  c.shape = m.choice("shape", {"disc", "sphere"});
+  c.centre = m.vec3("centre");
+  if (m.has("radius_m")) c.radius_m = m.positive("radius_m");
+  auto albedo = [&](const char* key) {
+    const Vec3 a = m.vec3(key);
+    for (int i = 0; i < 3; ++i) spec_in_range(a[i], m.at(key) + "[" + std::to_string(i) + "]", 0, false, 1, false);
+    return a;
+  };
+  if (m.has("albedo")) c.albedo = albedo("albedo");
+  if (c.shape == "sphere")
+    for (const char* k : {"normal", "rings", "ring_albedo"})
+      if (m.has(k)) spec_fail(m.at(k), "only for shape: disc");
+  if (m.has("normal")) {
+    c.normal = m.vec3("normal");
+    if (!(c.normal->norm() > 0)) spec_fail(m.at("normal"), "must be non-zero");
+    c.normal->normalize();
+  }
+  if (m.has("rings")) c.rings = int(spec_in_range(double(m.integer("rings")), m.at("rings"), 1, false, 64, false));
+  if (m.has("ring_albedo")) c.ring_albedo = albedo("ring_albedo");
+  return c;
+}
+
 SynthViewPlan parse_plan(const YAML::Node& node, const std::string& path) {
   const YamlMap m(node, path,
                   {"plan", "count", "azimuths_deg", "azimuth0_deg", "elevation_deg", "min_elevation_deg",
-                   "distance_m", "look_at", "roll_deg", "yaw_deg", "jitter_m", "jitter_deg"});
+                   "distance_m", "look_at", "roll_deg", "yaw_deg", "pan_deg", "jitter_m", "jitter_deg"});
   SynthViewPlan p;
   p.plan = m.choice("plan", {"ring", "icosa", "handheld"});
   auto only = [&](const char* key, std::initializer_list<const char*> plans) {
@@ -157,6 +194,7 @@ SynthViewPlan parse_plan(const YAML::Node& node, const std::string& path) {
   if (m.has("look_at")) p.look_at = m.vec3("look_at");
   if (m.has("roll_deg")) p.roll_deg = m.number_in("roll_deg", -180, false, 180, false);
   if (m.has("yaw_deg")) p.yaw_deg = m.number_in("yaw_deg", -89, false, 89, false);
+  if (m.has("pan_deg")) p.pan_deg = m.number_in("pan_deg", -89, false, 89, false);
   if (only("jitter_m", {"handheld"})) p.jitter_m = m.number_in("jitter_m", 0, false, 10, false);
   if (only("jitter_deg", {"handheld"})) p.jitter_deg = m.number_in("jitter_deg", 0, false, 45, false);
   return p;
@@ -165,7 +203,7 @@ SynthViewPlan parse_plan(const YAML::Node& node, const std::string& path) {
 SynthScene parse_root(const YAML::Node& root, const std::filesystem::path& folder) {
   const YamlMap m(root, "scene",
                   {"rsibr_synth", "seed", "environment", "balls", "stand", "photographer", "camera", "exposure",
-                   "views", "chessboards", "truth_map_size"});
+                   "views", "chessboards", "truth_map_size", "clutter"});
   if (m.integer("rsibr_synth") != 1) spec_fail(m.at("rsibr_synth"), "unsupported version (expected 1)");
   SynthScene s;
   if (m.has("seed")) s.seed = std::uint64_t(spec_in_range(double(m.integer("seed")), m.at("seed"), 0, false, 9e15, false));
@@ -184,6 +222,12 @@ SynthScene parse_root(const YAML::Node& root, const std::filesystem::path& folde
         spec_fail(m.at("balls") + "[" + std::to_string(i) + "]", "overlaps ball " + s.balls[j].name);
   if (m.has("stand")) s.stand = m.boolean("stand");
   if (m.has("photographer")) s.photographer = m.boolean("photographer");
+  if (m.has("clutter")) {
+    const YAML::Node cl = m.get("clutter");
+    if (!cl.IsSequence()) spec_fail(m.at("clutter"), "expected a list");
+    for (std::size_t i = 0; i < cl.size(); ++i)
+      s.clutter.push_back(parse_clutter(cl[i], m.at("clutter") + "[" + std::to_string(i) + "]"));
+  }
   s.camera = parse_camera(m.get("camera"), m.at("camera"), folder);
   if (m.has("exposure")) {
     const YamlMap e(m.get("exposure"), m.at("exposure"), {"middle_s", "count", "step_ev", "iso", "aperture"});

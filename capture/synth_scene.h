@@ -42,6 +42,20 @@ struct SynthBall {
   std::string brdf;  // glossy: a BRDF spec (bake/brdf_spec.h), flow YAML, e.g. GGX with Fresnel
 };
 
+// Background objects that are not balls (the clocks, lamps, plates and spheres of real rooms that
+// a ball finder must not take for a ball): Lambert, lit by the unoccluded environment, not in the
+// photo set's ball list. A disc (centre, radius, normal; default: facing the rig centre) is split
+// into `rings` concentric annuli alternating albedo and ring_albedo; a sphere is a tessellated mesh.
+struct SynthClutter {
+  std::string shape;  // "disc" or "sphere"
+  Vec3 centre = Vec3::Zero();
+  double radius_m = 0.2;
+  std::optional<Vec3> normal;  // disc
+  Vec3 albedo = Vec3::Constant(0.7);
+  int rings = 1;                            // disc
+  Vec3 ring_albedo = Vec3::Constant(0.1);   // disc, odd annuli
+};
+
 struct SynthViewPlan {
   std::string plan;                 // "ring", "icosa" or "handheld"
   int count = 3;                    // ring, handheld: views evenly spaced in azimuth
@@ -53,6 +67,9 @@ struct SynthViewPlan {
   std::optional<Vec3> look_at;      // default: the centre of the balls
   double roll_deg = 0;
   double yaw_deg = 0;               // after aiming: turn the camera right by this (the target moves left)
+                                    // about its own y axis (aimed up or down, that tilts the horizon)
+  double pan_deg = 0;               // after aiming: turn right about the world's vertical (a person turning:
+                                    // the horizon stays level)
   double jitter_m = 0.03, jitter_deg = 1.5;  // handheld: position and orientation jitter (std dev)
 };
 
@@ -72,6 +89,9 @@ struct SynthCamera {
   std::string format = "png";  // "png" (8-bit), "jpeg" (8-bit), "tiff" (16-bit)
   int supersampling = 2;       // n: n x n stratified, jittered samples per pixel
   double vignetting = 0.0;     // v = 1 - vignetting * (r / r_corner)^2
+  // Instead of that, when set: v = 1 + k1 r^2 + k2 r^4 + k3 r^6, r = |p - c| / r_corner (the
+  // polynomial of lens databases; real lenses fall off faster than r^2 toward the corner).
+  std::optional<Vec3> vignetting_poly;
   Vec3 white_balance = Vec3::Ones();
   double full_well = 2e4, read_noise = 3;
   std::optional<double> gain;  // electrons per unit radiance-exposure; auto (median metering) when absent
@@ -89,6 +109,7 @@ struct SynthScene {
   SynthEnvironment environment;
   std::vector<SynthBall> balls;
   bool stand = true, photographer = true;
+  std::vector<SynthClutter> clutter;
   SynthCamera camera;
   SynthExposure exposure;
   std::vector<SynthViewPlan> views;

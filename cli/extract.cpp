@@ -4,6 +4,7 @@
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
+#include "calib/ball_identification.h"
 #include "calib/ball_locator.h"
 #include "calib/pose_file.h"
 #include "calib/view_orientation.h"
@@ -70,8 +71,10 @@ int run_extract(const ExtractArgs& a) {
                                 std::to_string(view.radiance.rows) + " but the lens model " + a.lens + " is " +
                                 std::to_string(lens.width()) + "x" + std::to_string(lens.height()));
 
-  BallGuess guess;
+  // The ball: given, or among the candidates with a clean outline (calib/ball_identification.h),
+  // left to right.
   int candidates = 0;
+  BallLocation loc;
   if (given) {
     // A ball must overlap the image and be no larger than it (the outline search scales with R).
     const double w = view.radiance.cols, h = view.radiance.rows;
@@ -80,22 +83,20 @@ int run_extract(const ExtractArgs& a) {
         given->centre_px.y() > h + given->radius_px)
       throw std::invalid_argument("--ball '" + a.ball + "': the ball does not fit the " + std::to_string(int(w)) + "x" +
                                   std::to_string(int(h)) + " image");
-    guess = *given;
+    try {
+      loc = locate_ball(view.radiance, lens, *given);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(a.image + ": " + e.what());
+    }
   } else {
-    const double m = std::min(lens.width(), lens.height());
-    std::vector<BallGuess> found = detect_balls(view.radiance, std::max(4.0, m / 40), m / 2, 8);
+    std::vector<BallCandidate> found = find_ball_candidates(view.radiance, lens);
     candidates = static_cast<int>(found.size());
     if (a.which >= candidates)
       throw std::invalid_argument(a.image + ": found " + std::to_string(candidates) + " ball(s), --which " +
                                   std::to_string(a.which) + " asked for; give the ball with --ball X,Y,R");
-    std::sort(found.begin(), found.end(), [](const BallGuess& p, const BallGuess& q) { return p.centre_px.x() < q.centre_px.x(); });
-    guess = found[a.which];
-  }
-  BallLocation loc;
-  try {
-    loc = locate_ball(view.radiance, lens, guess);
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(a.image + ": " + e.what());
+    std::sort(found.begin(), found.end(),
+              [](const BallCandidate& p, const BallCandidate& q) { return p.loc.centre_px.x() < q.loc.centre_px.x(); });
+    loc = found[std::size_t(a.which)].loc;
   }
 
   ExtractOptions o;

@@ -20,7 +20,7 @@ namespace {
 
 struct ProcessArgs {
   ProcessOptions o;
-  std::string size = "320x240", json, up = "0,-1,0";
+  std::string size = "320x240", json, up = "auto";
   bool quiet = false, no_sources = false;
 };
 
@@ -30,8 +30,12 @@ int run_process_verb(ProcessArgs a) {
   std::istringstream in(a.size);
   if (!(in >> w >> x >> h) || x != 'x' || !(in >> std::ws).eof() || w < 16 || h < 16 || w > 8192 || h > 8192)
     throw std::invalid_argument("--size '" + a.size + "': expected WxH, 16..8192 each");
-  if (a.up == "none") a.o.up.reset();
-  else a.o.up = parse_vec3(a.up, "--up");
+  if (a.up == "auto" || a.up == "none") {
+    a.o.up.reset();
+    a.o.estimate_up = a.up == "auto";
+  } else {
+    a.o.up = parse_vec3(a.up, "--up");
+  }
   a.o.recover_sources = !a.no_sources;
   a.o.render_width = w;
   a.o.render_height = h;
@@ -66,9 +70,11 @@ Runner add_process(CLI::App& app) {
   auto a = std::make_shared<ProcessArgs>();
   CLI::App* c = app.add_subcommand("process", "The whole job: photo set -> probe, captured vs computed maps, render, report");
   c->footer(
-      "Steps (each skipped when its outputs are newer than its inputs and its settings are unchanged; records in "
-      "DIR/steps/<step>.json): calibrate (chessboards, or --lens) -> hdr (response + merge per view) -> orient "
-      "(solved from the chrome ball's features, or --poses) -> extract (every ball of every view; chrome by reflection indexing, grey orthographic) -> probe "
+      "Steps (each skipped when its inputs and outputs hold what its record says and its settings are unchanged; records in "
+      "DIR/steps/<step>.json): calibrate (chessboards, or --lens) -> hdr (response, vignetting, merge per view) -> orient "
+      "(solved from the chrome ball's features, world up estimated, or --poses) -> extract (every listed ball of every view, "
+      "identified and checked across views; a ball not found in a view is left out and reported; chrome by reflection "
+      "indexing with the other balls, stands and photographer masked, grey orthographic) -> probe "
       "(chrome maps blended) -> sources (light clipped in every chrome view recovered from the grey and glossy balls, "
       "written into the probe; --no-sources: not) -> bake (grey balls from the probe, Lambert) -> compare (captured vs computed, gains "
       "fitted) -> render (turntable of --mesh or a torus lit by the probe) -> report (DIR/report.html, "
@@ -78,8 +84,13 @@ Runner add_process(CLI::App& app) {
   c->add_option("--out", a->o.out, "Output folder DIR (created; its parent must exist)")->required();
   c->add_option("--lens", a->o.lens, "The camera's .cameramodel (instead of calibrating from chessboards)");
   c->add_option("--poses", a->o.poses, "Camera orientations: poses.yaml (rsibr orient) or a synth truth.yaml");
-  c->add_option("--up", a->up, "World up X,Y,Z in the first camera's frame for the orientation solve ('none': "
-                              "world = first camera)")->capture_default_str();
+  c->add_option("--up", a->up, "World up: 'auto' (estimated from the views: cameras are held level in roll), "
+                              "X,Y,Z in the first camera's frame (0,-1,0 for a levelled camera), or 'none' (world = "
+                              "first camera)")->capture_default_str();
+  c->add_option("--ball", a->o.ball_overrides, "VIEW:BALL=X,Y,R: that ball of that view is at pixel (X, Y) with radius R "
+                                               "(roughly), instead of the detection (repeatable)");
+  c->add_option("--vignetting", a->o.vignetting, "'auto' (estimated from the chessboards), 'none', or a JSON model "
+                                                 "(DIR/hdr/vignetting.json of another run)")->capture_default_str();
   c->add_option("--radiance", a->o.radiance_dir, "Use these linear EXRs (<view>_radiance.exr or <view>.exr) instead of the merge");
   c->add_option("--probe", a->o.probe_file, "Use this environment as the probe instead of the chrome maps' blend");
   c->add_option("--mesh", a->o.mesh, "Mesh for the turntable (.glb, .gltf, .obj; default: a torus)");

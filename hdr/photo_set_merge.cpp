@@ -29,7 +29,7 @@ PhotoSetResponse recover_photo_set_response(const std::vector<const PhotoView*>&
 }
 
 ViewMerge merge_photo_view(const PhotoView& view, const ResponseCurve& curve, const std::optional<NoiseModel>& noise,
-                           bool align, const MergeOptions& options) {
+                           bool align, const MergeOptions& options, const Vignetting* vignetting) {
   const auto t0 = std::chrono::steady_clock::now();
   ViewMerge m;
   m.brackets = load_brackets(view);
@@ -43,6 +43,7 @@ ViewMerge merge_photo_view(const PhotoView& view, const ResponseCurve& curve, co
   m.noise = noise ? *noise : estimate_noise(b, curve, default_saturation_code(b.max_code));
   const auto t1 = std::chrono::steady_clock::now();
   m.image = merge_brackets(b, curve, m.noise, options);
+  if (vignetting) divide_vignetting(m.image, *vignetting);
   const auto t2 = std::chrono::steady_clock::now();
   m.seconds_load = std::chrono::duration<double>(t1 - t0).count();
   m.seconds_merge = std::chrono::duration<double>(t2 - t1).count();

@@ -8,6 +8,7 @@
 #include "hdr/merge.h"
 #include "hdr/noise_model.h"
 #include "hdr/response_recovery.h"
+#include "hdr/vignetting.h"
 
 #include <opencv2/core.hpp>
 
@@ -35,8 +36,9 @@ struct ViewMerge {
   double seconds_load = 0, seconds_merge = 0;  // loading + alignment + noise estimate; the merge
 };
 
+// `vignetting`, when given, is divided out of the merged radiance and variance (hdr/vignetting.h).
 // Throws std::runtime_error("view <name>: ...") when the photos' bit depth is not the curve's.
 ViewMerge merge_photo_view(const PhotoView& view, const ResponseCurve& curve, const std::optional<NoiseModel>& noise,
-                           bool align, const MergeOptions& options = {});
+                           bool align, const MergeOptions& options = {}, const Vignetting* vignetting = nullptr);
 
 }  // namespace rsibr

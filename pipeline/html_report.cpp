@@ -90,6 +90,85 @@ std::vector<unsigned char> read_bytes(const fs::path& dir, const fs::path& file)
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+// Hdr: the vignetting model divided out of the merge (hdr/vignetting.h).
+void write_vignetting_section(std::ostringstream& h, const nlohmann::json& v) {
+  const nlohmann::json& m = v.value("model", nlohmann::json::object());
+  h << "<h3>Vignetting</h3><p>";
+  if (m.contains("k") && m.value("source", "none") != "none") {
+    h << "Divided out of every view: v = 1 + k1 r&sup2; + k2 r&#8308; + k3 r&#8310; (r = 1 at the farthest corner), k = ("
+      << jnum(m["k"][0]) << ", " << jnum(m["k"][1]) << ", " << jnum(m["k"][2]) << "), the corner "
+      << jnum(m["corner_stops"], 3) << " stops darker; " << html_escape(m.value("source", "")) << ".";
+    if (v.contains("estimate")) {
+      const auto& e = v["estimate"];
+      h << " Estimated from " << jnum(e["squares"]) << " white squares on " << jnum(e["boards"]) << " boards ("
+        << jnum(e["degree"]) << " term(s) chosen by leave-one-board-out error), fit RMS " << num(100 * e["rms"].get<double>(), 2)
+        << "%, corner &sigma; " << jnum(e["corner_sigma_stops"], 2) << " stops; squares reach r = " << jnum(e["max_r"], 2)
+        << " (beyond, the polynomial extrapolates).";
+    }
+  } else {
+    h << "Not corrected";
+  }
+  if (v.contains("note")) h << " " << html_escape(v["note"].get<std::string>());
+  h << "</p>";
+}
+
+// Orient: the world's up and the views left out.
+void write_orientation_notes(std::ostringstream& h, const nlohmann::json& s) {
+  if (s.contains("world_up") && s["world_up"].is_object()) {
+    const auto& w = s["world_up"];
+    h << "<p>World up estimated from the views (cameras held level in roll): " << jnum(w["tilt_from_first_camera_deg"], 3)
+      << " degrees from the first camera's up, &sigma; " << jnum(w["sigma_deg"], 2) << " degrees (roll scatter "
+      << jnum(w["roll_sigma_deg"], 2) << " degrees, " << (w.value("roll_sigma_estimated", false) ? "from the views" : "assumed")
+      << ").</p>";
+  }
+  if (s.contains("left_out") && !s["left_out"].empty()) {
+    h << "<p class=\"warn\"><b>Views left out:</b>";
+    for (const auto& l : s["left_out"]) h << "<br>" << html_escape(l.get<std::string>());
+    h << "</p>";
+  }
+}
+
+// Extract: every ball of every view as identified, and each chrome view's mask.
+void write_balls_section(std::ostringstream& h, const nlohmann::json& s, const fs::path& dir) {
+  h << "<h2>Balls</h2><p>Each listed ball of each view, identified by its outline, its appearance and the rig's "
+       "geometry across views; a ball not found with confidence is left out of its maps.</p>"
+       "<table><tr><th>view</th><th>ball</th><th>status</th><th>centre (px)</th><th>radius (px)</th>"
+       "<th>outline RMS (px)</th><th>confident</th><th>note</th></tr>";
+  for (const auto& v : s["views"]) {
+    const std::string name = v["name"].get<std::string>();
+    if (v.contains("left_out")) {
+      h << "<tr><td>" << html_escape(name) << "</td><td>-</td><td>left out</td><td></td><td></td><td></td><td></td><td>"
+        << html_escape(v["left_out"].get<std::string>()) << "</td></tr>";
+      continue;
+    }
+    for (const auto& b : v["balls"]) {
+      const bool found = b.contains("centre_px");
+      h << "<tr><td>" << html_escape(name) << "</td><td>" << html_escape(b["ball"].get<std::string>()) << "</td><td"
+        << (found ? "" : " class=\"warn\"") << ">" << html_escape(b.value("status", "")) << (b.value("cut", false) ? ", cut by the frame" : "")
+        << "</td>";
+      if (found)
+        h << "<td>(" << jnum(b["centre_px"][0], 5) << ", " << jnum(b["centre_px"][1], 5) << ")</td><td>" << jnum(b["radius_px"])
+          << "</td><td>" << jnum(b["outline_rms_px"]) << "</td><td>"
+          << (b.contains("confident_fraction") ? num(100 * b["confident_fraction"].get<double>(), 3) + "%" : "") << "</td>";
+      else
+        h << "<td></td><td></td><td></td><td></td>";
+      h << "<td style=\"text-align:left\">" << html_escape(b.value("note", "")) << "</td></tr>";
+    }
+  }
+  h << "</table>";
+  bool any = false;
+  for (const auto& v : s["views"])
+    for (const auto& b : v["balls"])
+      if (b.contains("mask")) {
+        if (!any) h << "<h3>Masks</h3><p>Each view's map of each ball (left) and its confidence (right): red is left out "
+                       "(chrome: the camera and photographer, the stands, the other balls; grey: what this view alone sees "
+                       "differently, a shadow of the photographer; both: a ball in front, clipped pixels, the rim).</p>";
+        any = true;
+        h << "<p>" << html_escape(v["name"].get<std::string>() + " " + b["ball"].get<std::string>()) << "<br>"
+          << img_tag(read_bytes(dir, dir / b["mask"].get<std::string>()), v["name"].get<std::string>()) << "</p>";
+      }
+}
+
 }  // namespace
 
 std::string svg_line_plot(const std::vector<PlotSeries>& series, const std::string& x_label, const std::string& y_label,
@@ -191,6 +270,7 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
         << num(100 * v["clipped_fraction"].get<double>(), 3) << "%</td><td>"
         << num(100 * v["ghost_fraction"].get<double>(), 3) << "%</td></tr>";
     h << "</table>";
+    if (s.contains("vignetting")) write_vignetting_section(h, s["vignetting"]);
   }
 
   if (rec.count("orient")) {
@@ -201,20 +281,10 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
       h << "<tr><td>" << html_escape(v["name"].get<std::string>()) << "</td><td>(" << jnum(v["forward"][0], 3) << ", "
         << jnum(v["forward"][1], 3) << ", " << jnum(v["forward"][2], 3) << ")</td><td>" << jnum(v["sigma_deg"]) << "</td></tr>";
     h << "</table>";
+    write_orientation_notes(h, s);
   }
 
-  if (rec.count("extract")) {
-    const auto& s = rec["extract"].summary;
-    h << "<h2>Balls</h2><table><tr><th>view</th><th>ball</th><th>centre (px)</th><th>radius (px)</th>"
-         "<th>outline RMS (px)</th><th>confident</th></tr>";
-    for (const auto& v : s["views"])
-      for (const auto& b : v["balls"])
-        h << "<tr><td>" << html_escape(v["name"].get<std::string>()) << "</td><td>" << html_escape(b["ball"].get<std::string>())
-          << "</td><td>(" << jnum(b["centre_px"][0], 5) << ", " << jnum(b["centre_px"][1], 5) << ")</td><td>"
-          << jnum(b["radius_px"]) << "</td><td>" << jnum(b["outline_rms_px"]) << "</td><td>"
-          << num(100 * b["confident_fraction"].get<double>(), 3) << "%</td></tr>";
-    h << "</table>";
-  }
+  if (rec.count("extract")) write_balls_section(h, rec["extract"].summary, dir);
 
   if (rec.count("probe")) {
     const auto& s = rec["probe"].summary;
@@ -266,7 +336,7 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
         << jnum(b["overall"]["after"]["relative_rms"]) << "</th><th>" << jnum(b["overall"]["after"]["log_rms_stops"])
         << "</th><th>" << jnum(b["overall"]["after"]["psnr_db"]) << "</th></tr></table>";
       for (const auto& v : b["views"])
-        h << "<p>" << img_tag(read_bytes(dir, fs::path(b["folder"].get<std::string>()) / v["picture"].get<std::string>()),
+        h << "<p>" << img_tag(read_bytes(dir, dir / fs::path(b["folder"].get<std::string>()) / v["picture"].get<std::string>()),
                               v["image"].get<std::string>())
           << "</p>";
     }

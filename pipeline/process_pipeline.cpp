@@ -2,8 +2,11 @@
 
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
+#include "calib/ball_identification.h"
 #include "calib/ball_locator.h"
 #include "calib/intrinsics.h"
+#include "calib/lambert_consensus.h"
+#include "calib/occluders.h"
 #include "calib/probe.h"
 #include "calib/sphere_map_extraction.h"
 #include "calib/view_image.h"
@@ -31,12 +34,15 @@
 #include "hdr/photo_set_merge.h"
 #include "hdr/response_recovery.h"
 #include "lights/recovered_probe.h"
+#include "pipeline/ball_override.h"
 #include "pipeline/chessboard_problem.h"
 #include "pipeline/html_report.h"
 #include "pipeline/light_sources_step.h"
+#include "pipeline/mask_picture.h"
 #include "pipeline/pose_input.h"
 #include "pipeline/step_record.h"
 #include "pipeline/torus_mesh.h"
+#include "pipeline/vignetting_input.h"
 #include "runtime/renderer.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -81,11 +87,12 @@ void run_step(Context& c, const std::string& step, const nlohmann::json& setting
               const std::function<void(StepRecord&)>& body) {
   const bool forced = std::find(c.o.force.begin(), c.o.force.end(), step) != c.o.force.end() ||
                       std::find(c.o.force.begin(), c.o.force.end(), "all") != c.o.force.end();
-  std::string reason = forced ? "forced" : step_stale_reason(c.dir, step, settings, inputs);
+  const RecordRoots roots{c.dir, c.set.folder};
+  std::string reason = forced ? "forced" : step_stale_reason(c.dir, step, settings, inputs, roots);
   StepOutcome outcome;
   outcome.step = step;
   if (reason.empty()) {
-    const StepRecord old = read_step_record(c.dir, step);
+    const StepRecord old = read_step_record(c.dir, step, roots);
     outcome.recorded_seconds = old.seconds;
     c.result.summary[step] = old.summary;
     c.result.steps.push_back(outcome);
@@ -106,7 +113,7 @@ void run_step(Context& c, const std::string& step, const nlohmann::json& setting
     throw std::runtime_error(step + ": " + e.what());
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  write_step_record(c.dir, r);
+  write_step_record(c.dir, r, roots);
   outcome.ran = true;
   outcome.reason = reason;
   outcome.seconds = outcome.recorded_seconds = r.seconds;
@@ -216,7 +223,10 @@ void step_hdr(Context& c) {
   std::vector<fs::path> inputs;
   for (const PhotoView& v : c.set.views)
     for (const BracketPhoto& b : v.brackets) inputs.push_back(b.file);
-  run_step(c, "hdr", {{"response", "auto"}}, inputs, [&](StepRecord& r) {
+  // Vignetting (pipeline/vignetting_input.h): its inputs and the lens's principal point.
+  for (const fs::path& f : vignetting_inputs(c.set, c.o.vignetting)) inputs.push_back(f);
+  if (c.o.vignetting != "none") inputs.push_back(c.dir / "camera.cameramodel");
+  run_step(c, "hdr", {{"response", "auto"}, {"vignetting", c.o.vignetting}}, inputs, [&](StepRecord& r) {
     fs::create_directories(c.dir / "hdr");
     std::vector<const PhotoView*> all;
     for (const PhotoView& v : c.set.views) all.push_back(&v);
@@ -237,11 +247,21 @@ void step_hdr(Context& c) {
       plot.push_back({z, curve.linear(0, z), curve.linear(1, z), curve.linear(2, z)});
     }
     r.outputs.push_back(response);
+    nlohmann::json vignetting;
+    const Vignetting vig = photo_set_vignetting(c.set, c.o.vignetting, curve, LensModel::read(c.dir / "camera.cameramodel"),
+                                                &vignetting);
+    const fs::path vfile = c.dir / "hdr" / "vignetting.json";
+    write_atomically(vfile, [&](const std::string& tmp) {
+      std::ofstream f(tmp);
+      f << vignetting["model"].dump(2) << "\n";
+      if (!f) throw std::runtime_error(tmp + ": cannot write");
+    });
+    r.outputs.push_back(vfile);
     nlohmann::json views = nlohmann::json::array();
     Progress bar("hdr", c.o.progress);
     for (std::size_t i = 0; i < c.set.views.size(); ++i) {
       const PhotoView& v = c.set.views[i];
-      const ViewMerge vm = merge_photo_view(v, curve, std::nullopt, false);
+      const ViewMerge vm = merge_photo_view(v, curve, std::nullopt, false, {}, &vig);
       const BracketSet& b = vm.brackets;
       const NoiseModel& noise = vm.noise;
       const MergedImage& m = vm.image;
@@ -260,13 +280,21 @@ void step_hdr(Context& c) {
     }
     bar.done();
     r.summary = {{"model", curve.model}, {"recovered_from", richest->name}, {"candidates", cands},
-                 {"curve", plot}, {"max_code", curve.max_code}, {"views", views}, {"camera", c.set.camera_name}};
+                 {"curve", plot}, {"max_code", curve.max_code}, {"views", views}, {"vignetting", vignetting},
+                 {"camera", c.set.camera_name}};
   });
 }
 
 // ---- orient: world_from_cam per view, solved from the chrome ball's reflected features
-// (calib/view_orientation.h; world +Y up when `up` gives the world's up in the first camera's
-// frame), or given (--poses).
+// (calib/view_orientation.h; world +Y up: estimated from the views, or `up` given in the first
+// camera's frame), or given (--poses: the file's chrome balls, refined here by the features with
+// the rotations held when the file has none; a first-view file levelled by the estimated up).
+nlohmann::json world_up_json(const WorldUp& w) {
+  return {{"up_in_first_camera", {w.up.x(), w.up.y(), w.up.z()}}, {"sigma_deg", w.sigma_deg},
+          {"roll_sigma_deg", w.roll_sigma_deg}, {"roll_sigma_estimated", w.roll_sigma_estimated},
+          {"roll_deg", w.roll_deg}, {"tilt_from_first_camera_deg", w.tilt_from_first_deg}, {"lines", w.lines}};
+}
+
 void step_orient(Context& c) {
   std::vector<fs::path> inputs = hdr_files(c);
   inputs.push_back(c.dir / "camera.cameramodel");
@@ -276,179 +304,329 @@ void step_orient(Context& c) {
     for (const PhotoView& v : c.set.views)
       if (!given.find(v.name)) throw std::invalid_argument(c.o.poses + ": no pose for view '" + v.name + "'");
   }
-  const nlohmann::json settings = {{"source", c.o.poses.empty() ? "solve" : "given"},
-                                   {"up", c.o.up ? nlohmann::json{c.o.up->x(), c.o.up->y(), c.o.up->z()} : nlohmann::json()}};
+  const std::vector<BallOverride> overrides = parse_ball_overrides(c.o.ball_overrides, c.set);
+  const std::vector<ListedBall> listed = listed_balls(c.set);
+  std::vector<std::optional<BallGuess>> given_chrome;
+  nlohmann::json chrome_overrides = nlohmann::json::array();
+  // The chrome ball given by hand in a view (the first listed chrome ball's --ball).
+  for (const PhotoView& v : c.set.views) {
+    std::optional<BallGuess> g;
+    for (const BallSpec& b : c.set.balls)
+      if (b.kind == BallKind::chrome && !g) g = find_override(overrides, v.name, b.name);
+    if (g) chrome_overrides.push_back({v.name, g->centre_px.x(), g->centre_px.y(), g->radius_px});
+    given_chrome.push_back(g);
+  }
+  nlohmann::json balls = nlohmann::json::array();
+  for (const BallSpec& b : c.set.balls) balls.push_back({b.name, to_string(b.kind), b.diameter_m.value_or(0.0)});
+  const nlohmann::json settings = {
+      {"source", c.o.poses.empty() ? "solve" : "given"},
+      {"up", c.o.up ? nlohmann::json{c.o.up->x(), c.o.up->y(), c.o.up->z()} : nlohmann::json(c.o.estimate_up ? "auto" : "none")},
+      {"balls", balls}, {"chrome_overrides", chrome_overrides}};
   run_step(c, "orient", settings, inputs, [&](StepRecord& r) {
     PoseSet poses;
     std::string source;
-    nlohmann::json solve;
-    if (!c.o.poses.empty()) {
-      poses = read_given_poses(c.o.poses);
-      source = "given (" + c.o.poses + ")";
-    } else {
-      const LensModel lens = LensModel::read(c.dir / "camera.cameramodel");
-      std::vector<std::string> names;
-      std::vector<ViewImage> images;
+    nlohmann::json solve, left_out = nlohmann::json::array(), up = nullptr;
+    const LensModel lens = LensModel::read(c.dir / "camera.cameramodel");
+    std::vector<std::string> names;
+    std::vector<ViewImage> images;
+    auto load_images = [&] {
       for (const PhotoView& v : c.set.views) {
         names.push_back(v.name);
         images.push_back(read_view_image(merged_path(c, v.name).string()));
       }
-      ViewOrientationOptions vo;
+    };
+    ViewOrientationOptions vo;
+    vo.listed = listed;
+    vo.given_chrome = given_chrome;
+    ViewOrientationReport report;
+    if (!c.o.poses.empty()) {
+      poses = read_given_poses(c.o.poses);
+      source = "given (" + c.o.poses + ")";
+      PoseSet ordered;
+      ordered.gauge = poses.gauge;
+      for (const PhotoView& v : c.set.views) ordered.views.push_back(*poses.find(v.name));
+      poses = ordered;
+      bool all_balls = true;
+      for (const ViewPose& p : poses.views) all_balls = all_balls && p.ball.has_value();
+      if (!all_balls) {
+        // The chrome balls refined by the features with the file's rotations held.
+        load_images();
+        for (const ViewPose& p : poses.views) vo.known_world_from_cam.push_back(p.world_from_cam);
+        const PoseSet refined = orient_views(names, images, lens, vo, &report);
+        for (ViewPose& p : poses.views)
+          if (!p.ball)
+            if (const ViewPose* q = refined.find(p.name)) p.ball = q->ball;
+        source += ", chrome balls refined by the features with the rotations held";
+        for (const std::string& w : report.left_out) left_out.push_back(w);
+      }
+      if (poses.gauge == "first-view" && !c.o.up && c.o.estimate_up) {
+        up = world_up_json(level_pose_set(poses));
+        source += ", levelled by the estimated up";
+      }
+    } else {
+      load_images();
       vo.up = c.o.up;
-      ViewOrientationReport report;
+      vo.estimate_up = c.o.estimate_up;
       poses = orient_views(names, images, lens, vo, &report);
       source = "solved (chrome-ball features)";
       solve = {{"tracks", report.tracks}, {"observations", report.observations}, {"inliers", report.inliers},
                {"rms_sigmas", report.rms_sigmas}, {"features", report.features},
                {"tracks_relocated", report.track_refinement.tracks_refined}};
+      for (const std::string& w : report.left_out) left_out.push_back(w);
+      if (report.world_up) up = world_up_json(*report.world_up);
     }
-    // In the set's order, only its views.
+    // In the set's order, only its views (those left out have no pose).
     PoseSet ordered;
     ordered.gauge = poses.gauge;
-    for (const PhotoView& v : c.set.views) ordered.views.push_back(*poses.find(v.name));
+    for (const PhotoView& v : c.set.views)
+      if (const ViewPose* p = poses.find(v.name)) ordered.views.push_back(*p);
     const fs::path out = c.dir / "poses.yaml";
     write_pose_file(out.string(), ordered);
     nlohmann::json views = nlohmann::json::array();
     for (const ViewPose& p : ordered.views) {
       const Vec3 forward = p.world_from_cam.col(2);
-      views.push_back({{"name", p.name}, {"sigma_deg", p.sigma_deg}, {"forward", {forward.x(), forward.y(), forward.z()}}});
+      nlohmann::json vj = {{"name", p.name}, {"sigma_deg", p.sigma_deg}, {"forward", {forward.x(), forward.y(), forward.z()}}};
+      if (p.ball) {
+        const Vec2 cp = lens.project(p.ball->axis);
+        vj["chrome_centre_px"] = {cp.x(), cp.y()};
+      }
+      views.push_back(vj);
     }
     r.outputs = {out};
-    r.summary = {{"source", source}, {"gauge", ordered.gauge}, {"views", views}, {"solve", solve}};
+    r.summary = {{"source", source}, {"gauge", ordered.gauge}, {"views", views}, {"solve", solve},
+                 {"left_out", left_out}, {"world_up", up}};
   });
 }
 
-// ---- extract: every ball of every view, in the world frame.
-int kind_rank(BallKind k) { return k == BallKind::chrome ? 2 : k == BallKind::glossy ? 1 : 0; }
-
-// How mirror-like the ball's image is: a grey (diffuse) ball's image is smooth, its log luminance
-// changing by a few stops over the whole disc, while a mirror shows the environment's edges
-// (horizon, sun, stand, photographer) compressed toward its rim. The score is the 98th percentile,
-// over the pixels within 0.9 radii, of |grad ln(luminance + eps)| in stops per ball radius (central
-// differences; eps = 1e-3 of the mean): a grey ball scores a few stops, a chrome ball tens.
-double mirror_score(const cv::Mat& rgb, const BallLocation& loc) {
-  const double r = loc.radius_px, inner = 0.9 * r;
-  std::vector<double> grads;
-  cv::Mat lum(rgb.rows, rgb.cols, CV_64F);
-  double mean = 0;
-  long count = 0;
-  for (int py = 0; py < rgb.rows; ++py)
-    for (int px = 0; px < rgb.cols; ++px) {
-      const cv::Vec3f p = rgb.at<cv::Vec3f>(py, px);
-      lum.at<double>(py, px) = std::max(0.0, 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]);
-      if (std::hypot(px - loc.centre_px.x(), py - loc.centre_px.y()) <= inner) mean += lum.at<double>(py, px), ++count;
-    }
-  if (count < 20 || !(mean > 0)) return 0;
-  const double eps = 1e-3 * mean / double(count);
-  for (int py = 1; py + 1 < rgb.rows; ++py)
-    for (int px = 1; px + 1 < rgb.cols; ++px) {
-      if (std::hypot(px - loc.centre_px.x(), py - loc.centre_px.y()) > inner) continue;
-      auto l = [&](int x, int y) { return std::log2(lum.at<double>(y, x) + eps); };
-      const double gx = 0.5 * (l(px + 1, py) - l(px - 1, py)), gy = 0.5 * (l(px, py + 1) - l(px, py - 1));
-      grads.push_back(std::hypot(gx, gy) * r);
-    }
-  if (grads.empty()) return 0;
-  const auto q = grads.begin() + long(0.98 * double(grads.size() - 1));
-  std::nth_element(grads.begin(), q, grads.end());
-  return *q;
+// ---- extract: every listed ball of every view, identified and checked across views
+// (calib/ball_identification.h), in the world frame; a ball not found in a view is left out of that
+// ball's maps and reported. Chrome maps mask the other balls, the stands and the photographer by
+// geometry (calib/occluders.h); each chrome view's mask is drawn into DIR/masks/<view>.png.
+nlohmann::json finding_json(const std::string& ball, const BallFinding& f) {
+  nlohmann::json j = {{"ball", ball}, {"status", f.status}, {"note", f.note}};
+  if (f.predicted_px) j["predicted_px"] = {f.predicted_px->x(), f.predicted_px->y(), f.predicted_radius_px};
+  if (f.disagreement >= 0) j["disagreement_radii"] = f.disagreement;
+  if (!f.ball) return j;
+  const BallCandidate& b = *f.ball;
+  j.update({{"centre_px", {b.loc.centre_px.x(), b.loc.centre_px.y()}}, {"radius_px", b.loc.radius_px},
+            {"outline_rms_px", b.loc.fit.rms_px}, {"inlier_fraction", b.inlier_fraction}, {"texture", b.texture},
+            {"mirror_score", b.mirror_score}, {"diffuse_residual", std::isfinite(b.diffuse_residual) ? b.diffuse_residual : -1.0},
+            {"frame_fraction", b.frame_fraction}, {"cut", b.cut}});
+  return j;
 }
 
 void step_extract(Context& c) {
   std::vector<fs::path> inputs = hdr_files(c);
   inputs.push_back(c.dir / "camera.cameramodel");
   inputs.push_back(c.dir / "poses.yaml");
-  nlohmann::json balls = nlohmann::json::array();
-  for (const BallSpec& b : c.set.balls) balls.push_back({b.name, to_string(b.kind)});
-  run_step(c, "extract", {{"map_size", c.o.map_size}, {"balls", balls}}, inputs, [&](StepRecord& r) {
+  const std::vector<BallOverride> overrides = parse_ball_overrides(c.o.ball_overrides, c.set);
+  nlohmann::json balls = nlohmann::json::array(), given = nlohmann::json::array();
+  for (const BallSpec& b : c.set.balls) balls.push_back({b.name, to_string(b.kind), b.diameter_m.value_or(0.0)});
+  for (const BallOverride& o : overrides) given.push_back({o.view, o.ball, o.guess.centre_px.x(), o.guess.centre_px.y(), o.guess.radius_px});
+  const nlohmann::json settings = {{"map_size", c.o.map_size}, {"balls", balls}, {"given", given}, {"identification", 4}};
+  run_step(c, "extract", settings, inputs, [&](StepRecord& r) {
     if (c.set.balls.empty()) throw std::invalid_argument(c.o.photoset + ": balls: the photo set lists no ball");
     const LensModel lens = LensModel::read(c.dir / "camera.cameramodel");
     const PoseSet poses = read_pose_file((c.dir / "poses.yaml").string());
-    // World down for the stand mask: -Y when the world is +Y up, else the first camera's +y.
-    const Vec3 world_down = poses.gauge == "up" ? Vec3(0, -1, 0) : Vec3(0, 1, 0);
-    std::vector<MapSet> sets(c.set.balls.size());
-    nlohmann::json views = nlohmann::json::array();
-    Progress bar("extract", c.o.progress);
-    for (std::size_t vi = 0; vi < c.set.views.size(); ++vi) {
-      const PhotoView& v = c.set.views[vi];
+    const std::vector<ListedBall> listed = listed_balls(c.set);
+    // World down for the stands and the photographer: -Y when the world is +Y up, else the first camera's +y.
+    const Vec3 world_down = poses.gauge != "first-view" ? Vec3(0, -1, 0) : Vec3(0, 1, 0);
+    int chrome_index = -1;
+    for (std::size_t b = 0; b < listed.size(); ++b)
+      if (listed[b].kind == BallKind::chrome && chrome_index < 0) chrome_index = int(b);
+    const double chrome_radius_m =
+        chrome_index >= 0 && listed[std::size_t(chrome_index)].diameter_m ? 0.5 * *listed[std::size_t(chrome_index)].diameter_m : 0.05;
+    auto read_view = [&](const PhotoView& v) {
       const std::string file = merged_path(c, v.name).string();
-      const ViewImage img = read_view_image(file);
+      ViewImage img = read_view_image(file);
       if (img.radiance.cols != lens.width() || img.radiance.rows != lens.height())
         throw std::invalid_argument(file + ": " + std::to_string(img.radiance.cols) + "x" +
                                     std::to_string(img.radiance.rows) + " but the lens model is " +
                                     std::to_string(lens.width()) + "x" + std::to_string(lens.height()));
-      const double m = std::min(lens.width(), lens.height());
-      std::vector<BallGuess> found = detect_balls(img.radiance, std::max(4.0, m / 40), m / 2, 8);
-      if (found.size() < c.set.balls.size())
-        throw std::runtime_error(file + ": found " + std::to_string(found.size()) + " ball(s), the photo set lists " +
-                                 std::to_string(c.set.balls.size()));
-      // The strongest candidates, one per listed ball, located; then matched to the listed balls by
-      // appearance: a chrome ball mirrors the whole scene (sharp, high contrast), a grey one is
-      // smooth, so ranking by the spread of log luminance inside the disc (mirror_score) and the
-      // listed balls by kind (chrome, glossy, grey) pairs them whatever the camera's side of the rig.
-      found.resize(c.set.balls.size());
-      std::vector<BallLocation> located;
-      std::vector<double> score;
-      for (const BallGuess& g : found) {
-        try {
-          located.push_back(locate_ball(img.radiance, lens, g));
-        } catch (const std::invalid_argument& e) {
-          throw std::runtime_error(file + ": " + e.what());
-        }
-        score.push_back(mirror_score(img.radiance, located.back()));
+      return img;
+    };
+    // Pass 1: every view's candidates and its chrome ball (the anchor).
+    std::vector<ViewBalls> vb;
+    std::vector<const PhotoView*> used;
+    nlohmann::json views = nlohmann::json::array();
+    Progress bar("extract", c.o.progress);
+    const double steps = 2.0 * double(c.set.views.size());
+    for (std::size_t vi = 0; vi < c.set.views.size(); ++vi) {
+      const PhotoView& v = c.set.views[vi];
+      const ViewPose* pose = poses.find(v.name);
+      if (!pose) {
+        views.push_back({{"name", v.name}, {"left_out", "no pose (the orient step found no chrome ball in it)"},
+                         {"balls", nlohmann::json::array()}});
+        continue;
       }
-      std::vector<std::size_t> by_score(found.size()), by_kind(c.set.balls.size());
-      for (std::size_t i = 0; i < by_score.size(); ++i) by_score[i] = by_kind[i] = i;
-      std::stable_sort(by_score.begin(), by_score.end(), [&](std::size_t p, std::size_t q) { return score[p] > score[q]; });
-      std::stable_sort(by_kind.begin(), by_kind.end(), [&](std::size_t p, std::size_t q) {
-        return kind_rank(c.set.balls[p].kind) > kind_rank(c.set.balls[q].kind);
-      });
-      const ViewPose& pose = *poses.find(v.name);
-      const Mat3 world_from_cam = pose.world_from_cam;
+      const ViewImage img = read_view(v);
+      ViewBalls one;
+      one.name = v.name;
+      one.world_from_cam = pose->world_from_cam;
+      one.candidates = find_ball_candidates(img.radiance, lens);
+      if (chrome_index >= 0) {
+        if (auto g = find_override(overrides, v.name, listed[std::size_t(chrome_index)].name)) {
+          one.chrome = given_ball(img.radiance, lens, *g).loc.fit.cone;
+        } else if (pose->ball) {
+          one.chrome = pose->ball;  // refined with the orientations (the outline lies inside its limb)
+        } else {
+          const std::vector<int> pick = assign_balls_in_view(one.candidates, listed);
+          if (pick[std::size_t(chrome_index)] >= 0) one.chrome = one.candidates[std::size_t(pick[std::size_t(chrome_index)])].loc.fit.cone;
+        }
+      }
+      vb.push_back(std::move(one));
+      used.push_back(&v);
+      bar.update(double(vi + 1) / steps);
+    }
+    const std::vector<RigMember> rig = fit_ball_rig(vb, listed);
+    int anchored = 0;
+    for (const ViewBalls& v : vb) anchored += v.chrome.has_value();
+    const bool trust_views = anchored < 2;  // one view: nothing to check it against
+    // Pass 2: each view's balls decided, extracted; the chrome maps masked.
+    std::vector<MapSet> sets(listed.size());
+    FolderContents masks;
+    for (std::size_t k = 0; k < vb.size(); ++k) {
+      const PhotoView& v = *used[k];
+      const ViewImage img = read_view(v);
+      std::vector<BallFinding> found = identify_view_balls(vb[k], rig, listed, img.radiance, lens, {}, {}, trust_views);
+      for (std::size_t b = 0; b < listed.size(); ++b)
+        if (auto g = find_override(overrides, v.name, listed[b].name)) {
+          found[b] = BallFinding{};
+          found[b].status = "given";
+          found[b].note = "--ball";
+          found[b].ball = given_ball(img.radiance, lens, *g);
+          if (int(b) == chrome_index && vb[k].chrome) found[b].ball->loc.fit.cone = *vb[k].chrome;
+        }
+      const Mat3 world_from_cam = vb[k].world_from_cam;
+      const Vec3 down_cam = world_from_cam.transpose() * world_down;
+      std::vector<OtherBall> others;
+      for (std::size_t b = 0; b < listed.size(); ++b)
+        if (int(b) != chrome_index && found[b].found() && chrome_index >= 0 && found[std::size_t(chrome_index)].found()) {
+          const BallCone chrome = found[std::size_t(chrome_index)].ball->loc.fit.cone, cone = found[b].ball->loc.fit.cone;
+          // The radius over the chrome's: the rig's, else the listed diameters', else the same distance as the chrome ball.
+          double scale = rig.size() == listed.size() && rig[b].known ? rig[b].scale : 0;
+          if (!(scale > 0) && listed[b].diameter_m && listed[std::size_t(chrome_index)].diameter_m)
+            scale = *listed[b].diameter_m / *listed[std::size_t(chrome_index)].diameter_m;
+          if (!(scale > 0)) scale = std::sin(cone.half_angle) / std::sin(chrome.half_angle);
+          others.push_back({listed[b].name, cone, scale});
+        }
       nlohmann::json vj = {{"name", v.name}, {"balls", nlohmann::json::array()}};
-      for (std::size_t k = 0; k < by_kind.size(); ++k) {
-        const std::size_t bi = by_kind[k];
-        const BallSpec& ball = c.set.balls[bi];
-        const BallLocation& loc = located[by_score[k]];
+      for (std::size_t b = 0; b < listed.size(); ++b) {
+        const ListedBall& ball = listed[b];
+        nlohmann::json bj = finding_json(ball.name, found[b]);
+        if (!found[b].found()) {
+          vj["balls"].push_back(bj);
+          continue;
+        }
+        const BallCone cone = found[b].ball->loc.fit.cone;
         ExtractOptions eo;
         eo.size = c.o.map_size;
         eo.mirror = ball.kind == BallKind::chrome;
         eo.indexing = eo.mirror ? SphereIndexing::reflection : SphereIndexing::orthographic;
         eo.camera_mask_deg = eo.mirror ? 12.0 : 0.0;
-        eo.down = world_from_cam.transpose() * world_down;
+        eo.down = down_cam;
         eo.material = eo.mirror ? "{type: mirror}" : "{type: lambert}";
-        // The chrome ball as refined with the orientations (the outline lies inside its limb).
-        const BallCone cone = eo.mirror ? extraction_cone(loc, pose, lens) : loc.fit.cone;
-        // The view's other balls, which hide this one where they are nearer the camera.
-        for (std::size_t k2 = 0; k2 < by_kind.size(); ++k2) {
-          if (k2 == k) continue;
-          const BallSpec& other = c.set.balls[by_kind[k2]];
-          const double ratio = other.diameter_m && ball.diameter_m ? *other.diameter_m / *ball.diameter_m : 1.0;
-          eo.hiding.push_back({located[by_score[k2]].fit.cone, ratio});
+        // Radii of this ball over the chrome's (the extraction's geometry is in this ball's radii).
+        double own_scale = 1;
+        for (const OtherBall& o : others)
+          if (o.name == ball.name) own_scale = o.scale;
+        std::vector<OtherBall> rest;
+        if (chrome_index >= 0 && int(b) != chrome_index && found[std::size_t(chrome_index)].found())
+          rest.push_back({listed[std::size_t(chrome_index)].name, found[std::size_t(chrome_index)].ball->loc.fit.cone, 1.0});
+        for (const OtherBall& o : others)
+          if (o.name != ball.name) rest.push_back(o);
+        for (const OtherBall& o : rest) {
+          Occluder f;
+          f.centre = o.scale / own_scale * o.cone.axis.normalized() / std::sin(o.cone.half_angle);
+          f.radius = 1.03 * o.scale / own_scale;
+          f.what = "ball " + o.name + " in front";
+          eo.in_front.push_back(f);
         }
+        if (eo.mirror && int(b) == chrome_index) eo.occluders = chrome_occluders(cone, rest, down_cam, chrome_radius_m);
         MapView mv = extract_sphere_map(img.radiance, img.flags, lens, cone, world_from_cam, eo);
         mv.attributes["image"] = v.name;
         mv.attributes["ball"] = ball.name;
         mv.attributes["ballKind"] = to_string(ball.kind);
         mv.attributes["frame"] = "world (poses.yaml)";
+        mv.attributes["identified"] = found[b].status;
         const cv::Mat& conf = mv.confidence;
-        vj["balls"].push_back({{"ball", ball.name}, {"centre_px", {loc.centre_px.x(), loc.centre_px.y()}},
-                               {"radius_px", loc.radius_px}, {"outline_rms_px", loc.fit.rms_px},
-                               {"mirror_score", score[by_score[k]]},
-                               {"confident_fraction", cv::countNonZero(conf > 0.5) /
-                                                          (kPiD / 4 * c.o.map_size * c.o.map_size)}});
-        sets[bi].views.push_back(std::move(mv));
+        bj["confident_fraction"] = cv::countNonZero(conf > 0.5) / (kPiD / 4 * c.o.map_size * c.o.map_size);
+        nlohmann::json occ = nlohmann::json::array();
+        for (const Occluder& o : eo.occluders) occ.push_back(o.what);
+        for (const Occluder& o : eo.in_front) occ.push_back(o.what);
+        bj["masked"] = occ;
+        vj["balls"].push_back(bj);
+        sets[b].views.push_back(std::move(mv));
       }
       views.push_back(vj);
-      bar.update(double(vi + 1) / double(c.set.views.size()));
+      bar.update(double(vb.size() + k + 1) / steps);
     }
     bar.done();
+    // Grey balls: what one view alone sees differently (the photographer's shadow) is masked, a view
+    // mostly so is left out (calib/lambert_consensus.h).
+    auto ball_entry = [&](const std::string& view, const std::string& ball) -> nlohmann::json* {
+      for (auto& vj : views)
+        if (vj["name"] == view)
+          for (auto& bj : vj["balls"])
+            if (bj["ball"] == ball) return &bj;
+      return nullptr;
+    };
+    for (std::size_t b = 0; b < listed.size(); ++b) {
+      if (listed[b].kind != BallKind::grey) continue;
+      const std::vector<LambertConsensusView> cons = mask_lambert_inconsistencies(sets[b].views);
+      std::vector<MapView> kept;
+      for (std::size_t k = 0; k < cons.size(); ++k) {
+        MapView& mv = sets[b].views[k];
+        nlohmann::json* bj = ball_entry(mv.attributes["image"], listed[b].name);
+        if (bj) {
+          (*bj)["consensus"] = {{"judged", cons[k].judged}, {"masked", cons[k].masked}, {"median_stops", cons[k].median_stops}};
+          (*bj)["confident_fraction"] = cv::countNonZero(mv.confidence > 0.5) / (kPiD / 4 * c.o.map_size * c.o.map_size);
+        }
+        if (cons[k].left_out) {
+          if (bj) {
+            (*bj)["status"] = "left out: inconsistent with the other views";
+            (*bj)["note"] = std::to_string(cons[k].masked) + " of " + std::to_string(cons[k].judged) +
+                            " texels differ from the other views' median by more than 0.12 stops (median " +
+                            std::to_string(cons[k].median_stops).substr(0, 5) + "): a shadow or occluder of this view alone";
+          }
+          continue;
+        }
+        kept.push_back(std::move(mv));
+      }
+      sets[b].views = std::move(kept);
+    }
+    // Each map's mask for the report.
+    for (std::size_t b = 0; b < listed.size(); ++b)
+      for (const MapView& mv : sets[b].views) {
+        const cv::Scalar mean = cv::mean(mv.rgb);
+        const std::string image = mv.attributes.at("image");
+        const std::string name = int(b) == chrome_index ? image + ".png" : image + "-" + listed[b].name + ".png";
+        masks[name] = png_bytes(mask_picture(mv, auto_exposure(mean[0], mean[1], mean[2])), name);
+        if (nlohmann::json* bj = ball_entry(image, listed[b].name)) (*bj)["mask"] = "masks/" + name;
+      }
+    for (std::size_t b = 0; b < listed.size(); ++b)
+      if (sets[b].views.empty())
+        throw std::runtime_error("ball '" + listed[b].name + "' was found in no view (see the balls' notes with --json; "
+                                 "give it with --ball VIEW:" + listed[b].name + "=X,Y,R)");
     fs::create_directories(c.dir / "maps");
     for (std::size_t bi = 0; bi < c.set.balls.size(); ++bi) {
       const fs::path out = captured_path(c, c.set.balls[bi]);
       write_map_set(out.string(), sets[bi]);
       r.outputs.push_back(out);
     }
-    r.summary = {{"views", views}, {"map_size", c.o.map_size}};
+    if (!masks.empty()) {
+      write_folder_atomically(c.dir / "masks", masks);
+      for (const auto& [name, bytes] : masks) r.outputs.push_back(c.dir / "masks" / name);
+    }
+    nlohmann::json rj = nlohmann::json::array();
+    for (std::size_t b = 0; b < listed.size(); ++b) {
+      const RigMember& m = rig.size() == listed.size() ? rig[b] : RigMember{};
+      rj.push_back({{"ball", listed[b].name}, {"known", m.known}, {"offset_chrome_radii", {m.offset.x(), m.offset.y(), m.offset.z()}},
+                    {"scale", m.scale}, {"scale_from_diameters", m.scale_given}, {"views_agreeing", m.support}, {"rms_radii", m.rms}});
+    }
+    r.summary = {{"views", views}, {"map_size", c.o.map_size}, {"rig", rj},
+                 {"chrome_radius_m", chrome_radius_m},
+                 {"chrome_radius_source", chrome_index >= 0 && listed[std::size_t(chrome_index)].diameter_m ? "listed diameter" : "assumed 5 cm"}};
   });
 }
 
@@ -643,7 +821,7 @@ void step_compare(Context& c) {
       fs::create_directories(folder.parent_path());
       write_folder_atomically(folder, files);
       for (const auto& [name, bytes] : files) r.outputs.push_back(folder / name);
-      nlohmann::json bj = {{"ball", b->name}, {"folder", folder.string()}, {"views", views}, {"untrusted_views", untrusted},
+      nlohmann::json bj = {{"ball", b->name}, {"folder", "compare/" + b->name}, {"views", views}, {"untrusted_views", untrusted},
                            {"overall", {{"before", metrics_json(cmp.before)}, {"after", metrics_json(cmp.after)}}},
                            {"heat_max_stops", heat_max}, {"log_epsilon", cmp.settings.log_epsilon}};
       if (cmp.fit)
@@ -737,6 +915,10 @@ ProcessResult run_process(const ProcessOptions& o) {
   if (!o.radiance_dir.empty() && !fs::is_directory(o.radiance_dir))
     throw std::invalid_argument(o.radiance_dir + ": no such folder");
   if (!o.poses.empty()) read_given_poses(o.poses);  // errors before any work
+  if (o.vignetting != "auto" && o.vignetting != "none") {
+    if (!fs::is_regular_file(o.vignetting)) throw std::invalid_argument(o.vignetting + ": no such file (--vignetting)");
+    photo_set_vignetting(PhotoSet{}, o.vignetting, ResponseCurve::identity(255), LensModel::pinhole(100, 64, 64), nullptr);
+  }
   if (o.up && !(o.up->norm() > 0 && o.up->allFinite())) throw std::invalid_argument("--up: expected a non-zero direction");
   parse_brdf(o.render_brdf);
   chrome_fresnel_from_spec(o.chrome_fresnel, "--chrome-fresnel");  // errors before any work
@@ -750,6 +932,7 @@ ProcessResult run_process(const ProcessOptions& o) {
   ProcessResult result;
   Context c{o, fs::absolute(o.out).lexically_normal(), load_photo_set(o.photoset), result};
   if (c.set.views.empty()) throw std::invalid_argument(o.photoset + ": views: none");
+  parse_ball_overrides(o.ball_overrides, c.set);  // errors before any work
   if (fs::exists(c.dir) && !fs::is_directory(c.dir)) throw std::invalid_argument(o.out.string() + ": not a folder");
   if (!fs::is_directory(c.dir.parent_path()))
     throw std::invalid_argument(o.out.string() + ": its parent folder does not exist");

@@ -2,11 +2,16 @@
 // turntable render and an HTML report, as a graph of resumable steps (pipeline/step_record.h):
 //
 //   calibrate  chessboards -> DIR/camera.cameramodel (mrcal, model by cross-validation), or --lens
-//   hdr        brackets -> DIR/hdr/<view>.exr, DIR/hdr/response.json (response recovered once)
+//   hdr        brackets -> DIR/hdr/<view>.exr, DIR/hdr/response.json (response recovered once),
+//              DIR/hdr/vignetting.json (estimated from the chessboards, divided out of every view)
 //   orient     -> DIR/poses.yaml (world_from_cam per view: solved from the chrome ball's features,
-//              calib/view_orientation.h, world +Y up given the up of the first camera; or --poses)
-//   extract    every ball of every view -> DIR/maps/captured-<ball>.exr, one part per view in the
-//              world frame (chrome: reflection indexing, mirror warp; grey/glossy: orthographic)
+//              calib/view_orientation.h, world +Y up estimated from the views or given; or --poses,
+//              whose chrome balls are refined here when the file has none)
+//   extract    every ball of every view, identified and checked across views
+//              (calib/ball_identification.h) -> DIR/maps/captured-<ball>.exr, one part per view in
+//              the world frame (chrome: reflection indexing, mirror warp, the other balls, the stands
+//              and the photographer masked, calib/occluders.h; grey/glossy: orthographic), and each
+//              chrome view's mask as DIR/masks/<view>.png; a ball not found in a view is left out
 //   probe      chrome maps -> DIR/probe-measured.exr (lat-long, confidence-weighted blend)
 //   sources    the light clipped in every chrome view, recovered from the grey (and glossy) balls
 //              (pipeline/light_sources_step.h) -> DIR/probe.exr, the probe the later steps use
@@ -40,7 +45,10 @@ struct ProcessOptions {
   std::filesystem::path out; // DIR (created; its parent must exist)
   std::string lens;          // given .cameramodel (skips the chessboards)
   std::string poses;         // given poses (pipeline/pose_input.h); empty: the orientation solve
-  std::optional<Vec3> up = Vec3(0, -1, 0);  // world up in the first camera's frame (a level camera); none: first-view gauge
+  std::optional<Vec3> up;    // world up in the first camera's frame (e.g. 0,-1,0 for a levelled camera)
+  bool estimate_up = true;   // without `up`: estimated from the views (calib/world_up.h); false: first-view gauge
+  std::vector<std::string> ball_overrides;  // "VIEW:BALL=X,Y,R": that ball of that view located there (pipeline/ball_override.h)
+  std::string vignetting = "auto";  // "auto" (from the chessboards when there are 3 or more), "none", or a JSON file (hdr/vignetting.h)
   // Stages swapped for given data (the truth of a synthetic capture: the error budget):
   std::string radiance_dir;  // hdr: linear EXRs <view>_radiance.exr or <view>.exr instead of the merge
   std::string probe_file;    // probe: this environment (resampled) instead of the chrome maps' blend

@@ -2,29 +2,118 @@
 
 #include "core/atomic_file.h"
 
+#include <openssl/evp.h>
+
 #include <fstream>
-#include <limits>
+#include <memory>
 #include <stdexcept>
 
 namespace rsibr {
 
 namespace fs = std::filesystem;
 
-nlohmann::json file_stamp(const fs::path& file) {
+namespace {
+
+fs::path normal(const fs::path& p) { return fs::absolute(p).lexically_normal(); }
+
+// p relative to root when it lies under it ("" otherwise).
+fs::path under(const fs::path& p, const fs::path& root) {
+  if (root.empty()) return {};
+  const fs::path rel = p.lexically_relative(normal(root));
+  if (rel.empty() || *rel.begin() == "..") return {};
+  return rel;
+}
+
+// {"path", "root"}: relative to the more specific root that holds the file, else absolute.
+nlohmann::json located(const fs::path& file, const RecordRoots& roots) {
+  const fs::path p = normal(file);
+  const fs::path a = under(p, roots.run), b = under(p, roots.photos);
+  nlohmann::json j;
+  if (!a.empty() && (b.empty() || std::distance(a.begin(), a.end()) <= std::distance(b.begin(), b.end()))) {
+    j["path"] = a.generic_string();
+    j["root"] = "run";
+  } else if (!b.empty()) {
+    j["path"] = b.generic_string();
+    j["root"] = "photos";
+  } else {
+    j["path"] = p.string();
+  }
+  return j;
+}
+
+bool same_place(const nlohmann::json& recorded, const nlohmann::json& now) {
+  return recorded.value("path", "") == now.value("path", "") && recorded.value("root", "") == now.value("root", "");
+}
+
+// The file still has the recorded contents: its size and its mtime or (when the mtime differs) its SHA-256.
+bool same_contents(const nlohmann::json& recorded, const fs::path& file) {
+  std::error_code ec;
+  const auto size = fs::file_size(file, ec);
+  if (ec || !recorded.contains("size") || recorded["size"].get<std::uint64_t>() != size) return false;
+  const auto mtime = fs::last_write_time(file, ec);
+  if (ec) return false;
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(mtime.time_since_epoch()).count();
+  if (recorded.contains("mtime_ns") && recorded["mtime_ns"].get<std::int64_t>() == static_cast<std::int64_t>(ns))
+    return true;
+  return recorded.contains("sha256") && recorded["sha256"].get<std::string>() == file_sha256(file);
+}
+
+}  // namespace
+
+std::string file_sha256(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::runtime_error(file.string() + ": cannot read");
+  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> ctx(EVP_MD_CTX_new(), EVP_MD_CTX_free);
+  if (!ctx || EVP_DigestInit_ex(ctx.get(), EVP_sha256(), nullptr) != 1)
+    throw std::runtime_error(file.string() + ": SHA-256 unavailable");
+  std::vector<char> buf(1 << 20);
+  while (in) {
+    in.read(buf.data(), std::streamsize(buf.size()));
+    if (in.gcount() > 0) EVP_DigestUpdate(ctx.get(), buf.data(), std::size_t(in.gcount()));
+  }
+  if (in.bad()) throw std::runtime_error(file.string() + ": read error");
+  unsigned char md[EVP_MAX_MD_SIZE];
+  unsigned int len = 0;
+  EVP_DigestFinal_ex(ctx.get(), md, &len);
+  static const char* hex = "0123456789abcdef";
+  std::string out;
+  for (unsigned int i = 0; i < len; ++i) out += hex[md[i] >> 4], out += hex[md[i] & 15];
+  return out;
+}
+
+nlohmann::json file_stamp(const fs::path& file, const RecordRoots& roots) {
   std::error_code ec;
   const auto size = fs::file_size(file, ec);
   if (ec) throw std::runtime_error(file.string() + ": " + ec.message());
   const auto mtime = fs::last_write_time(file, ec);
   if (ec) throw std::runtime_error(file.string() + ": " + ec.message());
-  return {{"path", fs::absolute(file).lexically_normal().string()},
-          {"size", static_cast<std::uint64_t>(size)},
-          {"mtime_ns", static_cast<std::int64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                           mtime.time_since_epoch()).count())}};
+  nlohmann::json j = located(file, roots);
+  j["size"] = static_cast<std::uint64_t>(size);
+  j["mtime_ns"] = static_cast<std::int64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(mtime.time_since_epoch()).count());
+  j["sha256"] = file_sha256(file);
+  return j;
+}
+
+fs::path stamp_path(const nlohmann::json& stamp, const RecordRoots& roots) {
+  const fs::path p = stamp.at("path").get<std::string>();
+  const std::string root = stamp.value("root", "");
+  if (root == "run") return normal(roots.run / p);
+  if (root == "photos") return normal(roots.photos / p);
+  return p;
 }
 
 fs::path step_record_path(const fs::path& dir, const std::string& step) { return dir / "steps" / (step + ".json"); }
 
-StepRecord read_step_record(const fs::path& dir, const std::string& step) {
+namespace {
+RecordRoots with_run(const fs::path& dir, RecordRoots roots) {
+  if (roots.run.empty()) roots.run = dir;
+  return roots;
+}
+}  // namespace
+
+StepRecord read_step_record(const fs::path& dir, const std::string& step, const RecordRoots& given) {
+  const RecordRoots roots = with_run(dir, given);
   const fs::path file = step_record_path(dir, step);
   std::ifstream in(file);
   if (!in) throw std::runtime_error(file.string() + ": no record of the step (run it first)");
@@ -34,8 +123,8 @@ StepRecord read_step_record(const fs::path& dir, const std::string& step) {
     StepRecord r;
     r.step = j.at("step").get<std::string>();
     r.settings = j.at("settings");
-    for (const auto& s : j.at("inputs")) r.inputs.emplace_back(s.at("path").get<std::string>());
-    for (const auto& s : j.at("outputs")) r.outputs.emplace_back(s.at("path").get<std::string>());
+    for (const auto& s : j.at("inputs")) r.inputs.push_back(stamp_path(s, roots));
+    for (const auto& s : j.at("outputs")) r.outputs.push_back(stamp_path(s, roots));
     r.seconds = j.at("seconds").get<double>();
     r.summary = j.at("summary");
     return r;
@@ -45,7 +134,8 @@ StepRecord read_step_record(const fs::path& dir, const std::string& step) {
 }
 
 std::string step_stale_reason(const fs::path& dir, const std::string& step, const nlohmann::json& settings,
-                              const std::vector<fs::path>& inputs) {
+                              const std::vector<fs::path>& inputs, const RecordRoots& given) {
+  const RecordRoots roots = with_run(dir, given);
   std::ifstream in(step_record_path(dir, step));
   if (!in) return "no record";
   nlohmann::json j;
@@ -55,40 +145,40 @@ std::string step_stale_reason(const fs::path& dir, const std::string& step, cons
     return "unreadable record";
   }
   if (!j.contains("settings") || j["settings"] != settings) return "settings changed";
-  if (!j.contains("inputs") || !j.contains("outputs")) return "incomplete record";
-  // The recorded inputs must be the ones asked for now, unchanged.
-  std::vector<nlohmann::json> now;
-  for (const fs::path& p : inputs) {
-    std::error_code ec;
-    if (!fs::exists(p, ec)) return p.string() + " missing";
-    now.push_back(file_stamp(p));
-  }
-  if (j["inputs"].size() != now.size()) return "inputs changed";
-  std::int64_t newest_input = std::numeric_limits<std::int64_t>::min();  // file_clock times can be negative
-  for (std::size_t i = 0; i < now.size(); ++i) {
-    if (j["inputs"][i] != now[i]) return now[i]["path"].get<std::string>() + " changed";
-    newest_input = std::max(newest_input, now[i]["mtime_ns"].get<std::int64_t>());
-  }
-  for (const auto& o : j["outputs"]) {
-    const fs::path p = o.at("path").get<std::string>();
-    std::error_code ec;
-    if (!fs::exists(p, ec)) return p.string() + " missing";
-    const nlohmann::json s = file_stamp(p);
-    if (s["mtime_ns"].get<std::int64_t>() < newest_input) return p.string() + " older than its inputs";
-    if (s != o) return p.string() + " changed";
+  if (!j.contains("inputs") || !j.contains("outputs") || !j["inputs"].is_array() || !j["outputs"].is_array())
+    return "incomplete record";
+  if (j["inputs"].size() != inputs.size()) return "inputs changed";
+  try {
+    // The recorded inputs must be the ones asked for now, with the recorded contents.
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      std::error_code ec;
+      if (!fs::exists(inputs[i], ec)) return inputs[i].string() + " missing";
+      const nlohmann::json& rec = j["inputs"][i];
+      if (!same_place(rec, located(inputs[i], roots)) || !same_contents(rec, inputs[i]))
+        return inputs[i].string() + " changed";
+    }
+    for (const auto& o : j["outputs"]) {
+      const fs::path p = stamp_path(o, roots);
+      std::error_code ec;
+      if (!fs::exists(p, ec)) return p.string() + " missing";
+      if (!same_contents(o, p)) return p.string() + " changed";
+    }
+  } catch (const std::exception&) {
+    return "incomplete record";
   }
   return "";
 }
 
-void write_step_record(const fs::path& dir, const StepRecord& r) {
+void write_step_record(const fs::path& dir, const StepRecord& r, const RecordRoots& given) {
+  const RecordRoots roots = with_run(dir, given);
   nlohmann::json j;
-  j["rsibr_step"] = 1;
+  j["rsibr_step"] = 2;
   j["step"] = r.step;
   j["settings"] = r.settings;
   j["inputs"] = nlohmann::json::array();
-  for (const fs::path& p : r.inputs) j["inputs"].push_back(file_stamp(p));
+  for (const fs::path& p : r.inputs) j["inputs"].push_back(file_stamp(p, roots));
   j["outputs"] = nlohmann::json::array();
-  for (const fs::path& p : r.outputs) j["outputs"].push_back(file_stamp(p));
+  for (const fs::path& p : r.outputs) j["outputs"].push_back(file_stamp(p, roots));
   j["seconds"] = r.seconds;
   j["summary"] = r.summary;
   fs::create_directories(dir / "steps");

@@ -10,6 +10,7 @@ packages=(
   libeigen3-dev libtbb-dev libopenexr-dev libimath-dev libopencolorio-dev
   libopencv-dev
   libcli11-dev libyaml-cpp-dev nlohmann-json3-dev
+  libssl-dev  # pipeline/step_record.cpp: SHA-256 of the files a step read and wrote
   # meshes (core/mesh.cpp)
   libtinyobjloader-dev libtinygltf-dev libdraco-dev
   # bake / capture / calib / hdr

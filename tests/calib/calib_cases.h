@@ -51,11 +51,12 @@ struct RenderedView {
 
 // View `view` of the rig; `noise` > 0 adds Gaussian noise of std dev noise * (value + 0.02)
 // (shot-like relative noise with a read floor), seeded.
-inline RenderedView render_view(const SynthScene& scene, int view = 0, double noise = 0.0, std::uint64_t seed = 5) {
+inline RenderedView render_view(const SynthScene& scene, int view = 0, double noise = 0.0, std::uint64_t seed = 5,
+                                int supersampling = 3) {
   RenderedView r{scene, synth_environment(scene), plan_camera_poses(scene).at(view), {}};
   const RigRenderer renderer(scene, r.env);
   RigRenderOptions opt;
-  opt.supersampling = 3;
+  opt.supersampling = supersampling;
   r.radiance = renderer.render(r.pose, scene.camera.lens, RayTable(scene.camera.lens), opt);
   if (noise > 0) {
     std::mt19937_64 rng(seed);

@@ -1,6 +1,7 @@
 // calib/orientation_solve.h: the cost's gradient, orientation accuracy with realistic noise and
 // outliers, the reported uncertainty against the observed error, clear errors.
 #include "calib/orientation_solve.h"
+#include "calib/sphere_map_extraction.h"
 #include "random_directions.h"
 
 #include <ceres/ceres.h>
@@ -165,5 +166,62 @@ TEST(OrientationSolve, TooFewViewsOrNoSharedFeaturesAreClearErrors) {
   }
 }
 
+// A view whose features no other view shares (a wrong ball in it, say) is left out when asked,
+// with the reason, and the others are solved as before.
+TEST(OrientationSolve, AViewSharingNothingIsLeftOutWhenAskedAndTheRestAreSolved) {
+  Truth t = make_case(Case{}, 4);
+  std::mt19937_64 rng(12);
+  for (int f = 400; f < 450; ++f) t.obs.push_back({8, f, testing::random_direction(rng), 0.0035});
+  EXPECT_THROW(solve_orientations(9, 450, t.obs), std::invalid_argument);
+  OrientationOptions o;
+  o.leave_out_unplaced = true;
+  const OrientationSolution s = solve_orientations(9, 450, t.obs, o);
+  ASSERT_EQ(s.oriented.size(), 9u);
+  EXPECT_EQ(s.oriented[8], 0);
+  EXPECT_NE(s.left_out[8].find("shares fewer than 3 features"), std::string::npos);
+  for (int v = 1; v < 8; ++v) {
+    EXPECT_EQ(s.oriented[v], 1);
+    EXPECT_TRUE(s.left_out[v].empty());
+    EXPECT_LT(rotation_error_deg(s.world_from_cam[v], t.world_from_cam[v]), 0.2) << v;
+  }
+}
+
+// Known rotations (a pose file without balls): held exactly, and each view's ball refined by the
+// features from a prior 1 degree off to within a few hundredths of a degree.
+TEST(OrientationSolve, KnownRotationsAreHeldAndTheBallsRefinedFromThem) {
+  std::mt19937_64 rng(21);
+  std::normal_distribution<double> g(0, 1);
+  const int views = 4, features = 300;
+  std::vector<Mat3> r;
+  for (int v = 0; v < views; ++v) r.push_back(random_rotation(rng));
+  std::vector<Vec3> axis(views);
+  std::vector<double> sine(views, 0.1);  // the ball 10 radii away
+  OrientationOptions o;
+  o.fixed_world_from_cam = r;
+  std::vector<DirectionObservation> obs;
+  const double sigma = 0.05 * kPi / 180;
+  for (int v = 0; v < views; ++v) {
+    axis[v] = Vec3(0.1 * g(rng), 0.1 * g(rng), 1).normalized();
+    const Vec3 prior = Eigen::AngleAxisd(kPi / 180, axis[v].unitOrthogonal()).toRotationMatrix() * axis[v];
+    o.balls.push_back({prior, std::asin(sine[v]), kPi / 180, 0});
+  }
+  for (int f = 0; f < features; ++f) {
+    const Vec3 d = testing::random_direction(rng);
+    for (int v = 0; v < views; ++v) {
+      // The camera ray that reflects into d, where d is not behind the ball (the rim).
+      const Vec3 rc = r[v].transpose() * d, c = axis[v] / sine[v];
+      if (rc.dot(axis[v]) > 0.3) continue;
+      const auto n = reflection_normal(c, rc, (rc.normalized() - axis[v]).normalized());
+      if (!n) continue;
+      obs.push_back({v, f, rc, sigma, (c + *n).normalized(), -1});
+    }
+  }
+  const OrientationSolution s = solve_orientations(views, features, obs, o);
+  for (int v = 0; v < views; ++v) {
+    EXPECT_LT(rotation_error_deg(s.world_from_cam[v], r[v]), 1e-9) << v;
+    EXPECT_EQ(s.sigma_deg[v], 0);
+    EXPECT_LT(angle_between(s.ball_axes[v], axis[v]) * 180 / kPi, 0.05) << v;
+  }
+}
 }  // namespace
 }  // namespace rsibr

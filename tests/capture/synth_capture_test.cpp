@@ -199,5 +199,27 @@ TEST(CameraPoses, RingCamerasSitAtTheDistanceAndLookAtTheTarget) {
   EXPECT_EQ(again[5].eye, poses[5].eye);
 }
 
+// Pan turns a camera aimed down about the world's vertical: the target moves left and the horizon
+// stays level (x stays horizontal); yaw turns it about its own y axis, which tilts the horizon.
+TEST(CameraPoses, PanKeepsTheHorizonLevelWhereYawTiltsIt) {
+  SynthScene scene = testing::small_scene();
+  SynthViewPlan p;
+  p.plan = "ring";
+  p.count = 1;
+  p.elevation_deg = 25;
+  scene.views = {p, p, p};
+  scene.views[1].pan_deg = 15;
+  scene.views[2].yaw_deg = 15;
+  const auto poses = plan_camera_poses(scene);
+  const Vec3 at = scene.rig_centre();
+  for (int i : {1, 2}) {
+    const Vec3 target = poses[std::size_t(i)].world_from_cam.transpose() * (at - poses[std::size_t(i)].eye);
+    EXPECT_LT(target.x(), -0.2 * target.z()) << i << ": the target moves left";
+  }
+  EXPECT_LT(std::abs(poses[1].world_from_cam.col(0).y()), 1e-12);
+  EXPECT_GT(std::abs(poses[2].world_from_cam.col(0).y()), 0.05);
+  EXPECT_NEAR(poses[1].world_from_cam.col(2).y(), poses[0].world_from_cam.col(2).y(), 1e-12);  // still aimed down as much
+}
+
 }  // namespace
 }  // namespace rsibr

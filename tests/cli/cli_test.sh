@@ -442,7 +442,16 @@ expect_error "process: missing poses file" "noposes.yaml" process "$work/psyn/ph
 expect_error "process: output parent missing" "nofolder" process "$work/psyn/photos" --out "$work/nofolder/pe4" --poses "$work/psyn/truth/truth.yaml" -q
 expect_error "process: bad --size" "--size" process "$work/psyn/photos" --out "$work/pe5" --size 10 -q
 expect_error "process: missing --probe environment" "noenv.exr" process "$work/psyn/photos" --out "$work/pe6" --probe "$work/noenv.exr" -q
+expect_error "process: malformed --ball" "--ball 'view00:grey=1,2'" process "$work/psyn/photos" --out "$work/pe7" --ball view00:grey=1,2 -q
+expect_error "process: --ball of an unlisted view" "no view 'west'" process "$work/psyn/photos" --out "$work/pe8" --ball west:grey=10,10,20 -q
+expect_error "process: missing --vignetting model" "novig.json" process "$work/psyn/photos" --out "$work/pe9" --vignetting "$work/novig.json" -q
 check "process: no output after errors" bash -c "! ls -A '$work' | grep -q '^pe[0-9]'"
 check "process: no temporaries" no_temporaries "$work/pout"
+# A copy of the run folder (cp -r: new file times) resumes without redoing a step.
+cp -r "$work/pout" "$work/pout-copy"
+"$rsibr" process "$work/psyn/photos" --out "$work/pout-copy" --poses "$work/psyn/truth/truth.yaml" --chrome-fresnel "$fres" \
+  --map-size 32 --turntable 2 --size 64x48 --json "$work/p3.json" -q >/dev/null
+check "process: a copied run folder skips every step" python3 -c "
+import json; j = json.load(open('$work/p3.json')); assert not any(s['ran'] for s in j['steps']), j['steps']"
 
 finish cli

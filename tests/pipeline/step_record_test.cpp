@@ -63,13 +63,14 @@ TEST_F(StepRecordTest, MissingRecordChangedSettingsTouchedInputOrDeletedOutputAr
   touch_later(dir / "in.txt", dir / "out.txt");
   EXPECT_NE(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}).find("in.txt changed"), std::string::npos);
   write_step_record(dir, record({{"samples", 64}}));
-  // The output older than its input (restored from a backup, say).
+  // A touched input with the same contents (a later mtime, the same bytes) is no change.
   touch_later(dir / "in.txt", dir / "out.txt");
-  write_step_record(dir, record({{"samples", 64}}));
-  EXPECT_NE(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}).find("older than its inputs"),
-            std::string::npos);
+  EXPECT_EQ(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}), "");
+  // An output replaced by other bytes of the same size (restored from a backup, say) is stale.
+  write(dir / "out.txt", "x");
   touch_later(dir / "out.txt", dir / "in.txt");
-  write_step_record(dir, record({{"samples", 64}}));
+  EXPECT_NE(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}).find("out.txt changed"), std::string::npos);
+  write(dir / "out.txt", "b");
   EXPECT_EQ(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}), "");
   fs::remove(dir / "out.txt");
   EXPECT_NE(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}).find("missing"), std::string::npos);
@@ -86,6 +87,55 @@ TEST_F(StepRecordTest, AMalformedRecordIsStaleAndReadingItNamesTheFile) {
     EXPECT_NE(std::string(e.what()).find("bake.json"), std::string::npos);
   }
   EXPECT_THROW(file_stamp(dir / "nothere"), std::runtime_error);
+}
+
+// A run folder copied without its files' times (cp -r), with its photo folder moved elsewhere, is
+// up to date: paths are relative to the run and photo folders, and contents are compared by size
+// and SHA-256 when the times differ.
+TEST_F(StepRecordTest, ACopiedRunFolderWithMovedPhotosIsUpToDate) {
+  const fs::path run = dir / "run", photos = dir / "photos";
+  fs::create_directories(run / "maps");
+  fs::create_directories(photos / "v0");
+  write(photos / "v0" / "b0.png", "photo bytes");
+  write(run / "maps" / "m.exr", "map bytes");
+  write(run / "camera.cameramodel", "lens");
+  StepRecord r;
+  r.step = "extract";
+  r.inputs = {photos / "v0" / "b0.png", run / "camera.cameramodel"};
+  r.outputs = {run / "maps" / "m.exr"};
+  const RecordRoots roots{run, photos};
+  write_step_record(run, r, roots);
+  ASSERT_EQ(step_stale_reason(run, "extract", nlohmann::json::object(), r.inputs, roots), "");
+  // Copy (new times: a copy made later) and move the photos.
+  const fs::path run2 = dir / "elsewhere" / "run", photos2 = dir / "moved" / "photos";
+  fs::create_directories(run2.parent_path());
+  fs::create_directories(photos2.parent_path());
+  fs::copy(run, run2, fs::copy_options::recursive);
+  fs::rename(photos, photos2);
+  for (const fs::path& p : {run2 / "maps" / "m.exr", run2 / "camera.cameramodel", photos2 / "v0" / "b0.png"})
+    fs::last_write_time(p, fs::last_write_time(p) + std::chrono::seconds(7));
+  const RecordRoots roots2{run2, photos2};
+  const std::vector<fs::path> inputs2 = {photos2 / "v0" / "b0.png", run2 / "camera.cameramodel"};
+  EXPECT_EQ(step_stale_reason(run2, "extract", nlohmann::json::object(), inputs2, roots2), "");
+  const StepRecord back = read_step_record(run2, "extract", roots2);
+  ASSERT_EQ(back.outputs.size(), 1u);
+  EXPECT_EQ(back.outputs[0], fs::absolute(run2 / "maps" / "m.exr").lexically_normal());
+  EXPECT_EQ(back.inputs[0], fs::absolute(photos2 / "v0" / "b0.png").lexically_normal());
+  // The copy is independent: an edited input in it is a change there only.
+  write(photos2 / "v0" / "b0.png", "other bytes");
+  EXPECT_NE(step_stale_reason(run2, "extract", nlohmann::json::object(), inputs2, roots2).find("b0.png changed"), std::string::npos);
+  // Another file in the input's place (another name) is a change even with the same contents.
+  write(run2 / "lens2.cameramodel", "lens");
+  write(photos2 / "v0" / "b0.png", "photo bytes");
+  EXPECT_EQ(step_stale_reason(run2, "extract", nlohmann::json::object(), {photos2 / "v0" / "b0.png", run2 / "lens2.cameramodel"}, roots2),
+            (run2 / "lens2.cameramodel").string() + " changed");
+}
+
+TEST_F(StepRecordTest, Sha256OfAKnownTextIsTheStandardDigest) {
+  write(dir / "abc.txt", "abc");
+  EXPECT_EQ(file_sha256(dir / "abc.txt"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  write(dir / "empty.txt", "");
+  EXPECT_EQ(file_sha256(dir / "empty.txt"), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
 }
 
 }  // namespace

@@ -1,0 +1,148 @@
+// Which ball is which, in every view, and whether it is a ball at all. The photo set lists the
+// balls (kind, diameter when known); a view's image holds them and much else that is round
+// (clocks, lamps, plates, wheels, other spheres). Three stages:
+//
+// 1. Candidates (find_ball_candidates): Hough circles in radius bands a factor 2 apart (one band's
+//    strong circles cannot crowd out another's), each located (calib/ball_locator.h) and measured:
+//    outline quality (inlier fraction, RMS), appearance (texture: a mirror shows the whole world;
+//    smoothness and a Lambert fit: a diffuse ball's shading is a low-order function of its normal)
+//    and how much of the disc lies inside the frame (a ball cut by the frame edge is flagged).
+// 2. One view (assign_balls_in_view): the listed balls matched to candidates by appearance (chrome
+//    the most textured, grey the smoothest, glossy between) and size (balls of a rig are at about
+//    the same distance from the camera, so their image radii go with their diameters).
+// 3. Across views (fit_ball_rig, identify_view_balls), once the rotations are known: the balls sit
+//    on one rig, so each ball's centre relative to the chrome ball's, turned into the world frame,
+//    is the same vector in every view:
+//
+//        o_b = R_i (s_b g_bi - c_i),   c_i = a_ci / sin(alpha_ci),   g_bi = a_bi / sin(alpha_bi)
+//
+//    (in chrome-ball radii; a the cone axes, alpha the half angles, R_i world_from_cam, s_b the
+//    ball's radius over the chrome's: the diameters' ratio when both are listed, else estimated).
+//    o_b and s_b come from the largest set of views whose candidates agree (every candidate a
+//    hypothesis, its support counted), then each view takes its candidate that agrees or, when
+//    none does, searches at the place o_b predicts; a view where neither finds the ball reports it
+//    missing and leaves it out, never taking a circle that disagrees.
+#pragma once
+
+#include "calib/ball_cone.h"
+#include "calib/ball_locator.h"
+#include "core/lens_model.h"
+#include "core/photo_set.h"
+#include "core/vec.h"
+
+#include <opencv2/core.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rsibr {
+
+struct BallCandidate {
+  BallLocation loc;
+  double inlier_fraction = 0;   // outline points within the cone fit's inlier threshold
+  double texture = 0;           // mean |ln L| change between neighbouring pixels within 0.8 radii
+  double rim_texture = 0;       // fraction of the pixels between 0.5 and 0.9 radii whose ln L changes by > 0.06 to a neighbour
+  double mirror_score = 0;      // 98th percentile of |grad log2 L| within 0.9 radii, stops per radius
+  double diffuse_residual = 0;  // RMS of a Lambert (order-2 spherical harmonics) fit over 0.9 radii / mean
+  double frame_fraction = 1;    // fraction of the fitted outline inside the image
+  bool cut = false;             // the disc reaches beyond the frame
+};
+
+struct BallSearchOptions {
+  double min_radius_px = 0;     // 0: max(4, min(width, height) / 40)
+  double max_radius_px = 0;     // 0: min(width, height) / 2
+  int per_band = 6;             // Hough circles kept per radius band
+  double min_inlier_fraction = 0.6;
+  double max_rms_px = 0.8;       // a chrome ball's limb reflects what lies behind it: 0.5 px on low contrast
+  double min_frame_fraction = 0.5;
+};
+
+// The measures above for a located ball (`image` CV_32FC3 RGB linear, the lens's size).
+BallCandidate measure_ball(const cv::Mat& image, const LensModel& lens, const BallLocation& loc);
+
+// Whether a measured ball passes the outline and frame gates of `options`.
+bool acceptable_outline(const BallCandidate& c, const BallSearchOptions& options);
+
+// Candidates passing the gates, one per ball (fits within half a radius of each other merged,
+// the one with the most inliers kept; a circle inside a chrome-like candidate's disc dropped: a
+// reflection), strongest outline first.
+std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const LensModel& lens,
+                                                const BallSearchOptions& options = {});
+
+// What the photo set says about a ball.
+struct ListedBall {
+  std::string name;
+  BallKind kind = BallKind::chrome;
+  std::optional<double> diameter_m;
+};
+std::vector<ListedBall> listed_balls(const PhotoSet& set);
+
+// Appearance: the kind a candidate looks like, from its measures: "chrome", "glossy", "grey"
+// compatible (a candidate may fit more than one; none for a ringed disc or a flat textured circle).
+bool looks_like(const BallCandidate& c, BallKind kind);
+
+// One view: candidate index per listed ball (-1: none fits), maximising appearance and size
+// agreement. Throws nothing; an empty candidate list gives all -1.
+std::vector<int> assign_balls_in_view(const std::vector<BallCandidate>& candidates, const std::vector<ListedBall>& balls);
+
+// One view's balls as the cross-view stage sees them.
+struct ViewBalls {
+  std::string name;
+  std::vector<BallCandidate> candidates;
+  std::optional<BallCone> chrome;  // the anchor (the pose's refined chrome ball, or the view's chrome candidate)
+  Mat3 world_from_cam = Mat3::Identity();
+};
+
+// The rig: per listed ball its centre relative to the chrome ball's (world, chrome-ball radii) and
+// its radius over the chrome's; unknown when too few views agree.
+struct RigMember {
+  bool known = false;
+  Vec3 offset = Vec3::Zero();
+  double scale = 1;        // radius / chrome radius
+  bool scale_given = false;  // from the listed diameters (else estimated)
+  int support = 0;         // views agreeing
+  double rms = 0;          // RMS disagreement of the supporting views, chrome radii
+};
+
+struct RigOptions {
+  double tolerance = 1.0;           // agreement: within tolerance + relative * (|c| + |s g|) / 2 chrome radii
+  double relative_tolerance = 0.04;
+  int min_support = 2;              // views that must agree (fewer views: all of them)
+};
+
+// Chrome balls (kind chrome) are the anchors (offset 0, scale 1 for the first; others fitted like
+// the rest). Each view's candidates are claimed by one ball at most.
+std::vector<RigMember> fit_ball_rig(const std::vector<ViewBalls>& views, const std::vector<ListedBall>& balls,
+                                    const RigOptions& options = {});
+
+// One ball in one view, as identification decided.
+struct BallFinding {
+  std::string status = "missing";  // "found", "found at the predicted place", "given", "missing"
+  std::optional<BallCandidate> ball;  // when found
+  std::string note;                // what was checked (for the report), or why it is missing
+  double disagreement = -1;        // distance from the rig's prediction, chrome radii (-1: not checked)
+  std::optional<Vec2> predicted_px;  // where the rig put it
+  double predicted_radius_px = 0;
+  bool found() const { return ball.has_value(); }
+};
+
+// Per listed ball of one view. `image` is searched at the predicted place of a ball no candidate
+// agrees with. Without an anchor (no chrome in the view) or a known rig member, a ball is taken
+// from the view's own assignment only when `trust_view` (single-view shoots); otherwise it is missing.
+std::vector<BallFinding> identify_view_balls(const ViewBalls& view, const std::vector<RigMember>& rig,
+                                             const std::vector<ListedBall>& balls, const cv::Mat& image,
+                                             const LensModel& lens, const RigOptions& rig_options = {},
+                                             const BallSearchOptions& search = {}, bool trust_view = false);
+
+// The cone of a ball at `offset` (world, chrome radii) and radius `scale` from the chrome cone of a view.
+BallCone predicted_cone(const BallCone& chrome, const Mat3& world_from_cam, const Vec3& offset, double scale);
+
+// The ball's cone fitted again without its outline points on or inside `others` (balls in front of
+// it, whose edges are not its own): the located ball unchanged when no point goes or too few stay.
+BallLocation refit_outline_excluding(const BallLocation& ball, const LensModel& lens, const std::vector<BallLocation>& others);
+
+// A ball given by hand: located at the guess (calib/ball_locator.h) and measured.
+BallCandidate given_ball(const cv::Mat& image, const LensModel& lens, const BallGuess& guess);
+
+}  // namespace rsibr
