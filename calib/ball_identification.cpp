@@ -1,8 +1,10 @@
 #include "calib/ball_identification.h"
 
 #include <Eigen/Dense>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -98,33 +100,140 @@ double disc_mirror_score(const cv::Mat& image, const Vec2& c, double r, const st
 }
 
 // A Lambertian ball's radiance is albedo E(n) / pi, and E is smooth: spherical harmonics of order
-// 2 (9 terms) hold all but a few percent of any irradiance. Least squares of the luminance over
-// the pixels within 0.9 radii on those 9 functions of the exact surface normal (the pixel's ray
-// meets the sphere of radius 1 about C = axis / sin(alpha)); RMS residual over the mean.
-double lambert_residual(const cv::Mat& image, const LensModel& lens, const BallLocation& loc, const std::vector<Disc>& ex) {
+// 2 (9 terms) hold all but a few percent of the irradiance of an extended sky, but not the kink a
+// sun leaves at its terminator (a clamped cosine's energy above order 2 reaches 10-30% of a
+// mostly shadowed disc's mean). So the model is the 9 terms plus k max(0, n . l) for the best of
+// directions l (k >= 0 is not imposed: a kink the wrong way fits worse):
+//
+//   L(n) ~ sum_j c_j Y_j(n) + k max(0, n . l)
+//
+// fitted by least squares over the pixels within 0.9 radii (the exact surface normal: the pixel's
+// ray meets the sphere of radius 1 about C = axis / sin(alpha)), by normal equations per l (the
+// 9 x 9 part shared) and once more, exactly, for the best l. Returned: the RMS residual over the
+// mean, and the mean |change of ln(L / fit)| between neighbouring pixels within 0.8 radii (the
+// texture smooth shading does not explain).
+struct LambertFit {
+  double residual = std::numeric_limits<double>::infinity();
+  double unexplained_texture = std::numeric_limits<double>::infinity();
+};
+
+LambertFit lambert_fit(const cv::Mat& image, const LensModel& lens, const BallLocation& loc, const std::vector<Disc>& ex) {
   const Vec3 centre = loc.fit.cone.axis.normalized() / std::sin(loc.fit.cone.half_angle);
-  std::vector<std::array<double, 9>> rows;
-  std::vector<double> values;
+  struct Px {
+    int x, y;
+    Vec3 n;
+    double v;
+  };
+  std::vector<Px> px;
   for_disc(image, loc.centre_px, loc.radius_px, 0.9, ex, [&](int x, int y) {
     const Vec3 d = lens.unproject(Vec2(x, y)).normalized();
     const double b = d.dot(centre), disc = b * b - (centre.squaredNorm() - 1);
     if (!(disc > 0)) return;
-    const Vec3 n = (b - std::sqrt(disc)) * d - centre;
-    rows.push_back({1, n.x(), n.y(), n.z(), n.x() * n.y(), n.x() * n.z(), n.y() * n.z(), n.x() * n.x() - n.y() * n.y(),
-                    3 * n.z() * n.z() - 1});
-    values.push_back(lum_of(image.at<cv::Vec3f>(y, x)));
+    px.push_back({x, y, (b - std::sqrt(disc)) * d - centre, lum_of(image.at<cv::Vec3f>(y, x))});
   });
-  if (rows.size() < 30) return std::numeric_limits<double>::infinity();
-  Eigen::MatrixXd a(int(rows.size()), 9);
-  Eigen::VectorXd v(int(rows.size()));
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    for (int k = 0; k < 9; ++k) a(int(i), k) = rows[i][std::size_t(k)];
-    v[int(i)] = values[i];
+  LambertFit out;
+  if (px.size() < 30) return out;
+  auto sh = [](const Vec3& n) {
+    return Eigen::Matrix<double, 9, 1>(1, n.x(), n.y(), n.z(), n.x() * n.y(), n.x() * n.z(), n.y() * n.z(),
+                                       n.x() * n.x() - n.y() * n.y(), 3 * n.z() * n.z() - 1);
+  };
+  // The direction search on at most 4096 pixels (a stride); the final fit on all.
+  const std::size_t stride = std::max<std::size_t>(1, px.size() / 4096);
+  Eigen::Matrix<double, 9, 9> g = Eigen::Matrix<double, 9, 9>::Zero();
+  Eigen::Matrix<double, 9, 1> gv = Eigen::Matrix<double, 9, 1>::Zero();
+  double mean = 0;
+  for (const Px& p : px) mean += p.v;
+  mean /= double(px.size());
+  if (!(mean > 0)) return out;
+  std::vector<std::size_t> sample;
+  for (std::size_t i = 0; i < px.size(); i += stride) {
+    const auto y = sh(px[i].n);
+    g += y * y.transpose(), gv += y * (px[i].v / mean);
+    sample.push_back(i);
   }
-  const double mean = v.mean();
-  if (!(mean > 0)) return std::numeric_limits<double>::infinity();
+  // Sum of squared residuals (in units of the mean) with the sun term along l.
+  auto sse_along = [&](const Vec3& l) {
+    Eigen::Matrix<double, 10, 10> a = Eigen::Matrix<double, 10, 10>::Zero();
+    Eigen::Matrix<double, 10, 1> rhs = Eigen::Matrix<double, 10, 1>::Zero();
+    a.topLeftCorner<9, 9>() = g;
+    rhs.head<9>() = gv;
+    double vv = 0;
+    for (std::size_t i : sample) {
+      const double c = std::max(0.0, px[i].n.dot(l)), v = px[i].v / mean;
+      if (c > 0) {
+        a.block<9, 1>(0, 9) += sh(px[i].n) * c;
+        a(9, 9) += c * c;
+        rhs[9] += c * v;
+      }
+      vv += v * v;
+    }
+    a.block<1, 9>(9, 0) = a.block<9, 1>(0, 9).transpose();
+    if (!(a(9, 9) > 1e-9)) return std::numeric_limits<double>::infinity();
+    const Eigen::Matrix<double, 10, 1> x = a.ldlt().solve(rhs);
+    const double sse = vv - 2 * x.dot(rhs) + x.dot(a * x);
+    return std::isfinite(sse) ? sse : std::numeric_limits<double>::infinity();
+  };
+  // 256 directions (a Fibonacci sphere, about 13 degrees apart), then the best refined by a
+  // pattern search down to 0.4 degrees: a sun behind the ball lights a crescent a coarse l misses.
+  const int kDirections = 256;
+  double best = std::numeric_limits<double>::infinity();
+  Vec3 best_l = Vec3::UnitZ();
+  for (int k = 0; k < kDirections; ++k) {
+    const double z = 1 - (2 * k + 1.0) / kDirections, r = std::sqrt(std::max(0.0, 1 - z * z));
+    const double phi = k * 2.399963229728653;  // the golden angle
+    const Vec3 l(r * std::cos(phi), r * std::sin(phi), z);
+    const double e = sse_along(l);
+    if (e < best) best = e, best_l = l;
+  }
+  for (double step = 0.12; step > 0.007; step *= 0.5) {
+    const Vec3 u = best_l.unitOrthogonal(), v = best_l.cross(u);
+    bool moved = true;
+    while (moved) {
+      moved = false;
+      for (const Vec3 d : std::array<Vec3, 4>{u, Vec3(-u), v, Vec3(-v)}) {
+        const Vec3 l = (best_l + step * d).normalized();
+        const double e = sse_along(l);
+        if (e < best) best = e, best_l = l, moved = true;
+      }
+    }
+  }
+  Eigen::MatrixXd a(int(px.size()), 10);
+  Eigen::VectorXd v(int(px.size()));
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    a.block<1, 9>(int(i), 0) = sh(px[i].n).transpose();
+    a(int(i), 9) = std::max(0.0, px[i].n.dot(best_l));
+    v[int(i)] = px[i].v;
+  }
   const Eigen::VectorXd x = a.colPivHouseholderQr().solve(v);
-  return std::sqrt((a * x - v).squaredNorm() / double(rows.size())) / mean;
+  const Eigen::VectorXd fit = a * x;
+  out.residual = std::sqrt((fit - v).squaredNorm() / double(px.size())) / mean;
+  // ln(L / fit) on the pixels within 0.8 radii (the fit floored at 1e-3 of the mean: a shadow),
+  // averaged over 3 x 3 neighbours (pixel noise, 2-6% in a merged HDR, is not texture; a mirror's
+  // reflected edges survive the average), then its change between neighbours.
+  const double rr = 0.8 * loc.radius_px;
+  const int x0 = std::max(0, int(loc.centre_px.x() - rr) - 1), y0 = std::max(0, int(loc.centre_px.y() - rr) - 1);
+  const int x1 = std::min(image.cols, int(loc.centre_px.x() + rr) + 2), y1 = std::min(image.rows, int(loc.centre_px.y() + rr) + 2);
+  if (x1 - x0 < 3 || y1 - y0 < 3) return out;
+  cv::Mat q(y1 - y0, x1 - x0, CV_64F, cv::Scalar(0)), w(y1 - y0, x1 - x0, CV_64F, cv::Scalar(0));
+  for (std::size_t i = 0; i < px.size(); ++i)
+    if ((Vec2(px[i].x, px[i].y) - loc.centre_px).norm() <= rr && px[i].x >= x0 && px[i].x < x1 && px[i].y >= y0 && px[i].y < y1) {
+      q.at<double>(px[i].y - y0, px[i].x - x0) = std::log(std::max(1e-6, px[i].v) / std::max(1e-3 * mean, fit[int(i)]));
+      w.at<double>(px[i].y - y0, px[i].x - x0) = 1;
+    }
+  cv::Mat qs, ws;
+  cv::boxFilter(q, qs, -1, cv::Size(3, 3), cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
+  cv::boxFilter(w, ws, -1, cv::Size(3, 3), cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
+  double s = 0;
+  long n = 0;
+  for (int y = 0; y + 1 < q.rows; ++y)
+    for (int x = 0; x + 1 < q.cols; ++x) {
+      if (w.at<double>(y, x) == 0) continue;
+      const double a = qs.at<double>(y, x) / ws.at<double>(y, x);
+      if (w.at<double>(y, x + 1) > 0) s += std::abs(qs.at<double>(y, x + 1) / ws.at<double>(y, x + 1) - a), ++n;
+      if (w.at<double>(y + 1, x) > 0) s += std::abs(qs.at<double>(y + 1, x) / ws.at<double>(y + 1, x) - a), ++n;
+    }
+  out.unexplained_texture = n > 0 ? s / double(n) : 0;
+  return out;
 }
 
 // Two fits of one circle: centres within half the smaller radius and radii within 30% (concentric
@@ -162,7 +271,9 @@ BallCandidate measure(const cv::Mat& image, const LensModel& lens, const BallLoc
   c.texture = disc_texture(image, loc.centre_px, loc.radius_px, ex);
   c.rim_texture = disc_rim_texture(image, loc.centre_px, loc.radius_px, ex);
   c.mirror_score = disc_mirror_score(image, loc.centre_px, loc.radius_px, ex);
-  c.diffuse_residual = lambert_residual(image, lens, loc, ex);
+  const LambertFit lf = lambert_fit(image, lens, loc, ex);
+  c.diffuse_residual = lf.residual;
+  c.shading_texture = lf.unexplained_texture;
   const std::vector<Vec2> outline = cone_outline(loc.fit.cone, lens, 128);
   int inside = 0;
   for (const Vec2& q : outline) inside += q.allFinite() && lens.in_image(q, 0.5);
@@ -248,6 +359,7 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
       if (!looks_like(without, BallKind::chrome)) {
         balls[k].texture = without.texture, balls[k].rim_texture = without.rim_texture;
         balls[k].mirror_score = without.mirror_score, balls[k].diffuse_residual = without.diffuse_residual;
+        balls[k].shading_texture = without.shading_texture;
         break;
       }
     }
@@ -269,7 +381,7 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
     if (ex.empty()) continue;
     const BallCandidate m = measure(image, lens, kept[i].loc, ex);
     out[i].texture = m.texture, out[i].rim_texture = m.rim_texture, out[i].mirror_score = m.mirror_score;
-    out[i].diffuse_residual = m.diffuse_residual;
+    out[i].diffuse_residual = m.diffuse_residual, out[i].shading_texture = m.shading_texture;
   }
   std::stable_sort(out.begin(), out.end(), [](const BallCandidate& a, const BallCandidate& b) {
     return a.loc.fit.inliers > b.loc.fit.inliers;
@@ -286,7 +398,9 @@ std::vector<ListedBall> listed_balls(const PhotoSet& set) {
 // Thresholds measured on rendered balls (datasets-synthetic: the lobby, park, studio and warehouse
 // shoots, the analytic sky): chrome balls in textured surroundings have 40-60% of their rim
 // textured and a Lambert residual of 0.3-4, those in a smooth sky 3-8% and 11-14 (the sun); grey
-// balls fit the Lambert shading within 1-5% (10% where a nearer ball hides part of one); ringed
+// balls fit the Lambert shading within 1-5% (10% where a nearer ball hides part of one; 1-2% lit
+// by a clipped sun from any side, leaving a shading texture of 0.002-0.004 where a chrome ball in a
+// smooth sky leaves 0.06-0.35); ringed
 // targets texture 5-15% of the disc's rim with residuals of 0.3-1.7; flat discs fit it within 1%
 // (only size and the rig's geometry tell those from a grey ball).
 bool looks_like(const BallCandidate& c, BallKind kind) {
@@ -295,7 +409,7 @@ bool looks_like(const BallCandidate& c, BallKind kind) {
     // A textured rim (the world compressed there), or a range no diffuse ball shows (a light
     // source reflected: the sun in a smooth sky).
     case BallKind::chrome: return (c.rim_texture >= 0.25 && c.diffuse_residual >= 0.12) || c.diffuse_residual >= 2.0;
-    case BallKind::grey: return c.texture < 0.05 && c.diffuse_residual < 0.15;
+    case BallKind::grey: return c.shading_texture < 0.05 && c.diffuse_residual < 0.15;
     case BallKind::glossy: return c.diffuse_residual >= 0.04;
   }
   return false;
@@ -550,6 +664,50 @@ BallCandidate given_ball(const cv::Mat& image, const LensModel& lens, const Ball
   return measure_ball(image, lens, locate_ball(image, lens, guess));
 }
 
+std::optional<AnchorFromRig> anchor_from_rig(const ViewBalls& view, const std::vector<RigMember>& rig,
+                                             const std::vector<ListedBall>& balls, const RigOptions& ro) {
+  if (view.chrome || rig.size() != balls.size()) return std::nullopt;
+  // A ball b found at g (its radii, camera frame) puts the chrome ball's centre at
+  //   c = s_b g - R^T o_b   (chrome radii, camera frame; o_b = R (s_b g - c) solved for c).
+  // The candidate nearest such a c, within the rig's tolerance, is the chrome ball; the hypothesis
+  // with the most members agreeing, then the smallest disagreement, wins.
+  std::optional<AnchorFromRig> best;
+  int best_support = 0;
+  double best_d = 1e300;
+  for (std::size_t b = 0; b < balls.size(); ++b) {
+    if (balls[b].kind == BallKind::chrome || !rig[b].known) continue;
+    for (std::size_t k = 0; k < view.candidates.size(); ++k) {
+      if (!looks_like(view.candidates[k], balls[b].kind)) continue;
+      const Vec3 c = rig[b].scale * centre_in_radii(view.candidates[k].loc.fit.cone) -
+                     view.world_from_cam.transpose() * rig[b].offset;
+      const double tol = ro.tolerance + ro.relative_tolerance * c.norm();
+      for (std::size_t j = 0; j < view.candidates.size(); ++j) {
+        if (j == k) continue;
+        const double d = (centre_in_radii(view.candidates[j].loc.fit.cone) - c).norm();
+        if (!(d < tol)) continue;
+        // Support: the other members that a candidate confirms, placed from this chrome ball.
+        ViewBalls anchored = view;
+        anchored.chrome = view.candidates[j].loc.fit.cone;
+        int support = 1;
+        for (std::size_t m = 0; m < balls.size(); ++m) {
+          if (m == b || balls[m].kind == BallKind::chrome || !rig[m].known) continue;
+          for (std::size_t q = 0; q < view.candidates.size(); ++q)
+            if (q != j && q != k && looks_like(view.candidates[q], balls[m].kind) &&
+                (implied_offset(anchored, view.candidates[q], rig[m].scale) - rig[m].offset).norm() < tol) {
+              ++support;
+              break;
+            }
+        }
+        if (support > best_support || (support == best_support && d < best_d)) {
+          best_support = support, best_d = d;
+          best = AnchorFromRig{view.candidates[j].loc.fit.cone, balls[b].name, d};
+        }
+      }
+    }
+  }
+  return best;
+}
+
 std::vector<BallFinding> identify_view_balls(const ViewBalls& view, const std::vector<RigMember>& rig,
                                              const std::vector<ListedBall>& balls, const cv::Mat& image,
                                              const LensModel& lens, const RigOptions& ro, const BallSearchOptions& so,
@@ -587,7 +745,7 @@ std::vector<BallFinding> identify_view_balls(const ViewBalls& view, const std::v
       }
       c.loc.fit.cone = *view.chrome;
       f.status = "found";
-      f.note = "chrome ball (the orientation's anchor)";
+      f.note = view.anchor_note.empty() ? "chrome ball (the orientation's anchor)" : view.anchor_note;
       f.ball = c;
       f.disagreement = 0;
       continue;

@@ -5,7 +5,8 @@
 // 1. Candidates (find_ball_candidates): Hough circles in radius bands a factor 2 apart (one band's
 //    strong circles cannot crowd out another's), each located (calib/ball_locator.h) and measured:
 //    outline quality (inlier fraction, RMS), appearance (texture: a mirror shows the whole world;
-//    smoothness and a Lambert fit: a diffuse ball's shading is a low-order function of its normal)
+//    a Lambert fit, and the texture it leaves: a diffuse ball's shading is a low-order function of
+//    its normal and one sun)
 //    and how much of the disc lies inside the frame (a ball cut by the frame edge is flagged).
 // 2. One view (assign_balls_in_view): the listed balls matched to candidates by appearance (chrome
 //    the most textured, grey the smoothest, glossy between) and size (balls of a rig are at about
@@ -44,7 +45,8 @@ struct BallCandidate {
   double texture = 0;           // mean |ln L| change between neighbouring pixels within 0.8 radii
   double rim_texture = 0;       // fraction of the pixels between 0.5 and 0.9 radii whose ln L changes by > 0.06 to a neighbour
   double mirror_score = 0;      // 98th percentile of |grad log2 L| within 0.9 radii, stops per radius
-  double diffuse_residual = 0;  // RMS of a Lambert (order-2 spherical harmonics) fit over 0.9 radii / mean
+  double diffuse_residual = 0;  // RMS of a Lambert fit (order-2 spherical harmonics and one sun) over 0.9 radii / mean
+  double shading_texture = 0;   // mean |ln(L / that fit)| change between neighbouring pixels within 0.8 radii
   double frame_fraction = 1;    // fraction of the fitted outline inside the image
   bool cut = false;             // the disc reaches beyond the frame
 };
@@ -92,6 +94,7 @@ struct ViewBalls {
   std::vector<BallCandidate> candidates;
   std::optional<BallCone> chrome;  // the anchor (the pose's refined chrome ball, or the view's chrome candidate)
   Mat3 world_from_cam = Mat3::Identity();
+  std::string anchor_note;  // how the anchor was found, when not by the orientation (the report's note)
 };
 
 // The rig: per listed ball its centre relative to the chrome ball's (world, chrome-ball radii) and
@@ -115,6 +118,19 @@ struct RigOptions {
 // the rest). Each view's candidates are claimed by one ball at most.
 std::vector<RigMember> fit_ball_rig(const std::vector<ViewBalls>& views, const std::vector<ListedBall>& balls,
                                     const RigOptions& options = {});
+
+// A view whose chrome ball no appearance test accepts (backlit by a low sun, it shows a smooth sky
+// and a thin bright rim) and whose pose came without it: the rig, fitted on the other views, places
+// it from the balls that are found. The chrome cone, the ball it was placed from, and the
+// distance between the placed and the found centre (chrome radii). None when the view has an
+// anchor, no member is known or no candidate agrees.
+struct AnchorFromRig {
+  BallCone chrome;
+  std::string placed_from;
+  double disagreement = 0;
+};
+std::optional<AnchorFromRig> anchor_from_rig(const ViewBalls& view, const std::vector<RigMember>& rig,
+                                             const std::vector<ListedBall>& balls, const RigOptions& options = {});
 
 // One ball in one view, as identification decided.
 struct BallFinding {

@@ -479,6 +479,12 @@ void step_extract(Context& c) {
       bar.update(double(vi + 1) / steps);
     }
     const std::vector<RigMember> rig = fit_ball_rig(vb, listed);
+    for (ViewBalls& v : vb)
+      if (auto a = anchor_from_rig(v, rig, listed)) {
+        v.chrome = a->chrome;
+        v.anchor_note = "chrome ball placed by the rig from ball " + a->placed_from + " (within " +
+                        std::to_string(a->disagreement).substr(0, 4) + " chrome radii)";
+      }
     int anchored = 0;
     for (const ViewBalls& v : vb) anchored += v.chrome.has_value();
     const bool trust_views = anchored < 2;  // one view: nothing to check it against

@@ -206,6 +206,82 @@ TEST(BallIdentification, DrawnBallsAreMeasuredAndMatchedByAppearanceAndSize) {
   EXPECT_FALSE(c[std::size_t(pick[1])].cut);
 }
 
+// A grey ball lit by a sun 50 times its sky, from the front, the side and behind (a lit crescent
+// at the rim), with 2% pixel noise: its shading is one clamped cosine plus a smooth sky, which the
+// Lambert fit holds within a few percent, leaving no texture; a mirror-like disc of the same size
+// fits it by no means.
+TEST(BallIdentification, AGreyBallLitByASunLooksGreyFromAnySide) {
+  const LensModel lens = LensModel::pinhole(200, 160, 400);
+  const Vec2 c(100, 80);
+  const double r = 35;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<float> noise(0.0f, 0.02f);
+  std::uniform_real_distribution<float> u(0.05f, 2.0f);
+  for (const Vec3& sun : {Vec3(0.3, -0.5, -0.8), Vec3(1, 0, 0), Vec3(-0.5, -0.3, 0.8), Vec3(0.1, 0.2, 1)}) {
+    const Vec3 l = sun.normalized();  // camera frame: +z away from the camera, so z > 0 is behind the ball
+    for (int kind = 0; kind < 2; ++kind) {
+      cv::Mat img(160, 200, CV_32FC3, cv::Scalar::all(0.3));
+      const BallCone cone{lens.unproject(c).normalized(), std::asin(1.0 / 10)};  // 10 radii away
+      const Vec3 centre = cone.axis / std::sin(cone.half_angle);
+      for (int y = 0; y < img.rows; ++y)
+        for (int x = 0; x < img.cols; ++x) {
+          const Vec3 d = lens.unproject(Vec2(x, y)).normalized();
+          const double b = d.dot(centre), disc = b * b - (centre.squaredNorm() - 1);
+          if (!(disc > 0)) continue;
+          const Vec3 n = (b - std::sqrt(disc)) * d - centre;
+          const double shade = 0.05 * (1.2 - 0.4 * n.y()) + 2.5 * std::max(0.0, n.dot(l));
+          const float v = kind == 0 ? float(shade * (1 + noise(rng))) : u(rng);
+          img.at<cv::Vec3f>(y, x) = cv::Vec3f(v, v, v);
+        }
+      BallLocation loc;
+      loc.fit.cone = cone;
+      loc.centre_px = lens.project(cone.axis);
+      loc.radius_px = r;
+      const BallCandidate m = measure_ball(img, lens, loc);
+      if (kind == 0) {
+        EXPECT_LT(m.diffuse_residual, 0.05) << "sun " << l.transpose();
+        EXPECT_LT(m.shading_texture, 0.02) << "sun " << l.transpose();
+        EXPECT_TRUE(looks_like(m, BallKind::grey)) << "sun " << l.transpose();
+      } else {
+        EXPECT_GT(m.diffuse_residual, 0.3);
+        EXPECT_FALSE(looks_like(m, BallKind::grey));
+      }
+    }
+  }
+}
+
+// A view whose chrome ball is not its anchor (no pose ball, no appearance test passed) gets one
+// from the rig: placed from the grey ball where that is found, the true chrome ball within a
+// tenth of its radius; a view without the grey ball gets none.
+TEST(BallIdentification, TheRigPlacesAViewsChromeBallFromItsGreyBall) {
+  if (!fs::exists(kLobby)) GTEST_SKIP() << kLobby << " missing (scripts/fetch-assets.sh)";
+  const Views& r = rendered();
+  const std::vector<ViewBalls> vb = with_true_rotations(r);
+  const std::vector<RigMember> rig = fit_ball_rig(vb, r.listed);
+  ASSERT_TRUE(rig[1].known);
+  int placed = 0;
+  for (std::size_t i = 0; i < vb.size(); ++i) {
+    ViewBalls v = vb[i];
+    const bool had = v.chrome.has_value();
+    EXPECT_FALSE(anchor_from_rig(v, rig, r.listed)) << "a view with an anchor keeps it";
+    if (!had) continue;
+    const BallCone truth = *v.chrome;
+    v.chrome.reset();
+    const std::optional<AnchorFromRig> a = anchor_from_rig(v, rig, r.listed);
+    const Vec2 grey = testing::ball_centre_px(r.views[i], 1);
+    const bool grey_seen = visible(r.views[i], 1) && r.scene.camera.lens.in_image(grey, -35);
+    if (!a) {
+      EXPECT_FALSE(grey_seen) << "view " << i;
+      continue;
+    }
+    ++placed;
+    EXPECT_EQ(a->placed_from, "grey");
+    EXPECT_LT(angle_between(a->chrome.axis, truth.axis), 0.1 * truth.half_angle) << "view " << i;
+    EXPECT_NEAR(a->chrome.half_angle, truth.half_angle, 0.1 * truth.half_angle) << "view " << i;
+  }
+  EXPECT_GE(placed, 3);
+}
+
 // The rig's geometry predicts a ball's cone from the chrome ball's: exact for the truth.
 TEST(BallIdentification, ThePredictedConeOfATrueOffsetIsTheTrueCone) {
   const Mat3 world_from_cam = Eigen::AngleAxisd(0.3, Vec3(0.2, 1, 0.1).normalized()).toRotationMatrix();
