@@ -12,22 +12,33 @@ struct NakaRushton {
 };
 constexpr NakaRushton kMeasured[3] = {{0.62, 0.35}, {0.58, 0.30}, {0.66, 0.42}};
 
+double srgb_encode(double x) { return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055; }
+double srgb_decode(double f) { return f <= 0.04045 ? f / 12.92 : std::pow((f + 0.055) / 1.055, 2.4); }
+
+// The filmic contrast curve on the encoded value u in [0,1] (see the header).
+constexpr double kFilmicW = 0.5, kFilmicA = 1.6;
+double filmic_contrast(double u) {
+  const double p = std::pow(u, kFilmicA), q = std::pow(1 - u, kFilmicA);
+  return (1 - kFilmicW) * u + kFilmicW * p / (p + q);
+}
+
 }  // namespace
 
 const std::vector<std::string>& CameraResponse::kinds() {
-  static const std::vector<std::string> k = {"linear", "srgb", "measured"};
+  static const std::vector<std::string> k = {"linear", "srgb", "measured", "filmic"};
   return k;
 }
 
 CameraResponse::CameraResponse(const std::string& kind) : kind_(kind) {
   if (std::find(kinds().begin(), kinds().end(), kind) == kinds().end())
-    throw std::invalid_argument("unknown camera response '" + kind + "' (linear, srgb, measured)");
+    throw std::invalid_argument("unknown camera response '" + kind + "' (linear, srgb, measured, filmic)");
 }
 
 double CameraResponse::code(double x, int c) const {
   x = std::clamp(x, 0.0, 1.0);
   if (kind_ == "linear") return x;
-  if (kind_ == "srgb") return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
+  if (kind_ == "srgb") return srgb_encode(x);
+  if (kind_ == "filmic") return filmic_contrast(srgb_encode(x));
   const NakaRushton& p = kMeasured[c];
   const double xg = std::pow(x, p.g);
   return (1 + p.a) * xg / (xg + p.a);
@@ -36,7 +47,16 @@ double CameraResponse::code(double x, int c) const {
 double CameraResponse::relative(double f, int c) const {
   f = std::clamp(f, 0.0, 1.0);
   if (kind_ == "linear") return f;
-  if (kind_ == "srgb") return f <= 0.04045 ? f / 12.92 : std::pow((f + 0.055) / 1.055, 2.4);
+  if (kind_ == "srgb") return srgb_decode(f);
+  if (kind_ == "filmic") {
+    // Bisection on the increasing contrast curve: 64 halvings reach the double's resolution.
+    double lo = 0, hi = 1;
+    for (int i = 0; i < 64 && hi - lo > 0; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (filmic_contrast(mid) < f ? lo : hi) = mid;
+    }
+    return srgb_decode(0.5 * (lo + hi));
+  }
   const NakaRushton& p = kMeasured[c];
   return std::pow(p.a * f / (1 + p.a - f), 1.0 / p.g);
 }

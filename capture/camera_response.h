@@ -12,6 +12,12 @@
 //               f(x) = (1 + a) x^g / (x^g + a)
 //             with (g, a) = (0.62, 0.35), (0.58, 0.30), (0.66, 0.42) for R, G, B.
 //             Inverse: x = (a f / (1 + a - f))^(1/g).
+//   filmic    a consumer camera's JPEG tone curve, the same for every channel: the sRGB encoding
+//             u = srgb(x) followed by a contrast S-curve in the encoded domain,
+//               f = (1 - w) u + w S(u),  S(u) = u^a / (u^a + (1 - u)^a),  w = 0.5, a = 1.6
+//             (slope at both ends half the sRGB one: a toe that deepens the shadows and a
+//             highlight shoulder that rolls off toward white; 18% grey -> 0.45, code 115 of 255).
+//             Inverse: S is inverted by bisection (f is increasing), then the sRGB decoding.
 #pragma once
 
 #include <string>
@@ -21,7 +27,7 @@ namespace rsibr {
 
 class CameraResponse {
  public:
-  // "linear", "srgb" or "measured"; throws std::invalid_argument otherwise.
+  // "linear", "srgb", "measured" or "filmic"; throws std::invalid_argument otherwise.
   explicit CameraResponse(const std::string& kind = "srgb");
   static const std::vector<std::string>& kinds();
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 namespace rsibr {
@@ -73,6 +74,24 @@ cv::Mat expose_bracket(const cv::Mat& radiance, double e, const SensorNoise& noi
         const double X = record_electrons(mu, noise, rng);
         const auto& t = thresholds[std::size_t(c)];
         o[x * ch + c] = std::uint16_t(std::upper_bound(t.begin(), t.end(), X) - t.begin());
+      }
+    }
+  });
+  return out;
+}
+
+cv::Mat expose_raw(const cv::Mat& radiance, double e, const SensorNoise& noise, const Vec3& sensitivity,
+                   std::uint64_t seed, std::uint64_t stream) {
+  if (radiance.type() != CV_32FC3) throw std::invalid_argument("expose_raw: radiance must be CV_32FC3");
+  cv::Mat out(radiance.rows, radiance.cols, CV_64FC3);
+  parallel_for_rows(radiance.rows, [&](int y) {
+    const float* in = radiance.ptr<float>(y);
+    double* o = out.ptr<double>(y);
+    for (int x = 0; x < radiance.cols; ++x) {
+      NoiseRng rng(seed, (stream << 40) + std::uint64_t(y) * std::uint64_t(radiance.cols) + std::uint64_t(x));
+      for (int c = 0; c < 3; ++c) {
+        const double mu = std::max(0.0, double(in[x * 3 + c])) * e * noise.gain * sensitivity[c];
+        o[x * 3 + c] = record_electrons(mu, noise, rng) / noise.full_well;
       }
     }
   });

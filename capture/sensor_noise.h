@@ -13,6 +13,7 @@
 
 #include "bake/integrator.h"
 #include "capture/camera_response.h"
+#include "core/vec.h"
 
 #include <opencv2/core.hpp>
 
@@ -43,5 +44,12 @@ double record_electrons(double mu, const SensorNoise& noise, NoiseRng& rng);
 // Returns CV_16UC(channels), RGB order, every value <= max_code.
 cv::Mat expose_bracket(const cv::Mat& radiance, double e, const SensorNoise& noise, const CameraResponse& response,
                        int max_code, std::uint64_t seed, std::uint64_t stream);
+
+// The raw signal of one bracket before any response: X / full_well per channel (CV_64FC3, RGB, in
+// [0, 1]) for mean electrons mu_c = L_c * e * k * sensitivity_c (a sensor's per-channel colour
+// response; ones: as expose_bracket). Same streams and draws as expose_bracket, so with unit
+// sensitivities round(f(raw) * max_code) gives expose_bracket's codes. `radiance` CV_32FC3.
+cv::Mat expose_raw(const cv::Mat& radiance, double e, const SensorNoise& noise, const Vec3& sensitivity,
+                   std::uint64_t seed, std::uint64_t stream);
 
 }  // namespace rsibr

@@ -1,6 +1,7 @@
 #include "capture/synth_capture.h"
 
 #include "capture/camera_poses.h"
+#include "capture/camera_processing.h"
 #include "capture/camera_response.h"
 #include "capture/chessboard.h"
 #include "capture/irradiance.h"
@@ -41,7 +42,7 @@ void write_bytes(const fs::path& file, const std::vector<uchar>& bytes) {
 }
 
 // Codes (CV_16UC1/3, RGB) -> an encoded image file of the camera's format.
-void write_codes(const fs::path& file, const cv::Mat& codes, const std::string& format) {
+void write_codes(const fs::path& file, const cv::Mat& codes, const std::string& format, int jpeg_quality = 95) {
   cv::Mat bgr;
   if (codes.channels() == 3)
     cv::cvtColor(codes, bgr, cv::COLOR_RGB2BGR);
@@ -50,7 +51,7 @@ void write_codes(const fs::path& file, const cv::Mat& codes, const std::string& 
   if (format != "tiff") bgr.convertTo(bgr, CV_8U);  // codes are already <= 255
   std::vector<uchar> bytes;
   std::vector<int> params;
-  if (format == "jpeg") params = {cv::IMWRITE_JPEG_QUALITY, 95};
+  if (format == "jpeg") params = {cv::IMWRITE_JPEG_QUALITY, jpeg_quality};
   const std::string ext = format == "png" ? ".png" : format == "jpeg" ? ".jpg" : ".tif";
   if (!cv::imencode(ext, bgr, bytes, params)) throw std::runtime_error(file.string() + ": cannot encode");
   write_bytes(file, bytes);
@@ -222,6 +223,16 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
   tc["vignetting"] = cam.vignetting;
   if (cam.vignetting_poly) tc["vignetting"] = vec(*cam.vignetting_poly);
   tc["white_balance"] = vec(cam.white_balance);
+  if (cam.format == "jpeg") tc["jpeg_quality"] = cam.jpeg_quality;
+  if (cam.processing) {
+    YAML::Node tp;
+    tp["sensitivity"] = vec(cam.processing->sensitivity);
+    tp["white_balance_gains"] = vec(cam.processing->gains());
+    tp["colour_matrix"] = mat(cam.processing->matrix());
+    tp["order"] = "raw = X/full_well; w = min(1, gains * raw); m = clamp(M w, 0, 1); code = round(f(m)*max_code); JPEG";
+    tp["radiance_truth"] = "views/*_radiance.exr hold M (gains * sensitivity * L): the linear output, unclipped";
+    tc["processing"] = tp;
+  }
   tc["supersampling"] = cam.supersampling;
   tc["convention"] = "X = L e k electrons (L after vignetting and white balance, e = t*iso/100/N^2); "
                      "X = clamp(Poisson(X) + Normal(0, read_noise^2), 0, full_well); code = round(f(X/full_well)*max_code)";
@@ -234,7 +245,8 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
         renderer.render(pose, cam.lens, rays, ropt, [&](double f) { if (progress) progress(std::min(1.0, (before + f) / work)); });
     report.pixels_rendered += (long long)(scene_radiance.total()) * cam.supersampling * cam.supersampling;
     advance(1);
-    // L at the pixel: vignetting and white balance applied to the scene radiance.
+    // L at the pixel: vignetting and white balance applied to the scene radiance (with in-camera
+    // processing the sensor sees this; the truth written is the processed linear output).
     cv::Mat L(scene_radiance.size(), CV_32FC3);
     for (int y = 0; y < L.rows; ++y)
       for (int x = 0; x < L.cols; ++x) {
@@ -275,11 +287,15 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
     tv["scene_radiance"] = "views/" + pose.name + "_scene.exr";
     for (std::size_t bi = 0; bi < times.size(); ++bi) {
       const double e = relative_exposure(times[bi]);
-      const cv::Mat codes = expose_bracket(L, e, noise, response, max_code, scene.seed, 1 + vi * 64 + bi);
+      const std::uint64_t stream = 1 + vi * 64 + bi;
+      const cv::Mat codes =
+          cam.processing ? process_raw(expose_raw(L, e, noise, cam.processing->sensitivity, scene.seed, stream), *cam.processing,
+                                       response, max_code)
+                         : expose_bracket(L, e, noise, response, max_code, scene.seed, stream);
       char name[64];
       std::snprintf(name, sizeof name, "%s_b%02zu.%s", pose.name.c_str(), bi, ext_of(cam.format).c_str());
       const fs::path file = photos / pose.name / name;
-      write_codes(file, codes, cam.format);
+      write_codes(file, codes, cam.format, cam.jpeg_quality);
       pv.brackets.push_back({file, times[bi], scene.exposure.iso, scene.exposure.aperture});
       YAML::Node tb;
       tb["file"] = pose.name + "/" + name;
@@ -296,8 +312,10 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
                                                 {"view", pose.name},
                                                 {"cameraModel", cam.lens.name()},
                                                 {"seed", std::to_string(scene.seed)}};
-    attrs["content"] = "L at the pixel (after vignetting and white balance): X = L e k";
-    write_truth_image(file_in_folder(truth / "views", pose.name + "_radiance.exr"), L, &pose, attrs);
+    attrs["content"] = cam.processing ? "the camera's linear output M (gains * sensitivity * L) for L at the pixel: X = L e k"
+                                      : "L at the pixel (after vignetting and white balance): X = L e k";
+    write_truth_image(file_in_folder(truth / "views", pose.name + "_radiance.exr"),
+                      cam.processing ? linear_output(L, *cam.processing) : L, &pose, attrs);
     attrs["content"] = "scene radiance along each pixel's rays (before vignetting and white balance)";
     write_truth_image(file_in_folder(truth / "views", pose.name + "_scene.exr"), scene_radiance, &pose, attrs);
     for (const SynthBall& b : scene.balls) {

@@ -108,10 +108,30 @@ LensModel parse_lens(const YAML::Node& node, const std::string& path, int width,
   }
 }
 
+CameraProcessing parse_processing(const YAML::Node& node, const std::string& path) {
+  const YamlMap m(node, path, {"sensitivity", "white_balance", "saturation", "colour_matrix"});
+  CameraProcessing p;
+  if (m.has("sensitivity")) p.sensitivity = vec3_in(m, "sensitivity", 0, true);
+  if (m.has("white_balance")) {
+    const YAML::Node wb = m.get("white_balance");
+    if (!(wb.IsScalar() && wb.as<std::string>() == "auto")) p.white_balance = vec3_in(m, "white_balance", 0, true);
+  }
+  if (m.has("saturation")) p.saturation = m.number_in("saturation", 0, false, 4, false);
+  if (m.has("colour_matrix")) {
+    if (m.has("saturation")) spec_fail(m.at("colour_matrix"), "give colour_matrix or saturation");
+    const std::vector<double> v = m.numbers("colour_matrix");
+    if (v.size() != 9) spec_fail(m.at("colour_matrix"), "9 numbers, row by row");
+    Mat3 M;
+    for (int i = 0; i < 9; ++i) M(i / 3, i % 3) = v[std::size_t(i)];
+    p.colour_matrix = M;
+  }
+  return p;
+}
+
 SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const std::filesystem::path& folder) {
   const YamlMap m(node, path,
-                  {"name", "width", "height", "lens", "response", "format", "supersampling", "vignetting",
-                   "white_balance", "full_well", "read_noise", "gain"});
+                  {"name", "width", "height", "lens", "response", "format", "jpeg_quality", "processing", "supersampling",
+                   "vignetting", "white_balance", "full_well", "read_noise", "gain"});
   SynthCamera c;
   const int w = int(spec_in_range(double(m.integer("width")), m.at("width"), 16, false, 16384, false));
   const int h = int(spec_in_range(double(m.integer("height")), m.at("height"), 16, false, 16384, false));
@@ -121,6 +141,11 @@ SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const 
   if (m.has("name")) c.name = valid_utf8(m.string("name"));  // free text (bytes that are not UTF-8 replaced)
   if (m.has("response")) c.response = m.choice("response", CameraResponse::kinds());
   if (m.has("format")) c.format = m.choice("format", {"png", "jpeg", "tiff"});
+  if (m.has("jpeg_quality")) {
+    if (c.format != "jpeg") spec_fail(m.at("jpeg_quality"), "only for format: jpeg");
+    c.jpeg_quality = int(spec_in_range(double(m.integer("jpeg_quality")), m.at("jpeg_quality"), 1, false, 100, false));
+  }
+  if (m.has("processing")) c.processing = parse_processing(m.get("processing"), m.at("processing"));
   if (m.has("supersampling"))
     c.supersampling = int(spec_in_range(double(m.integer("supersampling")), m.at("supersampling"), 1, false, 16, false));
   if (m.has("vignetting")) {

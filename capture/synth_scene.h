@@ -7,6 +7,7 @@
 // World frame: +Y up, metres. Defaults are the values the README states.
 #pragma once
 
+#include "capture/camera_processing.h"
 #include "core/lens_model.h"
 #include "core/vec.h"
 
@@ -87,6 +88,10 @@ struct SynthCamera {
   std::string name = "synthetic camera";
   std::string response = "srgb";
   std::string format = "png";  // "png" (8-bit), "jpeg" (8-bit), "tiff" (16-bit)
+  int jpeg_quality = 95;       // format jpeg: the encoder's quality, 1..100
+  // In-camera processing (capture/camera_processing.h): raw sensitivities, white balance, colour
+  // matrix, then `response` as the tone curve. Absent: codes are response(raw) per channel.
+  std::optional<CameraProcessing> processing;
   int supersampling = 2;       // n: n x n stratified, jittered samples per pixel
   double vignetting = 0.0;     // v = 1 - vignetting * (r / r_corner)^2
   // Instead of that, when set: v = 1 + k1 r^2 + k2 r^4 + k3 r^6, r = |p - c| / r_corner (the

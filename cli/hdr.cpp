@@ -29,6 +29,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 namespace rsibr::cli {
@@ -37,10 +38,11 @@ namespace {
 namespace fs = std::filesystem;
 
 struct HdrArgs {
-  std::string photoset, out, response, model = "auto", noise, input_colour_space, json;
+  std::string photoset, out, response, model = "auto", channels = "auto", noise, input_colour_space, json, saturation,
+      white_balance;
   std::vector<std::string> views;
-  int samples = 3000;
-  double smoothness = 100.0, ghost_sigmas = 6.0;
+  int samples = 20000;
+  double smoothness = 1000.0, ghost_sigmas = -1;
   bool align = false, deghost = false, quiet = false, no_preview = false;
   std::optional<float> preview_exposure;
 };
@@ -66,11 +68,47 @@ NoiseModel parse_noise(const std::string& text) {
   return n;
 }
 
+// "N" (every channel) or "R,G,B": codes, each in (0, max_code] once the bit depth is known.
+std::array<int, 3> parse_saturation(const std::string& text) {
+  std::array<int, 3> out{-1, -1, -1};
+  if (text.empty()) return out;
+  std::istringstream in(text);
+  std::vector<int> v;
+  for (std::string item; std::getline(in, item, ',');) {
+    try {
+      std::size_t used = 0;
+      const int code = std::stoi(item, &used);
+      if (used != item.size() || code <= 0) throw std::invalid_argument("");
+      v.push_back(code);
+    } catch (const std::exception&) {
+      throw std::invalid_argument("--saturation-code '" + text + "': expected N or R,G,B, positive codes");
+    }
+  }
+  if (v.size() == 1) v.assign(3, v[0]);
+  if (v.size() != 3) throw std::invalid_argument("--saturation-code '" + text + "': expected N or R,G,B");
+  for (int c = 0; c < 3; ++c) out[std::size_t(c)] = v[std::size_t(c)];
+  return out;
+}
+
+// "R,G,B" positive gains.
+std::optional<cv::Vec3f> parse_gains(const std::string& text) {
+  if (text.empty() || text == "camera") return std::nullopt;
+  cv::Vec3f g;
+  char c1 = 0, c2 = 0;
+  std::istringstream in(text);
+  if (!(in >> g[0] >> c1 >> g[1] >> c2 >> g[2]) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof() ||
+      !(g[0] > 0 && g[1] > 0 && g[2] > 0) || !std::isfinite(g[0] + g[1] + g[2]))
+    throw std::invalid_argument("--white-balance '" + text + "': expected camera or R,G,B positive gains");
+  return g;
+}
+
 std::string describe(const NoiseModel& n) {
   std::ostringstream s;
   s.precision(4);
-  s << "var(X) = shot*X + read + quantisation (" << n.source << "); shot " << n.shot[0] << " " << n.shot[1] << " "
-    << n.shot[2] << "; read " << n.read[0] << " " << n.read[1] << " " << n.read[2];
+  s << "var(X) = shot*X + read + (1/12 + code + texture a^2) step^2 (" << n.source << "); shot " << n.shot[0] << " "
+    << n.shot[1] << " " << n.shot[2] << "; read " << n.read[0] << " " << n.read[1] << " " << n.read[2] << "; code "
+    << n.code[0] << " " << n.code[1] << " " << n.code[2] << "; texture " << n.texture[0] << " " << n.texture[1] << " "
+    << n.texture[2];
   return s.str();
 }
 
@@ -120,6 +158,10 @@ int run_hdr(const HdrArgs& a) {
   }
   std::optional<NoiseModel> given_noise;
   if (!a.noise.empty()) given_noise = parse_noise(a.noise);
+  const std::array<int, 3> given_saturation = parse_saturation(a.saturation);
+  const std::optional<cv::Vec3f> gains = parse_gains(a.white_balance);
+  if (a.channels != "auto" && a.channels != "shared" && a.channels != "separate")
+    throw std::invalid_argument("--channels '" + a.channels + "': expected auto, shared or separate");
   std::optional<ResponseCurve> given_curve;
   if (!a.response.empty()) given_curve = load_response(a.response);
   if (a.model != "auto" && a.model != "identity" && a.model != "gamma" && a.model != "polynomial" &&
@@ -159,34 +201,47 @@ int run_hdr(const HdrArgs& a) {
   nlohmann::json summary;
   try {
     Progress bar("hdr", !a.quiet && Progress::stderr_is_terminal());
-    // The response: reused, or recovered once per photo set (one camera) from the view with the
-    // most brackets.
+    // The response: reused, or recovered once per photo set (one camera) from every view; the noise
+    // model likewise from every view (unless given).
     RecoveryOptions ro;
     ro.model = a.model;
+    ro.channels = a.channels;
     ro.samples = a.samples;
     ro.smoothness = a.smoothness;
+    ro.saturation_code = given_saturation;
     ResponseCurve curve;
     nlohmann::json response_json;
+    const PhotoSetResponse psr = recover_photo_set_response(views, ro, a.align, given_curve);
+    const NoiseModel pooled_noise = given_noise ? *given_noise : psr.noise;
+    nlohmann::json from = nlohmann::json::array();
+    for (const PhotoView* v : psr.from) from.push_back(v->name);
     if (given_curve) {
       curve = *given_curve;
+      for (int c = 0; c < 3; ++c)
+        if (given_saturation[std::size_t(c)] > 0) curve.saturation[std::size_t(c)] = given_saturation[std::size_t(c)];
       response_json = {{"model", curve.model}, {"source", a.response}};
     } else {
-      const PhotoSetResponse psr = recover_photo_set_response(views, ro, a.align);
       const ResponseRecovery& rec = psr.recovery;
-      const PhotoView* richest = psr.from;
       curve = rec.curve;
-      nlohmann::json cands = nlohmann::json::array();
-      for (const auto& c : rec.candidates)
-        cands.push_back({{"model", c.model}, {"complexity", c.complexity},
-                         {"held_out_error", std::isfinite(c.held_out_error) ? nlohmann::json(c.held_out_error) : nlohmann::json("rejected")},
-                         {"parameters", c.parameters}});
-      response_json = {{"model", curve.model}, {"parameters", curve.parameters}, {"recovered_from", richest->name},
-                       {"candidates", cands}, {"train_samples", rec.train_samples}, {"held_out_samples", rec.held_out_samples},
-                       {"file", response_out.string()}};
+      response_json = recovery_json(rec);
+      response_json["model"] = curve.model;
+      response_json["parameters"] = curve.parameters;
+      response_json["recovered_from"] = from;
+      response_json["file"] = response_out.string();
       save_response(stage / "response.json", curve,
-                    {{"camera", set.camera_name}, {"recovered_from", richest->name}, {"candidates", cands}});
+                    {{"camera", set.camera_name}, {"recovered_from", from}, {"recovery", recovery_json(rec)}});
       staged.push_back({stage / "response.json", response_out});
+      if (rec.near_tie && !a.quiet) std::cerr << "rsibr hdr: warning: " << rec.warning << "\n";
     }
+    for (int c = 0; c < 3; ++c)
+      if (given_saturation[std::size_t(c)] > curve.max_code)
+        throw std::invalid_argument("--saturation-code: " + std::to_string(given_saturation[std::size_t(c)]) +
+                                    " is above the photos' top code " + std::to_string(curve.max_code));
+    curve.validate();
+    response_json["saturation_code"] = {curve.saturation_code(0), curve.saturation_code(1), curve.saturation_code(2)};
+    response_json["noise"] = {{"source", pooled_noise.source}, {"views", pooled_noise.views}, {"shot", pooled_noise.shot},
+                              {"read", pooled_noise.read}, {"code", pooled_noise.code}, {"texture", pooled_noise.texture}};
+    response_json["white_balance"] = gains ? nlohmann::json({(*gains)[0], (*gains)[1], (*gains)[2]}) : nlohmann::json("camera");
     // A plot-friendly curve: 65 points per channel.
     nlohmann::json plot = nlohmann::json::array();
     for (int k = 0; k <= 64; ++k) {
@@ -198,14 +253,19 @@ int run_hdr(const HdrArgs& a) {
     summary["response"] = response_json;
 
     std::string response_model = curve.model;
-    for (const auto& c : response_json.value("candidates", nlohmann::json::array()))
-      if (c["model"] == curve.model && c["held_out_error"].is_number()) {
-        std::ostringstream s;
-        s.precision(3);
-        s << curve.model << " (held-out code error " << c["held_out_error"].get<double>() << ")";
-        response_model = s.str();
-        break;
-      }
+    if (!given_curve) {
+      std::ostringstream s;
+      s.precision(3);
+      s << psr.recovery.chosen;
+      for (const auto& c : psr.recovery.candidates)
+        if (c.tied && c.model == curve.model && c.shared == curve.parameters.value("shared", true)) {
+          s << ", held-out code error " << c.held_out_error;
+          break;
+        }
+      if (std::isfinite(psr.recovery.margin_sigmas)) s << ", margin " << psr.recovery.margin_sigmas << " sigma";
+      if (psr.recovery.near_tie) s << " (near tie)";
+      response_model = s.str();
+    }
 
     nlohmann::json view_list = nlohmann::json::array();
     for (std::size_t vi = 0; vi < views.size(); ++vi) {
@@ -214,13 +274,19 @@ int run_hdr(const HdrArgs& a) {
       mo.ghost_sigmas = a.ghost_sigmas;
       mo.deghost = a.deghost;
       const auto t0 = std::chrono::steady_clock::now();
-      ViewMerge vm = merge_photo_view(v, curve, given_noise, a.align, mo);
+      ViewMerge vm = merge_photo_view(v, curve, pooled_noise, a.align, mo);
       const auto t1 = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                std::chrono::duration<double>(vm.seconds_load));
       const BracketSet& b = vm.brackets;
       const std::vector<cv::Point>& shifts = vm.shifts;
       const NoiseModel& noise = vm.noise;
       MergedImage& m = vm.image;
+      if (gains) {
+        // The user's white balance: gains on the camera's (the merge keeps the camera's own).
+        const cv::Vec3f g = *gains;
+        m.radiance.forEach<cv::Vec3f>([&](cv::Vec3f& p, const int*) { p = p.mul(g); });
+        m.variance.forEach<cv::Vec3f>([&](cv::Vec3f& p, const int*) { p = p.mul(g.mul(g)); });
+      }
       if (to_working) {
         convert_colour_space(m.radiance, a.input_colour_space, working);
         // Variances through the squared matrix (channel covariances are not kept).
@@ -325,12 +391,19 @@ Runner add_hdr(CLI::App& app) {
   c->add_option("--view", a->views, "Merge only this view (repeatable; default: all)");
   c->add_option("--response", a->response, "Reuse this response curve file (from an earlier run, same camera)");
   c->add_option("--model", a->model, "Response model: auto (held-out error), identity, gamma, polynomial, robertson, debevec");
-  c->add_option("--samples", a->samples, "Pixels sampled for response recovery")->check(CLI::Range(100, 100000));
-  c->add_option("--smoothness", a->smoothness, "Debevec's smoothness weight lambda")->check(CLI::Range(0.0, 1e6));
+  c->add_option("--channels", a->channels,
+                "Response curves: auto (held-out error), shared (one curve for R, G, B: in-camera JPEG), separate");
+  c->add_option("--samples", a->samples, "Pixels sampled for response recovery, over all views")->check(CLI::Range(100, 200000));
+  c->add_option("--smoothness", a->smoothness, "Smoothness weight lambda of the debevec and robertson curves")->check(CLI::Range(0.0, 1e8));
+  c->add_option("--saturation-code", a->saturation,
+                "Codes at or above this saturate: N or R,G,B (default: measured from the brackets)");
+  c->add_option("--white-balance", a->white_balance,
+                "camera (default: keep the camera's own) or R,G,B gains applied to the merged radiance");
   c->add_option("--noise", a->noise, "Given noise model SHOT,READ: var(X) = SHOT*X + READ, X normalised to saturation");
   c->add_flag("--align", a->align, "Align brackets by small shifts (OpenCV median threshold bitmaps)");
   c->add_flag("--deghost", a->deghost, "Ghost pixels take the longest usable bracket alone instead of a blend");
-  c->add_option("--ghost-sigmas", a->ghost_sigmas, "Ghost threshold in standard deviations of chi-square")->check(CLI::Range(0.0, 1e6));
+  c->add_option("--ghost-sigmas", a->ghost_sigmas,
+                "Ghost threshold in standard deviations of chi-square (default: 6, 8 for JPEG)")->check(CLI::Range(0.0, 1e6));
   c->add_option("--input-colorspace", a->input_colour_space,
                 "OpenColorIO colour space of the linearised camera RGB (default: the working space; $OCIO honoured)");
   c->add_option("--preview-exposure", a->preview_exposure, "Preview exposure in stops (default: median grey at 0.18)");

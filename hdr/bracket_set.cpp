@@ -4,6 +4,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
@@ -75,10 +77,17 @@ BracketSet load_brackets(const PhotoView& view) {
     names.push_back(name);
   }
   if (codes.empty()) throw std::runtime_error("view " + view.name + ": no brackets");
-  return assemble(std::move(codes), std::move(ranges), std::move(exposures), std::move(metadata), std::move(names));
+  BracketSet s = assemble(std::move(codes), std::move(ranges), std::move(exposures), std::move(metadata), std::move(names));
+  for (const std::string& f : s.files) {
+    std::string ext = std::filesystem::path(f).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+    if (ext == ".jpg" || ext == ".jpeg") s.lossy = true;
+  }
+  return s;
 }
 
-BracketSet make_brackets(std::vector<cv::Mat> images, std::vector<double> exposures, std::vector<std::string> names) {
+BracketSet make_brackets(std::vector<cv::Mat> images, std::vector<double> exposures, std::vector<std::string> names,
+                         bool lossy) {
   if (images.size() != exposures.size()) throw std::invalid_argument("make_brackets: one exposure per image");
   for (std::size_t j = names.size(); j < images.size(); ++j) names.push_back("bracket " + std::to_string(j));
   std::vector<cv::Mat> codes(images.size());
@@ -92,7 +101,9 @@ BracketSet make_brackets(std::vector<cv::Mat> images, std::vector<double> exposu
     m.source = "memory";
     metadata.push_back(m);
   }
-  return assemble(std::move(codes), std::move(ranges), std::move(exposures), std::move(metadata), std::move(names));
+  BracketSet s = assemble(std::move(codes), std::move(ranges), std::move(exposures), std::move(metadata), std::move(names));
+  s.lossy = lossy;
+  return s;
 }
 
 }  // namespace rsibr

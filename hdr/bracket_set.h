@@ -19,6 +19,7 @@ struct BracketSet {
   std::vector<ResolvedExposure> metadata;   // per bracket, same order
   std::vector<std::string> files;           // per bracket, same order
   int max_code = 255;                       // 255 (8-bit files) or 65535 (16-bit)
+  bool lossy = false;                       // some bracket is a lossy file (JPEG: .jpg, .jpeg)
 
   int rows() const { return codes.empty() ? 0 : codes[0].rows; }
   int cols() const { return codes.empty() ? 0 : codes[0].cols; }
@@ -32,8 +33,8 @@ struct BracketSet {
 BracketSet load_brackets(const PhotoView& view);
 
 // Builds a set from in-memory images (CV_8UC3 or CV_16UC3, RGB) and exposures; sorts by exposure.
-// Same checks as load_brackets. For tests and benchmarks.
+// Same checks as load_brackets. For tests and benchmarks (lossy: the images went through JPEG).
 BracketSet make_brackets(std::vector<cv::Mat> images, std::vector<double> exposures,
-                         std::vector<std::string> names = {});
+                         std::vector<std::string> names = {}, bool lossy = false);
 
 }  // namespace rsibr

@@ -32,6 +32,15 @@ Eigen::VectorXd nnls_gram(const Eigen::MatrixXd& Q, const Eigen::VectorXd& p, do
   const int n = int(p.size());
   if (Q.rows() != n || Q.cols() != n) throw std::invalid_argument("nnls_gram: Q must be n x n with n = p.size()");
   if (max_iterations <= 0) max_iterations = 3 * n + 10;
+  // When the unconstrained minimum is feasible it is the answer (Q positive definite); the active
+  // set iterations are for when it is not.
+  {
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(Q);
+    if (ldlt.info() == Eigen::Success && ldlt.isPositive()) {
+      const Eigen::VectorXd z = ldlt.solve(p);
+      if (z.allFinite() && (z.array() >= 0).all() && (Q * z - p).norm() <= 1e-9 * (1 + p.norm())) return z;
+    }
+  }
   Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
   std::vector<bool> passive(std::size_t(n), false);
   for (int outer = 0; outer < max_iterations; ++outer) {

@@ -1,6 +1,6 @@
 // A photo set's views merged the way rsibr hdr and rsibr process both do it: the camera response
-// recovered once, from the view with the most brackets (the first on ties), then each view's
-// brackets loaded (aligned when asked), its noise estimated (unless given) and merged.
+// and the noise model recovered once, from every view (loaded one at a time, aligned when asked;
+// bracket_statistics.h), then each view's brackets loaded again and merged.
 #pragma once
 
 #include "core/photo_set.h"
@@ -20,13 +20,16 @@ namespace rsibr {
 
 struct PhotoSetResponse {
   ResponseRecovery recovery;          // model "identity": the identity curve, no candidates
-  const PhotoView* from = nullptr;    // the view it was recovered from
+  NoiseModel noise;                   // estimated from every view with that curve
+  std::vector<const PhotoView*> from; // the views with at least two brackets (what it was recovered from)
 };
 
-// `views` non-empty. options.model "identity" skips the fit (linear input). Throws
-// std::runtime_error("view <name>: <problem>") when the recovery fails.
+// `views` non-empty. options.model "identity" skips the fit (linear input). `curve`: reuse this
+// response instead of recovering one (the noise is still estimated). Throws
+// std::runtime_error("view <name>: <problem>") when a view cannot be read, or "<problem>" when the
+// recovery fails.
 PhotoSetResponse recover_photo_set_response(const std::vector<const PhotoView*>& views, const RecoveryOptions& options,
-                                            bool align);
+                                            bool align, const std::optional<ResponseCurve>& curve = std::nullopt);
 
 struct ViewMerge {
   BracketSet brackets;
@@ -36,8 +39,9 @@ struct ViewMerge {
   double seconds_load = 0, seconds_merge = 0;  // loading + alignment + noise estimate; the merge
 };
 
-// `vignetting`, when given, is divided out of the merged radiance and variance (hdr/vignetting.h).
-// Throws std::runtime_error("view <name>: ...") when the photos' bit depth is not the curve's.
+// `noise` nullopt: estimated from this view alone. `vignetting`, when given, is divided out of the
+// merged radiance and variance (hdr/vignetting.h). Throws std::runtime_error("view <name>: ...")
+// when the photos' bit depth is not the curve's.
 ViewMerge merge_photo_view(const PhotoView& view, const ResponseCurve& curve, const std::optional<NoiseModel>& noise,
                            bool align, const MergeOptions& options = {}, const Vignetting* vignetting = nullptr);
 

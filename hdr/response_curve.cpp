@@ -2,6 +2,7 @@
 
 #include "core/atomic_file.h"
 #include "core/input_file.h"
+#include "hdr/saturation_level.h"
 
 #include <algorithm>
 #include <cmath>
@@ -41,9 +42,17 @@ void ResponseCurve::tables(std::array<std::vector<float>, 3>& x, std::array<std:
   }
 }
 
+int ResponseCurve::saturation_code(int channel) const {
+  const int s = saturation[std::size_t(channel)];
+  return s > 0 ? s : default_saturation_code(max_code);
+}
+
 void ResponseCurve::validate() const {
   if (max_code != 255 && max_code != 65535) throw std::invalid_argument("max_code must be 255 or 65535");
+  double top = 0;
   for (int c = 0; c < 3; ++c) {
+    if (saturation[std::size_t(c)] == 0 || saturation[std::size_t(c)] > max_code || saturation[std::size_t(c)] < -1)
+      throw std::invalid_argument("channel " + std::to_string(c) + ": saturation code must be in (0, max_code]");
     const auto& k = knots[std::size_t(c)];
     const std::string ch = "channel " + std::to_string(c);
     if (k.size() < 2) throw std::invalid_argument(ch + ": fewer than 2 knots");
@@ -51,12 +60,28 @@ void ResponseCurve::validate() const {
       if (!std::isfinite(k[i]) || k[i] < 0) throw std::invalid_argument(ch + ": knot " + std::to_string(i) + " is negative or not finite");
       if (i > 0 && k[i] < k[i - 1]) throw std::invalid_argument(ch + ": decreasing at knot " + std::to_string(i));
     }
-    if (std::abs(k.back() - 1.0) > 1e-6) throw std::invalid_argument(ch + ": the top knot must be 1");
+    if (k.back() > 1.0 + 1e-6) throw std::invalid_argument(ch + ": the top knot must be at most 1");
+    top = std::max(top, k.back());
   }
+  if (std::abs(top - 1.0) > 1e-6) throw std::invalid_argument("the largest top knot must be 1");
 }
 
 ResponseCurve ResponseCurve::identity(int max_code) {
   return sampled("identity", max_code, 2, [](int, double u) { return u; });
+}
+
+void tie_channels(ResponseCurve& r) {
+  const double mid = 0.5 * r.max_code;
+  const double ref = r.linear(1, mid);
+  for (int c = 0; c < 3; ++c) {
+    const double here = r.linear(c, mid);
+    if (!(here > 0) || !(ref > 0)) throw std::invalid_argument("degenerate response (0 at the middle code)");
+    for (double& v : r.knots[std::size_t(c)]) v *= ref / here;
+  }
+  double top = 0;
+  for (const auto& k : r.knots) top = std::max(top, k.back());
+  for (auto& k : r.knots)
+    for (double& v : k) v = std::min(1.0, v / top);
 }
 
 void save_response(const std::filesystem::path& path, const ResponseCurve& curve, const nlohmann::json& extra) {
@@ -65,6 +90,7 @@ void save_response(const std::filesystem::path& path, const ResponseCurve& curve
   j["model"] = curve.model;
   j["parameters"] = curve.parameters;
   j["max_code"] = curve.max_code;
+  j["saturation_code"] = {curve.saturation_code(0), curve.saturation_code(1), curve.saturation_code(2)};
   j["knots"] = {curve.knots[0], curve.knots[1], curve.knots[2]};
   // The camera name is not always UTF-8: bad bytes are replaced.
   write_text_atomically(path, j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
@@ -84,6 +110,11 @@ ResponseCurve load_response(const std::filesystem::path& path) {
     const auto& k = j.at("knots");
     if (!k.is_array() || k.size() != 3) throw std::invalid_argument("knots must be three lists");
     for (int c = 0; c < 3; ++c) r.knots[std::size_t(c)] = k[std::size_t(c)].get<std::vector<double>>();
+    if (j.contains("saturation_code")) {
+      const auto& s = j.at("saturation_code");
+      if (!s.is_array() || s.size() != 3) throw std::invalid_argument("saturation_code must be three codes");
+      for (int c = 0; c < 3; ++c) r.saturation[std::size_t(c)] = s[std::size_t(c)].get<int>();
+    }
     r.validate();
     return r;
   } catch (const std::exception& e) {

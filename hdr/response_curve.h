@@ -1,7 +1,9 @@
-// A camera's inverse response: code z -> linear signal X, per channel, normalised so that the top
-// code maps to X = 1 (X is the recorded signal L * e * k divided by the signal that saturates).
+// A camera's inverse response: code z -> linear signal X, per channel, normalised so that the
+// largest top knot over the channels is X = 1 (X is the recorded signal L * e * k divided by the
+// signal that saturates; the channels share that unit, so their ratios are the camera's colour).
 // Stored as knots uniformly spaced in code over [0, max_code] with linear interpolation between
-// them (for 8-bit input one knot per code). Saved as a small JSON file per camera and reused.
+// them (for 8-bit input one knot per code), with the code at which each channel saturates. Saved as
+// a small JSON file per camera and reused.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -18,6 +20,10 @@ struct ResponseCurve {
   nlohmann::json parameters = nlohmann::json::object();  // model parameters (gamma, coefficients, ...)
   int max_code = 255;
   std::array<std::vector<double>, 3> knots;  // X at codes k * max_code / (K-1), K >= 2, non-decreasing
+  std::array<int, 3> saturation{-1, -1, -1};  // per channel: codes at or above are saturated; -1: the default
+
+  // The channel's saturation code (default_saturation_code(max_code) when not set).
+  int saturation_code(int channel) const;
 
   // X for code z (clamped to [0, max_code]) in channel c.
   double linear(int channel, double z) const;
@@ -28,7 +34,8 @@ struct ResponseCurve {
   // ((X(z+1/2) - X(z-1/2))^2 / 12), each max_code+1 floats per channel.
   void tables(std::array<std::vector<float>, 3>& x, std::array<std::vector<float>, 3>& quantisation_var) const;
 
-  // Throws std::invalid_argument naming what is wrong (sizes, non-finite, decreasing, top != 1).
+  // Throws std::invalid_argument naming what is wrong (sizes, non-finite, decreasing, a top knot
+  // above 1 or none at 1, a saturation code outside (0, max_code]).
   void validate() const;
 
   static ResponseCurve identity(int max_code);
@@ -37,8 +44,15 @@ struct ResponseCurve {
   static ResponseCurve sampled(std::string model, int max_code, int knot_count, F&& f);
 };
 
-// JSON: {"rsibr_response": 1, "model", "parameters", "max_code", "knots": [[R...],[G...],[B...]]}
-// plus any extra keys given (camera name, held-out errors). Written atomically.
+// The channels' common unit, the convention every recovered curve follows (a camera's own white
+// balance): each channel scaled so that X_c(max_code / 2) is the same for all three (equal middle
+// codes are grey), then all together so that the largest top knot is 1. Throws
+// std::invalid_argument when a channel is 0 at the middle code.
+void tie_channels(ResponseCurve& curve);
+
+// JSON: {"rsibr_response": 1, "model", "parameters", "max_code", "saturation_code": [R, G, B],
+// "knots": [[R...],[G...],[B...]]} plus any extra keys given (camera name, held-out errors). Written
+// atomically. Files without saturation_code (older ones) load with the default.
 void save_response(const std::filesystem::path& path, const ResponseCurve& curve,
                    const nlohmann::json& extra = nlohmann::json::object());
 // Throws std::runtime_error("<path>: <problem>").

@@ -7,6 +7,7 @@
 #include "core/text.h"
 #include "pipeline/light_sources_report.h"
 #include "pipeline/process_pipeline.h"
+#include "pipeline/response_choice_html.h"
 #include "pipeline/step_record.h"
 
 #include <nlohmann/json.hpp>
@@ -258,8 +259,9 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
     const auto& s = rec["hdr"].summary;
     h << "<h2>Camera response</h2><p>";
     if (!s.value("camera", "").empty()) h << "Camera <b>" << html_escape(s.value("camera", "")) << "</b>. ";
-    h << "Model <b>" << html_escape(s.value("model", "")) << "</b>, recovered from view "
+    h << "Model <b>" << html_escape(s.value("model", "")) << "</b>, recovered from "
       << html_escape(s.value("recovered_from", "")) << ".</p>";
+    h << response_choice_html(s.value("recovery", nlohmann::json::object()));
     std::vector<PlotSeries> series = {{"R", "#d33", {}, {}}, {"G", "#2a2", {}, {}}, {"B", "#33d", {}, {}}};
     for (const auto& p : s["curve"])
       for (int ch = 0; ch < 3; ++ch) series[ch].x.push_back(p[0].get<double>()), series[ch].y.push_back(p[ch + 1].get<double>());

@@ -232,7 +232,7 @@ void step_hdr(Context& c) {
     for (const PhotoView& v : c.set.views) all.push_back(&v);
     const PhotoSetResponse psr = recover_photo_set_response(all, RecoveryOptions{}, false);
     const ResponseRecovery& rec = psr.recovery;
-    const PhotoView* richest = psr.from;
+    const std::string from = std::to_string(psr.from.size()) + " views (all with brackets)";
     const ResponseCurve& curve = rec.curve;
     nlohmann::json cands = nlohmann::json::array();
     for (const auto& k : rec.candidates)
@@ -240,7 +240,7 @@ void step_hdr(Context& c) {
                        {"held_out_error", std::isfinite(k.held_out_error) ? nlohmann::json(k.held_out_error)
                                                                           : nlohmann::json("rejected")}});
     const fs::path response = c.dir / "hdr" / "response.json";
-    save_response(response, curve, {{"camera", c.set.camera_name}, {"recovered_from", richest->name}});
+    save_response(response, curve, {{"camera", c.set.camera_name}, {"recovered_from", from}, {"recovery", recovery_json(rec)}});
     nlohmann::json plot = nlohmann::json::array();
     for (int k = 0; k <= 64; ++k) {
       const double z = double(k) * curve.max_code / 64;
@@ -261,7 +261,7 @@ void step_hdr(Context& c) {
     Progress bar("hdr", c.o.progress);
     for (std::size_t i = 0; i < c.set.views.size(); ++i) {
       const PhotoView& v = c.set.views[i];
-      const ViewMerge vm = merge_photo_view(v, curve, std::nullopt, false, {}, &vig);
+      const ViewMerge vm = merge_photo_view(v, curve, psr.noise, false, {}, &vig);
       const BracketSet& b = vm.brackets;
       const NoiseModel& noise = vm.noise;
       const MergedImage& m = vm.image;
@@ -279,7 +279,7 @@ void step_hdr(Context& c) {
       bar.update(double(i + 1) / double(c.set.views.size()));
     }
     bar.done();
-    r.summary = {{"model", curve.model}, {"recovered_from", richest->name}, {"candidates", cands},
+    r.summary = {{"model", curve.model}, {"recovered_from", from}, {"candidates", cands}, {"recovery", recovery_json(rec)},
                  {"curve", plot}, {"max_code", curve.max_code}, {"views", views}, {"vignetting", vignetting},
                  {"camera", c.set.camera_name}};
   });

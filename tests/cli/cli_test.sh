@@ -192,9 +192,24 @@ python3 "$(dirname "$0")/bracket_shoot.py" "$work/shoot"
 check "hdr writes EXR, PNG and the response" test -s "$work/hdr/north.exr" -a -s "$work/hdr/north.png" -a -s "$work/hdr/response.json"
 check "hdr JSON: model chosen by held-out error, sun clipped, no ghosts" python3 -c "
 import json; j = json.load(open('$work/hdr.json')); v = j['views'][0]
-assert j['response']['model'] in ('gamma', 'polynomial'), j['response']['model']
+assert j['response']['model'] in ('gamma', 'polynomial', 'debevec'), j['response']['model']
 assert len(j['response']['candidates']) >= 5 and len(j['response']['curve']) == 65
 assert 20 < v['clipped_pixels'] < 80 and v['ghost_fraction'] < 0.01, v"
+check "hdr JSON: the choice, its margin, the near-tie flag, saturation codes and the noise from every view" python3 -c "
+import json; r = json.load(open('$work/hdr.json'))['response']
+assert r['chosen'] and isinstance(r['near_tie'], bool) and ('margin_sigmas' in r) and len(r['saturation_code']) == 3, r
+assert r['noise']['views'] == 1 and r['recovered_from'] == ['north'] and r['white_balance'] == 'camera', r"
+"$rsibr" hdr "$work/shoot" --out "$work/hdr7" --saturation-code 200 --white-balance 2,1,1 --channels shared --json "$work/hdr7.json" -q
+check "hdr: a given saturation code and white balance are used" python3 -c "
+import json; a = json.load(open('$work/hdr.json')); b = json.load(open('$work/hdr7.json'))
+assert b['response']['saturation_code'] == [200, 200, 200] and b['response']['saturation_source'] == 'given', b['response']
+assert b['response']['white_balance'] == [2, 1, 1] and '(shared)' in b['response']['chosen'], b['response']
+va, vb = a['views'][0], b['views'][0]
+# The unit is the signal at the saturation code: code 200 is below the measured one, so every value
+# rises (a power-law curve: about (254/200)^2.2 = 1.7); the sun, clipped, is 1 / e_0 in that unit, times
+# the red gain 2.
+assert vb['radiance_min'] > 1.2 * va['radiance_min'], (va, vb)
+assert abs(vb['radiance_max'] / va['radiance_max'] - 2) < 0.05, (va, vb)"
 check "hdr EXR carries channels and provenance" bash -c "'$rsibr' info '$work/hdr/north.exr' >/dev/null 2>&1; grep -aq variance.R '$work/hdr/north.exr' && grep -aq rsibr.responseModel '$work/hdr/north.exr' && grep -aq 'north/0.png' '$work/hdr/north.exr'"
 "$rsibr" hdr "$work/shoot" --out "$work/hdr5" -q
 check "hdr: same photos, same bytes" cmp -s "$work/hdr/north.exr" "$work/hdr5/north.exr"
@@ -205,6 +220,10 @@ expect_error "hdr: missing photo set" "nothere" hdr "$work/nothere" --out "$work
 expect_error "hdr: output parent missing" "nofolder" hdr "$work/shoot" --out "$work/nofolder/sub"
 expect_error "hdr: unknown model" "fancy" hdr "$work/shoot" --out "$work/hdr3" --model fancy
 expect_error "hdr: malformed noise" "noise" hdr "$work/shoot" --out "$work/hdr3" --noise 1e-4
+expect_error "hdr: malformed saturation code" "saturation-code" hdr "$work/shoot" --out "$work/hdr3" --saturation-code 1,2
+expect_error "hdr: saturation code above the top code" "above the photos' top code" hdr "$work/shoot" --out "$work/hdr3" --saturation-code 300
+expect_error "hdr: malformed white balance" "white-balance" hdr "$work/shoot" --out "$work/hdr3" --white-balance 1,0,1
+expect_error "hdr: unknown channel mode" "channels" hdr "$work/shoot" --out "$work/hdr3" --channels some
 expect_error "hdr: unknown view" "south" hdr "$work/shoot" --out "$work/hdr3" --view south
 expect_error "hdr: JSON folder missing (checked before merging)" "nofolder" hdr "$work/shoot" --out "$work/hdr3" --json "$work/nofolder/s.json"
 printf '{"rsibr_response": 1, "model": "x", "max_code": 255, "knots": [[0,1],[0,1]]}' >"$work/bad-response.json"

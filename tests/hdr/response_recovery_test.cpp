@@ -140,7 +140,7 @@ TEST(ResponseRecovery, CurveSurvivesSaveAndLoad) {
 TEST(ResponseRecovery, MalformedResponseFileIsAnErrorNamingIt) {
   testing::TempDir dir;
   const auto path = dir.path() / "bad.json";
-  std::ofstream(path) << R"({"rsibr_response": 1, "model": "x", "max_code": 255, "knots": [[0, 0.5], [0, 1], [0, 1]]})";
+  std::ofstream(path) << R"({"rsibr_response": 1, "model": "x", "max_code": 255, "knots": [[0, 1.5], [0, 1], [0, 1]]})";
   try {
     load_response(path);
     FAIL() << "expected an error";
