@@ -39,14 +39,7 @@ PY
 printf 'plain text, not an image\n' >"$in/text.exr"
 mkdir -p "$in/folder.exr"
 mkfifo "$in/fifo.exr"
-cat >"$in/lens.cameramodel" <<'CM'
-{
-    'lensmodel':  'LENSMODEL_PINHOLE',
-    'intrinsics': [ 100, 100, 47.5, 31.5 ],
-    'imagersize': [ 96, 64 ],
-    'extrinsics': [ 0, 0, 0, 0, 0, 0 ],
-}
-CM
+pinhole_lens "$in/lens.cameramodel"
 printf "{ 'lensmodel': 'LENSMODEL_PINHOLE', 'intrinsics': [ 100, 100, 47.5 " >"$in/truncated.cameramodel"
 # A bracketed shoot and its broken variants (photos).
 python3 "$here/bracket_shoot.py" "$in/shoot"

@@ -22,6 +22,17 @@ expect_error() {
     fail=$((fail + 1)); echo "FAILED: $name (exit $rc, $lines lines):"; cat "$work/err"
   fi
 }
+# pinhole_lens FILE: the mrcal pinhole model of the scripts' 96x64 test images.
+pinhole_lens() {
+  cat >"$1" <<'CM'
+{
+    'lensmodel':  'LENSMODEL_PINHOLE',
+    'intrinsics': [ 100, 100, 47.5, 31.5 ],
+    'imagersize': [ 96, 64 ],
+    'extrinsics': [ 0, 0, 0, 0, 0, 0 ],
+}
+CM
+}
 no_temporaries() { ! ls -A "$1" | grep -q '\.tmp'; }
 finish() {
   echo "$1: $pass passed, $fail failed"

@@ -77,14 +77,7 @@ sed -i '1a balls: [{name: "../../esc/ball", kind: chrome}]' "$work/balls/photose
 expect_error "hdr: ball named with a traversal" "photoset.balls\[0\].name: a name starting with '.'" hdr "$work/balls" --out "$work/trav/t/a/hb"
 hostile_set "$work/good" north
 "$rsibr" hdr "$work/good" --out "$work/good-hdr" -q --no-preview
-cat >"$work/lens.cameramodel" <<'CM'
-{
-    'lensmodel':  'LENSMODEL_PINHOLE',
-    'intrinsics': [ 100, 100, 47.5, 31.5 ],
-    'imagersize': [ 96, 64 ],
-    'extrinsics': [ 0, 0, 0, 0, 0, 0 ],
-}
-CM
+pinhole_lens "$work/lens.cameramodel"
 printf 'rsibr_poses: 1\ngauge: first-view\nviews:\n  - name: "../north"\n    world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n    sigma_deg: 0\n' >"$work/poses.yaml"
 expect_error "extract --poses: a pose file's view named with a traversal" "poses.yaml: poses.views\[0\].name: a name starting with '.'" \
   extract "$work/good-hdr/north.exr" --lens "$work/lens.cameramodel" --poses "$work/poses.yaml" --out "$work/trav/t/a/e.exr"
