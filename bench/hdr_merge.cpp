@@ -167,7 +167,7 @@ int run(int argc, char** argv) {
   std::nth_element(lum.begin(), lum.begin() + long(lum.size() / 2), lum.end());
   const double e_mid = 0.18 / lum[lum.size() / 2];
   const auto e = testing::exposure_series(e_mid / 64, 4.0, 7);
-  testing::SynthCamera cam;
+  testing::BracketCamera cam;
   cam.max_code = 255;
   cam.read_sigma = 5e-4;
   cam.response = testing::s_curve;

@@ -19,7 +19,7 @@ TEST(Alignment, MedianThresholdBitmapUndoesASmallShift) {
       const double v = 1.0 + 0.8 * std::sin(x * 0.21) * std::cos(r * 0.17) + 0.5 * ((x / 16 + r / 16) % 2);
       L.at<cv::Vec3d>(r, x) = cv::Vec3d::all(v);
     }
-  testing::SynthCamera cam;
+  testing::BracketCamera cam;
   cam.max_code = 255;
   cam.response = [](int, double X) { return std::pow(X, 1 / 2.2); };
   const std::vector<double> e = {0.1, 0.25, 0.6};

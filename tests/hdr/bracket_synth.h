@@ -15,7 +15,7 @@
 
 namespace rsibr::testing {
 
-struct SynthCamera {
+struct BracketCamera {
   std::function<double(int channel, double X)> response = [](int, double X) { return X; };  // [0,1] -> [0,1]
   double gain = 1.0;        // k
   double full_well = 2e4;   // electrons at X = 1 (0: no shot noise)
@@ -27,7 +27,7 @@ struct SynthCamera {
 
 // radiance: CV_64FC3 (or CV_32FC3), RGB. Returns RGB codes, CV_16UC3 or CV_8UC3.
 inline std::vector<cv::Mat> synthesize(const cv::Mat& radiance, const std::vector<double>& exposures,
-                                       const SynthCamera& cam, unsigned seed) {
+                                       const BracketCamera& cam, unsigned seed) {
   cv::Mat L;
   radiance.convertTo(L, CV_64FC3);
   std::vector<cv::Mat> out;

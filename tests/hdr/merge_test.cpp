@@ -13,9 +13,9 @@
 namespace rsibr {
 namespace {
 
-using testing::SynthCamera;
+using testing::BracketCamera;
 
-NoiseModel true_noise(const SynthCamera& cam) {
+NoiseModel true_noise(const BracketCamera& cam) {
   NoiseModel n;
   for (int c = 0; c < 3; ++c) n.shot[std::size_t(c)] = cam.shot(), n.read[std::size_t(c)] = cam.read();
   n.source = "given";
@@ -36,7 +36,7 @@ cv::Mat level_scene(const std::vector<double>& levels, int per_level) {
 // The noise-optimal variance of an unbiased combination: 1 / sum_j e_j^2 / var(X_j), over the
 // brackets that do not saturate (X = L e k; the merge's unit is X / e, so its truth is L k).
 // A bracket counts when its brightest channel (Lk_max) does not saturate: the merge's rule.
-double optimal_variance(double Lk, double Lk_max, const std::vector<double>& e, const SynthCamera& cam, double sat_X) {
+double optimal_variance(double Lk, double Lk_max, const std::vector<double>& e, const BracketCamera& cam, double sat_X) {
   double info = 0;
   for (double ej : e) {
     const double X = Lk * ej;
@@ -48,7 +48,7 @@ double optimal_variance(double Lk, double Lk_max, const std::vector<double>& e, 
 
 // True when bracket saturation is ambiguous for this level (some bracket's X within 6 sigma of
 // the threshold): the truncation there is a selection effect, not the estimator's bias.
-bool near_saturation(double Lk, const std::vector<double>& e, const SynthCamera& cam, double sat_X) {
+bool near_saturation(double Lk, const std::vector<double>& e, const BracketCamera& cam, double sat_X) {
   for (double ej : e) {
     const double X = Lk * ej;
     if (std::abs(X - sat_X) < 6 * std::sqrt(cam.shot() * X + cam.read())) return true;
@@ -63,7 +63,7 @@ struct LevelStats {
 };
 
 LevelStats level_stats(const MergedImage& m, const std::vector<double>& levels, const std::vector<double>& e,
-                       const SynthCamera& cam, double sat_X) {
+                       const BracketCamera& cam, double sat_X) {
   LevelStats s;
   double ratio_sum = 0;
   int ratio_n = 0;
@@ -96,7 +96,7 @@ std::vector<double> log_levels(double lo, double hi, int n) {
 }
 
 TEST(Merge, MergedRadianceIsUnbiasedAndWithinTenPercentOfTheNoiseOptimalBound) {
-  SynthCamera cam;  // 16-bit linear, shot + read noise
+  BracketCamera cam;  // 16-bit linear, shot + read noise
   cam.gain = 0.5;
   const auto e = testing::exposure_series(1.0 / 1000, 4.0, 7);
   const auto levels = log_levels(-1.5, 3.0, 48);
@@ -113,7 +113,7 @@ TEST(Merge, MergedRadianceIsUnbiasedAndWithinTenPercentOfTheNoiseOptimalBound) {
 
 TEST(Merge, WeightsFromTheMeasuredSignalAreBiasedLowAndThePilotPassRemovesIt) {
   // Few photo-electrons: weighting by the measured X favours low draws. The pilot pass must matter.
-  SynthCamera cam;
+  BracketCamera cam;
   cam.full_well = 200;
   cam.read_sigma = 1e-3;
   const auto e = testing::exposure_series(1.0 / 100, 2.0, 5);
@@ -130,7 +130,7 @@ TEST(Merge, WeightsFromTheMeasuredSignalAreBiasedLowAndThePilotPassRemovesIt) {
 }
 
 TEST(Merge, PixelsClippedInEveryBracketAreFlaggedAndNeverExceedTheTruth) {
-  SynthCamera cam;
+  BracketCamera cam;
   const auto e = testing::exposure_series(1.0 / 100, 4.0, 5);
   // Left half: moderate radiance; right half: a sun 1000x beyond the shortest bracket's saturation.
   cv::Mat L(16, 32, CV_64FC3, cv::Scalar::all(5.0));
@@ -156,7 +156,7 @@ TEST(Merge, PixelsClippedInEveryBracketAreFlaggedAndNeverExceedTheTruth) {
 TEST(Merge, ABracketSaturatedInAnyChannelIsExcludedSoHueIsKept) {
   // An orange light: red saturates one bracket before green and blue. Keeping the clipped red
   // with the unclipped green would pull the merge toward a pinker, darker red.
-  SynthCamera cam;
+  BracketCamera cam;
   cam.max_code = 255;
   cam.full_well = 0;
   cam.read_sigma = 0;
@@ -186,7 +186,7 @@ TEST(Merge, ABracketSaturatedInAnyChannelIsExcludedSoHueIsKept) {
 }
 
 TEST(Merge, ExposuresFrom1Over32000To60SecondsMergeWithoutNanAndUnbiased) {
-  SynthCamera cam;
+  BracketCamera cam;
   const std::vector<double> e = {1.0 / 32000, 1.0 / 4000, 1.0 / 500, 1.0 / 60, 1.0 / 8, 1.0, 8.0, 60.0};
   const auto levels = log_levels(-5.0, 4.0, 40);
   const cv::Mat L = level_scene(levels, 300);
@@ -221,7 +221,7 @@ TEST(Merge, AllBlackAndAllWhiteInputsAreFlaggedNeverNan) {
 }
 
 TEST(Merge, SameInputsGiveTheSameBytes) {
-  SynthCamera cam;
+  BracketCamera cam;
   const auto e = testing::exposure_series(1.0 / 100, 4.0, 5);
   const cv::Mat L = testing::ramp_scene(40, 60, -2, 2);
   const BracketSet b = make_brackets(testing::synthesize(L, e, cam, 16), e);
@@ -235,7 +235,7 @@ TEST(Merge, SameInputsGiveTheSameBytes) {
 }
 
 TEST(Merge, VarianceChannelMatchesTheObservedScatter) {
-  SynthCamera cam;
+  BracketCamera cam;
   const auto e = testing::exposure_series(1.0 / 1000, 4.0, 6);
   const auto levels = log_levels(-1.0, 2.5, 16);
   const BracketSet b = make_brackets(testing::synthesize(level_scene(levels, 500), e, cam, 17), e);
@@ -255,7 +255,7 @@ TEST(Merge, VarianceChannelMatchesTheObservedScatter) {
 }
 
 TEST(Merge, EstimatedNoiseModelMatchesTheCamera) {
-  SynthCamera cam;
+  BracketCamera cam;
   cam.full_well = 5000;
   cam.read_sigma = 4e-4;
   const auto e = testing::exposure_series(1.0 / 1000, 4.0, 6);
@@ -270,7 +270,7 @@ TEST(Merge, EstimatedNoiseModelMatchesTheCamera) {
 }
 
 TEST(Merge, GhostsAreFlaggedWhereTheSceneMovedAndRarelyElsewhere) {
-  SynthCamera cam;
+  BracketCamera cam;
   const auto e = testing::exposure_series(1.0 / 100, 4.0, 5);
   const cv::Mat L = testing::ramp_scene(64, 64, -1, 1.5);
   auto imgs = testing::synthesize(L, e, cam, 19);
@@ -313,7 +313,7 @@ TEST(Merge, GhostsAreFlaggedWhereTheSceneMovedAndRarelyElsewhere) {
 }
 
 TEST(Merge, BeatsHatWeightingByThreeDecibelsInTheDarkestDecade) {
-  SynthCamera cam;
+  BracketCamera cam;
   cam.read_sigma = 5e-4;
   const auto e = testing::exposure_series(1.0 / 1000, 4.0, 7);
   const auto levels = log_levels(-3.0, 2.0, 50);  // the darkest decade: levels below 10^-2

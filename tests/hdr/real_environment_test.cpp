@@ -40,7 +40,7 @@ TEST(RealEnvironment, SunIsFlaggedAsALowerBoundAndMidTonesAreWithinFivePercent) 
   std::nth_element(lum.begin(), lum.begin() + long(lum.size() / 2), lum.end());
   const double median = lum[lum.size() / 2];
   const auto e = testing::exposure_series(0.18 / median / 64, 4.0, 7);
-  testing::SynthCamera cam;
+  testing::BracketCamera cam;
   cam.max_code = 255;
   cam.response = testing::s_curve;
   const BracketSet b = make_brackets(testing::synthesize(truth, e, cam, 40), e);

@@ -14,25 +14,25 @@
 namespace rsibr {
 namespace {
 
-using testing::SynthCamera;
+using testing::BracketCamera;
 
 // Seven brackets two stops apart (the usual bracketing), or in irregular steps.
-BracketSet synth_set(const SynthCamera& cam, unsigned seed, bool irregular = false) {
+BracketSet synth_set(const BracketCamera& cam, unsigned seed, bool irregular = false) {
   const cv::Mat L = testing::ramp_scene(96, 192, -3.5, 1.0);
   const auto e = irregular ? std::vector<double>{1.0 / 64, 3.0 / 64, 10.0 / 64, 40.0 / 64, 110.0 / 64, 500.0 / 64, 1600.0 / 64}
                            : testing::exposure_series(1.0 / 64, 4.0, 7);
   return make_brackets(testing::synthesize(L, e, cam, seed), e);
 }
 
-SynthCamera eight_bit(std::function<double(int, double)> response) {
-  SynthCamera cam;
+BracketCamera eight_bit(std::function<double(int, double)> response) {
+  BracketCamera cam;
   cam.max_code = 255;
   cam.response = std::move(response);
   return cam;
 }
 
 // Truth: X(z) = u^-1(z / max), by bisection on the monotone response.
-double true_inverse(const SynthCamera& cam, int c, double z) {
+double true_inverse(const BracketCamera& cam, int c, double z) {
   double lo = 0, hi = 1;
   for (int i = 0; i < 60; ++i) {
     const double mid = 0.5 * (lo + hi);
@@ -43,7 +43,7 @@ double true_inverse(const SynthCamera& cam, int c, double z) {
 
 // Worst relative error of X(z)/X(128) over codes 16..242 (the curve is known up to scale; codes
 // below 16 sit in the read noise of this camera and carry little weight in any merge).
-double worst_curve_error(const ResponseCurve& curve, const SynthCamera& cam) {
+double worst_curve_error(const ResponseCurve& curve, const BracketCamera& cam) {
   double worst = 0;
   for (int c = 0; c < 3; ++c) {
     const double s_rec = curve.linear(c, 128), s_true = true_inverse(cam, c, 128);
@@ -56,7 +56,7 @@ double worst_curve_error(const ResponseCurve& curve, const SynthCamera& cam) {
 }
 
 TEST(ResponseRecovery, DebevecRecoversAnSCurveWithinThreePercent) {
-  const SynthCamera cam = eight_bit(testing::s_curve);
+  const BracketCamera cam = eight_bit(testing::s_curve);
   RecoveryOptions o;
   o.model = "debevec";
   const ResponseRecovery r = recover_response(synth_set(cam, 1, true), o);
@@ -67,14 +67,14 @@ TEST(ResponseRecovery, DebevecRecoversAnSCurveWithinThreePercent) {
 
 TEST(ResponseRecovery, DebevecWithConstantRatioBracketsIsWithinEightPercent) {
   // Two-stop steps leave the log-periodic ambiguity (response_recovery.h); smoothness bounds it.
-  const SynthCamera cam = eight_bit(testing::s_curve);
+  const BracketCamera cam = eight_bit(testing::s_curve);
   RecoveryOptions o;
   o.model = "debevec";
   EXPECT_LT(worst_curve_error(recover_response(synth_set(cam, 1), o).curve, cam), 0.08);
 }
 
 TEST(ResponseRecovery, RobertsonRecoversAnSCurveWithinTenPercent) {
-  const SynthCamera cam = eight_bit(testing::s_curve);
+  const BracketCamera cam = eight_bit(testing::s_curve);
   RecoveryOptions o;
   o.model = "robertson";
   const ResponseRecovery r = recover_response(synth_set(cam, 2, true), o);
@@ -82,14 +82,14 @@ TEST(ResponseRecovery, RobertsonRecoversAnSCurveWithinTenPercent) {
 }
 
 TEST(ResponseRecovery, PolynomialRecoversAnSCurveWithinThreePercent) {
-  const SynthCamera cam = eight_bit(testing::s_curve);
+  const BracketCamera cam = eight_bit(testing::s_curve);
   RecoveryOptions o;
   o.model = "polynomial";
   EXPECT_LT(worst_curve_error(recover_response(synth_set(cam, 3), o).curve, cam), 0.03);
 }
 
 TEST(ResponseRecovery, CurveIsIdenticalOnEveryRun) {
-  const SynthCamera cam = eight_bit(testing::s_curve);
+  const BracketCamera cam = eight_bit(testing::s_curve);
   const ResponseRecovery a = recover_response(synth_set(cam, 3));
   const ResponseRecovery b = recover_response(synth_set(cam, 3));
   EXPECT_EQ(a.curve.model, b.curve.model);
@@ -100,13 +100,13 @@ TEST(ResponseRecovery, CurveIsIdenticalOnEveryRun) {
 }
 
 TEST(ResponseRecovery, HeldOutErrorChoosesIdentityForLinearInput) {
-  SynthCamera cam;  // 16-bit linear
+  BracketCamera cam;  // 16-bit linear
   const ResponseRecovery r = recover_response(synth_set(cam, 4));
   EXPECT_EQ(r.curve.model, "identity");
 }
 
 TEST(ResponseRecovery, HeldOutErrorChoosesGammaForAPowerLaw) {
-  const SynthCamera cam = eight_bit([](int c, double X) { return std::pow(X, 1.0 / (2.0 + 0.2 * c)); });
+  const BracketCamera cam = eight_bit([](int c, double X) { return std::pow(X, 1.0 / (2.0 + 0.2 * c)); });
   const ResponseRecovery r = recover_response(synth_set(cam, 5));
   EXPECT_EQ(r.curve.model, "gamma");
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.curve.parameters["gamma"][std::size_t(c)].get<double>(), 2.0 + 0.2 * c, 0.05);
