@@ -320,7 +320,8 @@ def section(j):
         lines.append("")
     lines += ["What the numbers say:", ""] + ["- " + v for v in verdicts] + [""]
     lines += ["Sweep on the tuning shoot (mid-tone / colour-ratio error in stops; bold: the setting chosen for that "
-              "format; the %d best of each tool in either format and its default are listed, the rest are worse in both):" % TOP,
+              "format; listed: the %d best of each tool per format by mid + colour and its default, the others rank below "
+              "those in both formats):" % TOP,
               "", "| tool | setting | PNG mid | PNG colour ratio | JPEG mid | JPEG colour ratio |", "|---|---|---|---|---|---|"]
     table = {}  # (tool, label) -> {q: (mid, colour)}
     for q in fmts:
