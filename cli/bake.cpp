@@ -7,18 +7,16 @@
 
 #include "core/atomic_file.h"
 
-#include "bake/albedo_table.h"
 #include "bake/brdf_lobes.h"
-#include "core/albedo_normalisation.h"
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
+#include "bake/map_set_bake.h"
 #include "core/exr_io.h"
 #include "core/map_set.h"
 #include "core/output_plan.h"
 #include "core/progress.h"
 #include "core/view_set.h"
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -62,37 +60,15 @@ int run_bake(const BakeArgs& a) {
   const auto t1 = std::chrono::steady_clock::now();
 
   // --normalise albedo: texels hold L / A(n.v), the runtime multiplies A back (core/albedo_normalisation.h).
-  const std::vector<float> albedo = a.normalise == "albedo" ? albedo_table(*brdf) : std::vector<float>{};
+  MapSetBakeOptions bake_options;
+  bake_options.res = a.res;
+  bake_options.integrator = options;
+  bake_options.normalise_albedo = a.normalise == "albedo";
+  bake_options.environment_name = std::filesystem::path(a.env).filename().string();
   const std::string warp = brdf->central_direction() == Lobe::Normal ? "normal" : "mirror";
   const bool stochastic = a.method == "mis" || a.method == "fis";
   Progress bar("bake", !a.quiet && Progress::stderr_is_terminal());
-  const double total_rows = double(views.views().size()) * a.res;
-  std::atomic<long> rows_before{0};
-  MapSet set;
-  for (const Vec3& v : views.views()) {
-    MapView mv;
-    mv.view = v;
-    mv.world_from_view = world_from_view_for(v);
-    mv.warp = warp;
-    mv.source = "computed";
-    mv.material = brdf->spec();
-    mv.attributes["version"] = RSIBR_VERSION;
-    mv.attributes["environment"] = std::filesystem::path(a.env).filename().string();
-    mv.attributes["method"] = a.method;
-    mv.attributes["samples"] = stochastic ? std::to_string(a.samples) : "n/a";
-    mv.attributes["seed"] = stochastic ? std::to_string(a.seed) : "n/a";
-    if (a.method == "reference")
-      mv.attributes["referenceWidth"] = a.reference_width > 0 ? std::to_string(a.reference_width) : "full";
-    const long before = rows_before.load();
-    mv.rgb = integrator->radiance_map(*brdf, v, mv.world_from_view, a.res, options,
-                                      [&](int done) { bar.update((before + done) / total_rows); });
-    rows_before += a.res;
-    if (!albedo.empty()) {
-      normalise_by_albedo(mv.rgb, albedo);
-      mv.albedo = albedo;
-    }
-    set.views.push_back(std::move(mv));
-  }
+  const MapSet set = bake_map_set(*brdf, *integrator, views, bake_options, [&](double f) { bar.update(f); });
   bar.done();
   const auto t2 = std::chrono::steady_clock::now();
   write_map_set(exr, set);

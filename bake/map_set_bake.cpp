@@ -1,0 +1,50 @@
+#include "bake/map_set_bake.h"
+
+#include "bake/albedo_table.h"
+#include "core/albedo_normalisation.h"
+
+#include <atomic>
+#include <stdexcept>
+
+namespace rsibr {
+
+MapSet bake_map_set(const Brdf& brdf, const Integrator& integrator, const ViewSet& views,
+                    const MapSetBakeOptions& options, const std::function<void(double)>& progress) {
+  if (options.res < 1) throw std::invalid_argument("bake: the map size must be at least 1, not " + std::to_string(options.res));
+  const std::string method = integrator.name();
+  const std::vector<float> albedo = options.normalise_albedo ? albedo_table(brdf) : std::vector<float>{};
+  const std::string warp = brdf.central_direction() == Lobe::Normal ? "normal" : "mirror";
+  const bool stochastic = method == "mis" || method == "fis";
+  const IntegratorOptions& io = options.integrator;
+  const double total_rows = double(views.views().size()) * options.res;
+  std::atomic<long> rows_before{0};
+  MapSet set;
+  for (const Vec3& v : views.views()) {
+    MapView mv;
+    mv.view = v;
+    mv.world_from_view = world_from_view_for(v);
+    mv.warp = warp;
+    mv.source = "computed";
+    mv.material = brdf.spec();
+    mv.attributes["version"] = RSIBR_VERSION;
+    if (!options.environment_name.empty()) mv.attributes["environment"] = options.environment_name;
+    mv.attributes["method"] = method;
+    mv.attributes["samples"] = stochastic ? std::to_string(io.samples) : "n/a";
+    mv.attributes["seed"] = stochastic ? std::to_string(io.seed) : "n/a";
+    if (method == "reference")
+      mv.attributes["referenceWidth"] = io.reference_width > 0 ? std::to_string(io.reference_width) : "full";
+    const long before = rows_before.load();
+    std::function<void(int)> rows;
+    if (progress) rows = [&](int done) { progress((before + done) / total_rows); };
+    mv.rgb = integrator.radiance_map(brdf, v, mv.world_from_view, options.res, io, rows);
+    rows_before += options.res;
+    if (!albedo.empty()) {
+      normalise_by_albedo(mv.rgb, albedo);
+      mv.albedo = albedo;
+    }
+    set.views.push_back(std::move(mv));
+  }
+  return set;
+}
+
+}  // namespace rsibr
