@@ -23,6 +23,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev clang-14 libclang-rt-14-dev
   # real-data fetch (npm registry) and docs plots
   python3 python3-numpy python3-matplotlib
+  # the Python module (python/) and its tests (tests/python)
+  python3-dev pybind11-dev python3-pybind11 python3-pytest
 )
 # node and npm: some images ship a nodejs that bundles npm (and conflicts with
 # Debian's npm package); only ask apt for them when they are absent.
