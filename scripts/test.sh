@@ -5,9 +5,7 @@
 #      message when the npm registry cannot be reached),
 #   3. builds and tests the release preset, then the address+undefined sanitizer preset, which leaves
 #      out the tests labelled `long` (numerical sweeps and end-to-end shoots; their code paths run
-#      under the sanitizers in shorter tests) and `asan_boundary` (a bad-free between Eigen's
-#      aligned allocation under ASan and Debian's uninstrumented libceres); the lists are in
-#      tests/CMakeLists.txt,
+#      under the sanitizers in shorter tests; the list is in tests/CMakeLists.txt),
 #   4. builds the libFuzzer targets of the file readers with clang (fuzz preset) and runs each for a
 #      bounded time from its seed corpus (fuzz/README.md); any finding fails the run.
 # Options: --fast skips the sanitizer and fuzz builds.
