@@ -21,6 +21,7 @@
 // the truth's. For the clipped class the same log2 luminance ratio is reported with the fraction
 // of saturated channel values at or below the truth (a lower bound should be).
 #include "bench/measure.h"
+#include "core/atomic_file.h"
 #include "core/truth_image.h"
 #include "hdr/camera_shoot.h"
 #include "hdr/merge.h"
@@ -42,24 +43,6 @@ namespace {
 
 using bench::Clock;
 using bench::seconds_since;
-
-// The views side by side, bracket j: what the single-image peers see (all views, as rsibr does).
-std::vector<cv::Mat> side_by_side_bgr(const testing::Shoot& sh) {
-  std::vector<cv::Mat> stack;
-  for (std::size_t j = 0; j < sh.exposures.size(); ++j) {
-    std::vector<cv::Mat> row;
-    for (const auto& b : sh.views) {
-      cv::Mat eight, bgr;
-      b.codes[j].convertTo(eight, CV_8UC3);
-      cv::cvtColor(eight, bgr, cv::COLOR_RGB2BGR);
-      row.push_back(bgr);
-    }
-    cv::Mat h;
-    cv::hconcat(row, h);
-    stack.push_back(h);
-  }
-  return stack;
-}
 
 // A side-by-side RGB float image back into views.
 std::vector<cv::Mat> split_views(const cv::Mat& rgb, const testing::Shoot& sh) {
@@ -172,7 +155,7 @@ int run(int argc, char** argv) {
   const auto t_shoot = Clock::now();
   const testing::Shoot sh = testing::shoot(spec_of(env, jpeg, seed));
   const double shoot_s = seconds_since(t_shoot);
-  const std::vector<cv::Mat> stack = side_by_side_bgr(sh);
+  const std::vector<cv::Mat> stack = testing::side_by_side_bgr(sh);
   const std::vector<float> times(sh.exposures.begin(), sh.exposures.end());
 
   if (!write_dir.empty()) {
@@ -248,9 +231,7 @@ int run(int argc, char** argv) {
   }
   nlohmann::json out = {{"env", std::filesystem::path(env).filename().string()}, {"jpeg_quality", jpeg}, {"seed", seed},
                         {"exposures", sh.exposures}, {"methods", methods}};
-  const std::string tmp = out_path + ".tmp";
-  std::ofstream(tmp) << out.dump(1) << "\n";
-  std::filesystem::rename(tmp, out_path);
+  write_text_atomically(out_path, out.dump(1) + "\n");
   return 0;
 }
 

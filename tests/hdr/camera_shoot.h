@@ -21,6 +21,7 @@
 #include "hdr/bracket_set.h"
 #include "hdr/merge.h"
 
+#include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -137,6 +138,25 @@ inline Shoot shoot(const ShootSpec& s) {
 }
 
 // ---- error measures (every method's output is known up to one global factor) ----
+
+// The views side by side, one 8-bit BGR image per bracket: what a merge of single images (OpenCV,
+// luminance-hdr, pfstools) sees, so it too gets every view.
+inline std::vector<cv::Mat> side_by_side_bgr(const Shoot& sh) {
+  std::vector<cv::Mat> stack;
+  for (std::size_t j = 0; j < sh.exposures.size(); ++j) {
+    std::vector<cv::Mat> row;
+    for (const auto& b : sh.views) {
+      cv::Mat eight, bgr;
+      b.codes[j].convertTo(eight, CV_8UC3);
+      cv::cvtColor(eight, bgr, cv::COLOR_RGB2BGR);
+      row.push_back(bgr);
+    }
+    cv::Mat h;
+    cv::hconcat(row, h);
+    stack.push_back(h);
+  }
+  return stack;
+}
 
 inline double luminance(const cv::Vec3f& v) { return 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]; }
 

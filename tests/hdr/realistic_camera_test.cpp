@@ -172,19 +172,7 @@ TEST_F(RealisticCamera, TheCurveHasNoRippleAtTheExposureSteps) {
 // OpenCV's calibration and merge on the same brackets (all views side by side, so it sees every
 // view too): its Debevec and Robertson.
 std::vector<cv::Mat> opencv_merge(const testing::Shoot& sh, bool robertson) {
-  std::vector<cv::Mat> stack;
-  for (std::size_t j = 0; j < sh.exposures.size(); ++j) {
-    std::vector<cv::Mat> row;
-    for (const auto& b : sh.views) {
-      cv::Mat eight, bgr;
-      b.codes[j].convertTo(eight, CV_8UC3);
-      cv::cvtColor(eight, bgr, cv::COLOR_RGB2BGR);
-      row.push_back(bgr);
-    }
-    cv::Mat h;
-    cv::hconcat(row, h);
-    stack.push_back(h);
-  }
+  const std::vector<cv::Mat> stack = testing::side_by_side_bgr(sh);
   const std::vector<float> times(sh.exposures.begin(), sh.exposures.end());
   cv::Mat response, hdr;
   if (robertson) {
