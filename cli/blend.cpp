@@ -8,7 +8,7 @@
 #include "core/map_set.h"
 #include "core/output_plan.h"
 #include "runtime/blend.h"
-#include "runtime/tessellated_warp.h"
+#include "runtime/make_warp.h"
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -24,6 +24,7 @@ struct BlendArgs {
   std::vector<double> view{0, 0, 1}, up{0, 1, 0};
   int size = 0;
   int rings = 16;
+  int table = 0;
   double rim_fade = 0.4;
   float preview_exposure = 0.f;
   bool sanitize = false;
@@ -42,14 +43,7 @@ int run_blend(const BlendArgs& a) {
   options.width = w;
   options.height = h;
   options.rim_fade = a.rim_fade;
-  std::unique_ptr<Warp> warp;
-  if (a.warp == "precomputed") {
-    warp = std::make_unique<PrecomputedWarp>(w, h);
-  } else if (a.warp == "tessellated") {
-    warp = std::make_unique<TessellatedWarp>(w, h, TessellationOptions{a.rings, 4 * a.rings});
-  } else if (a.warp != "exact") {
-    throw std::invalid_argument("--warp must be 'exact', 'precomputed' or 'tessellated', not '" + a.warp + "'");
-  }
+  const std::unique_ptr<Warp> warp = make_warp({a.warp, a.rings, axis_in_views(set, up), a.table}, w, h);
   options.warp = warp.get();
   const auto t0 = std::chrono::steady_clock::now();
   BlendResult r;
@@ -113,9 +107,13 @@ Runner add_blend(CLI::App& app) {
   c->add_option("--up", a->up, "Up hint for the view frame (world)")->expected(3);
   c->add_option("--size", a->size, "Output map size (default: the map set's)")->check(CLI::Range(2, 8192));
   c->add_option("--warp", a->warp,
-                "exact, precomputed (per-texel directions cached; same result) or tessellated (the paper's mesh: "
-                "vertices warped exactly, texture coordinates interpolated)");
+                "exact, precomputed (per-texel directions cached; same result), tessellated (the paper's mesh: "
+                "vertices warped exactly, texture coordinates interpolated) or double-indirection (a screen table "
+                "and a parametric table; a rotation about --up, as between views of one ring or turntable, is an "
+                "offset into them)");
   c->add_option("--rings", a->rings, "tessellated: rings of the disc mesh (4x as many segments)")->check(CLI::Range(1, 1024));
+  c->add_option("--table", a->table, "double-indirection: columns of the parametric table (half as many rows; "
+                                     "default: the map width)")->check(CLI::Range(3, 65536));
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--preview", a->preview, "Also write a display-encoded PNG");
   c->add_option("--preview-exposure", a->preview_exposure, "Exposure of the preview in stops");

@@ -14,6 +14,7 @@
 #include "core/output_plan.h"
 #include "core/progress.h"
 #include "core/text.h"
+#include "runtime/make_warp.h"
 #include "runtime/renderer.h"
 
 #include <OpenEXR/ImfChannelList.h>
@@ -67,8 +68,8 @@ int run_render(const RenderArgs& a) {
   options.rings = a.rings;
   options.blend.rim_fade = a.rim_fade;
   options.spp = a.spp;
-  if (a.warp != "exact" && a.warp != "precomputed" && a.warp != "tessellated")
-    throw std::invalid_argument("--warp must be 'exact', 'precomputed' or 'tessellated', not '" + a.warp + "'");
+  if (!is_warp_name(a.warp))
+    throw std::invalid_argument(std::string("--warp must be ") + warp_names() + ", not '" + a.warp + "'");
 
   // Every output is checked before any work.
   std::vector<std::filesystem::path> inputs(a.maps.begin(), a.maps.end());
@@ -191,7 +192,7 @@ Runner add_render(CLI::App& app) {
   c->add_option("--mode", a->mode, "per-pixel (exact) or paper (one destination map per frame)")->capture_default_str();
   c->add_option("--size-map", a->map_size, "paper: destination map size (default: the first map set's)")
       ->check(CLI::Range(2, 8192));
-  c->add_option("--warp", a->warp, "paper: exact, precomputed or tessellated warp for the destination map")
+  c->add_option("--warp", a->warp, "paper: exact, precomputed, tessellated or double-indirection (about world up) warp for the destination map")
       ->capture_default_str();
   c->add_option("--rings", a->rings, "tessellated: rings of the disc mesh (4x as many segments)")->check(CLI::Range(1, 1024));
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));

@@ -14,6 +14,7 @@
 #include "core/output_plan.h"
 #include "core/progress.h"
 #include "core/text.h"
+#include "runtime/make_warp.h"
 #include "runtime/renderer.h"
 #if RSIBR_HAVE_VIEWER
 #include "runtime/viewer/viewer.h"
@@ -55,8 +56,8 @@ MapSet load_maps(const std::string& path, bool sanitize) {
 int run_view(const ViewArgs& a) {
   if (a.mode != "paper" && a.mode != "per-pixel")
     throw std::invalid_argument("--mode must be 'paper' or 'per-pixel', not '" + a.mode + "'");
-  if (a.warp != "exact" && a.warp != "precomputed" && a.warp != "tessellated")
-    throw std::invalid_argument("--warp must be 'exact', 'precomputed' or 'tessellated', not '" + a.warp + "'");
+  if (!is_warp_name(a.warp))
+    throw std::invalid_argument(std::string("--warp must be ") + warp_names() + ", not '" + a.warp + "'");
   if (a.compare != "wipe" && a.compare != "side")
     throw std::invalid_argument("--compare must be 'wipe' or 'side', not '" + a.compare + "'");
   const bool scripted = a.orbit > 0;
@@ -204,7 +205,7 @@ Runner add_view(CLI::App& app) {
   add_camera_options(c, a->camera);
   c->remove_option(c->get_option("--turntable"));  // --orbit here
   c->add_option("--mode", a->mode, "per-pixel (fragment shader) or paper (CPU destination map)")->capture_default_str();
-  c->add_option("--warp", a->warp, "paper: exact, precomputed or tessellated warp")->capture_default_str();
+  c->add_option("--warp", a->warp, "paper: exact, precomputed, tessellated or double-indirection (about world up) warp")->capture_default_str();
   c->add_option("--size-map", a->map_size, "paper: destination map size (default: the set's)")->check(CLI::Range(2, 8192));
   c->add_option("--rings", a->rings, "tessellated: rings of the disc mesh")->check(CLI::Range(1, 1024));
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));

@@ -4,7 +4,7 @@
 
 #include "core/map_set.h"
 #include "runtime/blend.h"
-#include "runtime/tessellated_warp.h"
+#include "runtime/make_warp.h"
 #include "runtime/warp.h"
 
 #include <pybind11/eigen.h>
@@ -46,10 +46,11 @@ void bind_blend(py::module_& m) {
         options.source_weights = source_weights;
         py::gil_scoped_release release;
         std::unique_ptr<Warp> warp;
-        if (warp_name == "precomputed") warp = std::make_unique<PrecomputedWarp>(w, h);
-        else if (warp_name == "tessellated") warp = std::make_unique<TessellatedWarp>(w, h, TessellationOptions{rings, 4 * rings});
-        else if (warp_name != "exact")
-          throw std::invalid_argument("blend: warp must be 'exact', 'precomputed' or 'tessellated', not '" + warp_name + "'");
+        try {
+          warp = make_warp({warp_name, rings, axis_in_views(maps, up)}, w, h);
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument(std::string("blend: ") + e.what());
+        }
         options.warp = warp.get();
         return blend(maps, view_set ? *view_set : maps.view_set(), view, up, options);
       },
@@ -60,7 +61,8 @@ void bind_blend(py::module_& m) {
       "the view's triangle in the set's view set (`view_set`, default maps.view_set()), each of its three maps "
       "warped in reflection space with its own warp, faded near its singularity (rim_fade; 0 disables) and "
       "normalised per texel. size: the output's side (0: the set's size). warp: 'exact', 'precomputed' (same "
-      "result, cached directions) or 'tessellated' (the paper's disc mesh of `rings` rings). Releases the GIL.");
+      "result, cached directions), 'tessellated' (the paper's disc mesh of `rings` rings) or 'double-indirection' "
+      "(screen and parametric tables; a rotation about `up` is an offset into them). Releases the GIL.");
 }
 
 }  // namespace rsibr::python

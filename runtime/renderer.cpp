@@ -2,7 +2,7 @@
 
 #include "runtime/direction_lookup.h"
 #include "runtime/disc_sampler.h"
-#include "runtime/tessellated_warp.h"
+#include "runtime/make_warp.h"
 #include "runtime/warp.h"
 
 #include <tbb/blocked_range.h>
@@ -143,12 +143,11 @@ Renderer::Renderer(const Mesh& mesh, const std::vector<const MapSet*>& sets, con
     throw std::invalid_argument("render: map size must be in [2, 16384]");
   if (options.mode == RenderMode::Paper) {
     const int n = impl_->map_size;
-    if (options.warp == "precomputed")
-      impl_->warp = std::make_unique<PrecomputedWarp>(n, n);
-    else if (options.warp == "tessellated")
-      impl_->warp = std::make_unique<TessellatedWarp>(n, n, TessellationOptions{options.rings, 4 * options.rings});
-    else if (options.warp != "exact")
-      throw std::invalid_argument("render: warp must be exact, precomputed or tessellated, not '" + options.warp + "'");
+    try {
+      impl_->warp = make_warp({options.warp, options.rings, axis_in_views(*sets.front(), Vec3(0, 1, 0))}, n, n);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("render: ") + e.what());
+    }
   }
   impl_->scene = std::make_unique<RayScene>(mesh);
   impl_->bounds = mesh.bounds();

@@ -57,8 +57,9 @@ struct RenderOptions {
   // mode's time on the bunny (bench/render_bench.cpp; both well above 20 frames/s at 1280x720).
   RenderMode mode = RenderMode::PerPixel;
   // Paper mode: the destination map is map_size x map_size (0: the first map set's width), blended
-  // with this warp ("exact", "precomputed" or "tessellated" with `rings` rings and 4 x rings segments).
-  // The warp tables are built once and reused for every frame.
+  // with this warp (runtime/make_warp.h: "exact", "precomputed", "tessellated" with `rings` rings and
+  // 4 x rings segments, or "double-indirection" about world up (0, 1, 0) as the first map set's views
+  // see it). The warp tables are built once and reused for every frame.
   int map_size = 0;
   std::string warp = "precomputed";
   int rings = 16;

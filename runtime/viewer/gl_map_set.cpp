@@ -1,6 +1,6 @@
 #include "runtime/viewer/gl_map_set.h"
 
-#include "runtime/tessellated_warp.h"
+#include "runtime/make_warp.h"
 
 #include <algorithm>
 #include <chrono>
@@ -27,15 +27,10 @@ GlMapSet::GlMapSet(const MapSet& maps, const BlendOptions& blend, const std::str
     throw std::invalid_argument("viewer: the GPU path implements the gnomonic barycentric weights only");
   if (view_set_.triangles().empty())
     throw std::invalid_argument("viewer: the map set's views have no spherical triangle (at least 3 views needed)");
-  if (warp == "exact") warp_ = std::make_unique<ExactWarp>();
-  else if (warp == "precomputed") warp_ = std::make_unique<PrecomputedWarp>(map_size_, map_size_);
-  else if (warp == "tessellated") {
-    TessellationOptions t;
-    t.rings = rings;
-    t.segments = 4 * rings;  // as the renderer (runtime/renderer.h)
-    warp_ = std::make_unique<TessellatedWarp>(map_size_, map_size_, t);
-  } else {
-    throw std::invalid_argument("viewer: unknown warp '" + warp + "' (exact, precomputed or tessellated)");
+  try {
+    warp_ = make_warp({warp, rings, axis_in_views(maps, Vec3(0, 1, 0))}, map_size_, map_size_);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("viewer: ") + e.what());
   }
   const int W = maps.width(), H = maps.height(), N = int(maps.views.size());
   glGenTextures(6, textures_);

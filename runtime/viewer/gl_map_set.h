@@ -20,8 +20,9 @@ namespace rsibr::viewer {
 class GlMapSet {
  public:
   // Keeps a reference to maps. blend: rim_fade, use_confidence, barycentric (the GPU path supports
-  // the gnomonic weights only: std::invalid_argument otherwise). warp: "exact", "precomputed" or
-  // "tessellated" (rings rings) for paper mode's destination map of map_size^2 (0: the set's width).
+  // the gnomonic weights only: std::invalid_argument otherwise). warp: a name of make_warp
+  // (runtime/make_warp.h; tessellated with `rings` rings, double-indirection about world up) for
+  // paper mode's destination map of map_size^2 (0: the set's width).
   GlMapSet(const MapSet& maps, const BlendOptions& blend, const std::string& warp = "precomputed", int map_size = 0,
            int rings = 16);
   ~GlMapSet();

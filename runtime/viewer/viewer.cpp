@@ -229,7 +229,7 @@ int run_interactive(const ViewerScene& scene, const ViewerSettings& initial) {
   glGenTextures(1, &dest_texture);
   const std::vector<std::string> views = DisplayTransform::views(s.display);
   const char* modes[] = {"per pixel (GPU shader)", "paper (CPU engine, one map per frame)"};
-  const char* warps[] = {"exact", "precomputed", "tessellated"};
+  const char* warps[] = {"exact", "precomputed", "tessellated", "double-indirection"};
   double last_x = 0, last_y = 0, frame_seconds = 0, smoothed = 0;
   bool dragging = false;
 
@@ -304,7 +304,7 @@ int run_interactive(const ViewerScene& scene, const ViewerSettings& initial) {
     int mode = s.mode == RenderMode::PerPixel ? 0 : 1;
     if (ImGui::Combo("mode", &mode, modes, 2)) s.mode = mode == 0 ? RenderMode::PerPixel : RenderMode::Paper;
     int warp = int(std::find(std::begin(warps), std::end(warps), s.warp) - std::begin(warps));
-    if (ImGui::Combo("warp (paper)", &warp, warps, 3)) {
+    if (ImGui::Combo("warp (paper)", &warp, warps, IM_ARRAYSIZE(warps))) {
       s.warp = warps[warp];
       rebuild = true;
     }

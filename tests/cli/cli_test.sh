@@ -53,7 +53,9 @@ expect_error "malformed view file" "views.txt:3" pattern direction "$work/bad-se
 check "blend writes a one-view map set with confidence" bash -c "'$rsibr' info '$work/novel.exr' | grep -q '1 views.*' && '$rsibr' info '$work/novel.exr' | grep -q confidence"
 "$rsibr" blend "$work/mirror.exr" "$work/novel-t.exr" --view 0.3 0.5 0.8 --warp tessellated >/dev/null
 check "blend with the tessellated warp" test -s "$work/novel-t.exr"
-expect_error "blend with an unknown warp" "tessellated" blend "$work/mirror.exr" "$work/novel4.exr" --warp fancy
+"$rsibr" blend "$work/mirror.exr" "$work/novel-d.exr" --view 0.3 0.5 0.8 --warp double-indirection --table 64 >/dev/null
+check "blend with the double-indirection warp" test -s "$work/novel-d.exr"
+expect_error "blend with an unknown warp" "tessellated or double-indirection, not 'fancy'" blend "$work/mirror.exr" "$work/novel4.exr" --warp fancy
 expect_error "blend with a zero view" "non-zero" blend "$work/mirror.exr" "$work/novel2.exr" --view 0 0 0
 expect_error "blend of a plain environment" "view.000" blend "$work/sky.exr" "$work/novel3.exr"
 check "no output from failed blends" test ! -e "$work/novel2.exr" -a ! -e "$work/novel3.exr"
@@ -133,6 +135,9 @@ OBJ
 check "render writes a PNG" test -s "$work/cube.png"
 check "render JSON has hits and fps" python3 -c "import json; j=json.load(open('$work/cube.json')); assert j['hits'] > 500 and j['fps'] > 0 and j['mode'] == 'per-pixel', j"
 "$rsibr" render --maps "$work/mirror.exr" --mesh "$work/cube.obj" --size 64x48 --mode paper --size-map 33 --warp tessellated --out "$work/cube.exr"
+expect_error "render with an unknown warp" "double-indirection, not 'fancy'" render --maps "$work/mirror.exr" --mesh "$work/cube.obj" --mode paper --warp fancy "$work/cube-f.png"
+"$rsibr" render --maps "$work/mirror.exr" --mesh "$work/cube.obj" --size 32x24 --mode paper --warp double-indirection "$work/cube-d.png"
+check "render in paper mode with the double-indirection warp" test -s "$work/cube-d.png"
 check "render writes an RGBA float EXR with the camera" bash -c "test -s '$work/cube.exr' && grep -aq rsibr.worldFromCam '$work/cube.exr' && grep -aq 'paper' '$work/cube.exr'"
 for i in 1 2; do "$rsibr" render --maps "$work/mirror.exr" --maps "$work/grey.exr" --mesh "$work/cube.obj" --size 40x30 --spp 4 "$work/sum$i.exr"; done
 check "render: two map sets, same bytes twice" cmp -s "$work/sum1.exr" "$work/sum2.exr"

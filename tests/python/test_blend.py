@@ -6,9 +6,9 @@ import rsibr
 from conftest import random_map_set
 
 
-@pytest.mark.parametrize("warp", ["precomputed", "exact", "tessellated"])
+@pytest.mark.parametrize("warp", ["precomputed", "exact", "tessellated", "double-indirection"])
 def test_a_blend_equals_the_command_line_blend_bit_for_bit(tmp_path, cli, warp):
-    rng = np.random.default_rng({"precomputed": 1, "exact": 2, "tessellated": 3}[warp])
+    rng = np.random.default_rng({"precomputed": 1, "exact": 2, "tessellated": 3, "double-indirection": 4}[warp])
     maps = random_map_set(rng, "icosa", size=32, captured=warp == "exact")
     path = tmp_path / "maps.exr"
     rsibr.write_map_set(str(path), maps)
