@@ -119,8 +119,8 @@ camera:
 exposure: {middle_s: 0.03, count: 5, step_ev: 2}
 views:
   - {plan: handheld, count: 6, elevation_deg: 18, distance_m: 0.8, azimuth0_deg: 10, jitter_m: 0.02, jitter_deg: 1.0}
-  - {plan: ring, azimuths_deg: [40], elevation_deg: 14, distance_m: 0.8, pan_deg: 15}
-  - {plan: ring, azimuths_deg: [220], elevation_deg: 14, distance_m: 0.8, pan_deg: 15}
+  - {plan: ring, azimuths_deg: [40], elevation_deg: 14, distance_m: 0.8, pan_deg: 19}
+  - {plan: ring, azimuths_deg: [220], elevation_deg: 14, distance_m: 0.8, pan_deg: -19}
 chessboards: {count: 6, corners: 10, spacing_m: 0.03}
 """,
 }

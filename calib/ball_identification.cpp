@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <sstream>
@@ -826,6 +827,73 @@ std::vector<BallFinding> identify_view_balls(const ViewBalls& view, const std::v
       f.note = s.str();
     } catch (const std::invalid_argument& e) {
       f.note = "no outline at the predicted place " + px_text(pc, pr);
+    }
+  }
+  return out;
+}
+
+ViewCandidates view_candidates(const cv::Mat& image, const LensModel& lens, const std::vector<ListedBall>& balls,
+                               const BallSearchOptions& search) {
+  ViewCandidates vc;
+  vc.cands = find_ball_candidates(image, lens, search);
+  vc.pick = assign_balls_in_view(vc.cands, balls);
+  return vc;
+}
+
+namespace {
+
+// The centre of candidate c in the camera frame, in chrome-ball radii, for a ball `scale` times the
+// chrome ball's size: scale * axis / sin(alpha).
+Vec3 centre_in_chrome_radii(const BallCandidate& c, double scale) {
+  return scale * c.loc.fit.cone.axis.normalized() / std::sin(c.loc.fit.cone.half_angle);
+}
+
+}  // namespace
+
+std::vector<ChromeRescue> rescue_chrome_balls(const std::vector<std::optional<ViewCandidates>>& views,
+                                              const std::vector<ListedBall>& balls, const BallSearchOptions& search) {
+  std::vector<ChromeRescue> out(views.size());
+  int chrome = -1;
+  for (std::size_t b = 0; b < balls.size(); ++b)
+    if (balls[b].kind == BallKind::chrome) chrome = chrome < 0 ? int(b) : chrome;
+  if (chrome < 0 || !balls[std::size_t(chrome)].diameter_m) return out;
+  const double tolerance = 1.0, relative = 0.04;
+  for (std::size_t b = 0; b < balls.size(); ++b) {
+    if (int(b) == chrome || !balls[b].diameter_m) continue;
+    const double scale = *balls[b].diameter_m / *balls[std::size_t(chrome)].diameter_m;
+    std::vector<double> d;
+    for (const auto& vc : views)
+      if (vc && vc->pick[std::size_t(chrome)] >= 0 && vc->pick[b] >= 0)
+        d.push_back((centre_in_chrome_radii(vc->cands[std::size_t(vc->pick[std::size_t(chrome)])], 1) -
+                     centre_in_chrome_radii(vc->cands[std::size_t(vc->pick[b])], scale)).norm());
+    if (d.size() < 2) continue;
+    std::sort(d.begin(), d.end());
+    const double rig = d[d.size() / 2];
+    int agree = 0;
+    for (double x : d) agree += std::abs(x - rig) <= tolerance + relative * rig;
+    if (agree < 2) continue;
+    for (std::size_t v = 0; v < views.size(); ++v) {
+      const auto& vc = views[v];
+      if (!vc || vc->pick[std::size_t(chrome)] >= 0 || vc->pick[b] < 0 || out[v].candidate >= 0) continue;
+      const BallCandidate& other = vc->cands[std::size_t(vc->pick[b])];
+      const Vec3 g = centre_in_chrome_radii(other, scale);
+      int hit = -1, hits = 0;
+      double hit_d = 0;
+      for (std::size_t k = 0; k < vc->cands.size(); ++k) {
+        const BallCandidate& c = vc->cands[k];
+        if (std::find(vc->pick.begin(), vc->pick.end(), int(k)) != vc->pick.end()) continue;
+        if (!acceptable_outline(c, search) || looks_like(c, BallKind::grey) || !looks_like(c, BallKind::glossy)) continue;
+        const Vec3 cc = centre_in_chrome_radii(c, 1);
+        const double dist = (cc - g).norm();
+        if (std::abs(dist - rig) <= tolerance + relative * 0.5 * (cc.norm() + g.norm())) ++hits, hit = int(k), hit_d = dist;
+      }
+      if (hits != 1) continue;
+      char note[256];
+      std::snprintf(note, sizeof note,
+                    "chrome ball taken at %.1f chrome radii from the %s ball (the other views agree on %.1f; its rim "
+                    "is too smooth for the appearance test)",
+                    hit_d, balls[b].name.c_str(), rig);
+      out[v] = {hit, note};
     }
   }
   return out;

@@ -88,6 +88,30 @@ bool looks_like(const BallCandidate& c, BallKind kind);
 // agreement. Throws nothing; an empty candidate list gives all -1.
 std::vector<int> assign_balls_in_view(const std::vector<BallCandidate>& candidates, const std::vector<ListedBall>& balls);
 
+// One view's candidates and the listed balls assign_balls_in_view matched them to.
+struct ViewCandidates {
+  std::vector<BallCandidate> cands;
+  std::vector<int> pick;  // per listed ball, candidate index or -1
+};
+ViewCandidates view_candidates(const cv::Mat& image, const LensModel& lens, const std::vector<ListedBall>& balls,
+                               const BallSearchOptions& search = {});
+
+// Appearance alone can miss a chrome ball: in a soft, low-contrast room its rim is smooth and it
+// passes no chrome test (it still shows a mirror's range, unlike a diffuse ball). The distance between
+// the chrome ball's centre and another listed ball's does not depend on the camera's rotation, so
+// the views where both were matched give it before any solve: their median d, when at least two
+// views agree with it (within 1 + 0.04 d chrome radii). A view where the chrome ball was missed but
+// the other ball was matched takes the one remaining candidate with an acceptable outline that looks
+// glossy and not grey and lies at distance d from it (within 1 + 0.04 x the mean camera distance,
+// chrome radii); two such candidates or none: still missed. Needs both diameters listed (the scale
+// between the balls). Per view (nullopt: not searched): the rescued candidate (-1: none) and a note.
+struct ChromeRescue {
+  int candidate = -1;
+  std::string note;
+};
+std::vector<ChromeRescue> rescue_chrome_balls(const std::vector<std::optional<ViewCandidates>>& views,
+                                              const std::vector<ListedBall>& balls, const BallSearchOptions& search = {});
+
 // One view's balls as the cross-view stage sees them.
 struct ViewBalls {
   std::string name;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <regex>
 #include <stdexcept>
 
@@ -64,25 +65,39 @@ BallCone extraction_cone(const BallLocation& located, const ViewPose& pose, cons
   return c.allFinite() && (c - located.centre_px).norm() < 0.5 * located.radius_px ? *pose.ball : located.fit.cone;
 }
 
+namespace {
+
+std::vector<ListedBall> balls_or_one_chrome(const std::vector<ListedBall>& listed) {
+  return listed.empty() ? std::vector<ListedBall>{{"chrome", BallKind::chrome, {}}} : listed;
+}
+
+int chrome_index(const ViewCandidates& vc, const std::vector<ListedBall>& balls) {
+  for (std::size_t b = 0; b < balls.size(); ++b)
+    if (balls[b].kind == BallKind::chrome && vc.pick[b] >= 0) return vc.pick[b];
+  return -1;
+}
+
+std::optional<BallCandidate> chrome_of(const ViewCandidates& vc, int k, std::vector<BallLocation>* overlapping) {
+  if (k < 0) return std::nullopt;
+  const BallCandidate& chrome = vc.cands[std::size_t(k)];
+  if (overlapping)
+    for (std::size_t i = 0; i < vc.cands.size(); ++i) {
+      const BallLocation& o = vc.cands[i].loc;
+      if (int(i) != k && (o.centre_px - chrome.loc.centre_px).norm() < o.radius_px + chrome.loc.radius_px &&
+          o.radius_px > 0.5 * chrome.loc.radius_px && o.radius_px < 2 * chrome.loc.radius_px)
+        overlapping->push_back(o);
+    }
+  return chrome;
+}
+
+}  // namespace
+
 std::optional<BallCandidate> find_chrome_ball(const cv::Mat& image, const LensModel& lens,
                                               const std::vector<ListedBall>& listed, const BallSearchOptions& search,
                                               std::vector<BallLocation>* overlapping) {
-  const std::vector<ListedBall> balls = listed.empty() ? std::vector<ListedBall>{{"chrome", BallKind::chrome, {}}} : listed;
-  const std::vector<BallCandidate> cands = find_ball_candidates(image, lens, search);
-  const std::vector<int> pick = assign_balls_in_view(cands, balls);
-  for (std::size_t b = 0; b < balls.size(); ++b)
-    if (balls[b].kind == BallKind::chrome && pick[b] >= 0) {
-      const BallCandidate& chrome = cands[std::size_t(pick[b])];
-      if (overlapping)
-        for (std::size_t k = 0; k < cands.size(); ++k) {
-          const BallLocation& o = cands[k].loc;
-          if (int(k) != pick[b] && (o.centre_px - chrome.loc.centre_px).norm() < o.radius_px + chrome.loc.radius_px &&
-              o.radius_px > 0.5 * chrome.loc.radius_px && o.radius_px < 2 * chrome.loc.radius_px)
-            overlapping->push_back(o);
-        }
-      return chrome;
-    }
-  return std::nullopt;
+  const std::vector<ListedBall> balls = balls_or_one_chrome(listed);
+  const ViewCandidates vc = view_candidates(image, lens, balls, search);
+  return chrome_of(vc, chrome_index(vc, balls), overlapping);
 }
 
 namespace {
@@ -123,6 +138,17 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
       throw std::invalid_argument(all_names[v] + ": " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
                                   " float RGB expected of the lens model's size " + std::to_string(lens.width()) + "x" +
                                   std::to_string(lens.height()));
+  }
+  // Candidates of the views whose chrome ball is searched for, then the cross-view rescue.
+  const std::vector<ListedBall> balls = balls_or_one_chrome(options.listed);
+  std::vector<std::optional<ViewCandidates>> searched(all_views.size());
+  for (std::size_t v = 0; v < all_views.size(); ++v) {
+    const bool given = (!options.given_chrome.empty() && options.given_chrome[v]) || !options.balls.empty();
+    if (!given) searched[v] = view_candidates(all_views[v].radiance, lens, balls, options.search);
+  }
+  const auto rescued = rescue_chrome_balls(searched, balls, options.search);
+  for (std::size_t v = 0; v < all_views.size(); ++v) {
+    const cv::Mat& img = all_views[v].radiance;
     std::optional<BallCandidate> found;
     std::vector<BallLocation> overlapping;
     const std::optional<BallGuess> guess = !options.given_chrome.empty() && options.given_chrome[v]
@@ -135,7 +161,9 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
         throw std::invalid_argument(all_names[v] + ": no ball found (" + e.what() + ")");
       }
     } else {
-      found = find_chrome_ball(img, lens, options.listed, options.search, &overlapping);
+      const int k = chrome_index(*searched[v], balls);
+      found = chrome_of(*searched[v], k >= 0 ? k : rescued[v].candidate, &overlapping);
+      if (k < 0 && found) rep.notes.push_back(all_names[v] + ": " + rescued[v].note);
     }
     if (!found) {
       rep.left_out.push_back(all_names[v] + ": no chrome ball found (no candidate with a clean outline that looks like a mirror)");

@@ -82,6 +82,7 @@ struct ViewOrientationOptions {
 struct ViewOrientationReport {
   std::vector<std::string> names;       // the views oriented (the rest were left out)
   std::vector<std::string> left_out;    // "<view>: <why>"
+  std::vector<std::string> notes;       // "<view>: <what was decided>" (a chrome ball placed from another ball)
   std::vector<BallLocation> balls;      // per view oriented (centre_px and the cone's axis refined when refine_balls)
   std::vector<BallCandidate> measured;  // per view oriented: the chrome ball as found (before refinement)
   std::optional<WorldUp> world_up;      // estimated up (in the first view's camera frame)

@@ -105,6 +105,7 @@ int run_orient(const OrientArgs& a) {
   }
   j["views"] = jv;
   j["left_out"] = rep.left_out;
+  j["notes"] = rep.notes;
   if (rep.world_up)
     j["world_up"] = {{"up_in_first_camera", {rep.world_up->up.x(), rep.world_up->up.y(), rep.world_up->up.z()}},
                      {"sigma_deg", rep.world_up->sigma_deg}, {"roll_sigma_deg", rep.world_up->roll_sigma_deg},
@@ -117,6 +118,7 @@ int run_orient(const OrientArgs& a) {
     std::cerr << poses.views.size() << " views, " << rep.tracks << " feature tracks, largest orientation sigma " << worst
               << " deg -> " << a.out << "\n";
     for (const std::string& l : rep.left_out) std::cerr << "rsibr orient: left out " << l << "\n";
+    for (const std::string& l : rep.notes) std::cerr << "rsibr orient: " << l << "\n";
   }
   return 0;
 }

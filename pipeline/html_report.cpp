@@ -122,6 +122,11 @@ void write_orientation_notes(std::ostringstream& h, const nlohmann::json& s) {
       << jnum(w["roll_sigma_deg"], 2) << " degrees, " << (w.value("roll_sigma_estimated", false) ? "from the views" : "assumed")
       << ").</p>";
   }
+  if (s.contains("notes") && !s["notes"].empty()) {
+    h << "<p><b>Chrome balls found across views:</b>";
+    for (const auto& l : s["notes"]) h << "<br>" << html_escape(l.get<std::string>());
+    h << "</p>";
+  }
   if (s.contains("left_out") && !s["left_out"].empty()) {
     h << "<p class=\"warn\"><b>Views left out:</b>";
     for (const auto& l : s["left_out"]) h << "<br>" << html_escape(l.get<std::string>());

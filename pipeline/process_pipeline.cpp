@@ -325,7 +325,7 @@ void step_orient(Context& c) {
   run_step(c, "orient", settings, inputs, [&](StepRecord& r) {
     PoseSet poses;
     std::string source;
-    nlohmann::json solve, left_out = nlohmann::json::array(), up = nullptr;
+    nlohmann::json solve, left_out = nlohmann::json::array(), notes = nlohmann::json::array(), up = nullptr;
     const LensModel lens = LensModel::read(c.dir / "camera.cameramodel");
     std::vector<std::string> names;
     std::vector<ViewImage> images;
@@ -373,6 +373,7 @@ void step_orient(Context& c) {
                {"rms_sigmas", report.rms_sigmas}, {"features", report.features},
                {"tracks_relocated", report.track_refinement.tracks_refined}};
       for (const std::string& w : report.left_out) left_out.push_back(w);
+      for (const std::string& w : report.notes) notes.push_back(w);
       if (report.world_up) up = world_up_json(*report.world_up);
     }
     // In the set's order, only its views (those left out have no pose).
@@ -394,7 +395,7 @@ void step_orient(Context& c) {
     }
     r.outputs = {out};
     r.summary = {{"source", source}, {"gauge", ordered.gauge}, {"views", views}, {"solve", solve},
-                 {"left_out", left_out}, {"world_up", up}};
+                 {"left_out", left_out}, {"notes", notes}, {"world_up", up}};
   });
 }
 
