@@ -3,6 +3,7 @@
 #include "runtime/double_indirection_warp.h"
 
 #include "analytic_map_set.h"
+#include "warp_error.h"
 #include "runtime/blend.h"
 #include "runtime/make_warp.h"
 
@@ -16,37 +17,6 @@
 namespace rsibr {
 namespace {
 
-struct WarpError {
-  double max_texels = 0, rms_texels = 0;
-  long texels = 0;
-};
-
-// Source-position error in source texels over destination texels whose exact sample has rim >= rim_min;
-// every sample must be finite and inside the disc.
-WarpError compare(const Warp& approx, WarpKind kind, const Mat3& m, int n, double rim_min) {
-  const ExactWarp exact;
-  std::vector<WarpSample> a(static_cast<std::size_t>(n)), e(static_cast<std::size_t>(n));
-  WarpError out;
-  double sum = 0;
-  for (int r = 0; r < n; ++r) {
-    const auto [c0, c1] = disc_span(r, n, n);
-    if (c0 == c1) continue;
-    approx.warp_row(kind, m, n, n, r, c0, c1, a.data());
-    exact.warp_row(kind, m, n, n, r, c0, c1, e.data());
-    for (int i = 0; i < c1 - c0; ++i) {
-      const WarpSample& s = a[std::size_t(i)];
-      EXPECT_TRUE(s.disc.allFinite() && std::isfinite(s.rim));
-      EXPECT_LE(s.disc.squaredNorm(), 1.0 + 1e-12);
-      if (e[std::size_t(i)].rim < rim_min) continue;
-      const double d = (s.disc - e[std::size_t(i)].disc).norm() * n / 2;
-      out.max_texels = std::max(out.max_texels, d);
-      sum += d * d;
-      ++out.texels;
-    }
-  }
-  out.rms_texels = out.texels ? std::sqrt(sum / out.texels) : 0;
-  return out;
-}
 
 // A ring of views around world up (0, 1, 0) at elevation `elev_deg`, `count` views.
 std::vector<Mat3> ring_frames(int count, double elev_deg, double phase_deg = 0) {
@@ -121,13 +91,13 @@ TEST(DoubleIndirectionWarp, ARotationAboutTheAxisIsAnOffsetAndBuildsNoTable) {
   for (std::size_t s = 1; s < ring.size(); ++s) {
     const Mat3 m = ring[s].transpose() * ring[0];
     EXPECT_TRUE(warp.offset_only(m));
-    compare(warp, WarpKind::Mirror, m, n, 0.2);
+    testing::compare_to_exact(warp, WarpKind::Mirror, m, n, 0.2);
   }
   EXPECT_EQ(warp.tables_built(), 0);
   const Mat3 general = general_rotations(1)[0];
   EXPECT_FALSE(warp.offset_only(general));
-  compare(warp, WarpKind::Mirror, general, n, 0.2);
-  compare(warp, WarpKind::Mirror, general, n, 0.2);  // the second frame reuses the table
+  testing::compare_to_exact(warp, WarpKind::Mirror, general, n, 0.2);
+  testing::compare_to_exact(warp, WarpKind::Mirror, general, n, 0.2);  // the second frame reuses the table
   EXPECT_EQ(warp.tables_built(), 1);
 }
 
@@ -142,7 +112,7 @@ TEST(DoubleIndirectionWarp, WithinItsResamplingErrorOfTheExactWarpForRingsAndGen
   for (const Mat3& m : general_rotations(4)) cases.push_back({"general", m});
   for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal})
     for (const auto& [what, m] : cases) {
-      const WarpError e = compare(warp, kind, m, n, 0.1);
+      const testing::WarpError e = testing::compare_to_exact(warp, kind, m, n, 0.1);
       std::printf("  %s %s: max %.3f, rms %.4f source texels over %ld texels, %d exact cells\n", to_string(kind),
                   what.c_str(), e.max_texels, e.rms_texels, e.texels, warp.exact_cells(kind, m));
       EXPECT_GT(e.texels, 1000);
@@ -161,7 +131,7 @@ TEST(DoubleIndirectionWarp, ALargerTableHasASmallerError) {
       o.longitudes = columns;
       o.latitudes = columns / 2 + 1;
       o.max_spread = 1;  // interpolate wherever the singularity allows, so that coarse tables are measured too
-      const WarpError e = compare(DoubleIndirectionWarp(n, n, o), kind, m, n, 0.1);
+      const testing::WarpError e = testing::compare_to_exact(DoubleIndirectionWarp(n, n, o), kind, m, n, 0.1);
       EXPECT_LT(e.rms_texels, previous) << to_string(kind) << " " << columns;
       previous = e.rms_texels;
     }
@@ -184,7 +154,7 @@ TEST(DoubleIndirectionWarp, NoNaNAtTheSingularityThePolesOrTheLongitudeSeam) {
     o.axis = axis;
     const DoubleIndirectionWarp warp(n, n, o);
     for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal}) {
-      const WarpError e = compare(warp, kind, m, n, 0.1);  // checks finiteness of every sample
+      const testing::WarpError e = testing::compare_to_exact(warp, kind, m, n, 0.1);  // checks finiteness of every sample
       EXPECT_LT(e.max_texels, 1.0);
     }
   }

@@ -2,6 +2,7 @@
 #include "runtime/tessellated_warp.h"
 
 #include "analytic_map_set.h"
+#include "warp_error.h"
 #include "runtime/blend.h"
 
 #include <gtest/gtest.h>
@@ -12,34 +13,6 @@
 namespace rsibr {
 namespace {
 
-struct WarpError {
-  double max_texels = 0, rms_texels = 0;
-  long texels = 0;
-};
-
-// Source-position error in source texels over destination texels whose exact sample has rim >= rim_min.
-WarpError compare(const Warp& approx, WarpKind kind, const Mat3& m, int n, double rim_min) {
-  const ExactWarp exact;
-  std::vector<WarpSample> a(static_cast<std::size_t>(n)), e(static_cast<std::size_t>(n));
-  WarpError out;
-  double sum = 0;
-  for (int r = 0; r < n; ++r) {
-    const auto [c0, c1] = disc_span(r, n, n);
-    if (c0 == c1) continue;
-    approx.warp_row(kind, m, n, n, r, c0, c1, a.data());
-    exact.warp_row(kind, m, n, n, r, c0, c1, e.data());
-    for (int i = 0; i < c1 - c0; ++i) {
-      EXPECT_TRUE(a[std::size_t(i)].disc.allFinite() && std::isfinite(a[std::size_t(i)].rim));
-      if (e[std::size_t(i)].rim < rim_min) continue;
-      const double d = (a[std::size_t(i)].disc - e[std::size_t(i)].disc).norm() * n / 2;
-      out.max_texels = std::max(out.max_texels, d);
-      sum += d * d;
-      ++out.texels;
-    }
-  }
-  out.rms_texels = out.texels ? std::sqrt(sum / out.texels) : 0;
-  return out;
-}
 
 std::vector<Mat3> rotations(int count) {
   std::vector<Mat3> out;
@@ -59,7 +32,7 @@ TEST(TessellatedWarp, ApproachesTheExactWarpAsTheMeshRefines) {
       const TessellatedWarp warp(n, n, {rings, 4 * rings});
       double rms = 0, worst = 0;
       for (const Mat3& m : rotations(6)) {
-        const WarpError e = compare(warp, kind, m, n, 0.3);
+        const testing::WarpError e = testing::compare_to_exact(warp, kind, m, n, 0.3);
         rms = std::max(rms, e.rms_texels);
         worst = std::max(worst, e.max_texels);
       }
