@@ -113,7 +113,7 @@ Runner add_blend(CLI::App& app) {
                 "offset into them)");
   c->add_option("--rings", a->rings, "tessellated: rings of the disc mesh (4x as many segments)")->check(CLI::Range(1, 1024));
   c->add_option("--table", a->table, "double-indirection: columns of the parametric table (half as many rows; "
-                                     "default: the map width)")->check(CLI::Range(3, 65536));
+                                     "default: the map width)")->check(CLI::Range(3, 4096));
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--preview", a->preview, "Also write a display-encoded PNG");
   c->add_option("--preview-exposure", a->preview_exposure, "Exposure of the preview in stops");

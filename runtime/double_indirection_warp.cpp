@@ -13,6 +13,7 @@ namespace rsibr {
 namespace {
 
 constexpr std::size_t kCacheTables = 8;
+constexpr double kMaxNodes = double(1 << 24);  // 200 MB of nodes per table
 
 int kind_index(WarpKind kind) { return kind == WarpKind::Mirror ? 0 : 1; }
 
@@ -38,6 +39,9 @@ DoubleIndirectionWarp::DoubleIndirectionWarp(int width, int height, const Double
   lon_ = options.longitudes > 0 ? options.longitudes : std::max(width, 3);
   lat_ = options.latitudes > 0 ? options.latitudes : std::max(width / 2 + 1, 3);
   if (lon_ < 3 || lat_ < 3) throw std::invalid_argument("DoubleIndirectionWarp: the table needs at least 3 x 3 nodes");
+  if (double(lon_) * double(lat_) > kMaxNodes)
+    throw std::invalid_argument("DoubleIndirectionWarp: a table of " + std::to_string(lon_) + " x " + std::to_string(lat_) +
+                                " nodes is larger than " + std::to_string(long(kMaxNodes)) + " nodes");
   axis_from_view_ = axis_frame(options.axis.normalized());
 
   // Screen tables: each texel's central direction (clamped to the disc) as table coordinates.
@@ -150,32 +154,39 @@ int DoubleIndirectionWarp::tables_built() const {
   return built_;
 }
 
-bool DoubleIndirectionWarp::interpolate(const Table& t, double u, double v, WarpSample& o) const {
-  u -= lon_ * std::floor(u / lon_);
-  int i = std::min(int(u), lon_ - 1);
-  const double fu = std::clamp(u - i, 0.0, 1.0);
-  const int i1 = i + 1 == lon_ ? 0 : i + 1;
-  v = std::clamp(v, 0.0, double(lat_ - 1));
-  const int j = std::min(int(v), lat_ - 2);
-  const double fv = v - j;
-  if (!t.safe[std::size_t(j * lon_ + i)]) return false;
-  const Node& a = t.nodes[std::size_t(j * lon_ + i)];
-  const Node& b = t.nodes[std::size_t(j * lon_ + i1)];
-  const Node& c = t.nodes[std::size_t((j + 1) * lon_ + i)];
-  const Node& d = t.nodes[std::size_t((j + 1) * lon_ + i1)];
-  const double w00 = (1 - fu) * (1 - fv), w10 = fu * (1 - fv), w01 = (1 - fu) * fv, w11 = fu * fv;
+// float32, as the table: u in [0, 2 columns) (a screen longitude plus a wrapped offset, each in
+// [0, columns), wraps with one subtraction), v in [0, rows - 1]. Raw pointers and the sizes as
+// arguments, inlined: the row loop keeps them in registers.
+inline bool DoubleIndirectionWarp::interpolate(const Node* nodes, const unsigned char* safe, int columns, int rows,
+                                               float u, float v, WarpSample& o) {
+  if (u >= float(columns)) u -= float(columns);
+  const int i = std::min(int(u), columns - 1), j = std::min(int(v), rows - 2);
+  const float fu = u - float(i), fv = v - float(j);
+  const int i1 = i + 1 == columns ? 0 : i + 1;
+  const int k = j * columns + i;
+  if (!safe[k]) return false;
+  const Node &a = nodes[k], &b = nodes[k - i + i1], &c = nodes[k + columns], &d = nodes[k + columns - i + i1];
+  const float w00 = (1 - fu) * (1 - fv), w10 = fu * (1 - fv), w01 = (1 - fu) * fv, w11 = fu * fv;
   Vec2 disc(w00 * a.x + w10 * b.x + w01 * c.x + w11 * d.x, w00 * a.y + w10 * b.y + w01 * c.y + w11 * d.y);
   // Interpolated points stay in the source disc (a chord of the rim can bulge past it).
   const double n2 = disc.squaredNorm();
   if (n2 > 1.0) disc /= std::sqrt(n2);
-  o = {disc, w00 * a.rim + w10 * b.rim + w01 * c.rim + w11 * d.rim};
+  o = {disc, double(w00 * a.rim + w10 * b.rim + w01 * c.rim + w11 * d.rim)};
   return true;
+}
+
+// The offset in table columns, wrapped into [0, columns).
+float DoubleIndirectionWarp::wrapped(double u) const {
+  const float w = float(u - lon_ * std::floor(u / lon_));
+  return w < float(lon_) ? w : 0.f;
 }
 
 WarpSample DoubleIndirectionWarp::lookup(WarpKind kind, const Mat3& source_from_dest, double lon, double lat) const {
   const Split s = split(source_from_dest);
   WarpSample o;
-  if (interpolate(*table(kind, s), lon * lon_ / (2 * kPi) + s.offset, lat * (lat_ - 1) / kPi, o)) return o;
+  const float v = float(std::clamp(lat, 0.0, kPi) * (lat_ - 1) / kPi);
+  const auto t = table(kind, s);
+  if (interpolate(t->nodes.data(), t->safe.data(), lon_, lat_, wrapped(lon * lon_ / (2 * kPi) + s.offset), v, o)) return o;
   return warp_direction(kind, source_from_dest * direction(lon, lat));
 }
 
@@ -188,34 +199,15 @@ void DoubleIndirectionWarp::warp_row(WarpKind kind, const Mat3& source_from_dest
   const Split s = split(source_from_dest);
   const auto t = table(kind, s);
   const float* screen = screen_[kind_index(kind)].data() + (std::size_t(row) * std::size_t(width)) * 2;
-  // The offset wrapped once into [0, columns): a screen longitude (also in [0, columns)) plus it
-  // wraps with one subtraction. float32 throughout, as the table.
-  const float columns = float(lon_);
-  float offset = float(s.offset - lon_ * std::floor(s.offset / lon_));
-  if (!(offset < columns)) offset = 0;
+  const float offset = wrapped(s.offset);
   const Node* nodes = t->nodes.data();
   const unsigned char* safe = t->safe.data();
+  const int columns = lon_, rows = lat_;
   for (int c = c_begin; c < c_end; ++c) {
-    float u = screen[2 * c] + offset;
-    if (u >= columns) u -= columns;
-    const float v = screen[2 * c + 1];
-    const int i = std::min(int(u), lon_ - 1), j = std::min(int(v), lat_ - 2);
-    const float fu = u - float(i), fv = v - float(j);
-    const int i1 = i + 1 == lon_ ? 0 : i + 1;
-    const int k = j * lon_ + i;
     WarpSample& o = out[c - c_begin];
-    if (!safe[k]) {
-      const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, row), width, height);
-      o = warp_direction(kind, source_from_dest * central_direction(kind, xy));
-      continue;
-    }
-    const Node &a = nodes[k], &b = nodes[k - i + i1], &n2 = nodes[k + lon_], &d = nodes[k + lon_ - i + i1];
-    const float w00 = (1 - fu) * (1 - fv), w10 = fu * (1 - fv), w01 = (1 - fu) * fv, w11 = fu * fv;
-    Vec2 disc(w00 * a.x + w10 * b.x + w01 * n2.x + w11 * d.x, w00 * a.y + w10 * b.y + w01 * n2.y + w11 * d.y);
-    // Interpolated points stay in the source disc (a chord of the rim can bulge past it).
-    const double r2 = disc.squaredNorm();
-    if (r2 > 1.0) disc /= std::sqrt(r2);
-    o = {disc, double(w00 * a.rim + w10 * b.rim + w01 * n2.rim + w11 * d.rim)};
+    if (interpolate(nodes, safe, columns, rows, screen[2 * c] + offset, screen[2 * c + 1], o)) continue;
+    const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, row), width, height);
+    o = warp_direction(kind, source_from_dest * central_direction(kind, xy));
   }
 }
 

@@ -46,7 +46,7 @@ struct DoubleIndirectionOptions {
 class DoubleIndirectionWarp final : public Warp {
  public:
   // Throws std::invalid_argument for a size < 1, a zero or non-finite axis, or a table of fewer than
-  // 3 columns or 3 rows.
+  // 3 columns or 3 rows or more than 2^24 nodes.
   DoubleIndirectionWarp(int width, int height, const DoubleIndirectionOptions& options = {});
   const char* name() const override { return "double-indirection"; }
   bool supports(int width, int height) const override { return width == width_ && height == height_; }
@@ -90,9 +90,11 @@ class DoubleIndirectionWarp final : public Warp {
   Split split(const Mat3& source_from_dest) const;
   std::shared_ptr<const Table> build(WarpKind kind, const Mat3& swing) const;
   std::shared_ptr<const Table> table(WarpKind kind, const Split& s) const;
-  // The bilinear read at table coordinates (u columns, any real; v rows in [0, latitudes - 1]);
-  // false (and o untouched) when the cell is not safe.
-  bool interpolate(const Table& t, double u, double v, WarpSample& o) const;
+  // The bilinear read of a table (nodes, per-cell safe flags, columns x rows) at u (columns, in
+  // [0, 2 columns)) and v (rows, in [0, rows - 1]); false (and o untouched) when the cell is not safe.
+  static bool interpolate(const Node* nodes, const unsigned char* safe, int columns, int rows, float u, float v,
+                          WarpSample& o);
+  float wrapped(double u) const;
 
   int width_, height_, lon_, lat_;
   DoubleIndirectionOptions options_;

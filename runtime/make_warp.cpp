@@ -3,6 +3,7 @@
 #include "runtime/double_indirection_warp.h"
 #include "runtime/tessellated_warp.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace rsibr {
@@ -27,7 +28,7 @@ std::unique_ptr<Warp> make_warp(const WarpSettings& s, int width, int height) {
     d.axis = s.axis;
     if (s.table_columns > 0) {
       d.longitudes = s.table_columns;
-      d.latitudes = s.table_columns / 2 + 1;
+      d.latitudes = std::max(3, s.table_columns / 2 + 1);
     }
     return std::make_unique<DoubleIndirectionWarp>(width, height, d);
   }

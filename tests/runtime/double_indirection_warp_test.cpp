@@ -208,6 +208,10 @@ TEST(DoubleIndirectionWarp, BadSettingsAndAnotherSizeAreRefused) {
   o = {};
   o.longitudes = 2;
   EXPECT_THROW(DoubleIndirectionWarp(8, 8, o), std::invalid_argument);
+  o.longitudes = 8192;  // refused before anything is allocated
+  o.latitudes = 4097;
+  EXPECT_THROW(DoubleIndirectionWarp(8, 8, o), std::invalid_argument);
+  EXPECT_STREQ(make_warp({"double-indirection", 16, Vec3(0, 1, 0), 3}, 8, 8)->name(), "double-indirection");
   const DoubleIndirectionWarp warp(8, 8);
   EXPECT_FALSE(warp.supports(16, 16));
   std::vector<WarpSample> out(16);
