@@ -11,6 +11,7 @@
 #include "runtime/double_indirection_warp.h"
 #include "runtime/make_warp.h"
 #include "runtime/tessellated_warp.h"
+#include "runtime/warp_error.h"
 
 #include <Eigen/Geometry>
 
@@ -78,29 +79,6 @@ void warp_map(const Warp& w, WarpKind kind, const std::vector<Mat3>& sources, in
     }
 }
 
-void error_of(const Warp& w, WarpKind kind, const std::vector<Mat3>& sources, int n, double* max_t, double* rms_t) {
-  const ExactWarp exact;
-  std::vector<WarpSample> a(std::size_t(n) + 1), e(std::size_t(n) + 1);
-  double sum = 0, worst = 0;
-  long count = 0;
-  for (const Mat3& m : sources)
-    for (int r = 0; r < n; ++r) {
-      const auto [c0, c1] = disc_span(r, n, n);
-      if (c0 == c1) continue;
-      w.warp_row(kind, m, n, n, r, c0, c1, a.data());
-      exact.warp_row(kind, m, n, n, r, c0, c1, e.data());
-      for (int i = 0; i < c1 - c0; ++i) {
-        if (e[std::size_t(i)].rim < 0.1) continue;
-        const double d = (a[std::size_t(i)].disc - e[std::size_t(i)].disc).norm() * n / 2;
-        worst = std::max(worst, d);
-        sum += d * d;
-        ++count;
-      }
-    }
-  *max_t = worst;
-  *rms_t = count ? std::sqrt(sum / count) : 0;
-}
-
 // A map set of two rings of 8 views (elevations -20 and 20) and the poles, random texels.
 MapSet ring_set(int n) {
   MapSet set;
@@ -135,8 +113,8 @@ int run(const std::vector<int>& sizes, int reps) {
         for (const Method& m : ms) {
           Mat3 dest;
           const std::vector<Mat3> src = sources_of(ring, 0, &dest);
-          double max_t = 0, rms_t = 0;
-          error_of(*m.warp, kind, src, n, &max_t, &rms_t);
+          const testing::WarpError e = testing::compare_to_exact(*m.warp, kind, src, n, 0.1);
+          const double max_t = e.max_texels, rms_t = e.rms_texels;
           // Frames: each a new destination (caches never serve a repeat); the best of `reps` passes.
           const int frames = std::max(2, 4 * 256 * 256 / (n * n));
           double best = INFINITY;

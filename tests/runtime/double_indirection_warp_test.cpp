@@ -91,13 +91,13 @@ TEST(DoubleIndirectionWarp, ARotationAboutTheAxisIsAnOffsetAndBuildsNoTable) {
   for (std::size_t s = 1; s < ring.size(); ++s) {
     const Mat3 m = ring[s].transpose() * ring[0];
     EXPECT_TRUE(warp.offset_only(m));
-    testing::compare_to_exact(warp, WarpKind::Mirror, m, n, 0.2);
+    EXPECT_EQ(testing::compare_to_exact(warp, WarpKind::Mirror, m, n, 0.2).bad, 0);
   }
   EXPECT_EQ(warp.tables_built(), 0);
   const Mat3 general = general_rotations(1)[0];
   EXPECT_FALSE(warp.offset_only(general));
-  testing::compare_to_exact(warp, WarpKind::Mirror, general, n, 0.2);
-  testing::compare_to_exact(warp, WarpKind::Mirror, general, n, 0.2);  // the second frame reuses the table
+  EXPECT_EQ(testing::compare_to_exact(warp, WarpKind::Mirror, general, n, 0.2).bad, 0);
+  EXPECT_EQ(testing::compare_to_exact(warp, WarpKind::Mirror, general, n, 0.2).bad, 0);  // reuses the table
   EXPECT_EQ(warp.tables_built(), 1);
 }
 
@@ -113,6 +113,7 @@ TEST(DoubleIndirectionWarp, WithinItsResamplingErrorOfTheExactWarpForRingsAndGen
   for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal})
     for (const auto& [what, m] : cases) {
       const testing::WarpError e = testing::compare_to_exact(warp, kind, m, n, 0.1);
+      EXPECT_EQ(e.bad, 0);
       std::printf("  %s %s: max %.3f, rms %.4f source texels over %ld texels, %d exact cells\n", to_string(kind),
                   what.c_str(), e.max_texels, e.rms_texels, e.texels, warp.exact_cells(kind, m));
       EXPECT_GT(e.texels, 1000);
@@ -132,6 +133,7 @@ TEST(DoubleIndirectionWarp, ALargerTableHasASmallerError) {
       o.latitudes = columns / 2 + 1;
       o.max_spread = 1;  // interpolate wherever the singularity allows, so that coarse tables are measured too
       const testing::WarpError e = testing::compare_to_exact(DoubleIndirectionWarp(n, n, o), kind, m, n, 0.1);
+      EXPECT_EQ(e.bad, 0);
       EXPECT_LT(e.rms_texels, previous) << to_string(kind) << " " << columns;
       previous = e.rms_texels;
     }
@@ -154,7 +156,8 @@ TEST(DoubleIndirectionWarp, NoNaNAtTheSingularityThePolesOrTheLongitudeSeam) {
     o.axis = axis;
     const DoubleIndirectionWarp warp(n, n, o);
     for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal}) {
-      const testing::WarpError e = testing::compare_to_exact(warp, kind, m, n, 0.1);  // checks finiteness of every sample
+      const testing::WarpError e = testing::compare_to_exact(warp, kind, m, n, 0.1);
+      EXPECT_EQ(e.bad, 0);  // every sample finite and in the disc
       EXPECT_LT(e.max_texels, 1.0);
     }
   }
