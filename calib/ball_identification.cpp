@@ -840,16 +840,6 @@ ViewCandidates view_candidates(const cv::Mat& image, const LensModel& lens, cons
   return vc;
 }
 
-namespace {
-
-// The centre of candidate c in the camera frame, in chrome-ball radii, for a ball `scale` times the
-// chrome ball's size: scale * axis / sin(alpha).
-Vec3 centre_in_chrome_radii(const BallCandidate& c, double scale) {
-  return scale * c.loc.fit.cone.axis.normalized() / std::sin(c.loc.fit.cone.half_angle);
-}
-
-}  // namespace
-
 std::vector<ChromeRescue> rescue_chrome_balls(const std::vector<std::optional<ViewCandidates>>& views,
                                               const std::vector<ListedBall>& balls, const BallSearchOptions& search) {
   std::vector<ChromeRescue> out(views.size());
@@ -864,8 +854,8 @@ std::vector<ChromeRescue> rescue_chrome_balls(const std::vector<std::optional<Vi
     std::vector<double> d;
     for (const auto& vc : views)
       if (vc && vc->pick[std::size_t(chrome)] >= 0 && vc->pick[b] >= 0)
-        d.push_back((centre_in_chrome_radii(vc->cands[std::size_t(vc->pick[std::size_t(chrome)])], 1) -
-                     centre_in_chrome_radii(vc->cands[std::size_t(vc->pick[b])], scale)).norm());
+        d.push_back((centre_in_radii(vc->cands[std::size_t(vc->pick[std::size_t(chrome)])].loc.fit.cone) -
+                     scale * centre_in_radii(vc->cands[std::size_t(vc->pick[b])].loc.fit.cone)).norm());
     if (d.size() < 2) continue;
     std::sort(d.begin(), d.end());
     const double rig = d[d.size() / 2];
@@ -876,14 +866,14 @@ std::vector<ChromeRescue> rescue_chrome_balls(const std::vector<std::optional<Vi
       const auto& vc = views[v];
       if (!vc || vc->pick[std::size_t(chrome)] >= 0 || vc->pick[b] < 0 || out[v].candidate >= 0) continue;
       const BallCandidate& other = vc->cands[std::size_t(vc->pick[b])];
-      const Vec3 g = centre_in_chrome_radii(other, scale);
+      const Vec3 g = scale * centre_in_radii(other.loc.fit.cone);  // chrome radii, camera frame
       int hit = -1, hits = 0;
       double hit_d = 0;
       for (std::size_t k = 0; k < vc->cands.size(); ++k) {
         const BallCandidate& c = vc->cands[k];
         if (std::find(vc->pick.begin(), vc->pick.end(), int(k)) != vc->pick.end()) continue;
         if (!acceptable_outline(c, search) || looks_like(c, BallKind::grey) || !looks_like(c, BallKind::glossy)) continue;
-        const Vec3 cc = centre_in_chrome_radii(c, 1);
+        const Vec3 cc = centre_in_radii(c.loc.fit.cone);
         const double dist = (cc - g).norm();
         if (std::abs(dist - rig) <= tolerance + relative * 0.5 * (cc.norm() + g.norm())) ++hits, hit = int(k), hit_d = dist;
       }
