@@ -11,15 +11,34 @@ namespace rsibr {
 MapSet bake_map_set(const Brdf& brdf, const Integrator& integrator, const ViewSet& views,
                     const MapSetBakeOptions& options, const std::function<void(double)>& progress) {
   if (options.res < 1) throw std::invalid_argument("bake: the map size must be at least 1, not " + std::to_string(options.res));
+  const double total_rows = double(views.views().size()) * options.res;
+  std::atomic<long> rows_before{0};
+  std::vector<cv::Mat> radiance;
+  for (const Vec3& v : views.views()) {
+    const long before = rows_before.load();
+    std::function<void(int)> rows;
+    if (progress) rows = [&](int done) { progress((before + done) / total_rows); };
+    radiance.push_back(integrator.radiance_map(brdf, v, world_from_view_for(v), options.res, options.integrator, rows));
+    rows_before += options.res;
+  }
+  return computed_map_set(brdf, integrator, views, options, std::move(radiance));
+}
+
+MapSet computed_map_set(const Brdf& brdf, const Integrator& integrator, const ViewSet& views,
+                        const MapSetBakeOptions& options, std::vector<cv::Mat> radiance) {
+  if (radiance.size() != views.views().size())
+    throw std::invalid_argument("bake: " + std::to_string(radiance.size()) + " maps for " +
+                                std::to_string(views.views().size()) + " views");
   const std::string method = integrator.name();
   const std::vector<float> albedo = options.normalise_albedo ? albedo_table(brdf) : std::vector<float>{};
   const std::string warp = brdf.central_direction() == Lobe::Normal ? "normal" : "mirror";
   const bool stochastic = method == "mis" || method == "fis";
   const IntegratorOptions& io = options.integrator;
-  const double total_rows = double(views.views().size()) * options.res;
-  std::atomic<long> rows_before{0};
   MapSet set;
-  for (const Vec3& v : views.views()) {
+  for (std::size_t i = 0; i < radiance.size(); ++i) {
+    const Vec3& v = views.views()[i];
+    if (radiance[i].type() != CV_32FC3 || radiance[i].rows != options.res || radiance[i].cols != options.res)
+      throw std::invalid_argument("bake: map " + std::to_string(i) + " is not CV_32FC3 of the map size");
     MapView mv;
     mv.view = v;
     mv.world_from_view = world_from_view_for(v);
@@ -33,11 +52,7 @@ MapSet bake_map_set(const Brdf& brdf, const Integrator& integrator, const ViewSe
     mv.attributes["seed"] = stochastic ? std::to_string(io.seed) : "n/a";
     if (method == "reference")
       mv.attributes["referenceWidth"] = io.reference_width > 0 ? std::to_string(io.reference_width) : "full";
-    const long before = rows_before.load();
-    std::function<void(int)> rows;
-    if (progress) rows = [&](int done) { progress((before + done) / total_rows); };
-    mv.rgb = integrator.radiance_map(brdf, v, mv.world_from_view, options.res, io, rows);
-    rows_before += options.res;
+    mv.rgb = std::move(radiance[i]);
     if (!albedo.empty()) {
       normalise_by_albedo(mv.rgb, albedo);
       mv.albedo = albedo;

@@ -11,6 +11,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace rsibr {
 
@@ -31,5 +32,13 @@ struct MapSetBakeOptions {
 // that is not Lambert).
 MapSet bake_map_set(const Brdf& brdf, const Integrator& integrator, const ViewSet& views,
                     const MapSetBakeOptions& options, const std::function<void(double)>& progress = {});
+
+// The set bake_map_set makes from maps already integrated: radiance[i] is the CV_32FC3 res x res
+// map of views.views()[i] that integrator.radiance_map gives (with options.integrator); this adds
+// the headers and the albedo normalisation. For bakes split over processes (cluster/), whose
+// texels are integrated apart and gathered: the same texels give the same set.
+// Throws std::invalid_argument when the counts or sizes do not match.
+MapSet computed_map_set(const Brdf& brdf, const Integrator& integrator, const ViewSet& views,
+                        const MapSetBakeOptions& options, std::vector<cv::Mat> radiance);
 
 }  // namespace rsibr

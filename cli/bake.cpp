@@ -11,6 +11,8 @@
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
 #include "bake/map_set_bake.h"
+#include "cluster/distributed_bake.h"
+#include "cluster/session.h"
 #include "core/exr_io.h"
 #include "core/map_set.h"
 #include "core/output_plan.h"
@@ -23,6 +25,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 
 namespace rsibr::cli {
 namespace {
@@ -36,23 +39,51 @@ struct BakeArgs {
   bool sanitize = false, quiet = false;
 };
 
+// The inputs every rank reads (each rank of an MPI bake reads them itself).
+struct BakeInputs {
+  EnvMap env;
+  std::shared_ptr<const Brdf> brdf;
+  ViewSet views;
+  std::unique_ptr<Integrator> integrator;  // made from env where it lies (see run_bake)
+};
+
+BakeInputs read_bake_inputs(const BakeArgs& a) {
+  BakeInputs in{read_environment_input(a.env, a.layout, a.sanitize), load_brdf(a.brdf), ViewSet::named(a.views), {}};
+  // --lobe: the whole BRDF, or one part of it (bake/brdf_lobes.h) with its own central direction.
+  if (a.lobe != "all") {
+    const Lobe part = lobe_from_string(a.lobe);
+    if (!in.brdf->has_lobe(part))
+      throw std::invalid_argument(a.brdf + ": --lobe " + a.lobe + ": the BRDF has no " + a.lobe + " lobe");
+    in.brdf = std::make_shared<BrdfLobe>(in.brdf, part);
+  }
+  return in;
+}
+
 int run_bake(const BakeArgs& a) {
   if (std::filesystem::path(a.output).extension() != ".exr")
     throw std::invalid_argument(a.output + ": the output must be an .exr file");
+  // Under mpirun the ranks split the texels (cluster/distributed_bake.h); the root writes.
+  const cluster::Session& session = cluster::Session::current();
   OutputPlan outputs({a.env, a.brdf, a.views});
   const std::string exr = outputs.file(a.output), json = outputs.file(a.json);
   const auto t0 = std::chrono::steady_clock::now();
-  const EnvMap env = read_environment_input(a.env, a.layout, a.sanitize);
-  // --lobe: the whole BRDF, or one part of it (bake/brdf_lobes.h) with its own central direction.
-  std::shared_ptr<const Brdf> brdf = load_brdf(a.brdf);
-  if (a.lobe != "all") {
-    const Lobe part = lobe_from_string(a.lobe);
-    if (!brdf->has_lobe(part))
-      throw std::invalid_argument(a.brdf + ": --lobe " + a.lobe + ": the BRDF has no " + a.lobe + " lobe");
-    brdf = std::make_shared<BrdfLobe>(brdf, part);
+  // Every rank reads the inputs; when one cannot, every rank stops here rather than wait for it.
+  std::optional<BakeInputs> read;
+  std::exception_ptr failed;
+  try {
+    read.emplace(read_bake_inputs(a));
+    // Made in place: the integrator keeps what it precomputes from the environment it is given.
+    read->integrator = make_integrator(a.method, read->env);
+  } catch (...) {
+    failed = std::current_exception();
   }
-  const ViewSet views = ViewSet::named(a.views);
-  const auto integrator = make_integrator(a.method, env);
+  if (!session.all(!failed)) {
+    if (failed) std::rethrow_exception(failed);
+    throw std::runtime_error("another rank could not read the inputs");
+  }
+  const BakeInputs& in = *read;
+  const EnvMap& env = in.env;
+  const Brdf* brdf = in.brdf.get();
   IntegratorOptions options;
   options.samples = a.samples;
   options.seed = a.seed;
@@ -67,9 +98,12 @@ int run_bake(const BakeArgs& a) {
   bake_options.environment_name = std::filesystem::path(a.env).filename().string();
   const std::string warp = brdf->central_direction() == Lobe::Normal ? "normal" : "mirror";
   const bool stochastic = a.method == "mis" || a.method == "fis";
-  Progress bar("bake", !a.quiet && Progress::stderr_is_terminal());
-  const MapSet set = bake_map_set(*brdf, *integrator, views, bake_options, [&](double f) { bar.update(f); });
+  Progress bar("bake", session.is_root() && !a.quiet && Progress::stderr_is_terminal());
+  cluster::DistributedBakeTimes times;
+  const MapSet set = cluster::bake_map_set_distributed(*brdf, *in.integrator, in.views, bake_options, session,
+                                                       [&](double f) { bar.update(f); }, &times);
   bar.done();
+  if (!session.is_root()) return 0;
   const auto t2 = std::chrono::steady_clock::now();
   write_map_set(exr, set);
   const auto t3 = std::chrono::steady_clock::now();
@@ -78,7 +112,8 @@ int run_bake(const BakeArgs& a) {
   if (!a.quiet)
     std::cerr << "rsibr bake: " << set.views.size() << " views x " << a.res << "^2, " << a.method
               << (stochastic ? " (" + std::to_string(a.samples) + " samples)" : std::string()) << ", " << secs(t2 - t1)
-              << " s (" << secs(t2 - t1) / double(set.views.size()) << " s per map)\n";
+              << " s (" << secs(t2 - t1) / double(set.views.size()) << " s per map"
+              << (session.size() > 1 ? ", " + std::to_string(session.size()) + " ranks" : std::string()) << ")\n";
   nlohmann::json j;
   j["output"] = a.output;
   j["environment"] = a.env;
@@ -93,8 +128,13 @@ int run_bake(const BakeArgs& a) {
   j["seed"] = a.seed;
   j["views"] = set.views.size();
   j["res"] = a.res;
+  j["ranks"] = session.size();
+  // integrate: the whole bake as the root saw it (its own rows, then the gather); gather: the part
+  // of it spent waiting for and receiving the other ranks' rows; root_integrate: the root's own rows.
   j["seconds"] = {{"setup", secs(t1 - t0)}, {"integrate", secs(t2 - t1)}, {"write", secs(t3 - t2)},
-                  {"per_map", secs(t2 - t1) / double(set.views.size())}};
+                  {"per_map", secs(t2 - t1) / double(set.views.size())}, {"gather", times.gather},
+                  {"root_integrate", times.integrate}};
+  j["root_rows"] = times.rows;
   write_summary(json, j);
   outputs.commit();
   return 0;
@@ -111,6 +151,8 @@ Runner add_bake(CLI::App& app) {
             "Multi-lobe maps: --lobe normal and --lobe mirror bake the two parts of a BRDF (clear coat: the binder; "
             "the coat and flakes) as two sets, each warped with its own warp; the runtime sums them "
             "(rsibr render --maps normal.exr --maps mirror.exr).\n"
+            "Under mpirun (a build with MPI) the ranks split the maps' texels and the root writes the set: the same "
+            "bytes as one process (mpirun -n 8 rsibr bake ...).\n"
             "--normalise albedo stores each texel divided by the BRDF's directional albedo at its n.v (a table in the "
             "file); the runtime multiplies it back at the destination view, so a view dependence through Fresnel "
             "factors is not warped (the clear coat's normal part becomes exactly view independent).");

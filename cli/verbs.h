@@ -14,6 +14,7 @@ Runner add_info(CLI::App& app);
 Runner add_pattern(CLI::App& app);
 Runner add_blend(CLI::App& app);
 Runner add_bake(CLI::App& app);
+Runner add_batch(CLI::App& app);
 Runner add_reference(CLI::App& app);
 Runner add_render(CLI::App& app);
 Runner add_view(CLI::App& app);

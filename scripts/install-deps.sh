@@ -11,6 +11,7 @@ packages=(
   libopencv-dev
   libcli11-dev libyaml-cpp-dev nlohmann-json3-dev
   libssl-dev  # pipeline/step_record.cpp: SHA-256 of the files a step read and wrote
+  libopenmpi-dev openmpi-bin  # cluster/: mpirun bakes and batches (Open MPI)
   # meshes (core/mesh.cpp)
   libtinyobjloader-dev libtinygltf-dev libdraco-dev
   # bake / capture / calib / hdr
