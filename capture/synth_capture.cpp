@@ -4,6 +4,7 @@
 #include "capture/camera_processing.h"
 #include "capture/camera_response.h"
 #include "capture/chessboard.h"
+#include "capture/dng_file.h"
 #include "capture/irradiance.h"
 #include "core/photo_set.h"
 #include "capture/rig_renderer.h"
@@ -57,7 +58,55 @@ void write_codes(const fs::path& file, const cv::Mat& codes, const std::string& 
   write_bytes(file, bytes);
 }
 
-std::string ext_of(const std::string& format) { return format == "png" ? "png" : format == "jpeg" ? "jpg" : "tif"; }
+std::string ext_of(const std::string& format) {
+  return format == "png" ? "png" : format == "jpeg" ? "jpg" : format == "dng" ? "dng" : "tif";
+}
+
+// Format dng: a 14-bit sensor. Raw signal r = X / full_well in [0, 1] -> codes black + r (white - black).
+constexpr int kDngBlack = 512, kDngWhite = 16383;
+
+cv::Mat dng_codes(const cv::Mat& raw) {
+  cv::Mat codes(raw.size(), CV_16UC3);
+  for (int y = 0; y < raw.rows; ++y)
+    for (int x = 0; x < raw.cols; ++x) {
+      const cv::Vec3d r = raw.at<cv::Vec3d>(y, x);
+      cv::Vec3w& o = codes.at<cv::Vec3w>(y, x);
+      for (int c = 0; c < 3; ++c)
+        o[c] = std::uint16_t(kDngBlack + std::lround(std::clamp(r[c], 0.0, 1.0) * (kDngWhite - kDngBlack)));
+    }
+  return codes;
+}
+
+// The DNG's colour: the sensor's sensitivities (no crosstalk) and the camera's white balance as
+// AsShotNeutral (the raw RGB of a neutral, largest 1).
+DngInfo dng_info(const SynthCamera& cam, double t, const SynthExposure& ex) {
+  DngInfo d;
+  d.model = cam.name;
+  d.black = kDngBlack;
+  d.white = kDngWhite;
+  const Vec3 s = cam.processing ? cam.processing->sensitivity : Vec3::Ones();
+  const Vec3 g = cam.processing ? cam.processing->gains() : Vec3::Ones();
+  d.camera_from_xyz = dng_colour_matrix(s.asDiagonal().toDenseMatrix());
+  const Vec3 neutral = g.cwiseInverse();
+  d.as_shot_neutral = neutral / neutral.maxCoeff();
+  d.exposure_s = t;
+  d.iso = ex.iso;
+  d.aperture = ex.aperture;
+  return d;
+}
+
+// What a RAW developer recovers from that DNG (hdr/raw_image.h): gains g / min(g) on s . L, in
+// linear Rec.709 (the sensor has no crosstalk, so its colour matrix is diagonal).
+cv::Mat dng_linear_output(const cv::Mat& L, const SynthCamera& cam) {
+  const Vec3 s = cam.processing ? cam.processing->sensitivity : Vec3::Ones();
+  const Vec3 g = cam.processing ? cam.processing->gains() : Vec3::Ones();
+  const Vec3 f = (g / g.minCoeff()).cwiseProduct(s);
+  cv::Mat out = L.clone();
+  out.forEach<cv::Vec3f>([&](cv::Vec3f& p, const int*) {
+    p = cv::Vec3f(float(p[0] * f[0]), float(p[1] * f[1]), float(p[2] * f[2]));
+  });
+  return out;
+}
 
 YAML::Node vec(const Vec3& v) {
   YAML::Node n(YAML::NodeType::Sequence);
@@ -179,7 +228,7 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
   const RigRenderer renderer(scene, env);
   const RayTable rays(cam.lens, 8);
   const CameraResponse response(cam.response);
-  const int max_code = cam.format == "tiff" ? 65535 : 255;
+  const int max_code = cam.format == "tiff" || cam.format == "dng" ? 65535 : 255;
   const std::vector<double> times = scene.exposure.times();
   auto relative_exposure = [&](double t) {
     return t * scene.exposure.iso / 100.0 / (scene.exposure.aperture * scene.exposure.aperture);
@@ -288,20 +337,26 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
     for (std::size_t bi = 0; bi < times.size(); ++bi) {
       const double e = relative_exposure(times[bi]);
       const std::uint64_t stream = 1 + vi * 64 + bi;
-      const cv::Mat codes =
-          cam.processing ? process_raw(expose_raw(L, e, noise, cam.processing->sensitivity, scene.seed, stream), *cam.processing,
-                                       response, max_code)
-                         : expose_bracket(L, e, noise, response, max_code, scene.seed, stream);
       char name[64];
       std::snprintf(name, sizeof name, "%s_b%02zu.%s", pose.name.c_str(), bi, ext_of(cam.format).c_str());
       const fs::path file = photos / pose.name / name;
-      write_codes(file, codes, cam.format, cam.jpeg_quality);
+      cv::Mat codes;
+      if (cam.format == "dng") {
+        const Vec3 s = cam.processing ? cam.processing->sensitivity : Vec3::Ones();
+        codes = dng_codes(expose_raw(L, e, noise, s, scene.seed, stream));
+        write_dng(file, bayer_mosaic(codes, "RGGB"), dng_info(cam, times[bi], scene.exposure));
+      } else {
+        codes = cam.processing ? process_raw(expose_raw(L, e, noise, cam.processing->sensitivity, scene.seed, stream),
+                                             *cam.processing, response, max_code)
+                               : expose_bracket(L, e, noise, response, max_code, scene.seed, stream);
+        write_codes(file, codes, cam.format, cam.jpeg_quality);
+      }
       pv.brackets.push_back({file, times[bi], scene.exposure.iso, scene.exposure.aperture});
       YAML::Node tb;
       tb["file"] = pose.name + "/" + name;
       tb["exposure_s"] = times[bi];
       tb["relative_exposure"] = e;
-      tb["clipped_fraction"] = clipped_fraction(codes, max_code);
+      tb["clipped_fraction"] = clipped_fraction(codes, cam.format == "dng" ? kDngWhite : max_code);
       tv["brackets"].push_back(tb);
       ++report.brackets;
       advance(0.1);
@@ -312,10 +367,12 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
                                                 {"view", pose.name},
                                                 {"cameraModel", cam.lens.name()},
                                                 {"seed", std::to_string(scene.seed)}};
-    attrs["content"] = cam.processing ? "the camera's linear output M (gains * sensitivity * L) for L at the pixel: X = L e k"
-                                      : "L at the pixel (after vignetting and white balance): X = L e k";
+    attrs["content"] = cam.format == "dng" ? "what a RAW developer recovers: (gains / min gain) * sensitivity * L for L at the pixel: X = L e k"
+                       : cam.processing ? "the camera's linear output M (gains * sensitivity * L) for L at the pixel: X = L e k"
+                                        : "L at the pixel (after vignetting and white balance): X = L e k";
     write_truth_image(file_in_folder(truth / "views", pose.name + "_radiance.exr"),
-                      cam.processing ? linear_output(L, *cam.processing) : L, &pose, attrs);
+                      cam.format == "dng" ? dng_linear_output(L, cam) : cam.processing ? linear_output(L, *cam.processing) : L,
+                      &pose, attrs);
     attrs["content"] = "scene radiance along each pixel's rays (before vignetting and white balance)";
     write_truth_image(file_in_folder(truth / "views", pose.name + "_scene.exr"), scene_radiance, &pose, attrs);
     for (const SynthBall& b : scene.balls) {
@@ -370,10 +427,18 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
       const cv::Mat lit1 = shot.reflectance.mul(vignette);
       cv::Mat lit;
       cv::merge(std::vector<cv::Mat>{lit1 * cam.white_balance[0], lit1 * cam.white_balance[1], lit1 * cam.white_balance[2]}, lit);
-      const cv::Mat codes = expose_bracket(lit, 1.0, board_noise, response, max_code, scene.seed, 0xB0000 + std::uint64_t(i));
       char name[32];
       std::snprintf(name, sizeof name, "board%02d", i);
-      write_codes(photos / "chessboards" / (std::string(name) + board_ext), codes, cam.format);
+      const std::uint64_t board_stream = 0xB0000 + std::uint64_t(i);
+      if (cam.format == "dng") {
+        const Vec3 s = cam.processing ? cam.processing->sensitivity : Vec3::Ones();
+        const cv::Mat codes = dng_codes(expose_raw(lit, 1.0, board_noise, s, scene.seed, board_stream));
+        write_dng(photos / "chessboards" / (std::string(name) + board_ext), bayer_mosaic(codes, "RGGB"),
+                  dng_info(cam, scene.exposure.middle_s, scene.exposure));
+      } else {
+        const cv::Mat codes = expose_bracket(lit, 1.0, board_noise, response, max_code, scene.seed, board_stream);
+        write_codes(photos / "chessboards" / (std::string(name) + board_ext), codes, cam.format);
+      }
       cs.files.push_back(photos / "chessboards" / (std::string(name) + board_ext));
       std::ofstream corners(truth / "chessboards" / (std::string(name) + ".txt"));
       corners.precision(10);

@@ -140,7 +140,8 @@ SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const 
     spec_fail(m.at("lens"), "models that see behind the camera (stereographic, splined) are not supported yet");
   if (m.has("name")) c.name = valid_utf8(m.string("name"));  // free text (bytes that are not UTF-8 replaced)
   if (m.has("response")) c.response = m.choice("response", CameraResponse::kinds());
-  if (m.has("format")) c.format = m.choice("format", {"png", "jpeg", "tiff"});
+  if (m.has("format")) c.format = m.choice("format", {"png", "jpeg", "tiff", "dng"});
+  if (c.format == "dng" && (w % 2 || h % 2)) spec_fail(m.at("format"), "dng needs an even width and height (a 2x2 Bayer pattern)");
   if (m.has("jpeg_quality")) {
     if (c.format != "jpeg") spec_fail(m.at("jpeg_quality"), "only for format: jpeg");
     c.jpeg_quality = int(spec_in_range(double(m.integer("jpeg_quality")), m.at("jpeg_quality"), 1, false, 100, false));

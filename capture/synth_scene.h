@@ -87,7 +87,9 @@ struct SynthCamera {
   LensModel lens = LensModel::pinhole(600, 640, 480);
   std::string name = "synthetic camera";
   std::string response = "srgb";
-  std::string format = "png";  // "png" (8-bit), "jpeg" (8-bit), "tiff" (16-bit)
+  std::string format = "png";  // "png" (8-bit), "jpeg" (8-bit), "tiff" (16-bit), "dng" (camera RAW:
+                               // the raw signal as a 14-bit RGGB mosaic, capture/dng_file.h; no
+                               // response, processing's sensitivities and white balance only)
   int jpeg_quality = 95;       // format jpeg: the encoder's quality, 1..100
   // In-camera processing (capture/camera_processing.h): raw sensitivities, white balance, colour
   // matrix, then `response` as the tone curve. Absent: codes are response(raw) per channel.

@@ -341,6 +341,18 @@ int run_hdr(const HdrArgs& a) {
           {"radiance_min", lo}, {"radiance_max", hi}, {"preview_exposure_stops", stops},
           {"exr", (out_dir / (v.name + ".exr")).string()},
           {"seconds", {{"load", secs(t1 - t0)}, {"merge", secs(t2 - t1)}, {"write", secs(t3 - t2)}}}};
+      if (b.raw) {
+        // How LibRaw developed the RAW files (hdr/raw_image.h), per bracket.
+        nlohmann::json rj = nlohmann::json::array();
+        for (const RawInfo& ri : b.raw_info) {
+          nlohmann::json M = nlohmann::json::array();
+          for (int r = 0; r < 3; ++r) M.push_back({ri.rgb_from_camera(r, 0), ri.rgb_from_camera(r, 1), ri.rgb_from_camera(r, 2)});
+          rj.push_back({{"camera", ri.make + " " + ri.model}, {"black", ri.black}, {"white", ri.white},
+                        {"white_balance", {ri.white_balance[0], ri.white_balance[1], ri.white_balance[2]}},
+                        {"rec709_from_camera", M}, {"saturated_fraction", ri.saturated_fraction}});
+        }
+        vj["raw"] = rj;
+      }
       if (a.align) {
         nlohmann::json sj = nlohmann::json::array();
         for (const auto& s : shifts) sj.push_back({s.x, s.y});

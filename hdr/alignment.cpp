@@ -32,6 +32,10 @@ std::vector<cv::Point> align_brackets(BracketSet& b, int max_bits) {
     cv::Mat moved;
     cv::warpAffine(b.codes[j], moved, M, b.codes[j].size(), cv::INTER_NEAREST, cv::BORDER_REPLICATE);
     b.codes[j] = moved;
+    if (!b.saturated.empty() && !b.saturated[j].empty()) {
+      cv::warpAffine(b.saturated[j], moved, M, b.saturated[j].size(), cv::INTER_NEAREST, cv::BORDER_REPLICATE);
+      b.saturated[j] = moved;
+    }
   }
   return shifts;
 }

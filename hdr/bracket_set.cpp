@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <cmath>
 #include <numeric>
+#include <optional>
+#include <utility>
 #include <stdexcept>
 
 namespace rsibr {
@@ -67,17 +69,64 @@ BracketSet load_brackets(const PhotoView& view) {
   std::vector<double> exposures;
   std::vector<ResolvedExposure> metadata;
   std::vector<std::string> names;
+  std::vector<RawInfo> raw_info;
+  std::vector<cv::Mat> raw_saturated;
+  std::optional<Vec3> raw_balance;  // the first RAW bracket's, for every other one
+  int raw_count = 0;
   for (const BracketPhoto& b : view.brackets) {
     const std::string name = b.file.string();
-    metadata.push_back(resolve_exposure(b));
-    exposures.push_back(metadata.back().relative);
     cv::Mat c;
-    ranges.push_back(to_codes(cv::imread(name, cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH), c, name, true));
+    if (is_raw_file(b.file)) {
+      RawImage r = read_raw_image(b.file, RawOptions{raw_balance});
+      if (!raw_balance) raw_balance = r.info.white_balance;
+      // What photoset.yaml leaves out, from the file; the rest (if any) from EXIF.
+      BracketPhoto filled = b;
+      const bool from_raw = (!b.exposure_s && r.info.exposure_s > 0) || (!b.iso && r.info.iso > 0) ||
+                            (!b.aperture && r.info.aperture > 0);
+      if (!filled.exposure_s && r.info.exposure_s > 0) filled.exposure_s = r.info.exposure_s;
+      if (!filled.iso && r.info.iso > 0) filled.iso = r.info.iso;
+      if (!filled.aperture && r.info.aperture > 0) filled.aperture = r.info.aperture;
+      metadata.push_back(resolve_exposure(filled));
+      if (from_raw) {
+        // Where the values came from: photoset.yaml, the RAW file, its EXIF (what LibRaw missed).
+        std::string source = (b.exposure_s || b.iso || b.aperture) ? "yaml+raw" : "raw";
+        if (metadata.back().source.find("exif") != std::string::npos) source += "+exif";
+        metadata.back().source = source;
+      }
+      c = std::move(r.codes);
+      ranges.push_back(65535);
+      raw_info.push_back(r.info);
+      raw_saturated.push_back(r.saturated);
+      ++raw_count;
+    } else {
+      metadata.push_back(resolve_exposure(b));
+      ranges.push_back(to_codes(cv::imread(name, cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH), c, name, true));
+      raw_info.emplace_back();
+      raw_saturated.emplace_back();
+    }
+    exposures.push_back(metadata.back().relative);
     codes.push_back(std::move(c));
     names.push_back(name);
   }
   if (codes.empty()) throw std::runtime_error("view " + view.name + ": no brackets");
+  if (raw_count > 0 && raw_count < int(codes.size()))
+    throw std::runtime_error("view " + view.name + ": mixes camera RAW files with other images (" +
+                             std::to_string(raw_count) + " of " + std::to_string(codes.size()) +
+                             " brackets are RAW); give one kind per view");
+  // assemble sorts by exposure; keep the RAW records in the same order.
+  struct Keyed {
+    double exposure;
+    RawInfo info;
+    cv::Mat saturated;
+  };
+  std::vector<Keyed> keyed;
+  for (std::size_t j = 0; j < raw_info.size(); ++j) keyed.push_back({exposures[j], raw_info[j], raw_saturated[j]});
   BracketSet s = assemble(std::move(codes), std::move(ranges), std::move(exposures), std::move(metadata), std::move(names));
+  if (raw_count > 0) {
+    s.raw = true;
+    std::stable_sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) { return a.exposure < b.exposure; });
+    for (Keyed& k : keyed) s.raw_info.push_back(std::move(k.info)), s.saturated.push_back(std::move(k.saturated));
+  }
   for (const std::string& f : s.files) {
     std::string ext = std::filesystem::path(f).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });

@@ -26,6 +26,12 @@ void BracketStatistics::add(const BracketSet& b) {
     return;
   }
   const int P = int(b.size()), H = b.rows(), W = b.cols();
+  // A pixel the file says is saturated (RAW) counts as the top code in every channel, so the
+  // saturation rule of recovery and noise estimation leaves it out as the merge does.
+  auto file_saturated = [&](int j, int r, int c) {
+    return std::size_t(j) < b.saturated.size() && !b.saturated[std::size_t(j)].empty() &&
+           b.saturated[std::size_t(j)].at<unsigned char>(r, c) != 0;
+  };
   ViewStatistics v;
   v.exposures = b.exposures;
   v.brackets = P;
@@ -38,7 +44,8 @@ void BracketStatistics::add(const BracketSet& b) {
       for (int j = 0; j < P; ++j) {
         const cv::Mat& img = b.codes[std::size_t(j)];
         const auto z = img.at<cv::Vec3w>(r, c);
-        for (int ch = 0; ch < 3; ++ch) v.sample_codes.push_back(z[ch]);
+        const bool top = file_saturated(j, r, c);
+        for (int ch = 0; ch < 3; ++ch) v.sample_codes.push_back(top ? std::uint16_t(max_code) : z[ch]);
         double sum[3] = {0, 0, 0}, sq[3] = {0, 0, 0};
         for (int dr = -2; dr <= 2; ++dr) {
           const auto* p = img.ptr<std::uint16_t>(r + dr) + 3 * (c - 2);
@@ -60,8 +67,9 @@ void BracketStatistics::add(const BracketSet& b) {
     for (int c = 0; c < W; c += ns)
       for (int j = 0; j < P; ++j) {
         const auto* z = b.codes[std::size_t(j)].ptr<std::uint16_t>(r) + 3 * c;
+        const bool top = file_saturated(j, r, c);
         for (int ch = 0; ch < 3; ++ch) {
-          v.noise_codes.push_back(z[ch]);
+          v.noise_codes.push_back(top ? std::uint16_t(max_code) : z[ch]);
           v.noise_activity.push_back(code_activity(b.codes[std::size_t(j)], r, c, ch));
         }
       }

@@ -17,8 +17,10 @@ std::optional<double> exif_number(const Exiv2::ExifData& exif, const char* key, 
   const auto it = exif.findKey(Exiv2::ExifKey(key));
   if (it == exif.end() || it->count() == 0) return std::nullopt;
   // Rationals as exact as double allows (toFloat would round through float).
+  // An unsigned rational whose denominator is 2^31 or more reads as negative through the signed
+  // pair (libtiff writes 1/400 s as 5368709/2^31): those go through toFloat.
   const Exiv2::Rational q = it->toRational(0);
-  const double v = q.second != 0 ? double(q.first) / double(q.second) : double(it->toFloat(0));
+  const double v = q.second > 0 && q.first >= 0 ? double(q.first) / double(q.second) : double(it->toFloat(0));
   if (!std::isfinite(v) || v <= 0)
     throw std::runtime_error(file + ": EXIF " + key + " is not a positive number (" + it->toString() + ")");
   return v;
@@ -30,9 +32,14 @@ ExifExposure read_exif(const std::string& file) {
     auto image = Exiv2::ImageFactory::open(file);
     image->readMetadata();
     const Exiv2::ExifData& exif = image->exifData();
-    out.exposure_s = exif_number(exif, "Exif.Photo.ExposureTime", file);
-    out.iso = exif_number(exif, "Exif.Photo.ISOSpeedRatings", file);
-    out.aperture = exif_number(exif, "Exif.Photo.FNumber", file);
+    // The EXIF IFD, else IFD 0 (TIFF/EP and some RAW formats keep them there).
+    auto either = [&](const char* photo, const char* image) {
+      const auto v = exif_number(exif, photo, file);
+      return v ? v : exif_number(exif, image, file);
+    };
+    out.exposure_s = either("Exif.Photo.ExposureTime", "Exif.Image.ExposureTime");
+    out.iso = either("Exif.Photo.ISOSpeedRatings", "Exif.Image.ISOSpeedRatings");
+    out.aperture = either("Exif.Photo.FNumber", "Exif.Image.FNumber");
   } catch (const Exiv2::Error& e) {
     throw std::runtime_error(file + ": cannot read EXIF: " + e.what());
   }

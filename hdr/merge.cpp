@@ -139,6 +139,9 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
     Scratch& s = scratch.local();
     const std::uint16_t* row[kMax];
     for (int j = 0; j < P; ++j) row[j] = b.codes[std::size_t(j)].ptr<std::uint16_t>(r);
+    const unsigned char* file_sat[kMax] = {};  // the file's own saturation (RAW), when it has one
+    for (int j = 0; j < P && j < int(b.saturated.size()); ++j)
+      if (!b.saturated[std::size_t(j)].empty()) file_sat[j] = b.saturated[std::size_t(j)].ptr<unsigned char>(r);
     float* out = m.radiance.ptr<float>(r);
     float* var = m.variance.ptr<float>(r);
     unsigned char* flag = m.flags.ptr<unsigned char>(r);
@@ -150,7 +153,8 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
       const float* prev = j > 0 ? &s.mask[std::size_t(j - 1) * W] : nullptr;
       const std::uint16_t* z = row[j];
       for (int x = 0; x < W; ++x) {
-        const bool ok = z[3 * x] < sat[0] && z[3 * x + 1] < sat[1] && z[3 * x + 2] < sat[2] && (!prev || prev[x] > 0.f);
+        const bool ok = z[3 * x] < sat[0] && z[3 * x + 1] < sat[1] && z[3 * x + 2] < sat[2] && (!prev || prev[x] > 0.f) &&
+                        !(file_sat[j] && file_sat[j][x]);
         mk[x] = ok ? 1.f : 0.f;
       }
     }

@@ -4,6 +4,7 @@
 #include "hdr/bracket_statistics.h"
 
 #include <chrono>
+#include <limits>
 #include <stdexcept>
 
 namespace rsibr {
@@ -13,9 +14,11 @@ PhotoSetResponse recover_photo_set_response(const std::vector<const PhotoView*>&
   if (views.empty()) throw std::invalid_argument("recover_photo_set_response: no views");
   PhotoSetResponse r;
   BracketStatistics stats(int(views.size()), 4 * options.samples);
+  std::size_t raw_views = 0;
   for (const PhotoView* v : views) {
     try {
       BracketSet b = load_brackets(*v);
+      if (b.raw) ++raw_views;
       if (align) align_brackets(b);
       stats.add(b);
       if (b.size() >= 2) r.from.push_back(v);
@@ -23,12 +26,24 @@ PhotoSetResponse recover_photo_set_response(const std::vector<const PhotoView*>&
       throw std::runtime_error("view " + v->name + ": " + e.what());
     }
   }
+  if (raw_views > 0 && raw_views < views.size())
+    throw std::runtime_error(std::to_string(raw_views) + " of " + std::to_string(views.size()) +
+                             " views are camera RAW files and the others are not: one response cannot serve both");
+  const bool raw = raw_views == views.size();
   if (curve) {
     r.recovery.curve = *curve;
-  } else if (options.model == "identity") {
+  } else if (options.model == "identity" || (raw && options.model == "auto")) {
+    // RAW files are linear by construction (hdr/raw_image.h): no response to recover, and their
+    // saturation is the top code.
     r.recovery.curve = ResponseCurve::identity(stats.max_code);
+    if (raw) r.recovery.curve.saturation = {65535, 65535, 65535};
     for (int c = 0; c < 3; ++c)
       if (options.saturation_code[std::size_t(c)] > 0) r.recovery.curve.saturation[std::size_t(c)] = options.saturation_code[std::size_t(c)];
+    r.recovery.chosen = raw ? "linear (camera RAW: identity response)" : "identity (given)";
+    r.recovery.saturation.code = {r.recovery.curve.saturation_code(0), r.recovery.curve.saturation_code(1),
+                                  r.recovery.curve.saturation_code(2)};
+    r.recovery.saturation.source = raw ? "raw white level" : "default";
+    r.recovery.margin_sigmas = std::numeric_limits<double>::infinity();
   } else {
     r.recovery = recover_response(stats, options);
   }

@@ -1,6 +1,13 @@
 #include "pipeline/chessboard_problem.h"
 
+#include "hdr/raw_image.h"
+
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
 
 #include <stdexcept>
 
@@ -8,7 +15,26 @@ namespace rsibr {
 
 namespace {
 
+// A RAW board (linear codes) as the 8-bit grey picture the corner finder expects: its 99th
+// percentile at 255, a 1/2.2 power in between (corners need contrast in the dark squares too).
+cv::Mat raw_board_grey8(const std::filesystem::path& file) {
+  const cv::Mat codes = read_raw_image(file).codes;
+  cv::Mat grey;
+  cv::cvtColor(codes, grey, cv::COLOR_RGB2GRAY);
+  std::vector<std::uint16_t> v(grey.begin<std::uint16_t>(), grey.end<std::uint16_t>());
+  const auto k = v.begin() + long(v.size() * 99 / 100);
+  std::nth_element(v.begin(), k, v.end());
+  const double top = std::max(1.0, double(*k));
+  cv::Mat out(grey.size(), CV_8UC1);
+  for (int y = 0; y < grey.rows; ++y)
+    for (int x = 0; x < grey.cols; ++x)
+      out.at<unsigned char>(y, x) =
+          cv::saturate_cast<unsigned char>(255.0 * std::pow(std::min(1.0, grey.at<std::uint16_t>(y, x) / top), 1 / 2.2));
+  return out;
+}
+
 cv::Mat read_grey8(const std::filesystem::path& file) {
+  if (is_raw_file(file)) return raw_board_grey8(file);
   cv::Mat img = cv::imread(file.string(), cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
   if (img.empty()) throw std::runtime_error(file.string() + ": cannot read the image");
   if (img.depth() == CV_16U) img.convertTo(img, CV_8U, 1.0 / 257);
