@@ -7,6 +7,7 @@
 #include "core/colour.h"
 #include "core/map_set.h"
 #include "core/output_plan.h"
+#include "core/preview_exposure.h"
 #include "runtime/blend.h"
 #include "runtime/make_warp.h"
 
@@ -15,6 +16,7 @@
 #include <chrono>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 namespace rsibr::cli {
 namespace {
@@ -26,7 +28,7 @@ struct BlendArgs {
   int rings = 16;
   int table = 0;
   double rim_fade = 0.4;
-  float preview_exposure = 0.f;
+  std::optional<float> preview_exposure;  // nullopt: metered (core/preview_exposure.h)
   bool sanitize = false;
 };
 
@@ -73,7 +75,7 @@ int run_blend(const BlendArgs& a) {
   mv.confidence = r.weight;
   out.views.push_back(mv);
   write_map_set(exr, out);
-  if (!preview.empty() && !cv::imwrite(preview, display_encode(r.rgb, a.preview_exposure)))
+  if (!preview.empty() && !cv::imwrite(preview, display_encode(r.rgb, a.preview_exposure ? *a.preview_exposure : preview_exposure(r.rgb))))
     throw std::runtime_error(a.preview + ": cannot write the preview image");
   nlohmann::json j;
   j["maps"] = a.maps;
@@ -116,7 +118,7 @@ Runner add_blend(CLI::App& app) {
                                      "default: the map width)")->check(CLI::Range(3, 4096));
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--preview", a->preview, "Also write a display-encoded PNG");
-  c->add_option("--preview-exposure", a->preview_exposure, "Exposure of the preview in stops");
+  c->add_option("--preview-exposure", a->preview_exposure, "Exposure of the preview in stops (default: the median luminance at mid-grey)");
   c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
                                          "confidences to [0, 1]) instead of failing; the JSON counts them");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");

@@ -10,6 +10,7 @@
 #include "core/exr_io.h"
 #include "core/map_compare.h"
 #include "core/output_plan.h"
+#include "core/preview_exposure.h"
 #include "core/progress.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -113,8 +114,9 @@ int run_compare(const CompareArgs& a) {
     weights.push_back(p.images.weight);
   }
   const double heat_max = a.heat_max > 0 ? a.heat_max : heat_scale_max(errors, weights);
-  const float exposure =
-      std::isfinite(a.exposure) ? a.exposure : auto_exposure(c.before.mean_b[0], c.before.mean_b[1], c.before.mean_b[2]);
+  std::vector<cv::Mat> shown, weighted;
+  for (const auto& p : c.pairs) shown.push_back(p.images.b), weighted.push_back(p.images.weight > 0);
+  const float exposure = std::isfinite(a.exposure) ? a.exposure : preview_exposure(shown, weighted);
 
   nlohmann::json j;
   j["a"] = a.a;

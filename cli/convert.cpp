@@ -6,6 +6,7 @@
 #include "core/colour.h"
 #include "core/exr_io.h"
 #include "core/output_plan.h"
+#include "core/preview_exposure.h"
 #include "core/progress.h"
 #include "core/resample.h"
 
@@ -16,6 +17,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 namespace rsibr::cli {
 namespace {
@@ -27,7 +29,7 @@ struct ConvertArgs {
   double supersampling = 4.0;
   double energy_tolerance = 1e-4;
   bool half = false, sanitize = false, quiet = false;
-  float preview_exposure = 0.f;
+  std::optional<float> preview_exposure;  // nullopt: metered (core/preview_exposure.h)
 };
 
 // The size in the target layout whose texel count matches the input's (same mean texel solid angle).
@@ -83,7 +85,7 @@ int run_convert(const ConvertArgs& a) {
   ExrWriteOptions wo;
   wo.half = a.half;
   write_environment(exr, out, wo);
-  if (!preview.empty() && !cv::imwrite(preview, display_encode(out.pixels, a.preview_exposure)))
+  if (!preview.empty() && !cv::imwrite(preview, display_encode(out.pixels, a.preview_exposure ? *a.preview_exposure : preview_exposure(out.pixels))))
     throw std::runtime_error(a.preview + ": cannot write the preview image");
   const auto t3 = std::chrono::steady_clock::now();
 
@@ -140,7 +142,7 @@ Runner add_convert(CLI::App& app) {
                 "its mean, e.g. a sun; 0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--max-subsamples", a->max_subsamples, "Cap on n for the n x n taps per output texel")->check(CLI::Range(1, 64));
   c->add_option("--preview", a->preview, "Also write a display-encoded PNG of the output");
-  c->add_option("--preview-exposure", a->preview_exposure, "Exposure of the preview in stops");
+  c->add_option("--preview-exposure", a->preview_exposure, "Exposure of the preview in stops (default: the median luminance at mid-grey)");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or report line");
   return [a] { return run_convert(*a); };

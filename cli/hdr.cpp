@@ -10,6 +10,7 @@
 #include "core/colour.h"
 #include "core/output_plan.h"
 #include "core/photo_set.h"
+#include "core/preview_exposure.h"
 #include "core/progress.h"
 #include "core/text.h"
 #include "hdr/alignment.h"
@@ -126,18 +127,10 @@ cv::Matx33f conversion_matrix(const std::string& from, const std::string& to) {
 }
 
 // Preview exposure: the median luminance of unclipped pixels maps to 0.18.
-float auto_exposure(const MergedImage& m) {
-  std::vector<float> lum;
-  for (int r = 0; r < m.radiance.rows; r += 4)
-    for (int x = 0; x < m.radiance.cols; x += 4) {
-      if (m.flags.at<unsigned char>(r, x) & kClipped) continue;
-      const cv::Vec3f v = m.radiance.at<cv::Vec3f>(r, x);
-      lum.push_back(0.2126f * v[0] + 0.7152f * v[1] + 0.0722f * v[2]);
-    }
-  if (lum.empty()) return 0.f;
-  std::nth_element(lum.begin(), lum.begin() + long(lum.size() / 2), lum.end());
-  const float median = lum[lum.size() / 2];
-  return median > 0 ? std::log2(0.18f / median) : 0.f;
+float unclipped_exposure(const MergedImage& m) {
+  cv::Mat unclipped;
+  cv::bitwise_and(m.flags, cv::Scalar(kClipped), unclipped);
+  return preview_exposure(m.radiance, unclipped == 0);
 }
 
 std::string relative_name(const fs::path& file, const fs::path& folder) {
@@ -320,7 +313,7 @@ int run_hdr(const HdrArgs& a) {
           {"flags", "clipped: lower bound (saturated in every bracket); black: nothing recorded; ghost: brackets disagree"}};
       write_merged_exr(file_in_folder(stage, v.name + ".exr").string(), m, attrs);
       staged.push_back({stage / (v.name + ".exr"), file_in_folder(out_dir, v.name + ".exr")});
-      const float stops = a.preview_exposure ? *a.preview_exposure : auto_exposure(m);
+      const float stops = a.preview_exposure ? *a.preview_exposure : unclipped_exposure(m);
       if (!a.no_preview) {
         const cv::Mat png = display_encode(m.radiance, stops);
         const fs::path p = file_in_folder(stage, v.name + ".png");

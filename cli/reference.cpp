@@ -13,6 +13,7 @@
 #include "core/exr_io.h"
 #include "core/mesh.h"
 #include "core/output_plan.h"
+#include "core/preview_exposure.h"
 #include "core/progress.h"
 #include "core/ray_scene.h"
 
@@ -33,6 +34,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace rsibr::cli {
@@ -44,7 +46,7 @@ struct ReferenceArgs {
   int spp = 64, light_samples = 1, bounces = 1;
   std::uint64_t seed = 0;
   bool shadows = true, sanitize = false, quiet = false;
-  float preview_exposure = 0.f;
+  std::optional<float> preview_exposure;  // nullopt: metered on the first frame (core/preview_exposure.h)
 };
 
 // RGBA float32 (RGB radiance, A coverage) with the render's provenance.
@@ -100,6 +102,7 @@ int run_reference(const ReferenceArgs& a) {
   double render_s = 0, write_s = 0;
   long samples = 0, hits = 0, shadow_rays = 0, bounce_rays = 0;
   nlohmann::json frames_json = nlohmann::json::array();
+  std::optional<float> stops = a.preview_exposure;  // every frame of a turntable at one exposure
   for (int k = 0; k < frames; ++k) {
     const Camera cam = k == 0 ? first : make_camera(a.camera, mesh.bounds(), k);
     const auto r0 = std::chrono::steady_clock::now();
@@ -110,7 +113,7 @@ int run_reference(const ReferenceArgs& a) {
     const auto r1 = std::chrono::steady_clock::now();
     const std::string out = frame_path(a.output, a.camera.turntable, k);
     write_render(exr_tmp[std::size_t(k)], im, cam, strings, o);
-    if (!a.preview.empty() && !cv::imwrite(png_tmp[std::size_t(k)], display_encode(im.rgb, a.preview_exposure)))
+    if (!a.preview.empty() && !cv::imwrite(png_tmp[std::size_t(k)], display_encode(im.rgb, *(stops = stops ? stops : preview_exposure(im.rgb)))))
       throw std::runtime_error(frame_path(a.preview, a.camera.turntable, k) + ": cannot write the preview image");
     const auto r2 = std::chrono::steady_clock::now();
     render_s += std::chrono::duration<double>(r1 - r0).count();
@@ -198,7 +201,7 @@ Runner add_reference(CLI::App& app) {
   c->add_option("--layout", a->layout, "Layout of the environment when its header and shape do not tell");
   c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and negative environment values instead of failing");
   c->add_option("--preview", a->preview, "Also write a display-encoded PNG (OCIO; numbered with --turntable)");
-  c->add_option("--preview-exposure", a->preview_exposure, "Exposure of the preview in stops");
+  c->add_option("--preview-exposure", a->preview_exposure, "Exposure of the preview in stops (default: the first frame's median luminance at mid-grey)");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or summary line");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   return [a] { return run_reference(*a); };

@@ -12,6 +12,7 @@
 #include "core/map_set.h"
 #include "core/mesh.h"
 #include "core/output_plan.h"
+#include "core/preview_exposure.h"
 #include "core/progress.h"
 #include "core/text.h"
 #include "runtime/make_warp.h"
@@ -33,6 +34,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 namespace rsibr::cli {
 namespace {
@@ -43,7 +45,7 @@ struct RenderArgs {
   CameraArgs camera;
   int map_size = 0, rings = 16, spp = 1;
   double rim_fade = 0.4;
-  float exposure = 0.f;
+  std::optional<float> exposure;  // nullopt: metered on the first frame (core/preview_exposure.h)
   bool quiet = false, sanitize = false;
 };
 
@@ -127,6 +129,7 @@ int run_render(const RenderArgs& a) {
   nlohmann::json jframes = nlohmann::json::array();
   double render_total = 0;
   long long hits_total = 0;
+  std::optional<float> stops = a.exposure;
   for (int k = 0; k < frames; ++k) {
     const Camera cam = make_camera(a.camera, mesh.bounds(), k);
     RenderStats stats;
@@ -137,7 +140,10 @@ int run_render(const RenderArgs& a) {
     auto p = provenance;
     if (a.camera.turntable > 0) p["frame"] = std::to_string(k) + "/" + std::to_string(a.camera.turntable);
     if (ext == ".exr") write_render_exr(frame_tmp[std::size_t(k)], image, cam, p);
-    else write_rgba_png(frame_tmp[std::size_t(k)], image, a.exposure);
+    else {
+      if (!stops) stops = preview_exposure(image);  // every frame of a turntable at one exposure
+      write_rgba_png(frame_tmp[std::size_t(k)], image, *stops);
+    }
     jframes.push_back({{"path", path},
                        {"seconds", stats.seconds},
                        {"seconds_blend", stats.seconds_blend},
@@ -198,7 +204,7 @@ Runner add_render(CLI::App& app) {
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--spp", a->spp, "Samples per pixel: a perfect square (1, 4, 9, ...)")->check(CLI::Range(1, 1024));
   c->add_option("--env", a->env, "Environment map shown where rays miss (alpha 1)")->check(CLI::ExistingFile);
-  c->add_option("--exposure", a->exposure, "PNG: exposure in stops before the display transform");
+  c->add_option("--exposure", a->exposure, "PNG: exposure in stops before the display transform (default: the first frame's median luminance at mid-grey)");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
                                          "confidences to [0, 1]) instead of failing; the JSON counts them");

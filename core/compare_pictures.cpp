@@ -161,9 +161,4 @@ cv::Mat contact_sheet(const std::vector<cv::Mat>& panels, int thumb_width) {
   return out;
 }
 
-float auto_exposure(double mean_r, double mean_g, double mean_b) {
-  const double y = 0.2126 * mean_r + 0.7152 * mean_g + 0.0722 * mean_b;
-  return y > 0 && std::isfinite(y) ? float(std::log2(0.18 / y)) : 0.f;
-}
-
 }  // namespace rsibr

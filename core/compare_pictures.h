@@ -46,7 +46,6 @@ cv::Mat side_by_side(const SideBySideInput& in, int min_panel = 192, int max_pan
 // (thumb_width pixels), on a dark background.
 cv::Mat contact_sheet(const std::vector<cv::Mat>& panels, int thumb_width = 480);
 
-// Exposure (stops) that puts the given linear RGB mean at display mid-grey 0.18 (0 for black).
-float auto_exposure(double mean_r, double mean_g, double mean_b);
+// The panels' exposure: core/preview_exposure.h.
 
 }  // namespace rsibr

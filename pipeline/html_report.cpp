@@ -4,6 +4,7 @@
 #include "core/colour.h"
 #include "core/compare_pictures.h"
 #include "core/exr_io.h"
+#include "core/preview_exposure.h"
 #include "core/text.h"
 #include "pipeline/light_sources_report.h"
 #include "pipeline/process_pipeline.h"
@@ -296,9 +297,9 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
   if (rec.count("probe")) {
     const auto& s = rec["probe"].summary;
     const EnvMap probe = read_environment((dir / "probe.exr").string());
-    const cv::Scalar mean = cv::mean(probe.pixels);
+    const float stops = preview_exposure(probe.pixels);
     std::vector<unsigned char> png;
-    cv::imencode(".png", display_encode(probe.pixels, auto_exposure(mean[0], mean[1], mean[2])), png);
+    cv::imencode(".png", display_encode(probe.pixels, stops), png);
     h << "<h2>Light probe</h2><p>" << jnum(s["views"]) << " chrome views blended, "
       << num(100 * s["covered_fraction"].get<double>(), 3) << "% of the sphere seen (lat-long, tone-mapped";
     const bool sources = rec.count("sources") && !rec["sources"].summary.value("sources", nlohmann::json::array()).empty();
@@ -306,7 +307,7 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
       // Before (as measured) and after (with the recovered sources), at the final probe's exposure.
       const EnvMap measured = read_environment((dir / "probe-measured.exr").string());
       std::vector<unsigned char> before;
-      cv::imencode(".png", display_encode(measured.pixels, auto_exposure(mean[0], mean[1], mean[2])), before);
+      cv::imencode(".png", display_encode(measured.pixels, stops), before);
       h << "; as measured, then with the recovered sources).</p>" << img_tag(before, "probe as measured") << img_tag(png, "probe");
     } else {
       h << ").</p>" << img_tag(png, "probe");

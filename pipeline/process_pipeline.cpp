@@ -23,6 +23,7 @@
 #include "core/map_set.h"
 #include "core/mesh.h"
 #include "core/photo_set.h"
+#include "core/preview_exposure.h"
 #include "core/progress.h"
 #include "core/resample.h"
 #include "core/view_set.h"
@@ -605,10 +606,9 @@ void step_extract(Context& c) {
     // Each map's mask for the report.
     for (std::size_t b = 0; b < listed.size(); ++b)
       for (const MapView& mv : sets[b].views) {
-        const cv::Scalar mean = cv::mean(mv.rgb);
         const std::string image = mv.attributes.at("image");
         const std::string name = int(b) == chrome_index ? image + ".png" : image + "-" + listed[b].name + ".png";
-        masks[name] = png_bytes(mask_picture(mv, auto_exposure(mean[0], mean[1], mean[2])), name);
+        masks[name] = png_bytes(mask_picture(mv, preview_exposure(mv.rgb)), name);
         if (nlohmann::json* bj = ball_entry(image, listed[b].name)) (*bj)["mask"] = "masks/" + name;
       }
     for (std::size_t b = 0; b < listed.size(); ++b)
@@ -800,7 +800,9 @@ void step_compare(Context& c) {
         weights.push_back(p.images.weight);
       }
       const double heat_max = heat_scale_max(errors, weights);
-      const float exposure = auto_exposure(cmp.before.mean_b[0], cmp.before.mean_b[1], cmp.before.mean_b[2]);
+      std::vector<cv::Mat> shown, weighted;
+      for (const auto& p : cmp.pairs) shown.push_back(p.images.b), weighted.push_back(p.images.weight > 0);
+      const float exposure = preview_exposure(shown, weighted);
       FolderContents files;
       nlohmann::json views = nlohmann::json::array();
       for (std::size_t i = 0; i < cmp.pairs.size(); ++i) {
@@ -878,9 +880,8 @@ void step_render(Context& c) {
     const Eigen::AlignedBox3f box = mesh.bounds();
     const Vec3 pivot = box.center().cast<double>();
     const Camera first = frame_bounds(box, Vec3(0, -0.4, -1), Vec3(0, 1, 0), 40, c.o.render_width, c.o.render_height);
-    // Display exposure: the probe's mean at mid-grey.
-    const cv::Scalar mean = cv::mean(probe.pixels);
-    const float stops = auto_exposure(mean[0], mean[1], mean[2]);
+    // Display exposure: the probe's median at mid-grey (the object reflects the environment).
+    const float stops = preview_exposure(probe.pixels);
     FolderContents files;
     double seconds = 0;
     Progress bar("render", c.o.progress);
