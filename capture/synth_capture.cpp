@@ -77,6 +77,17 @@ cv::Mat dng_codes(const cv::Mat& raw) {
   return codes;
 }
 
+// A Bayer sensor's optical low-pass filter: the birefringent plates split each ray into four
+// spots a pixel apart, so a point (a sun in a chrome ball) covers every colour of the mosaic
+// instead of one photosite (whose colour no demosaic could know). Modelled symmetric, [1 2 1] / 4
+// per axis (the 4-dot split over the pixel's own aperture), so images do not shift.
+cv::Mat optical_low_pass(const cv::Mat& L) {
+  const cv::Mat k = (cv::Mat_<float>(3, 1) << 0.25f, 0.5f, 0.25f);
+  cv::Mat out;
+  cv::sepFilter2D(L, out, CV_32F, k, k, cv::Point(-1, -1), 0, cv::BORDER_REFLECT);
+  return out;
+}
+
 // The DNG's colour: the sensor's sensitivities (no crosstalk) and the camera's white balance as
 // AsShotNeutral (the raw RGB of a neutral, largest 1).
 DngInfo dng_info(const SynthCamera& cam, double t, const SynthExposure& ex) {
@@ -304,6 +315,7 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
         L.at<cv::Vec3f>(y, x) = cv::Vec3f(float(s[0] * v * cam.white_balance[0]), float(s[1] * v * cam.white_balance[1]),
                                           float(s[2] * v * cam.white_balance[2]));
       }
+    if (cam.format == "dng") L = optical_low_pass(L);
     const auto r1 = Clock::now();
     report.seconds_render += secs(r1 - r0);
     if (vi == 0) {

@@ -460,6 +460,14 @@ check "process: a second run skips every step" python3 -c "
 import json; j = json.load(open('$work/p2.json')); assert not any(s['ran'] for s in j['steps']), j['steps']"
 check "process: nothing clipped in minimal-grey, so probe.exr is the measured probe" python3 -c "
 import json; j = json.load(open('$work/p1.json')); s = j['results']['sources']; assert s['regions'] == [] and s['sources'] == [], s"
+# The same rig shot in camera RAW (DNG through LibRaw): no response to recover, the same job.
+"$rsibr" synth "$(dirname "$0")/../../datasets-synthetic/minimal-raw.yaml" --out "$work/praw" -q
+"$rsibr" process "$work/praw/photos" --out "$work/prawout" --poses "$work/praw/truth/truth.yaml" --chrome-fresnel "$fres" \
+  --map-size 32 --turntable 2 --size 64x48 --json "$work/praw.json" -q >/dev/null 2>&1
+check "process: RAW brackets, linear response, captured grey within 10% of computed" python3 -c "
+import json; j = json.load(open('$work/praw.json')); assert all(s['ran'] for s in j['steps']), j['steps']
+assert j['results']['hdr']['recovery']['chosen'].startswith('linear (camera RAW'), j['results']['hdr']['recovery']
+b = j['results']['compare']['balls'][0]; assert b['ball'] == 'grey' and b['overall']['after']['relative_rms'] < 0.1, b['overall']"
 expect_error "process: missing photo set" "nothere" process "$work/nothere" --out "$work/pe1" -q
 expect_error "process: bad --glossy-brdf" "--glossy-brdf" process "$work/psyn/photos" --out "$work/pe7" --glossy-brdf '{type: velvet}' -q
 expect_error "process: unknown --force step" "--force 'merge'" process "$work/psyn/photos" --out "$work/pe2" --force merge -q

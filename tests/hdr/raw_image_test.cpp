@@ -263,7 +263,11 @@ TEST(RawFiles, TheExposureComesFromTheFileWhenTheYamlLeavesItOut) {
 // sun, clipped in every bracket, is flagged, and its clipped channels are never above the truth.
 TEST(RawFiles, SynthesizedDngBracketsMergeToTheTrueRadianceWithTheIdentityResponse) {
   testing::TempDir dir;
-  const SynthScene scene = testing::small_scene(", format: dng, processing: {sensitivity: [0.5, 1, 0.7]}");
+  const std::string camera = ", format: dng, processing: {sensitivity: [0.5, 1, 0.7]}";
+  // Metered, then exposed three stops brighter, so that the sun clips in every bracket.
+  write_synth_capture(testing::small_scene(camera), dir.path() / "metered");
+  const double metered = YAML::LoadFile((dir.path() / "metered" / "truth" / "truth.yaml").string())["camera"]["gain"].as<double>();
+  const SynthScene scene = testing::small_scene(camera + ", gain: " + std::to_string(8 * metered));
   write_synth_capture(scene, dir.path() / "out");
   const PhotoSet set = load_photo_set(dir.path() / "out" / "photos");
   std::vector<const PhotoView*> views;
