@@ -44,7 +44,7 @@ struct HdrArgs {
   std::vector<std::string> views;
   int samples = 20000;
   double smoothness = 1000.0, ghost_sigmas = -1;
-  bool align = false, deghost = false, quiet = false, no_preview = false;
+  bool align = false, no_align = false, deghost = false, quiet = false, no_preview = false;
   std::optional<float> preview_exposure;
 };
 
@@ -204,7 +204,8 @@ int run_hdr(const HdrArgs& a) {
     ro.saturation_code = given_saturation;
     ResponseCurve curve;
     nlohmann::json response_json;
-    const PhotoSetResponse psr = recover_photo_set_response(views, ro, a.align, given_curve);
+    const Alignment alignment = a.align ? Alignment::always : a.no_align ? Alignment::off : Alignment::automatic;
+    const PhotoSetResponse psr = recover_photo_set_response(views, ro, alignment, given_curve);
     const NoiseModel pooled_noise = given_noise ? *given_noise : psr.noise;
     nlohmann::json from = nlohmann::json::array();
     for (const PhotoView* v : psr.from) from.push_back(v->name);
@@ -267,7 +268,7 @@ int run_hdr(const HdrArgs& a) {
       mo.ghost_sigmas = a.ghost_sigmas;
       mo.deghost = a.deghost;
       const auto t0 = std::chrono::steady_clock::now();
-      ViewMerge vm = merge_photo_view(v, curve, pooled_noise, a.align, mo);
+      ViewMerge vm = merge_photo_view(v, curve, pooled_noise, alignment, mo);
       const auto t1 = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                std::chrono::duration<double>(vm.seconds_load));
       const BracketSet& b = vm.brackets;
@@ -308,7 +309,7 @@ int run_hdr(const HdrArgs& a) {
           {"radianceUnit", "X/e: signal over saturation per relative exposure t*iso/100/N^2"},
           {"colourSpace", working},
           {"inputColourSpace", a.input_colour_space.empty() ? working : a.input_colour_space},
-          {"alignment", a.align ? "MTB shifts " + shift_text : "none"},
+          {"alignment", alignment == Alignment::off ? "none" : std::string("MTB (") + to_string(alignment) + "), shifts " + shift_text},
           {"ghosts", a.deghost ? "flagged; longest usable bracket alone" : "flagged; merged as usual"},
           {"flags", "clipped: lower bound (saturated in every bracket); black: nothing recorded; ghost: brackets disagree"}};
       write_merged_exr(file_in_folder(stage, v.name + ".exr").string(), m, attrs);
@@ -346,9 +347,14 @@ int run_hdr(const HdrArgs& a) {
         }
         vj["raw"] = rj;
       }
-      if (a.align) {
-        nlohmann::json sj = nlohmann::json::array();
+      {
+        nlohmann::json sj = nlohmann::json::array(), fj = nlohmann::json::array(), sizes = nlohmann::json::array();
         for (const auto& s : shifts) sj.push_back({s.x, s.y});
+        for (const auto& s : vm.alignment.found) fj.push_back({s.x, s.y});
+        for (const auto& s : b.file_sizes) sizes.push_back({s.width, s.height});
+        vj["alignment"] = {{"mode", to_string(alignment)}, {"shifts", sj}, {"found", fj},
+                           {"mismatch_before", vm.alignment.mismatch_before}, {"mismatch_after", vm.alignment.mismatch_after},
+                           {"file_sizes", sizes}, {"sizes_fitted", b.fitted_sizes}};
         vj["alignment_shifts"] = sj;
       }
       view_list.push_back(vj);
@@ -405,7 +411,10 @@ Runner add_hdr(CLI::App& app) {
   c->add_option("--white-balance", a->white_balance,
                 "camera (default: keep the camera's own) or R,G,B gains applied to the merged radiance");
   c->add_option("--noise", a->noise, "Given noise model SHOT,READ: var(X) = SHOT*X + READ, X normalised to saturation");
-  c->add_flag("--align", a->align, "Align brackets by small shifts (OpenCV median threshold bitmaps)");
+  auto* on = c->add_flag("--align", a->align,
+                         "Apply every shift the median threshold bitmaps find (default: only shifts that make the "
+                         "brackets agree better; files of different sizes are registered on the middle one)");
+  c->add_flag("--no-align", a->no_align, "Never shift brackets; files of different sizes are an error")->excludes(on);
   c->add_flag("--deghost", a->deghost, "Ghost pixels take the longest usable bracket alone instead of a blend");
   c->add_option("--ghost-sigmas", a->ghost_sigmas,
                 "Ghost threshold in standard deviations of chi-square (default: 6, 8 for JPEG)")->check(CLI::Range(0.0, 1e6));

@@ -31,17 +31,46 @@ int to_codes(const cv::Mat& in, cv::Mat& out, const std::string& name, bool bgr)
   return in.depth() == CV_8U ? 255 : 65535;
 }
 
+std::string size_text(const cv::Mat& m) { return std::to_string(m.cols) + "x" + std::to_string(m.rows); }
+
+// `in` centred on a canvas of `size`: cropped where it is larger, padded with its per-channel
+// median code where it is smaller; `covered` is 255 where the canvas holds the file's pixels.
+cv::Mat centred(const cv::Mat& in, cv::Size size, cv::Mat& covered) {
+  cv::Scalar fill;
+  for (int c = 0; c < 3; ++c) {
+    cv::Mat ch;
+    cv::extractChannel(in, ch, c);
+    std::vector<std::uint16_t> v(ch.begin<std::uint16_t>(), ch.end<std::uint16_t>());
+    std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+    fill[c] = v[v.size() / 2];
+  }
+  cv::Mat out(size, in.type(), fill);
+  covered = cv::Mat(size, CV_8UC1, cv::Scalar(0));
+  const int ox = (size.width - in.cols) / 2, oy = (size.height - in.rows) / 2;  // where in's (0,0) lands
+  const cv::Rect dst = cv::Rect(ox, oy, in.cols, in.rows) & cv::Rect(0, 0, size.width, size.height);
+  in(cv::Rect(dst.x - ox, dst.y - oy, dst.width, dst.height)).copyTo(out(dst));
+  covered(dst).setTo(255);
+  return out;
+}
+
 BracketSet assemble(std::vector<cv::Mat> codes, std::vector<int> ranges, std::vector<double> exposures,
-                    std::vector<ResolvedExposure> metadata, std::vector<std::string> names) {
+                    std::vector<ResolvedExposure> metadata, std::vector<std::string> names, bool fit_sizes = false) {
   const std::size_t n = codes.size();
   if (n == 0) throw std::runtime_error("no brackets");
+  bool sizes_differ = false;
   for (std::size_t j = 0; j < n; ++j) {
     if (!(std::isfinite(exposures[j]) && exposures[j] > 0))
       throw std::runtime_error(names[j] + ": exposure must be positive and finite");
-    if (codes[j].size() != codes[0].size())
-      throw std::runtime_error(names[j] + ": size " + std::to_string(codes[j].cols) + "x" + std::to_string(codes[j].rows) +
-                               " differs from " + names[0] + " (" + std::to_string(codes[0].cols) + "x" +
-                               std::to_string(codes[0].rows) + ")");
+    if (codes[j].size() != codes[0].size()) {
+      const double dx = std::abs(codes[j].cols - codes[0].cols) / double(std::max(codes[j].cols, codes[0].cols));
+      const double dy = std::abs(codes[j].rows - codes[0].rows) / double(std::max(codes[j].rows, codes[0].rows));
+      if (!fit_sizes || dx > 0.1 || dy > 0.1)
+        throw std::runtime_error(names[j] + ": size " + size_text(codes[j]) + " differs from " + names[0] + " (" +
+                                 size_text(codes[0]) + ")" +
+                                 (fit_sizes ? ": more than 10% a side, not the same framing"
+                                            : "; brackets of different sizes need alignment (rsibr hdr --align auto)"));
+      sizes_differ = true;
+    }
     if (ranges[j] != ranges[0]) throw std::runtime_error(names[j] + ": bit depth differs from " + names[0]);
   }
   std::vector<std::size_t> order(n);
@@ -58,12 +87,20 @@ BracketSet assemble(std::vector<cv::Mat> codes, std::vector<int> ranges, std::ve
     s.metadata.push_back(metadata[j]);
     s.files.push_back(names[j]);
   }
+  for (const cv::Mat& c : s.codes) s.file_sizes.push_back(c.size());
+  if (sizes_differ) {
+    // The middle bracket's frame (the one alignment registers the others to).
+    const cv::Size frame = s.codes[n / 2].size();
+    s.fitted_sizes = true;
+    s.covered.resize(n);
+    for (std::size_t k = 0; k < n; ++k) s.codes[k] = centred(s.codes[k], frame, s.covered[k]);
+  }
   return s;
 }
 
 }  // namespace
 
-BracketSet load_brackets(const PhotoView& view) {
+BracketSet load_brackets(const PhotoView& view, bool fit_sizes) {
   std::vector<cv::Mat> codes;
   std::vector<int> ranges;
   std::vector<double> exposures;
@@ -121,8 +158,11 @@ BracketSet load_brackets(const PhotoView& view) {
   };
   std::vector<Keyed> keyed;
   for (std::size_t j = 0; j < raw_info.size(); ++j) keyed.push_back({exposures[j], raw_info[j], raw_saturated[j]});
-  BracketSet s = assemble(std::move(codes), std::move(ranges), std::move(exposures), std::move(metadata), std::move(names));
+  BracketSet s =
+      assemble(std::move(codes), std::move(ranges), std::move(exposures), std::move(metadata), std::move(names), fit_sizes);
   if (raw_count > 0) {
+    if (s.fitted_sizes)
+      throw std::runtime_error("view " + view.name + ": RAW brackets of different sizes (one sensor makes one size)");
     s.raw = true;
     std::stable_sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) { return a.exposure < b.exposure; });
     for (Keyed& k : keyed) s.raw_info.push_back(std::move(k.info)), s.saturated.push_back(std::move(k.saturated));

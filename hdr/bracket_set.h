@@ -28,6 +28,12 @@ struct BracketSet {
   // saturated (RAW: hdr/raw_image.h), whatever its codes; the merge leaves those pixels out of
   // the bracket (and so, by the consistency rule, out of every longer one).
   std::vector<cv::Mat> saturated;
+  // Per bracket (same order), or empty: CV_8UC1, zero where the bracket holds no data (padding
+  // of a smaller file, the edge a shift uncovered: hdr/alignment.h); the merge leaves those
+  // pixels out of that bracket only.
+  std::vector<cv::Mat> covered;
+  bool fitted_sizes = false;                // files of different sizes, centred on the middle bracket's frame
+  std::vector<cv::Size> file_sizes;         // per bracket, as read
 
   int rows() const { return codes.empty() ? 0 : codes[0].rows; }
   int cols() const { return codes.empty() ? 0 : codes[0].cols; }
@@ -38,10 +44,13 @@ struct BracketSet {
 // equal channels) or LibRaw (RAW files, by extension: is_raw_file), and their exposures
 // (resolve_exposure; for RAW files the file's own shutter, ISO and aperture fill what
 // photoset.yaml leaves out, source "raw"). Every RAW bracket of the view is developed with the
-// white balance of its first listed bracket, so the brackets share one colour scale. Throws
+// white balance of its first listed bracket, so the brackets share one colour scale.
+// fit_sizes: files whose sizes differ (hand-cropped brackets) by at most 10% a side are centred on
+// the middle bracket's frame, padded with their median code and marked uncovered there, for
+// align_brackets to register; without it, or beyond 10%, differing sizes are an error. Throws
 // std::runtime_error naming the file for unreadable images, other depths, mixed sizes or depths,
 // RAW mixed with other files, or two brackets with the same exposure.
-BracketSet load_brackets(const PhotoView& view);
+BracketSet load_brackets(const PhotoView& view, bool fit_sizes = false);
 
 // Builds a set from in-memory images (CV_8UC3 or CV_16UC3, RGB) and exposures; sorts by exposure.
 // Same checks as load_brackets. For tests and benchmarks (lossy: the images went through JPEG).

@@ -32,6 +32,12 @@ void BracketStatistics::add(const BracketSet& b) {
     return std::size_t(j) < b.saturated.size() && !b.saturated[std::size_t(j)].empty() &&
            b.saturated[std::size_t(j)].at<unsigned char>(r, c) != 0;
   };
+  // Pixels some bracket does not cover (padding, a shifted edge) are no evidence.
+  auto covered_by_all = [&](int r, int c) {
+    for (const cv::Mat& m : b.covered)
+      if (!m.empty() && m.at<unsigned char>(r, c) == 0) return false;
+    return true;
+  };
   ViewStatistics v;
   v.exposures = b.exposures;
   v.brackets = P;
@@ -41,6 +47,7 @@ void BracketStatistics::add(const BracketSet& b) {
   const int border = 2;
   for (int r = border + stride / 2; r < H - border; r += stride)
     for (int c = border + stride / 2; c < W - border; c += stride) {
+      if (!covered_by_all(r, c)) continue;
       for (int j = 0; j < P; ++j) {
         const cv::Mat& img = b.codes[std::size_t(j)];
         const auto z = img.at<cv::Vec3w>(r, c);
@@ -64,7 +71,8 @@ void BracketStatistics::add(const BracketSet& b) {
   const double want_noise = std::max(20000.0, double(noise_pixels_) / expected_views_);
   const int ns = std::max(1, int(std::sqrt(double(H) * W / want_noise)));
   for (int r = 0; r < H; r += ns)
-    for (int c = 0; c < W; c += ns)
+    for (int c = 0; c < W; c += ns) {
+      if (!covered_by_all(r, c)) continue;
       for (int j = 0; j < P; ++j) {
         const auto* z = b.codes[std::size_t(j)].ptr<std::uint16_t>(r) + 3 * c;
         const bool top = file_saturated(j, r, c);
@@ -73,6 +81,7 @@ void BracketStatistics::add(const BracketSet& b) {
           v.noise_activity.push_back(code_activity(b.codes[std::size_t(j)], r, c, ch));
         }
       }
+    }
   // Pair histograms (every pixel of a sparse grid).
   const int hs = std::max(1, int(std::sqrt(double(H) * W / 250000.0)));
   for (int j = 0; j + 1 < P; ++j) {

@@ -119,6 +119,7 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
   // Per-thread scratch rows.
   struct Scratch {
     std::vector<float> mask, L, B, T, V, sw, sw2v, num, pilot, chi2, n;
+    std::vector<unsigned char> chain;
   };
   tbb::enumerable_thread_specific<Scratch> scratch([&] {
     Scratch s;
@@ -133,6 +134,7 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
     s.pilot.resize(std::size_t(3) * W);
     s.chi2.resize(std::size_t(W));
     s.n.resize(std::size_t(W));
+    s.chain.resize(std::size_t(W));
     return s;
   });
   parallel_for_rows(H, [&](int r) {
@@ -142,20 +144,26 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
     const unsigned char* file_sat[kMax] = {};  // the file's own saturation (RAW), when it has one
     for (int j = 0; j < P && j < int(b.saturated.size()); ++j)
       if (!b.saturated[std::size_t(j)].empty()) file_sat[j] = b.saturated[std::size_t(j)].ptr<unsigned char>(r);
+    const unsigned char* cover[kMax] = {};  // where the bracket holds data (a shifted or padded file), when not everywhere
+    for (int j = 0; j < P && j < int(b.covered.size()); ++j)
+      if (!b.covered[std::size_t(j)].empty()) cover[j] = b.covered[std::size_t(j)].ptr<unsigned char>(r);
+    auto covers = [&](int j, int x) { return !cover[j] || cover[j][x] != 0; };
     float* out = m.radiance.ptr<float>(r);
     float* var = m.variance.ptr<float>(r);
     unsigned char* flag = m.flags.ptr<unsigned char>(r);
-    // Usable brackets: no channel saturated, here or in a shorter bracket.
+    // Usable brackets: covered, and no channel saturated, here or in a shorter bracket that covers
+    // the pixel (s.chain: not saturated so far).
     std::fill(s.n.begin(), s.n.end(), 0.f);
     std::fill(s.chi2.begin(), s.chi2.end(), 0.f);
+    std::fill(s.chain.begin(), s.chain.end(), 1);
     for (int j = 0; j < P; ++j) {
       float* mk = &s.mask[std::size_t(j) * W];
-      const float* prev = j > 0 ? &s.mask[std::size_t(j - 1) * W] : nullptr;
       const std::uint16_t* z = row[j];
       for (int x = 0; x < W; ++x) {
-        const bool ok = z[3 * x] < sat[0] && z[3 * x + 1] < sat[1] && z[3 * x + 2] < sat[2] && (!prev || prev[x] > 0.f) &&
-                        !(file_sat[j] && file_sat[j][x]);
-        mk[x] = ok ? 1.f : 0.f;
+        const bool here = covers(j, x);
+        if (here && (z[3 * x] >= sat[0] || z[3 * x + 1] >= sat[1] || z[3 * x + 2] >= sat[2] || (file_sat[j] && file_sat[j][x])))
+          s.chain[std::size_t(x)] = 0;
+        mk[x] = here && s.chain[std::size_t(x)] ? 1.f : 0.f;
       }
     }
     // The bracket estimates and the signal-independent part of their variances, every channel.
@@ -252,7 +260,10 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
       }
     for (int x = 0; x < W; ++x) {
       unsigned char f = 0;
-      const std::uint16_t* zl = row[P - 1] + 3 * x;
+      int longest = P - 1, shortest = 0;  // that cover the pixel (the middle bracket always does)
+      while (longest > 0 && !covers(longest, x)) --longest;
+      while (shortest < P - 1 && !covers(shortest, x)) ++shortest;
+      const std::uint16_t* zl = row[longest] + 3 * x;
       if (zl[0] == 0 && zl[1] == 0 && zl[2] == 0) f |= kBlack;
       const float n = s.n[std::size_t(x)];
       // One bracket's value and variance (clipped: the shortest; deghosted: the longest usable).
@@ -266,7 +277,7 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
       if (n == 0.f) {
         // Saturated in every bracket: the shortest bracket's value, a lower bound.
         f |= kClipped;
-        single(0);
+        single(shortest);
       } else if (n > 1.f) {
         // The channels' residuals are correlated (a JPEG's luma error and a colour matrix's shot noise
         // reach all three), so the test takes them as one measurement: mean chi2 over channels

@@ -10,16 +10,16 @@
 namespace rsibr {
 
 PhotoSetResponse recover_photo_set_response(const std::vector<const PhotoView*>& views, const RecoveryOptions& options,
-                                            bool align, const std::optional<ResponseCurve>& curve) {
+                                            Alignment align, const std::optional<ResponseCurve>& curve) {
   if (views.empty()) throw std::invalid_argument("recover_photo_set_response: no views");
   PhotoSetResponse r;
   BracketStatistics stats(int(views.size()), 4 * options.samples);
   std::size_t raw_views = 0;
   for (const PhotoView* v : views) {
     try {
-      BracketSet b = load_brackets(*v);
+      BracketSet b = load_brackets(*v, align != Alignment::off);
       if (b.raw) ++raw_views;
-      if (align) align_brackets(b);
+      align_brackets(b, align);
       stats.add(b);
       if (b.size() >= 2) r.from.push_back(v);
     } catch (const std::runtime_error& e) {
@@ -52,17 +52,17 @@ PhotoSetResponse recover_photo_set_response(const std::vector<const PhotoView*>&
 }
 
 ViewMerge merge_photo_view(const PhotoView& view, const ResponseCurve& curve, const std::optional<NoiseModel>& noise,
-                           bool align, const MergeOptions& options, const Vignetting* vignetting) {
+                           Alignment align, const MergeOptions& options, const Vignetting* vignetting) {
   const auto t0 = std::chrono::steady_clock::now();
   ViewMerge m;
-  m.brackets = load_brackets(view);
+  m.brackets = load_brackets(view, align != Alignment::off);
   const BracketSet& b = m.brackets;
   if (b.max_code != curve.max_code)
     throw std::runtime_error("view " + view.name + ": " + std::to_string(b.max_code == 255 ? 8 : 16) +
                              "-bit photos, but the response curve is for " +
                              std::to_string(curve.max_code == 255 ? 8 : 16) + "-bit input");
-  m.shifts.assign(b.size(), cv::Point(0, 0));
-  if (align) m.shifts = align_brackets(m.brackets);
+  m.alignment = align_brackets(m.brackets, align);
+  m.shifts = m.alignment.shifts;
   m.noise = noise ? *noise : estimate_noise(std::vector<const BracketSet*>{&b}, curve);
   const auto t1 = std::chrono::steady_clock::now();
   m.image = merge_brackets(b, curve, m.noise, options);

@@ -1,9 +1,11 @@
 // A photo set's views merged the way rsibr hdr and rsibr process both do it: the camera response
 // and the noise model recovered once, from every view (loaded one at a time, aligned when asked;
-// bracket_statistics.h), then each view's brackets loaded again and merged.
+// bracket_statistics.h), then each view's brackets loaded again and merged. `align`: how brackets
+// are registered first (hdr/alignment.h; files of different sizes are accepted unless off).
 #pragma once
 
 #include "core/photo_set.h"
+#include "hdr/alignment.h"
 #include "hdr/bracket_set.h"
 #include "hdr/merge.h"
 #include "hdr/noise_model.h"
@@ -29,11 +31,12 @@ struct PhotoSetResponse {
 // std::runtime_error("view <name>: <problem>") when a view cannot be read, or "<problem>" when the
 // recovery fails.
 PhotoSetResponse recover_photo_set_response(const std::vector<const PhotoView*>& views, const RecoveryOptions& options,
-                                            bool align, const std::optional<ResponseCurve>& curve = std::nullopt);
+                                            Alignment align, const std::optional<ResponseCurve>& curve = std::nullopt);
 
 struct ViewMerge {
   BracketSet brackets;
   std::vector<cv::Point> shifts;  // per bracket, (0, 0) without alignment
+  AlignmentResult alignment;      // what registration found and did
   NoiseModel noise;
   MergedImage image;
   double seconds_load = 0, seconds_merge = 0;  // loading + alignment + noise estimate; the merge
@@ -43,6 +46,6 @@ struct ViewMerge {
 // merged radiance and variance (hdr/vignetting.h). Throws std::runtime_error("view <name>: ...")
 // when the photos' bit depth is not the curve's.
 ViewMerge merge_photo_view(const PhotoView& view, const ResponseCurve& curve, const std::optional<NoiseModel>& noise,
-                           bool align, const MergeOptions& options = {}, const Vignetting* vignetting = nullptr);
+                           Alignment align, const MergeOptions& options = {}, const Vignetting* vignetting = nullptr);
 
 }  // namespace rsibr

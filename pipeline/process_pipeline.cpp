@@ -231,7 +231,7 @@ void step_hdr(Context& c) {
     fs::create_directories(c.dir / "hdr");
     std::vector<const PhotoView*> all;
     for (const PhotoView& v : c.set.views) all.push_back(&v);
-    const PhotoSetResponse psr = recover_photo_set_response(all, RecoveryOptions{}, false);
+    const PhotoSetResponse psr = recover_photo_set_response(all, RecoveryOptions{}, Alignment::automatic);
     const ResponseRecovery& rec = psr.recovery;
     const std::string from = std::to_string(psr.from.size()) + " views (all with brackets)";
     const ResponseCurve& curve = rec.curve;
@@ -262,7 +262,7 @@ void step_hdr(Context& c) {
     Progress bar("hdr", c.o.progress);
     for (std::size_t i = 0; i < c.set.views.size(); ++i) {
       const PhotoView& v = c.set.views[i];
-      const ViewMerge vm = merge_photo_view(v, curve, psr.noise, false, {}, &vig);
+      const ViewMerge vm = merge_photo_view(v, curve, psr.noise, Alignment::automatic, {}, &vig);
       const BracketSet& b = vm.brackets;
       const NoiseModel& noise = vm.noise;
       const MergedImage& m = vm.image;
@@ -274,9 +274,12 @@ void step_hdr(Context& c) {
                         {"producer", "rsibr process (hdr step)"}});
       r.outputs.push_back(exr);
       const double px = double(m.radiance.total());
+      nlohmann::json shifts = nlohmann::json::array();
+      for (const cv::Point& s : vm.shifts) shifts.push_back({s.x, s.y});
       views.push_back({{"name", v.name}, {"brackets", b.size()}, {"clipped_fraction", m.clipped / px},
                        {"clipped_pixels", m.clipped},
-                       {"ghost_fraction", m.ghost / px}, {"noise_read", noise.read}, {"noise_shot", noise.shot}});
+                       {"ghost_fraction", m.ghost / px}, {"noise_read", noise.read}, {"noise_shot", noise.shot},
+                       {"alignment_shifts", shifts}, {"sizes_fitted", b.fitted_sizes}});
       bar.update(double(i + 1) / double(c.set.views.size()));
     }
     bar.done();

@@ -68,11 +68,11 @@ TEST(OrientationFromPhotos, AnEightViewBracketedRingIsOrientedWithinTheIssuesFiv
   ASSERT_EQ(set.views.size(), 8u);
   std::vector<const PhotoView*> all;
   for (const PhotoView& v : set.views) all.push_back(&v);
-  const PhotoSetResponse response = recover_photo_set_response(all, RecoveryOptions{}, false);
+  const PhotoSetResponse response = recover_photo_set_response(all, RecoveryOptions{}, Alignment::off);
   std::vector<ViewImage> images;
   std::vector<std::string> names;
   for (const PhotoView& v : set.views) {
-    const ViewMerge m = merge_photo_view(v, response.recovery.curve, std::nullopt, false);
+    const ViewMerge m = merge_photo_view(v, response.recovery.curve, std::nullopt, Alignment::off);
     ViewImage vi;
     vi.radiance = m.image.radiance;
     vi.flags = m.image.flags;

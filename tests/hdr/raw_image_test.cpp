@@ -272,14 +272,14 @@ TEST(RawFiles, SynthesizedDngBracketsMergeToTheTrueRadianceWithTheIdentityRespon
   const PhotoSet set = load_photo_set(dir.path() / "out" / "photos");
   std::vector<const PhotoView*> views;
   for (const PhotoView& v : set.views) views.push_back(&v);
-  const PhotoSetResponse psr = recover_photo_set_response(views, RecoveryOptions{}, false);
+  const PhotoSetResponse psr = recover_photo_set_response(views, RecoveryOptions{}, Alignment::off);
   EXPECT_EQ(psr.recovery.curve.model, "identity");
   EXPECT_NE(psr.recovery.chosen.find("RAW"), std::string::npos);
   EXPECT_EQ(psr.recovery.curve.saturation_code(1), 65535);
   const YAML::Node ty = YAML::LoadFile((dir.path() / "out" / "truth" / "truth.yaml").string());
   const double k = ty["camera"]["gain_normalised"].as<double>();
   for (const PhotoView& v : set.views) {
-    const ViewMerge m = merge_photo_view(v, psr.recovery.curve, psr.noise, false);
+    const ViewMerge m = merge_photo_view(v, psr.recovery.curve, psr.noise, Alignment::automatic);
     const cv::Mat truth = read_truth_image(dir.path() / "out" / "truth" / "views" / (v.name + "_radiance.exr"));
     std::vector<double> ratios[3];
     long clipped = 0, clipped_above = 0;
