@@ -16,6 +16,7 @@
 #include "core/exr_io.h"
 #include "core/patterns.h"
 
+#include <exiv2/exiv2.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <yaml-cpp/yaml.h>
@@ -56,6 +57,30 @@ void write_codes(const fs::path& file, const cv::Mat& codes, const std::string& 
   const std::string ext = format == "png" ? ".png" : format == "jpeg" ? ".jpg" : ".tif";
   if (!cv::imencode(ext, bgr, bytes, params)) throw std::runtime_error(file.string() + ": cannot encode");
   write_bytes(file, bytes);
+}
+
+// The EXIF a camera writes into each photo (exiv2; JPEG, PNG and TIFF): the exposure, the focal
+// length (fx over the sensor's width) and its 35 mm equivalent on the diagonal, in whole mm.
+void write_photo_exif(const fs::path& file, const SynthCamera& cam, double t, const SynthExposure& ex) {
+  const double fx = cam.lens.intrinsics().at(0);
+  const double focal_mm = fx * cam.sensor_width_mm / cam.lens.width();
+  const double f35 = std::round(fx * 43.266615305567875 / std::hypot(double(cam.lens.width()), double(cam.lens.height())));
+  try {
+    auto image = Exiv2::ImageFactory::open(file.string());
+    image->readMetadata();
+    Exiv2::ExifData& exif = image->exifData();
+    exif["Exif.Image.Make"] = "rsibr";
+    exif["Exif.Image.Model"] = cam.name;
+    // Rationals with a fixed denominator: what cameras store (1/250 s, f/8, 35.5 mm).
+    exif["Exif.Photo.ExposureTime"] = Exiv2::URational(std::uint32_t(std::lround(t * 1e6)), 1000000u);
+    exif["Exif.Photo.FNumber"] = Exiv2::URational(std::uint32_t(std::lround(ex.aperture * 10)), 10u);
+    exif["Exif.Photo.ISOSpeedRatings"] = std::uint16_t(std::lround(ex.iso));
+    exif["Exif.Photo.FocalLength"] = Exiv2::URational(std::uint32_t(std::lround(focal_mm * 100)), 100u);
+    exif["Exif.Photo.FocalLengthIn35mmFilm"] = std::uint16_t(f35);
+    image->writeMetadata();
+  } catch (const Exiv2::Error& e) {
+    throw std::runtime_error(file.string() + ": cannot write EXIF: " + e.what());
+  }
 }
 
 std::string ext_of(const std::string& format) {
@@ -362,6 +387,7 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
                                              *cam.processing, response, max_code)
                                : expose_bracket(L, e, noise, response, max_code, scene.seed, stream);
         write_codes(file, codes, cam.format, cam.jpeg_quality);
+        write_photo_exif(file, cam, times[bi], scene.exposure);
       }
       pv.brackets.push_back({file, times[bi], scene.exposure.iso, scene.exposure.aperture});
       YAML::Node tb;

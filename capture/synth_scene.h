@@ -102,6 +102,9 @@ struct SynthCamera {
   Vec3 white_balance = Vec3::Ones();
   double full_well = 2e4, read_noise = 3;
   std::optional<double> gain;  // electrons per unit radiance-exposure; auto (median metering) when absent
+  // The sensor's width: with the lens's fx it gives the EXIF FocalLength the photos carry
+  // (FocalLengthIn35mmFilm: the diagonal equivalent, in whole mm, as cameras write it).
+  double sensor_width_mm = 23.5;
 };
 
 struct SynthChessboards {

@@ -5,6 +5,7 @@
 #include "calib/ball_identification.h"
 #include "calib/ball_locator.h"
 #include "calib/intrinsics.h"
+#include "calib/photo_optics.h"
 #include "calib/lambert_consensus.h"
 #include "calib/occluders.h"
 #include "calib/probe.h"
@@ -156,11 +157,31 @@ void step_calibrate(Context& c) {
     inputs.push_back(*c.set.camera_model);
     settings = {{"source", "photo set"}};
   } else {
-    throw std::invalid_argument(c.o.photoset + ": no chessboards and no camera model; give the lens with --lens FILE");
+    // The photos' own metadata: the first view's first bracket (calib/photo_optics.h).
+    if (c.set.views.empty() || c.set.views[0].brackets.empty())
+      throw std::invalid_argument(c.o.photoset + ": no views");
+    inputs.push_back(c.set.views[0].brackets[0].file);
+    settings = {{"source", "exif"}};
   }
   run_step(c, "calibrate", settings, inputs, [&](StepRecord& r) {
     nlohmann::json s;
-    if (settings["source"] != "chessboards") {
+    if (settings["source"] == "exif") {
+      const BracketSet b = load_brackets(c.set.views[0], true);
+      const PhotoOptics optics = read_photo_optics(inputs.front());
+      const std::optional<OpticsLens> guess = pinhole_from_optics(optics, b.cols(), b.rows());
+      if (!guess)
+        throw std::invalid_argument(inputs.front().string() +
+                                    ": no chessboards, no camera model and no usable focal length in the photo's "
+                                    "metadata (FocalLengthIn35mmFilm, or FocalLength of a camera lensfun knows); "
+                                    "give the lens with --lens FILE");
+      guess->lens.write(out);
+      s = {{"source", "exif"}, {"model", guess->lens.name()}, {"intrinsics", guess->lens.intrinsics()},
+           {"focal_px", guess->focal_px}, {"focal_sigma_relative", guess->sigma_relative},
+           {"focal_from", guess->source}, {"camera", optics.make + " " + optics.model}, {"lens", optics.lens},
+           {"assumed", "a pinhole: principal point at the image centre, no distortion"}};
+      if (optics.focal_mm) s["focal_mm"] = *optics.focal_mm;
+      if (optics.focal_35mm) s["focal_35mm"] = *optics.focal_35mm;
+    } else if (settings["source"] != "chessboards") {
       const LensModel lens = LensModel::read(inputs.front());
       lens.write(out);
       s = {{"source", inputs.front().string()}, {"model", lens.name()}, {"intrinsics", lens.intrinsics()}};

@@ -1,7 +1,8 @@
 // rsibr process: a photo set to light probe, captured and computed maps, their comparison, a
 // turntable render and an HTML report, as a graph of resumable steps (pipeline/step_record.h):
 //
-//   calibrate  chessboards -> DIR/camera.cameramodel (mrcal, model by cross-validation), or --lens
+//   calibrate  chessboards -> DIR/camera.cameramodel (mrcal, model by cross-validation), or --lens,
+//              or the photo set's model, or a pinhole from the photos' EXIF (calib/photo_optics.h)
 //   hdr        brackets -> DIR/hdr/<view>.exr, DIR/hdr/response.json (response recovered once),
 //              DIR/hdr/vignetting.json (estimated from the chessboards, divided out of every view)
 //   orient     -> DIR/poses.yaml (world_from_cam per view: solved from the chrome ball's features,

@@ -468,6 +468,16 @@ check "process: RAW brackets, linear response, captured grey within 10% of compu
 import json; j = json.load(open('$work/praw.json')); assert all(s['ran'] for s in j['steps']), j['steps']
 assert j['results']['hdr']['recovery']['chosen'].startswith('linear (camera RAW'), j['results']['hdr']['recovery']
 b = j['results']['compare']['balls'][0]; assert b['ball'] == 'grey' and b['overall']['after']['relative_rms'] < 0.1, b['overall']"
+# No chessboards and no camera model: the lens comes from the photos' EXIF (a pinhole from the
+# 35 mm-equivalent focal length), within its stated sigma of the true focal length.
+grep -v '^chessboards:' "$pspec" >"$work/noboards.yaml"
+"$rsibr" synth "$work/noboards.yaml" --out "$work/pnb" -q
+"$rsibr" process "$work/pnb/photos" --out "$work/pnbout" --poses "$work/pnb/truth/truth.yaml" --chrome-fresnel "$fres" \
+  --map-size 32 --turntable 2 --size 64x48 --json "$work/pnb.json" -q >/dev/null 2>&1
+check "process: no chessboards, the lens from EXIF within its stated sigma" python3 -c "
+import json; j = json.load(open('$work/pnb.json')); assert all(s['ran'] for s in j['steps']), j['steps']
+c = j['results']['calibrate']; assert c['source'] == 'exif' and c['model'] == 'LENSMODEL_PINHOLE', c
+assert abs(c['focal_px'] / 700 - 1) < c['focal_sigma_relative'], c"
 expect_error "process: missing photo set" "nothere" process "$work/nothere" --out "$work/pe1" -q
 expect_error "process: bad --glossy-brdf" "--glossy-brdf" process "$work/psyn/photos" --out "$work/pe7" --glossy-brdf '{type: velvet}' -q
 expect_error "process: unknown --force step" "--force 'merge'" process "$work/psyn/photos" --out "$work/pe2" --force merge -q

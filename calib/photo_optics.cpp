@@ -1,0 +1,114 @@
+#include "calib/photo_optics.h"
+
+#include <exiv2/exiv2.hpp>
+#include <lensfun/lensfun.h>
+#include <libraw/libraw.h>
+
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+
+namespace rsibr {
+namespace {
+
+constexpr double kFullFrameDiagonalMm = 43.266615305567875;  // hypot(36, 24)
+constexpr double kFocusSigma = 0.03;
+
+std::optional<double> positive(const Exiv2::ExifData& exif, const char* key) {
+  const auto it = exif.findKey(Exiv2::ExifKey(key));
+  if (it == exif.end() || it->count() == 0) return std::nullopt;
+  const double v = it->toFloat(0);
+  return std::isfinite(v) && v > 0 ? std::optional<double>(v) : std::nullopt;
+}
+
+std::string text(const Exiv2::ExifData& exif, const char* key) {
+  const auto it = exif.findKey(Exiv2::ExifKey(key));
+  if (it == exif.end()) return {};
+  std::string s = it->toString();
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\0')) s.pop_back();
+  return s;
+}
+
+// lensfun's database, loaded once (its files under /usr/share/lensfun).
+const lfDatabase* lens_database() {
+  static std::once_flag once;
+  static lfDatabase* db = nullptr;
+  std::call_once(once, [] {
+    db = lf_db_new();
+    if (db && lf_db_load(db) != LF_NO_ERROR) {
+      lf_db_destroy(db);
+      db = nullptr;
+    }
+  });
+  return db;
+}
+
+}  // namespace
+
+PhotoOptics read_photo_optics(const std::filesystem::path& image) {
+  PhotoOptics o;
+  bool exif_read = false;
+  try {
+    auto img = Exiv2::ImageFactory::open(image.string());
+    img->readMetadata();
+    const Exiv2::ExifData& exif = img->exifData();
+    o.make = text(exif, "Exif.Image.Make");
+    o.model = text(exif, "Exif.Image.Model");
+    o.lens = text(exif, "Exif.Photo.LensModel");
+    o.focal_mm = positive(exif, "Exif.Photo.FocalLength");
+    if (!o.focal_mm) o.focal_mm = positive(exif, "Exif.Image.FocalLength");
+    o.focal_35mm = positive(exif, "Exif.Photo.FocalLengthIn35mmFilm");
+    exif_read = true;
+  } catch (const Exiv2::Error&) {
+    // Not a format exiv2 reads (CR3, some RAWs): LibRaw below, or nothing.
+  }
+  if (!o.focal_mm) {
+    auto raw = std::make_unique<LibRaw>();
+    if (raw->open_file(image.c_str()) == LIBRAW_SUCCESS) {
+      if (raw->imgdata.other.focal_len > 0) o.focal_mm = raw->imgdata.other.focal_len;
+      if (o.make.empty()) o.make = raw->imgdata.idata.make;
+      if (o.model.empty()) o.model = raw->imgdata.idata.model;
+      if (o.lens.empty()) o.lens = raw->imgdata.lens.Lens;
+    } else if (!exif_read && !std::filesystem::is_regular_file(image)) {
+      throw std::runtime_error(image.string() + ": cannot read the file");
+    }
+  }
+  if (!o.make.empty() || !o.model.empty()) {
+    if (const lfDatabase* db = lens_database()) {
+      const lfCamera** cams = lf_db_find_cameras(db, o.make.c_str(), o.model.c_str());
+      if (cams && cams[0] && cams[0]->CropFactor > 0) {
+        o.crop_factor = cams[0]->CropFactor;
+        o.crop_camera = std::string(lf_mlstr_get(cams[0]->Maker)) + " " + lf_mlstr_get(cams[0]->Model);
+      }
+      lf_free(cams);
+    }
+  }
+  return o;
+}
+
+std::optional<OpticsLens> pinhole_from_optics(const PhotoOptics& o, int width, int height) {
+  if (width <= 0 || height <= 0) throw std::invalid_argument("pinhole_from_optics: the image size must be positive");
+  OpticsLens out;
+  double f35 = 0;
+  if (o.focal_35mm) {
+    f35 = *o.focal_35mm;
+    out.source = "FocalLengthIn35mmFilm";
+  } else if (o.focal_mm && o.crop_factor) {
+    f35 = *o.focal_mm * *o.crop_factor;
+    out.source = "FocalLength x crop factor " + std::to_string(*o.crop_factor) + " (lensfun: " + o.crop_camera + ")";
+  } else {
+    return std::nullopt;
+  }
+  const double diagonal = std::hypot(double(width), double(height));
+  out.focal_px = f35 * diagonal / kFullFrameDiagonalMm;
+  // The width-based definition of the equivalent, f35 = f * 36 / sensor width, differs from the
+  // diagonal one by this factor for this aspect ratio (1 for 3:2).
+  const double width_based = 36.0 * diagonal / (double(width) * kFullFrameDiagonalMm);
+  const double rounding = 0.29 / f35, convention = 0.5 * std::abs(1.0 - width_based);
+  out.sigma_relative = std::sqrt(rounding * rounding + convention * convention + kFocusSigma * kFocusSigma);
+  out.lens = LensModel::pinhole(out.focal_px, width, height);
+  return out;
+}
+
+}  // namespace rsibr

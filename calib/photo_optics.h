@@ -1,0 +1,45 @@
+// The lens of a shoot that brings neither chessboards nor a camera model, from what the photos
+// themselves say: the EXIF focal length (exiv2; LibRaw's for RAW files exiv2 cannot read), the
+// 35 mm-equivalent focal length, and the camera's crop factor from the lensfun database.
+//
+// A pinhole with the principal point at the image centre and
+//   f_px = f35 * hypot(W, H) / hypot(36 mm, 24 mm)
+// (the 35 mm equivalent is defined on the diagonal), f35 = FocalLengthIn35mmFilm, else
+// FocalLength * lensfun's crop factor. Its stated uncertainty (1 sigma, relative):
+//   sqrt(rounding^2 + convention^2 + focus^2), rounding = 0.29 mm / f35 (EXIF stores whole mm),
+//   convention = half the gap between the diagonal and the width definitions for this aspect
+//   ratio (cameras differ), focus = 3% (FocalLength is nominal, at infinity; a ball a metre
+//   away is focused closer and the image is larger by f / (d - f)).
+// No distortion is modelled: the JSON says so.
+#pragma once
+
+#include "core/lens_model.h"
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace rsibr {
+
+struct PhotoOptics {
+  std::string make, model, lens;           // EXIF Make, Model, LensModel (may be empty)
+  std::optional<double> focal_mm;          // FocalLength
+  std::optional<double> focal_35mm;        // FocalLengthIn35mmFilm
+  std::optional<double> crop_factor;       // lensfun's, for make + model
+  std::string crop_camera;                 // the lensfun entry it came from
+};
+
+// Never throws for missing metadata (the fields stay empty); throws std::runtime_error("<file>:
+// ...") when the file cannot be read at all.
+PhotoOptics read_photo_optics(const std::filesystem::path& image);
+
+struct OpticsLens {
+  LensModel lens = LensModel::pinhole(1, 2, 2);
+  double focal_px = 0, sigma_relative = 0;  // 1 sigma of f_px, relative
+  std::string source;                       // "FocalLengthIn35mmFilm" or "FocalLength x crop factor (lensfun: ...)"
+};
+
+// Nullopt when the metadata gives no focal length this can use.
+std::optional<OpticsLens> pinhole_from_optics(const PhotoOptics& optics, int width, int height);
+
+}  // namespace rsibr

@@ -1,0 +1,102 @@
+// The lens from the photos' metadata (calib/photo_optics.h): EXIF focal lengths, lensfun's crop
+// factors, and the pinhole they give with its stated uncertainty.
+#include "calib/photo_optics.h"
+
+#include "capture/synth_capture.h"
+#include "capture/synth_cases.h"
+#include "core/test_data.h"
+
+#include <exiv2/exiv2.hpp>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
+
+namespace rsibr {
+namespace {
+
+TEST(PhotoOptics, TheThirtyFiveMillimetreEquivalentGivesTheFocalOnTheDiagonal) {
+  PhotoOptics o;
+  o.focal_35mm = 50;
+  const auto p = pinhole_from_optics(o, 6000, 4000);
+  ASSERT_TRUE(p);
+  EXPECT_NEAR(p->focal_px, 50 * std::hypot(6000.0, 4000.0) / std::hypot(36.0, 24.0), 1e-9);
+  EXPECT_EQ(p->lens.name(), "LENSMODEL_PINHOLE");
+  EXPECT_NEAR(p->lens.intrinsics()[0], p->focal_px, 1e-9);
+  // 3:2: the diagonal and width conventions agree; rounding and focus remain.
+  EXPECT_NEAR(p->sigma_relative, std::hypot(0.29 / 50, 0.03), 1e-12);
+  // 4:3 (a phone): the two conventions differ by 4%, half of it is stated.
+  const auto q = pinhole_from_optics(o, 4000, 3000);
+  ASSERT_TRUE(q);
+  const double gap = 36.0 * 5000 / (4000 * std::hypot(36.0, 24.0)) - 1;
+  EXPECT_NEAR(q->sigma_relative, std::sqrt(std::pow(0.29 / 50, 2) + std::pow(0.5 * gap, 2) + 0.03 * 0.03), 1e-12);
+  EXPECT_GT(q->sigma_relative, p->sigma_relative);
+}
+
+TEST(PhotoOptics, FocalLengthNeedsACropFactorAndNothingGivesNothing) {
+  PhotoOptics o;
+  o.focal_mm = 35;
+  EXPECT_FALSE(pinhole_from_optics(o, 6000, 4000));  // the sensor's size unknown
+  o.crop_factor = 1.5;
+  o.crop_camera = "Nikon D7000";
+  const auto p = pinhole_from_optics(o, 6000, 4000);
+  ASSERT_TRUE(p);
+  EXPECT_NEAR(p->focal_px, 52.5 * std::hypot(6000.0, 4000.0) / std::hypot(36.0, 24.0), 1e-9);
+  EXPECT_NE(p->source.find("lensfun"), std::string::npos);
+  EXPECT_FALSE(pinhole_from_optics(PhotoOptics{}, 640, 480));
+  EXPECT_THROW(pinhole_from_optics(o, 0, 480), std::invalid_argument);
+}
+
+// A real camera's EXIF (make, model, focal length, no 35 mm equivalent): lensfun knows the camera.
+TEST(PhotoOptics, LensfunGivesTheCropFactorOfAKnownCamera) {
+  testing::TempDir dir;
+  cv::imwrite(dir.file("a.jpg"), cv::Mat(60, 90, CV_8UC3, cv::Scalar::all(90)));
+  {
+    auto image = Exiv2::ImageFactory::open(dir.file("a.jpg"));
+    image->readMetadata();
+    image->exifData()["Exif.Image.Make"] = "Canon";
+    image->exifData()["Exif.Image.Model"] = "Canon EOS 550D";
+    image->exifData()["Exif.Photo.FocalLength"] = Exiv2::URational(35, 1);
+    image->writeMetadata();
+  }
+  const PhotoOptics o = read_photo_optics(dir.path() / "a.jpg");
+  EXPECT_EQ(o.make, "Canon");
+  ASSERT_TRUE(o.focal_mm);
+  EXPECT_DOUBLE_EQ(*o.focal_mm, 35);
+  EXPECT_FALSE(o.focal_35mm);
+  ASSERT_TRUE(o.crop_factor) << "lensfun's database (liblensfun-data-v1) has the Canon EOS 550D";
+  EXPECT_NEAR(*o.crop_factor, 1.613, 1e-3);
+  ASSERT_TRUE(pinhole_from_optics(o, 90, 60));
+  // A photo without metadata: nothing, and no error.
+  cv::imwrite(dir.file("plain.png"), cv::Mat(8, 8, CV_8UC3, cv::Scalar::all(1)));
+  const PhotoOptics none = read_photo_optics(dir.path() / "plain.png");
+  EXPECT_FALSE(none.focal_mm);
+  EXPECT_FALSE(none.crop_factor);
+}
+
+// The synthetic camera writes the EXIF a camera does; the pinhole it gives is within its stated
+// sigma of the true focal length, for two lenses and two framings.
+TEST(PhotoOptics, TheSynthesizedPhotosEXIFGivesTheTrueFocalWithinItsStatedSigma) {
+  for (const char* camera : {", format: jpeg", ", format: png, lens: {model: LENSMODEL_PINHOLE, focal_px: 130}"}) {
+    testing::TempDir dir;
+    std::string text = testing::small_scene_text(camera);
+    if (std::string(camera).find("focal_px: 130") != std::string::npos) {
+      const auto at = text.find("lens: {model: LENSMODEL_PINHOLE, focal_px: 200}, ");
+      ASSERT_NE(at, std::string::npos);
+      text.erase(at, std::string("lens: {model: LENSMODEL_PINHOLE, focal_px: 200}, ").size());
+    }
+    const SynthScene scene = parse_synth_scene(text, "small.yaml", ".");
+    write_synth_capture(scene, dir.path() / "out");
+    const double truth = scene.camera.lens.intrinsics()[0];
+    const auto file = dir.path() / "out" / "photos" / "view00" / (std::string("view00_b00.") + (scene.camera.format == "jpeg" ? "jpg" : "png"));
+    const PhotoOptics o = read_photo_optics(file);
+    EXPECT_EQ(o.make, "rsibr");
+    ASSERT_TRUE(o.focal_35mm) << camera;
+    const auto p = pinhole_from_optics(o, scene.camera.lens.width(), scene.camera.lens.height());
+    ASSERT_TRUE(p);
+    EXPECT_LT(std::abs(p->focal_px / truth - 1), p->sigma_relative) << camera << ": " << p->focal_px << " vs " << truth;
+  }
+}
+
+}  // namespace
+}  // namespace rsibr
