@@ -116,8 +116,9 @@ cv::Mat masked_flags(const cv::Mat& flags, const cv::Size& size, const std::vect
 PoseSet orient_views(const std::vector<std::string>& all_names, const std::vector<ViewImage>& all_views, const LensModel& lens,
                      const ViewOrientationOptions& options, ViewOrientationReport* report) {
   if (all_names.size() != all_views.size()) throw std::invalid_argument("orient: names and views differ in number");
-  if (all_views.size() < 2 && options.known_world_from_cam.empty())
-    throw std::invalid_argument("orient: " + std::to_string(all_views.size()) + " view(s), need at least 2");
+  // One view is a shoot (the paper's own capture): its camera is the world frame, levelled below.
+  if (all_views.empty()) throw std::invalid_argument("orient: no views");
+  const bool single = all_views.size() == 1;
   if (!options.balls.empty() && options.balls.size() != all_views.size())
     throw std::invalid_argument("orient: ball guesses must be given for every view or none");
   if (!options.given_chrome.empty() && options.given_chrome.size() != all_views.size())
@@ -192,9 +193,9 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
     if (report) *report = rep;
     return PoseSet{};
   }
-  if (names.size() < 2 && known.empty()) {
+  if (names.size() < 2 && known.empty() && !(single && names.size() == 1)) {
     std::string why = "orient: a chrome ball was found in " + std::to_string(names.size()) + " of " + std::to_string(all_views.size()) +
-                      " views, need at least 2";
+                      " views, need at least " + (single ? "1" : "2");
     if (!rep.left_out.empty()) why += " (" + rep.left_out.front() + ")";
     throw std::invalid_argument(why);
   }
@@ -256,8 +257,9 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
   const int nv = static_cast<int>(n);
   try {
     if (n == 1 || (!known.empty() && obs.empty())) {
-      // Known rotations and nothing matched (or one view): the balls stay as located.
-      s.world_from_cam = known;
+      // Known rotations and nothing matched (or one view): the balls stay as located; a lone view
+      // without a known rotation is the gauge itself.
+      s.world_from_cam = known.empty() ? std::vector<Mat3>{so.first_world_from_cam} : known;
       s.sigma_deg.assign(n, 0.0);
       for (const BallLocation& b : rep.balls) s.ball_axes.push_back(b.fit.cone.axis), s.ball_half_angles.push_back(b.fit.cone.half_angle);
     } else {

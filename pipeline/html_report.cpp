@@ -306,7 +306,11 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
     std::vector<unsigned char> png;
     cv::imencode(".png", display_encode(probe.pixels, stops), png);
     h << "<h2>Light probe</h2><p>" << jnum(s["views"]) << " chrome views blended, "
-      << num(100 * s["covered_fraction"].get<double>(), 3) << "% of the sphere seen (lat-long, tone-mapped";
+      << num(100 * s["covered_fraction"].get<double>(), 3) << "% of the sphere seen";
+    if (s.contains("well_seen_fraction"))
+      h << ", " << num(100 * s["well_seen_fraction"].get<double>(), 3) << "% seen well (summed confidence at least 1/2"
+        << (s.value("views", 0) == 1 ? "; one view: behind the ball only its stretched rim, low confidence" : "") << ")";
+    h << " (lat-long, tone-mapped";
     const bool sources = rec.count("sources") && !rec["sources"].summary.value("sources", nlohmann::json::array()).empty();
     if (sources && fs::is_regular_file(dir / "probe-measured.exr")) {
       // Before (as measured) and after (with the recovered sources), at the final probe's exposure.

@@ -696,8 +696,18 @@ void step_probe(Context& c) {
     const fs::path out = c.dir / "probe-measured.exr";
     write_environment(out.string(), p.env);
     r.outputs = {out};
+    // Seen well: a summed confidence of at least one half (one view's centre to mid-disc; behind
+    // the ball a lone view sees only its stretched rim, where the confidence fades to 0).
+    double well = 0, all_sa = 0;
+    for (int y = 0; y < p.weight.rows; ++y) {
+      const double sa = std::cos((0.5 - (y + 0.5) / p.weight.rows) * kPiD);
+      for (int x = 0; x < p.weight.cols; ++x) {
+        all_sa += sa;
+        if (p.weight.at<float>(y, x) >= 0.5f) well += sa;
+      }
+    }
     r.summary = {{"views", all.views.size()}, {"width", c.o.probe_width}, {"covered_fraction", p.covered_fraction},
-                 {"clipped_fraction", p.clipped_fraction},
+                 {"well_seen_fraction", all_sa > 0 ? well / all_sa : 0.0}, {"clipped_fraction", p.clipped_fraction},
                  {"fresnel", fresnel ? fresnel->spec() : "none (the probe holds F L)"}};
   });
 }

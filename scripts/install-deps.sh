@@ -25,7 +25,7 @@ packages=(
   # tests and benchmarks; clang's libFuzzer for the fuzz targets (fuzz/)
   libgtest-dev libgmock-dev libbenchmark-dev clang-14 libclang-rt-14-dev
   # real-data fetch (npm registry) and docs plots
-  python3 python3-numpy python3-matplotlib
+  python3 python3-numpy python3-matplotlib python3-yaml
   # the Python module (python/) and its tests (tests/python)
   python3-dev pybind11-dev python3-pybind11 python3-pytest
 )

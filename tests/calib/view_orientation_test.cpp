@@ -254,14 +254,22 @@ TEST(ViewOrientation, TheChromeBallIsChosenOverTheGreyBallBesideIt) {
   }
 }
 
-TEST(ViewOrientation, OneViewNoBallOrNothingSharedGiveOneClearError) {
+TEST(ViewOrientation, OneViewIsAShootAndNoBallOrNothingSharedGiveOneClearError) {
   if (!std::filesystem::exists(kLobby)) GTEST_SKIP() << kLobby << " missing (scripts/fetch-assets.sh)";
   const Rendered r = render(kLobby, {0}, 60);
-  EXPECT_NE(error_of([&] { orient_views({"only"}, {r.views[0]}, r.lens); }).find("1 view(s), need at least 2"),
-            std::string::npos);
+  // One view: its camera is the world frame (levelled by the estimated up), its ball as located.
+  ViewOrientationReport rep;
+  const PoseSet one = orient_views({"only"}, {r.views[0]}, r.lens, {}, &rep);
+  ASSERT_EQ(one.views.size(), 1u);
+  const Mat3& R = one.views[0].world_from_cam;
+  EXPECT_LT((R.transpose() * R - Mat3::Identity()).norm(), 1e-9);
+  EXPECT_NEAR(R.determinant(), 1.0, 1e-9);
+  EXPECT_TRUE(one.views[0].ball.has_value());
   // No ball: a featureless flat image.
   ViewImage flat;
   flat.radiance = cv::Mat(r.views[0].radiance.size(), CV_32FC3, cv::Scalar(0.5, 0.5, 0.5));
+  EXPECT_NE(error_of([&] { orient_views({"flat"}, {flat}, r.lens); }).find("found in 0 of 1 views, need at least 1 (flat: no chrome ball"),
+            std::string::npos);
   // (A view without a chrome ball is left out; with fewer than 2 left, one line names it.)
   EXPECT_NE(error_of([&] { orient_views({"a", "empty"}, {r.views[0], flat}, r.lens); }).find("empty: no chrome ball found"),
             std::string::npos);
