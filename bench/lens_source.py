@@ -1,0 +1,104 @@
+#!/usr/bin/env python3
+"""What the lens's source costs: rsibr process on the same synthetic shoot with the lens from the
+truth (--lens), from the chessboards (mrcal, model by cross-validation) and from the photos' EXIF
+(a pinhole from the 35 mm-equivalent focal length: no chessboards in the photo set).
+
+Two lenses on the minimal-grey rig (320x240, 3 views, a chrome and a grey ball, 6 chessboards
+where used): its pinhole (f = 700 px) and a wide lens with distortion (OPENCV8, f = 350 px, the
+balls nearer, so they sit where the distortion is). Orientations are the truth's in every row
+(--poses), so the rows differ by the lens alone. Reported: the focal length against the truth,
+the captured grey against the computed one (relative RMS after the gain fit), and the calibrate
+step's time. Writes the section "Lens source (rsibr
+process)" of docs/tradeoffs.md.
+
+  /usr/bin/python3 bench/lens_source.py [--rsibr build/release/rsibr]
+"""
+import argparse
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "bench"))
+from convert_roundtrip import replace_section  # noqa: E402
+
+FRESNEL = "{type: conductor, eta: [2.9, 2.9, 2.6], k: [3.4, 3.4, 3.2]}"
+WIDE = ("  lens: {model: LENSMODEL_OPENCV8, focal_px: 350, "
+        "distortion: [-0.12, 0.03, 0.0004, -0.0003, 0.0, 0.01, 0.0, 0.005]}\n")
+
+
+def run(cmd):
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit("lens_source: %s failed:\n%s" % (" ".join(cmd[:3]), r.stderr[-2000:]))
+    return r.stdout
+
+
+def spec(lens, boards):
+    text = open(os.path.join(ROOT, "datasets-synthetic/minimal-grey.yaml")).read()
+    if lens == "wide":
+        text = re.sub(r"  lens: \{model: LENSMODEL_PINHOLE, focal_px: 700\}\n", WIDE, text)
+        text = text.replace("distance_m: 1.0", "distance_m: 0.55")
+    if not boards:
+        text = "\n".join(l for l in text.splitlines() if not l.startswith("chessboards:")) + "\n"
+    return text
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--rsibr", default=os.path.join(ROOT, "build/release/rsibr"))
+    a = ap.parse_args()
+    rows = []
+    with tempfile.TemporaryDirectory() as work:
+        for lens in ["pinhole", "wide"]:
+            for source in ["truth", "chessboards", "exif"]:
+                d = os.path.join(work, lens + "-" + source)
+                os.makedirs(d)
+                with open(os.path.join(d, "scene.yaml"), "w") as f:
+                    f.write(spec(lens, source != "exif"))
+                run([a.rsibr, "synth", os.path.join(d, "scene.yaml"), "--out", os.path.join(d, "syn"), "-q"])
+                syn = os.path.join(d, "syn")
+                cmd = [a.rsibr, "process", os.path.join(syn, "photos"), "--out", os.path.join(d, "run"),
+                       "--poses", os.path.join(syn, "truth", "truth.yaml"), "--chrome-fresnel", FRESNEL,
+                       "--map-size", "32", "--turntable", "1", "--size", "64x48", "--json", os.path.join(d, "run.json"), "-q"]
+                if source == "truth":
+                    cmd += ["--lens", os.path.join(syn, "truth", "camera.cameramodel")]
+                run(cmd)
+                j = json.load(open(os.path.join(d, "run.json")))
+                cal = j["results"]["calibrate"]
+                true_f = 700.0 if lens == "pinhole" else 350.0
+                grey = j["results"]["compare"]["balls"][0]["overall"]["after"]["relative_rms"]
+                step = next(s for s in j["steps"] if s["step"] == "calibrate")
+                rows.append({"lens": lens, "source": source, "model": cal.get("model", ""),
+                             "focal_error": cal["intrinsics"][0] / true_f - 1,
+                             "sigma": cal.get("focal_sigma_relative"), "grey": grey,
+                             "seconds": step.get("seconds", 0.0)})
+                print(rows[-1], flush=True)
+    body = ["Where the lens comes from, and what it costs (`bench/lens_source.py`): rsibr process on the",
+            "minimal-grey rig (320x240, 3 views, orientations from the truth so rows differ by the lens alone)",
+            "with its pinhole lens (f = 700 px) and with a wide distorting lens (OPENCV8, f = 350 px, the rig at",
+            "0.55 m). truth: `--lens` the true model; chessboards: 6 boards, mrcal, model by cross-validation;",
+            "exif: no boards, a pinhole from the photos' FocalLengthIn35mmFilm (calib/photo_optics.h). Focal",
+            "error against the truth (the stated 1-sigma in brackets), captured grey against computed after the",
+            "gain fit (relative RMS), and the calibrate step's time.",
+            "",
+            "| lens | source | model | focal error | captured vs computed grey | calibrate (s) |",
+            "|---|---|---|---|---|---|"]
+    for r in rows:
+        sigma = " (sigma %.1f%%)" % (100 * r["sigma"]) if r["sigma"] else ""
+        body.append("| %s | %s | %s | %+.2f%%%s | %.1f%% | %.2f |" % (
+            r["lens"], r["source"], r["model"], 100 * r["focal_error"], sigma, 100 * r["grey"], r["seconds"]))
+    body += ["",
+             "Reading it: the EXIF pinhole's focal length is within its stated sigma, and on an undistorted lens",
+             "it costs nothing measurable against the chessboards; on the wide lens it ignores the distortion,",
+             "which bends the balls' outlines and their reflections, and the captured-vs-computed row shows what",
+             "that costs; chessboards then pay for themselves."]
+    replace_section(os.path.join(ROOT, "docs/tradeoffs.md"), "Lens source (rsibr process)", "\n".join(body))
+    print("wrote docs/tradeoffs.md section 'Lens source (rsibr process)'")
+
+
+if __name__ == "__main__":
+    main()
