@@ -478,21 +478,28 @@ check "process: no chessboards, the lens from EXIF within its stated sigma" pyth
 import json; j = json.load(open('$work/pnb.json')); assert all(s['ran'] for s in j['steps']), j['steps']
 c = j['results']['calibrate']; assert c['source'] == 'exif' and c['model'] == 'LENSMODEL_PINHOLE', c
 assert abs(c['focal_px'] / 700 - 1) < c['focal_sigma_relative'], c"
-# One view is a shoot: no poses, one chrome and one grey ball, the world levelled from that camera
-# (its stand line and the upright prior) within 1.5 degrees of the truth.
-sed 's/count: 3, elevation_deg: 10/count: 1, elevation_deg: 10/' "$pspec" >"$work/oneview.yaml"
+# One view is a shoot, as people bring them: JPEG brackets with EXIF, no chessboards, no poses. The
+# lens from EXIF, the chrome ball found within 1 px of the truth, the world levelled from that
+# camera (its stand line and the upright prior) within 1.5 degrees, the probe and its preview.
+sed -e 's/count: 3, elevation_deg: 10/count: 1, elevation_deg: 10/' -e 's/  format: png/  format: jpeg/' -e '/^chessboards:/d' \
+  "$pspec" >"$work/oneview.yaml"
 "$rsibr" synth "$work/oneview.yaml" --out "$work/p1v" -q
 "$rsibr" process "$work/p1v/photos" --out "$work/p1vout" --map-size 32 --turntable 2 --size 64x48 --json "$work/p1v.json" -q \
   >/dev/null 2>&1
-check "process: one view, every step ran, a level probe, its low-confidence part reported" python3 -c "
+check "process: one JPEG view, no boards: EXIF lens, ball within 1 px, level within 1.5 degrees" python3 -c "
 import json, math, yaml
 j = json.load(open('$work/p1v.json')); assert all(s['ran'] for s in j['steps']), j['steps']
+assert j['results']['calibrate']['source'] == 'exif', j['results']['calibrate']
 p = j['results']['probe']; assert p['views'] == 1 and p['well_seen_fraction'] < p['covered_fraction'], p
-R = yaml.safe_load(open('$work/p1v/truth/truth.yaml'))['views'][0]['world_from_cam']
+truth = yaml.safe_load(open('$work/p1v/truth/truth.yaml'))['views'][0]
+c = j['results']['orient']['views'][0]['chrome_centre_px']; t = truth['balls'][0]['centre_px']
+assert math.hypot(c[0] - t[0], c[1] - t[1]) < 1, (c, t)
+R = truth['world_from_cam']
 t = R[1]  # world +Y in the camera frame: R^T (0, 1, 0), the second row
 u = j['results']['orient']['world_up']['up_in_first_camera']
 err = math.degrees(math.acos(max(-1, min(1, sum(a * b for a, b in zip(t, u)) / math.hypot(*u)))))
 assert err < 1.5, (err, t, u)"
+check "process: one view: the probe's preview is in the report" bash -c "grep -q 'alt=\"probe\"' '$work/p1vout/report.html'"
 expect_error "process: missing photo set" "nothere" process "$work/nothere" --out "$work/pe1" -q
 expect_error "process: bad --glossy-brdf" "--glossy-brdf" process "$work/psyn/photos" --out "$work/pe7" --glossy-brdf '{type: velvet}' -q
 expect_error "process: unknown --force step" "--force 'merge'" process "$work/psyn/photos" --out "$work/pe2" --force merge -q

@@ -37,14 +37,14 @@ TEST(Alignment, MedianThresholdBitmapUndoesASmallShift) {
 }
 
 // The textured scene of the tests above and three brackets through a gamma camera with noise.
-struct Shoot {
+struct TexturedShoot {
   cv::Mat L;
   std::vector<double> e = {0.1, 0.25, 0.6};
   std::vector<cv::Mat> images;
 };
 
-Shoot textured_shoot(unsigned seed = 30) {
-  Shoot s;
+TexturedShoot textured_shoot(unsigned seed = 30) {
+  TexturedShoot s;
   s.L.create(128, 160, CV_64FC3);
   for (int r = 0; r < s.L.rows; ++r)
     for (int x = 0; x < s.L.cols; ++x) {
@@ -85,7 +85,7 @@ TEST(Alignment, AutomaticAlignmentLeavesTripodBracketsAlone) {
 // better), marks the edge it uncovered, and the merge then flags no ghosts where the unaligned
 // merge flags the scene's every edge.
 TEST(Alignment, AHandheldShiftIsUndoneAutomaticallyAndItsUncoveredEdgeLeftOut) {
-  Shoot s = textured_shoot();
+  TexturedShoot s = textured_shoot();
   s.images[2] = moved(s.images[2], 3, -2);
   const BracketSet unaligned = make_brackets(s.images, s.e);
   BracketSet b = make_brackets(s.images, s.e);
@@ -116,7 +116,7 @@ TEST(Alignment, AHandheldShiftIsUndoneAutomaticallyAndItsUncoveredEdgeLeftOut) {
 // Brackets white almost everywhere (the long end of a sunny bracket set): no bitmap to compare,
 // so whatever MTB reports for them, they stay.
 TEST(Alignment, ABracketWithNothingToCompareIsNotMoved) {
-  const Shoot s = textured_shoot();
+  const TexturedShoot s = textured_shoot();
   testing::BracketCamera cam;
   cam.max_code = 255;
   cam.response = [](int, double X) { return std::pow(X, 1 / 2.2); };
@@ -149,7 +149,7 @@ TEST(Alignment, NoiseAloneNeverMovesABracket) {
 }
 
 TEST(Alignment, OffMovesNothingAndOnMovesWhatMtbFinds) {
-  Shoot s = textured_shoot();
+  TexturedShoot s = textured_shoot();
   s.images[0] = moved(s.images[0], -2, 1);
   BracketSet off = make_brackets(s.images, s.e), on = make_brackets(s.images, s.e);
   EXPECT_EQ(align_brackets(off, Alignment::off).shifts[0], cv::Point(0, 0));
@@ -163,7 +163,7 @@ TEST(Alignment, OffMovesNothingAndOnMovesWhatMtbFinds) {
 // the interior; without fit_sizes, or beyond 10% a side, the sizes are an error naming the file.
 TEST(Alignment, HandCroppedBracketsOfDifferentSizesAreRegisteredOnTheMiddleOne) {
   testing::TempDir dir;
-  const Shoot s = textured_shoot();
+  const TexturedShoot s = textured_shoot();
   PhotoView v;
   v.name = "v";
   const cv::Rect crops[3] = {cv::Rect(2, 0, 157, 127), cv::Rect(0, 0, 160, 128), cv::Rect(0, 3, 158, 124)};
