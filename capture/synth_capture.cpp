@@ -297,7 +297,8 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
   YAML::Node tc;
   tc["model"] = "camera.cameramodel";
   tc["lens"] = cam.lens.name();
-  tc["response"] = cam.response;
+  // A DNG holds the raw signal: no response is applied (the spec's names the other formats').
+  tc["response"] = cam.format == "dng" ? std::string("linear") : cam.response;
   tc["response_table"] = "response.csv";
   tc["max_code"] = max_code;
   tc["format"] = cam.format;
@@ -501,7 +502,8 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
     std::ofstream csv(truth / "response.csv");
     csv.precision(17);
     csv << "code,R,G,B\n";
-    for (const auto& row : response.table(max_code)) csv << row[0] << "," << row[1] << "," << row[2] << "," << row[3] << "\n";
+    const CameraResponse written(cam.format == "dng" ? "linear" : cam.response);
+    for (const auto& row : written.table(max_code)) csv << row[0] << "," << row[1] << "," << row[2] << "," << row[3] << "\n";
     if (!csv) throw std::runtime_error((truth / "response.csv").string() + ": cannot write");
   }
   {

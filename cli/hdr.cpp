@@ -395,7 +395,9 @@ Runner add_hdr(CLI::App& app) {
       "shot + read noise model (estimated from the brackets, or --noise), and the inverse-variance merge. A bracket "
       "saturated in any channel is left out for that pixel; pixels saturated in every bracket are flagged 'clipped' "
       "and hold a lower bound. OUT/<view>.exr has R,G,B, variance.R/G/B, clipped, black, ghost; OUT/<view>.png is a "
-      "preview. Radiance unit: X/e, the signal over its saturation value per relative exposure t*iso/100/N^2.\n"
+      "preview. Radiance unit: X/e, the signal over its saturation value per relative exposure t*iso/100/N^2. "
+      "Photos: PNG, JPEG, TIFF, or camera RAW files (DNG, CR2, CR3, NEF, ARW, ... through LibRaw: linear, no response "
+      "to recover, saturation from the file). Handheld brackets are registered first (--align, --no-align).\n"
       "Example: rsibr hdr shoot/photoset.yaml --out shoot/hdr --json shoot/hdr.json");
   c->add_option("photoset", a->photoset, "photoset.yaml or the folder holding it")->required();
   c->add_option("--out", a->out, "Output folder (created if missing; its parent must exist)")->required();
