@@ -59,7 +59,7 @@ void write_codes(const fs::path& file, const cv::Mat& codes, const std::string& 
   write_bytes(file, bytes);
 }
 
-// The EXIF a camera writes into each photo (exiv2; JPEG, PNG and TIFF): the exposure, the focal
+// The EXIF a camera writes into each photo (exiv2; JPEG, PNG, TIFF and DNG): the exposure, the focal
 // length (fx over the sensor's width) and its 35 mm equivalent on the diagonal, in whole mm.
 void write_photo_exif(const fs::path& file, const SynthCamera& cam, double t, const SynthExposure& ex) {
   const double fx = cam.lens.intrinsics().at(0);
@@ -383,6 +383,7 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
         const Vec3 s = cam.processing ? cam.processing->sensitivity : Vec3::Ones();
         codes = dng_codes(expose_raw(L, e, noise, s, scene.seed, stream));
         write_dng(file, bayer_mosaic(codes, "RGGB"), dng_info(cam, times[bi], scene.exposure));
+        write_photo_exif(file, cam, times[bi], scene.exposure);  // the EXIF IFD a camera's DNG carries
       } else {
         codes = cam.processing ? process_raw(expose_raw(L, e, noise, cam.processing->sensitivity, scene.seed, stream),
                                              *cam.processing, response, max_code)

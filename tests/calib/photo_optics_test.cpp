@@ -77,7 +77,8 @@ TEST(PhotoOptics, LensfunGivesTheCropFactorOfAKnownCamera) {
 // The synthetic camera writes the EXIF a camera does; the pinhole it gives is within its stated
 // sigma of the true focal length, for two lenses and two framings.
 TEST(PhotoOptics, TheSynthesizedPhotosEXIFGivesTheTrueFocalWithinItsStatedSigma) {
-  for (const char* camera : {", format: jpeg", ", format: png, lens: {model: LENSMODEL_PINHOLE, focal_px: 130}"}) {
+  for (const char* camera :
+       {", format: jpeg", ", format: png, lens: {model: LENSMODEL_PINHOLE, focal_px: 130}", ", format: dng"}) {
     testing::TempDir dir;
     std::string text = testing::small_scene_text(camera);
     if (std::string(camera).find("focal_px: 130") != std::string::npos) {
@@ -88,7 +89,8 @@ TEST(PhotoOptics, TheSynthesizedPhotosEXIFGivesTheTrueFocalWithinItsStatedSigma)
     const SynthScene scene = parse_synth_scene(text, "small.yaml", ".");
     write_synth_capture(scene, dir.path() / "out");
     const double truth = scene.camera.lens.intrinsics()[0];
-    const auto file = dir.path() / "out" / "photos" / "view00" / (std::string("view00_b00.") + (scene.camera.format == "jpeg" ? "jpg" : "png"));
+    const std::string ext = scene.camera.format == "jpeg" ? "jpg" : scene.camera.format;
+    const auto file = dir.path() / "out" / "photos" / "view00" / ("view00_b00." + ext);
     const PhotoOptics o = read_photo_optics(file);
     EXPECT_EQ(o.make, "rsibr");
     ASSERT_TRUE(o.focal_35mm) << camera;
