@@ -25,6 +25,7 @@ struct PhotoOptics {
   std::string make, model, lens;           // EXIF Make, Model, LensModel (may be empty)
   std::optional<double> focal_mm;          // FocalLength
   std::optional<double> focal_35mm;        // FocalLengthIn35mmFilm
+  std::optional<double> aperture;          // FNumber
   std::optional<double> crop_factor;       // lensfun's, for make + model
   std::string crop_camera;                 // the lensfun entry it came from
 };
@@ -41,5 +42,20 @@ struct OpticsLens {
 
 // Nullopt when the metadata gives no focal length this can use.
 std::optional<OpticsLens> pinhole_from_optics(const PhotoOptics& optics, int width, int height);
+
+// lensfun's vignetting of the photo's lens (found by camera and EXIF LensModel) at its focal length
+// and aperture, focused at `distance_m`, as the polynomial of hdr/vignetting.h (v = 1 + k1 r^2 +
+// k2 r^4 + k3 r^6, r = 1 at the farthest corner, the image centre as its centre): fitted by least
+// squares to lensfun's own correction of a flat field, so none of lensfun's coordinate conventions
+// (normalisation, crop factors) are copied here. fit_rms: the fit's RMS relative error over the
+// frame. Nullopt when lensfun lacks the camera, the lens or its vignetting, or the EXIF lacks the
+// focal length or the aperture.
+struct LensfunVignetting {
+  std::array<double, 3> k{0, 0, 0};
+  std::string lens;      // lensfun's name for it
+  double fit_rms = 0;
+};
+std::optional<LensfunVignetting> lensfun_vignetting(const PhotoOptics& optics, int width, int height,
+                                                    double distance_m = 1.0);
 
 }  // namespace rsibr

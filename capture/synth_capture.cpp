@@ -69,7 +69,8 @@ void write_photo_exif(const fs::path& file, const SynthCamera& cam, double t, co
     auto image = Exiv2::ImageFactory::open(file.string());
     image->readMetadata();
     Exiv2::ExifData& exif = image->exifData();
-    exif["Exif.Image.Make"] = "rsibr";
+    exif["Exif.Image.Make"] = cam.make;
+    if (!cam.lens_name.empty()) exif["Exif.Photo.LensModel"] = cam.lens_name;
     exif["Exif.Image.Model"] = cam.name;
     // Rationals with a fixed denominator: what cameras store (1/250 s, f/8, 35.5 mm).
     exif["Exif.Photo.ExposureTime"] = Exiv2::URational(std::uint32_t(std::lround(t * 1e6)), 1000000u);

@@ -131,7 +131,7 @@ CameraProcessing parse_processing(const YAML::Node& node, const std::string& pat
 SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const std::filesystem::path& folder) {
   const YamlMap m(node, path,
                   {"name", "width", "height", "lens", "response", "format", "jpeg_quality", "processing", "supersampling",
-                   "vignetting", "white_balance", "full_well", "read_noise", "gain", "sensor_width_mm"});
+                   "vignetting", "white_balance", "full_well", "read_noise", "gain", "sensor_width_mm", "make", "lens_name"});
   SynthCamera c;
   const int w = int(spec_in_range(double(m.integer("width")), m.at("width"), 16, false, 16384, false));
   const int h = int(spec_in_range(double(m.integer("height")), m.at("height"), 16, false, 16384, false));
@@ -167,6 +167,8 @@ SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const 
   if (m.has("read_noise")) c.read_noise = m.number_in("read_noise", 0, false, 1e6, false);
   if (m.has("gain")) c.gain = m.positive("gain");
   if (m.has("sensor_width_mm")) c.sensor_width_mm = m.number_in("sensor_width_mm", 1, false, 100, false);
+  if (m.has("make")) c.make = valid_utf8(m.string("make"));
+  if (m.has("lens_name")) c.lens_name = valid_utf8(m.string("lens_name"));
   return c;
 }
 

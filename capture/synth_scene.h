@@ -105,6 +105,8 @@ struct SynthCamera {
   // The sensor's width: with the lens's fx it gives the EXIF FocalLength the photos carry
   // (FocalLengthIn35mmFilm: the diagonal equivalent, in whole mm, as cameras write it).
   double sensor_width_mm = 23.5;
+  std::string make = "rsibr";  // EXIF Make (with `name` as Model: a real pair lets lensfun find the camera)
+  std::string lens_name;       // EXIF LensModel (empty: not written)
 };
 
 struct SynthChessboards {

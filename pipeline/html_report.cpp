@@ -100,7 +100,12 @@ void write_vignetting_section(std::ostringstream& h, const nlohmann::json& v) {
     h << "Divided out of every view: v = 1 + k1 r&sup2; + k2 r&#8308; + k3 r&#8310; (r = 1 at the farthest corner), k = ("
       << jnum(m["k"][0]) << ", " << jnum(m["k"][1]) << ", " << jnum(m["k"][2]) << "), the corner "
       << jnum(m["corner_stops"], 3) << " stops darker; " << html_escape(m.value("source", "")) << ".";
-    if (v.contains("estimate")) {
+    if (v.contains("estimate") && v["estimate"].contains("lensfun_lens")) {
+      const auto& e = v["estimate"];
+      h << " From the lensfun database's profile of " << html_escape(e["lensfun_lens"].get<std::string>())
+        << " at the photos' focal length and aperture (fitted to lensfun's correction to "
+        << num(100 * e["fit_rms"].get<double>(), 2) << "% RMS); no chessboards to measure it.";
+    } else if (v.contains("estimate")) {
       const auto& e = v["estimate"];
       h << " Estimated from " << jnum(e["squares"]) << " white squares on " << jnum(e["boards"]) << " boards ("
         << jnum(e["degree"]) << " term(s) chosen by leave-one-board-out error), fit RMS " << num(100 * e["rms"].get<double>(), 2)

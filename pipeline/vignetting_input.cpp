@@ -1,8 +1,10 @@
 #include "pipeline/vignetting_input.h"
 
+#include "calib/photo_optics.h"
 #include "pipeline/chessboard_problem.h"
 
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 
 namespace rsibr {
@@ -11,7 +13,12 @@ namespace fs = std::filesystem;
 
 std::vector<fs::path> vignetting_inputs(const PhotoSet& set, const std::string& mode) {
   if (mode == "none") return {};
-  if (mode == "auto") return set.chessboards ? set.chessboards->files : std::vector<fs::path>{};
+  if (mode == "auto") {
+    if (set.chessboards) return set.chessboards->files;
+    // Without boards: the lens database, for the lens the first photo's EXIF names.
+    if (!set.views.empty() && !set.views[0].brackets.empty()) return {set.views[0].brackets[0].file};
+    return {};
+  }
   return {fs::path(mode)};
 }
 
@@ -25,7 +32,23 @@ Vignetting photo_set_vignetting(const PhotoSet& set, const std::string& mode, co
     rep["note"] = "not corrected (--vignetting none)";
   } else if (mode == "auto") {
     if (!set.chessboards) {
-      rep["note"] = "not corrected: no chessboard images to estimate it from (give --vignetting FILE)";
+      // lensfun's profile of the lens the EXIF names, at its focal length and aperture.
+      std::optional<LensfunVignetting> lf;
+      if (!set.views.empty() && !set.views[0].brackets.empty()) {
+        const fs::path photo = set.views[0].brackets[0].file;
+        lf = lensfun_vignetting(read_photo_optics(photo), lens.width(), lens.height());
+      }
+      if (lf) {
+        // lensfun's profiles are about the image centre.
+        const Vec2 centre(0.5 * (lens.width() - 1), 0.5 * (lens.height() - 1));
+        v = Vignetting::none(lens.width(), lens.height(), centre);
+        v.k = lf->k;
+        v.source = "lensfun: " + lf->lens;
+        rep["estimate"] = {{"lensfun_lens", lf->lens}, {"fit_rms", lf->fit_rms}};
+      } else {
+        rep["note"] = "not corrected: no chessboard images to estimate it from and no lensfun profile for the lens "
+                      "the EXIF names (give --vignetting FILE)";
+      }
     } else {
       std::vector<VignettingBoard> boards;
       try {

@@ -1,6 +1,8 @@
 // The vignetting the hdr step divides out (hdr/vignetting.h), from what `--vignetting` says:
 //   auto   estimated from the photo set's chessboard images (their corners found by mrgingham,
-//          their codes made linear by the recovered response), none when it has fewer than 3 boards
+//          their codes made linear by the recovered response), none when it has fewer than 3 boards;
+//          without boards, lensfun's profile of the lens the first photo's EXIF names
+//          (calib/photo_optics.h lensfun_vignetting), none when lensfun has none
 //   none   no correction
 //   FILE   a JSON model as vignetting.json holds it (e.g. from a lens database)
 // The principal point is the lens model's.

@@ -74,6 +74,43 @@ TEST(PhotoOptics, LensfunGivesTheCropFactorOfAKnownCamera) {
   EXPECT_FALSE(none.crop_factor);
 }
 
+// A known lens's vignetting from lensfun (a Canon EF 50mm f/1.8 II wide open on a full-frame body):
+// the polynomial reproduces lensfun's own correction over the frame, darkens toward the corner, and
+// on a full-frame body (crop 1, lensfun's r = 1 at the corner) equals the database's pa terms.
+TEST(PhotoOptics, LensfunGivesTheVignettingOfAKnownLens) {
+  testing::TempDir dir;
+  cv::imwrite(dir.file("a.jpg"), cv::Mat(40, 60, CV_8UC3, cv::Scalar::all(90)));
+  {
+    auto image = Exiv2::ImageFactory::open(dir.file("a.jpg"));
+    image->readMetadata();
+    image->exifData()["Exif.Image.Make"] = "Canon";
+    image->exifData()["Exif.Image.Model"] = "Canon EOS 5D Mark II";
+    image->exifData()["Exif.Photo.LensModel"] = "Canon EF 50mm f/1.8 II";
+    image->exifData()["Exif.Photo.FocalLength"] = Exiv2::URational(50, 1);
+    image->exifData()["Exif.Photo.FNumber"] = Exiv2::URational(18, 10);
+    image->writeMetadata();
+  }
+  const PhotoOptics o = read_photo_optics(dir.path() / "a.jpg");
+  ASSERT_TRUE(o.aperture);
+  EXPECT_NEAR(*o.aperture, 1.8, 1e-6);
+  const auto v = lensfun_vignetting(o, 1500, 1000, 10.0);
+  ASSERT_TRUE(v) << "lensfun's database (liblensfun-data-v1) has the EF 50mm f/1.8 II's vignetting";
+  EXPECT_NE(v->lens.find("50mm"), std::string::npos) << v->lens;
+  EXPECT_LT(v->fit_rms, 0.01);
+  const double corner = 1 + v->k[0] + v->k[1] + v->k[2];
+  EXPECT_LT(corner, 0.5);  // wide open: more than a stop at the corner
+  EXPECT_NEAR(v->k[0], -1.4745, 0.02);
+  EXPECT_NEAR(v->k[1], 1.1285, 0.05);
+  EXPECT_NEAR(v->k[2], -0.4284, 0.05);
+  // A lens lensfun does not know: nothing.
+  PhotoOptics unknown = o;
+  unknown.lens = "rsibr imaginary 13mm f/0.7";
+  EXPECT_FALSE(lensfun_vignetting(unknown, 1500, 1000));
+  unknown = o;
+  unknown.aperture.reset();
+  EXPECT_FALSE(lensfun_vignetting(unknown, 1500, 1000));
+}
+
 // The synthetic camera writes the EXIF a camera does; the pinhole it gives is within its stated
 // sigma of the true focal length, for two lenses and two framings.
 TEST(PhotoOptics, TheSynthesizedPhotosEXIFGivesTheTrueFocalWithinItsStatedSigma) {

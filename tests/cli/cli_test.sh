@@ -478,6 +478,23 @@ check "process: no chessboards, the lens from EXIF within its stated sigma" pyth
 import json; j = json.load(open('$work/pnb.json')); assert all(s['ran'] for s in j['steps']), j['steps']
 c = j['results']['calibrate']; assert c['source'] == 'exif' and c['model'] == 'LENSMODEL_PINHOLE', c
 assert abs(c['focal_px'] / 700 - 1) < c['focal_sigma_relative'], c"
+# No chessboards, but a camera and lens lensfun knows (named in the EXIF): the vignetting comes
+# from lensfun's profile, within 2% of the lens's that the shoot was rendered with (the database's
+# pa terms for the EF 50mm f/1.8 II wide open, focused at 10 m; lensfun's at the 1 m assumed here).
+sed -e '/^chessboards:/d' -e 's/  lens: {model: LENSMODEL_PINHOLE, focal_px: 700}/  lens: {model: LENSMODEL_PINHOLE, focal_px: 444.444444}\
+  make: Canon\
+  name: Canon EOS 5D Mark II\
+  lens_name: Canon EF 50mm f\/1.8 II\
+  sensor_width_mm: 36\
+  vignetting: [-1.4745, 1.1285, -0.4284]/' -e 's/iso: 100, aperture: 8/iso: 100, aperture: 1.8/' "$pspec" >"$work/lensfun.yaml"
+"$rsibr" synth "$work/lensfun.yaml" --out "$work/plf" -q
+"$rsibr" process "$work/plf/photos" --out "$work/plfout" --poses "$work/plf/truth/truth.yaml" --chrome-fresnel "$fres" \
+  --map-size 32 --turntable 2 --size 64x48 --json "$work/plf.json" -q >/dev/null 2>&1
+check "process: no chessboards, a lens lensfun knows: its vignetting from lensfun, as rendered" python3 -c "
+import json; j = json.load(open('$work/plf.json')); assert all(s['ran'] for s in j['steps']), j['steps']
+m = j['results']['hdr']['vignetting']['model']; assert m['source'].startswith('lensfun: '), m
+v = lambda k, r: 1 + k[0] * r**2 + k[1] * r**4 + k[2] * r**6
+assert all(abs(v(m['k'], r / 10) / v([-1.4745, 1.1285, -0.4284], r / 10) - 1) < 0.02 for r in range(11)), m"
 # One view is a shoot, as people bring them: JPEG brackets with EXIF, no chessboards, no poses. The
 # lens from EXIF, the chrome ball found within 1 px of the truth, the world levelled from that
 # camera (its stand line and the upright prior) within 1.5 degrees, the probe and its preview.
