@@ -246,6 +246,15 @@ TEST(RawFiles, TheExposureComesFromTheFileWhenTheYamlLeavesItOut) {
   EXPECT_NEAR(b.metadata[0].iso, 200, 1e-9);
   EXPECT_EQ(b.metadata[0].source, "raw+exif");  // LibRaw leaves the IFD 0 ISO to exiv2
   EXPECT_NEAR(b.exposures[0], 0.0025 * 2 / 16, 1e-8);
+  // The exposure extremes (1/32000 s to 60 s) survive the file's rationals.
+  for (const double t : {1.0 / 32000, 60.0}) {
+    PhotoView one;
+    one.name = "x";
+    const auto f = dir.path() / "extreme.dng";
+    write_dng(f, bayer_mosaic(raw_codes(L, C, 0.3), "RGGB"), info_for(C, t));
+    one.brackets.push_back({f, std::nullopt, std::nullopt, std::nullopt});
+    EXPECT_NEAR(load_brackets(one).metadata[0].exposure_s / t, 1.0, 1e-6) << t;
+  }
   // A view mixing RAW and other images is refused with a message saying so.
   cv::imwrite(dir.file("c.png"), cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(100)));
   v.brackets.push_back({dir.path() / "c.png", 0.04, 200.0, 4.0});
