@@ -1,16 +1,14 @@
 #include "calib/photo_optics.h"
 
+#include "core/lensfun_lens.h"
+
 #include <exiv2/exiv2.hpp>
 #include <lensfun/lensfun.h>
 #include <libraw/libraw.h>
 
-#include <Eigen/Dense>
-
-#include <algorithm>
 #include <cmath>
-#include <vector>
+#include <cstdio>
 #include <memory>
-#include <mutex>
 #include <stdexcept>
 
 namespace rsibr {
@@ -18,6 +16,7 @@ namespace {
 
 constexpr double kFullFrameDiagonalMm = 43.266615305567875;  // hypot(36, 24)
 constexpr double kFocusSigma = 0.03;
+constexpr double kCropSigma = 0.005;
 
 std::optional<double> positive(const Exiv2::ExifData& exif, const char* key) {
   const auto it = exif.findKey(Exiv2::ExifKey(key));
@@ -32,20 +31,6 @@ std::string text(const Exiv2::ExifData& exif, const char* key) {
   std::string s = it->toString();
   while (!s.empty() && (s.back() == ' ' || s.back() == '\0')) s.pop_back();
   return s;
-}
-
-// lensfun's database, loaded once (its files under /usr/share/lensfun).
-const lfDatabase* lens_database() {
-  static std::once_flag once;
-  static lfDatabase* db = nullptr;
-  std::call_once(once, [] {
-    db = lf_db_new();
-    if (db && lf_db_load(db) != LF_NO_ERROR) {
-      lf_db_destroy(db);
-      db = nullptr;
-    }
-  });
-  return db;
 }
 
 }  // namespace
@@ -81,7 +66,7 @@ PhotoOptics read_photo_optics(const std::filesystem::path& image) {
     }
   }
   if (!o.make.empty() || !o.model.empty()) {
-    if (const lfDatabase* db = lens_database()) {
+    if (const lfDatabase* db = lensfun_database()) {
       const lfCamera** cams = lf_db_find_cameras(db, o.make.c_str(), o.model.c_str());
       if (cams && cams[0] && cams[0]->CropFactor > 0) {
         o.crop_factor = cams[0]->CropFactor;
@@ -96,64 +81,24 @@ PhotoOptics read_photo_optics(const std::filesystem::path& image) {
 std::optional<LensfunVignetting> lensfun_vignetting(const PhotoOptics& o, int width, int height, double distance_m) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("lensfun_vignetting: the image size must be positive");
   if (!o.focal_mm || !o.aperture || o.lens.empty()) return std::nullopt;
-  const lfDatabase* db = lens_database();
-  if (!db) return std::nullopt;
-  const lfCamera** cams = lf_db_find_cameras(db, o.make.c_str(), o.model.c_str());
-  const lfCamera* cam = cams && cams[0] ? cams[0] : nullptr;
-  const lfLens** lenses = lf_db_find_lenses_hd(db, cam, nullptr, o.lens.c_str(), 0);
-  std::optional<LensfunVignetting> out;
-  if (lenses && lenses[0]) {
-    const lfLens* lens = lenses[0];
-    lfLensCalibVignetting calib;
-    const float crop = cam ? cam->CropFactor : lens->CropFactor;
-    if (lf_lens_interpolate_vignetting(lens, float(*o.focal_mm), float(*o.aperture), float(distance_m), &calib) &&
-        crop > 0) {
-      // lensfun's correction of a flat field of ones is 1 / v: sampled on a grid of rows, fitted.
-      lfModifier* mod = lf_modifier_new(lens, crop, width, height);
-      const int flags = lf_modifier_initialize(mod, lens, LF_PF_F32, float(*o.focal_mm), float(*o.aperture),
-                                               float(distance_m), 1.0f, lens->Type, LF_MODIFY_VIGNETTING, 0);
-      if (flags & LF_MODIFY_VIGNETTING) {
-        const double cx = 0.5 * (width - 1), cy = 0.5 * (height - 1);
-        const double rc = std::hypot(std::max(cx, width - 1 - cx), std::max(cy, height - 1 - cy));
-        const int step = std::max(1, std::min(width, height) / 64);
-        Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
-        Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
-        std::vector<std::pair<double, double>> samples;  // (r^2, v)
-        std::vector<float> row(std::size_t(width) * 3);
-        for (int y = 0; y < height; y += step) {
-          std::fill(row.begin(), row.end(), 1.0f);
-          lf_modifier_apply_color_modification(mod, row.data(), 0.0f, float(y), width, 1,
-                                               LF_CR_3(RED, GREEN, BLUE), int(row.size() * sizeof(float)));
-          for (int x = 0; x < width; x += step) {
-            const double g = row[std::size_t(x) * 3 + 1];
-            if (!(g > 0) || !std::isfinite(g)) continue;
-            const double r2 = (std::pow(x - cx, 2) + std::pow(y - cy, 2)) / (rc * rc), v = 1.0 / g;
-            const Eigen::Vector3d a(r2, r2 * r2, r2 * r2 * r2);
-            AtA += a * a.transpose();
-            Atb += a * (v - 1);
-            samples.push_back({r2, v});
-          }
-        }
-        const Eigen::Vector3d k = AtA.ldlt().solve(Atb);
-        if (k.allFinite() && !samples.empty()) {
-          LensfunVignetting lv;
-          lv.k = {k[0], k[1], k[2]};
-          const std::string maker = lens->Maker ? lf_mlstr_get(lens->Maker) : "", model = lens->Model ? lf_mlstr_get(lens->Model) : "";
-          lv.lens = model.rfind(maker, 0) == 0 ? model : maker + " " + model;  // models usually start with the maker
-          double s2 = 0;
-          for (const auto& [r2, v] : samples) {
-            const double fit = 1 + r2 * (k[0] + r2 * (k[1] + r2 * k[2]));
-            s2 += std::pow(fit / v - 1, 2);
-          }
-          lv.fit_rms = std::sqrt(s2 / double(samples.size()));
-          out = lv;
-        }
-      }
-      lf_modifier_destroy(mod);
-    }
+  return lensfun_vignetting(o.make, o.model, o.lens, *o.focal_mm, *o.aperture, width, height, distance_m);
+}
+
+std::optional<OpticsLens> lensfun_from_optics(const PhotoOptics& o, int width, int height, std::string* why) {
+  if (width <= 0 || height <= 0) throw std::invalid_argument("lensfun_from_optics: the image size must be positive");
+  if (!o.focal_mm) {
+    if (why) *why = "the photo's metadata has no FocalLength";
+    return std::nullopt;
   }
-  lf_free(lenses);
-  lf_free(cams);
+  const std::optional<LensfunLens> L = lensfun_lens(o.make, o.model, o.lens, *o.focal_mm, width, height, why);
+  if (!L) return std::nullopt;
+  OpticsLens out;
+  out.lens = L->lens;
+  out.focal_px = L->focal_px;
+  out.sigma_relative = std::hypot(kFocusSigma, kCropSigma);
+  char fit[96];
+  std::snprintf(fit, sizeof fit, "; %s fitted within %.3f px", L->lens.name().c_str(), L->fit_max_px);
+  out.source = "lensfun: " + L->lens_name + " on the " + L->camera + ", " + L->profile + fit;
   return out;
 }
 

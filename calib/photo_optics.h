@@ -10,10 +10,12 @@
 //   convention = half the gap between the diagonal and the width definitions for this aspect
 //   ratio (cameras differ), focus = 3% (FocalLength is nominal, at infinity; a ball a metre
 //   away is focused closer and the image is larger by f / (d - f)).
-// No distortion is modelled: the JSON says so.
+// No distortion is modelled: the JSON says so. Where lensfun has a distortion profile of the lens
+// the EXIF names, lensfun_from_optics gives it instead (core/lensfun_lens.h).
 #pragma once
 
 #include "core/lens_model.h"
+#include "core/lensfun_lens.h"
 
 #include <filesystem>
 #include <optional>
@@ -43,18 +45,16 @@ struct OpticsLens {
 // Nullopt when the metadata gives no focal length this can use.
 std::optional<OpticsLens> pinhole_from_optics(const PhotoOptics& optics, int width, int height);
 
-// lensfun's vignetting of the photo's lens (found by camera and EXIF LensModel) at its focal length
-// and aperture, focused at `distance_m`, as the polynomial of hdr/vignetting.h (v = 1 + k1 r^2 +
-// k2 r^4 + k3 r^6, r = 1 at the farthest corner, the image centre as its centre): fitted by least
-// squares to lensfun's own correction of a flat field, so none of lensfun's coordinate conventions
-// (normalisation, crop factors) are copied here. fit_rms: the fit's RMS relative error over the
-// frame. Nullopt when lensfun lacks the camera, the lens or its vignetting, or the EXIF lacks the
-// focal length or the aperture.
-struct LensfunVignetting {
-  std::array<double, 3> k{0, 0, 0};
-  std::string lens;      // lensfun's name for it
-  double fit_rms = 0;
-};
+// lensfun's distortion profile of the photo's lens (EXIF Make, Model, LensModel, FocalLength) as
+// an mrcal model (core/lensfun_lens.h), the focal length paraxial with the crop factor of the
+// camera. Its stated uncertainty: sqrt(focus^2 + crop^2), focus as for the pinhole (3%), crop =
+// 0.5% (lensfun's crop factors are per camera model, to 3 digits). Nullopt with *why (when given)
+// set when the metadata lacks the focal length or lensfun the camera, the lens or its profile.
+std::optional<OpticsLens> lensfun_from_optics(const PhotoOptics& optics, int width, int height,
+                                              std::string* why = nullptr);
+
+// lensfun's vignetting of the photo's lens (core/lensfun_lens.h lensfun_vignetting) at the EXIF
+// focal length and aperture; nullopt when the EXIF lacks either or the lens model.
 std::optional<LensfunVignetting> lensfun_vignetting(const PhotoOptics& optics, int width, int height,
                                                     double distance_m = 1.0);
 

@@ -256,11 +256,13 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
     h << "<h2>Lens</h2><p>Model <b>" << html_escape(s.value("model", "")) << "</b> (" << html_escape(s.value("source", ""))
       << ")";
     if (s.contains("rms_px")) h << ", reprojection RMS " << jnum(s["rms_px"]) << " px over " << jnum(s["boards_found"]) << " boards";
-    if (s.value("source", "") == "exif")
+    if (s.value("source", "") == "exif" || s.value("source", "") == "lensfun")
       h << ": no chessboards and no camera model, so the photos' metadata (" << html_escape(s.value("focal_from", ""))
         << ") gives f = " << num(s.value("focal_px", 0.0), 4) << " px &plusmn; "
         << num(100 * s.value("focal_sigma_relative", 0.0), 2) << "% (1 sigma), " << html_escape(s.value("assumed", ""))
         << "; chessboards or --lens give a measured lens";
+    if (s.contains("lensfun") && s["lensfun"].is_string())
+      h << " (no distortion profile: " << html_escape(s["lensfun"].get<std::string>()) << ")";
     h << ".</p>";
     if (s.contains("models")) {
       h << "<table><tr><th>model</th><th>held-out RMS (px)</th><th>fit RMS (px)</th></tr>";

@@ -168,17 +168,24 @@ void step_calibrate(Context& c) {
     if (settings["source"] == "exif") {
       const BracketSet b = load_brackets(c.set.views[0], true);
       const PhotoOptics optics = read_photo_optics(inputs.front());
-      const std::optional<OpticsLens> guess = pinhole_from_optics(optics, b.cols(), b.rows());
+      // lensfun's profile of the lens the EXIF names (distortion included), else a pinhole.
+      std::string lensfun_why;
+      std::optional<OpticsLens> guess = lensfun_from_optics(optics, b.cols(), b.rows(), &lensfun_why);
+      const bool from_lensfun = guess.has_value();
+      if (!guess) guess = pinhole_from_optics(optics, b.cols(), b.rows());
       if (!guess)
         throw std::invalid_argument(inputs.front().string() +
                                     ": no chessboards, no camera model and no usable focal length in the photo's "
                                     "metadata (FocalLengthIn35mmFilm, or FocalLength of a camera lensfun knows); "
                                     "give the lens with --lens FILE");
       guess->lens.write(out);
-      s = {{"source", "exif"}, {"model", guess->lens.name()}, {"intrinsics", guess->lens.intrinsics()},
-           {"focal_px", guess->focal_px}, {"focal_sigma_relative", guess->sigma_relative},
-           {"focal_from", guess->source}, {"camera", optics.make + " " + optics.model}, {"lens", optics.lens},
-           {"assumed", "a pinhole: principal point at the image centre, no distortion"}};
+      s = {{"source", from_lensfun ? "lensfun" : "exif"}, {"model", guess->lens.name()},
+           {"intrinsics", guess->lens.intrinsics()}, {"focal_px", guess->focal_px},
+           {"focal_sigma_relative", guess->sigma_relative}, {"focal_from", guess->source},
+           {"camera", optics.make + " " + optics.model}, {"lens", optics.lens},
+           {"assumed", from_lensfun ? "lensfun's distortion profile of the lens, its centre at lensfun's"
+                                    : "a pinhole: principal point at the image centre, no distortion"}};
+      if (!from_lensfun) s["lensfun"] = lensfun_why;
       if (optics.focal_mm) s["focal_mm"] = *optics.focal_mm;
       if (optics.focal_35mm) s["focal_35mm"] = *optics.focal_35mm;
     } else if (settings["source"] != "chessboards") {

@@ -83,6 +83,34 @@ TEST(PhotoOptics, LensfunGivesTheCropFactorOfAKnownCamera) {
   EXPECT_FALSE(none.crop_factor);
 }
 
+// A real camera's EXIF naming a lens lensfun profiles: the lens is the profile (distortion
+// included), its focal length the EXIF's times the camera's crop factor, with the stated sigma;
+// a lens it does not know, or no focal length, leaves it to the pinhole and says why.
+TEST(PhotoOptics, ALensLensfunProfilesGivesItsDistortedModel) {
+  testing::TempDir dir;
+  const std::string file = dir.file("kit.jpg");
+  canon_jpeg(file, "Canon EOS 600D", "Canon EF-S 18-55mm f/3.5-5.6 IS", {18, 1}, Exiv2::URational{8, 1});
+  const PhotoOptics o = read_photo_optics(file);
+  std::string why;
+  const auto l = lensfun_from_optics(o, 648, 432, &why);
+  ASSERT_TRUE(l) << why;
+  EXPECT_EQ(l->lens.name().rfind("LENSMODEL_OPENCV", 0), 0u) << l->lens.name();
+  EXPECT_NEAR(l->focal_px, 18 * 1.613 * std::hypot(648.0, 432.0) / std::hypot(36.0, 24.0), 1e-3);
+  EXPECT_NEAR(l->sigma_relative, std::hypot(0.03, 0.005), 1e-12);
+  EXPECT_NE(l->source.find("ptlens"), std::string::npos) << l->source;
+  // Barrel distortion at 18 mm: the photo's corner is nearer the centre than the pinhole puts it.
+  const Vec3 corner_ray = LensModel::pinhole(l->focal_px, 648, 432).unproject(Vec2(0, 0));
+  EXPECT_GT(l->lens.project(corner_ray).x(), 1.0);
+  PhotoOptics unknown = o;
+  unknown.lens = "Acme Wonderlens";
+  EXPECT_FALSE(lensfun_from_optics(unknown, 648, 432, &why));
+  EXPECT_NE(why.find("does not know the lens"), std::string::npos) << why;
+  PhotoOptics no_focal = o;
+  no_focal.focal_mm.reset();
+  EXPECT_FALSE(lensfun_from_optics(no_focal, 648, 432, &why));
+  EXPECT_NE(why.find("FocalLength"), std::string::npos) << why;
+}
+
 // A known lens's vignetting from lensfun (a Canon EF 50mm f/1.8 II wide open on a full-frame body):
 // the polynomial reproduces lensfun's own correction over the frame, darkens toward the corner, and
 // on a full-frame body (crop 1, lensfun's r = 1 at the corner) equals the database's pa terms.
