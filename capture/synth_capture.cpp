@@ -63,7 +63,7 @@ void write_codes(const fs::path& file, const cv::Mat& codes, const std::string& 
 // length (fx over the sensor's width) and its 35 mm equivalent on the diagonal, in whole mm.
 void write_photo_exif(const fs::path& file, const SynthCamera& cam, double t, const SynthExposure& ex) {
   const double fx = cam.lens.intrinsics().at(0);
-  const double focal_mm = fx * cam.sensor_width_mm / cam.lens.width();
+  const double focal_mm = cam.exif_focal_mm > 0 ? cam.exif_focal_mm : fx * cam.sensor_width_mm / cam.lens.width();
   const double f35 = std::round(fx * 43.266615305567875 / std::hypot(double(cam.lens.width()), double(cam.lens.height())));
   try {
     auto image = Exiv2::ImageFactory::open(file.string());

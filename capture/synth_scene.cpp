@@ -2,6 +2,7 @@
 
 #include "bake/brdf_spec.h"
 #include "capture/camera_response.h"
+#include "core/lensfun_lens.h"
 #include "core/safe_name.h"
 #include "core/text.h"
 #include "core/yaml_spec.h"
@@ -79,9 +80,26 @@ SynthBall parse_ball(const YAML::Node& node, const std::string& path) {
   return b;
 }
 
+// `lens: {model: lensfun, focal_mm: F, lens: NAME}`: lensfun's profile of the lens NAME (default:
+// the camera's lens_name, which the photos' EXIF carries) on the camera (make, name) at F mm
+// (core/lensfun_lens.h).
 LensModel parse_lens(const YAML::Node& node, const std::string& path, int width, int height,
-                     const std::filesystem::path& folder) {
-  const YamlMap m(node, path, {"file", "model", "focal_px", "distortion", "intrinsics"});
+                     const std::filesystem::path& folder, SynthCamera& cam) {
+  const YamlMap m(node, path, {"file", "model", "focal_px", "distortion", "intrinsics", "focal_mm", "lens"});
+  if (m.has("model") && m.string("model") == "lensfun") {
+    for (const char* k : {"file", "focal_px", "distortion", "intrinsics"})
+      if (m.has(k)) spec_fail(m.at(k), "not with model: lensfun (the profile gives the lens)");
+    const double focal_mm = m.number_in("focal_mm", 0, false, 2000, false);
+    std::string why;
+    const std::string name = m.has("lens") ? valid_utf8(m.string("lens")) : cam.lens_name;
+    const std::optional<LensfunLens> L = lensfun_lens(cam.make, cam.name, name, focal_mm, width, height, &why);
+    if (!L) spec_fail(path, why + " (camera make and name, and lens or the camera's lens_name, name them)");
+    cam.exif_focal_mm = focal_mm;
+    cam.lensfun_lens = name;
+    return L->lens;
+  }
+  for (const char* k : {"focal_mm", "lens"})
+    if (m.has(k)) spec_fail(m.at(k), "only with model: lensfun");
   if (m.has("file")) {
     for (const char* k : {"model", "focal_px", "distortion", "intrinsics"})
       if (m.has(k)) spec_fail(m.at(k), "not with file");
@@ -135,10 +153,12 @@ SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const 
   SynthCamera c;
   const int w = int(spec_in_range(double(m.integer("width")), m.at("width"), 16, false, 16384, false));
   const int h = int(spec_in_range(double(m.integer("height")), m.at("height"), 16, false, 16384, false));
-  c.lens = parse_lens(m.get("lens"), m.at("lens"), w, h, folder);
+  if (m.has("name")) c.name = valid_utf8(m.string("name"));  // free text (bytes that are not UTF-8 replaced)
+  if (m.has("make")) c.make = valid_utf8(m.string("make"));
+  if (m.has("lens_name")) c.lens_name = valid_utf8(m.string("lens_name"));
+  c.lens = parse_lens(m.get("lens"), m.at("lens"), w, h, folder, c);
   if (c.lens.can_project_behind_camera())
     spec_fail(m.at("lens"), "models that see behind the camera (stereographic, splined) are not supported yet");
-  if (m.has("name")) c.name = valid_utf8(m.string("name"));  // free text (bytes that are not UTF-8 replaced)
   if (m.has("response")) c.response = m.choice("response", CameraResponse::kinds());
   if (m.has("format")) c.format = m.choice("format", {"png", "jpeg", "tiff", "dng"});
   if (c.format == "dng" && (w % 2 || h % 2)) spec_fail(m.at("format"), "dng needs an even width and height (a 2x2 Bayer pattern)");
@@ -167,8 +187,6 @@ SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const 
   if (m.has("read_noise")) c.read_noise = m.number_in("read_noise", 0, false, 1e6, false);
   if (m.has("gain")) c.gain = m.positive("gain");
   if (m.has("sensor_width_mm")) c.sensor_width_mm = m.number_in("sensor_width_mm", 1, false, 100, false);
-  if (m.has("make")) c.make = valid_utf8(m.string("make"));
-  if (m.has("lens_name")) c.lens_name = valid_utf8(m.string("lens_name"));
   return c;
 }
 
@@ -265,6 +283,14 @@ SynthScene parse_root(const YAML::Node& root, const std::filesystem::path& folde
     if (e.has("step_ev")) s.exposure.step_ev = e.number_in("step_ev", 0, true, 8, false);
     if (e.has("iso")) s.exposure.iso = e.positive("iso");
     if (e.has("aperture")) s.exposure.aperture = e.positive("aperture");
+  }
+  // A lens from lensfun vignettes as its profile says at this aperture (focused at 1 m).
+  const YAML::Node cam_node = m.get("camera");
+  if (!s.camera.lensfun_lens.empty() && !(cam_node.IsMap() && cam_node["vignetting"])) {
+    const SynthCamera& c = s.camera;
+    if (const auto v = lensfun_vignetting(c.make, c.name, c.lensfun_lens, c.exif_focal_mm, s.exposure.aperture,
+                                          c.lens.width(), c.lens.height()))
+      s.camera.vignetting_poly = Vec3(v->k[0], v->k[1], v->k[2]);
   }
   const YAML::Node views = m.get("views");
   if (!views.IsSequence() || views.size() == 0) spec_fail(m.at("views"), "expected a non-empty list of plans");

@@ -107,6 +107,9 @@ struct SynthCamera {
   double sensor_width_mm = 23.5;
   std::string make = "rsibr";  // EXIF Make (with `name` as Model: a real pair lets lensfun find the camera)
   std::string lens_name;       // EXIF LensModel (empty: not written)
+  double exif_focal_mm = 0;    // EXIF FocalLength; 0: fx * sensor_width_mm / width (a lensfun lens gives its own)
+  std::string lensfun_lens;    // the lensfun profile the lens came from (empty: none); its vignetting
+                               // at the exposure's aperture is the camera's unless `vignetting` is given
 };
 
 struct SynthChessboards {

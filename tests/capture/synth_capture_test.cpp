@@ -3,6 +3,7 @@
 
 #include "capture/camera_poses.h"
 #include "capture/camera_response.h"
+#include "core/lensfun_lens.h"
 #include "core/photo_set.h"
 #include "core/truth_image.h"
 #include "core/map_set.h"
@@ -169,6 +170,47 @@ TEST(SynthScene, UnknownKeysAndBadValuesNameTheirPath) {
                 .find("balls[1].albedo: glossy balls take a brdf"),
             std::string::npos);
   EXPECT_NE(error_of("rsibr_synth: 2\n").find("rsibr_synth"), std::string::npos);
+}
+
+// `lens: {model: lensfun, ...}` is the database's profile (core/lensfun_lens.h) of the named lens
+// on the named camera; the photos' EXIF then carries its nominal focal length, and the camera
+// vignettes as the profile says at the exposure's aperture unless the spec gives a vignetting.
+TEST(SynthScene, ALensfunLensIsTheDatabasesProfileWithItsVignetting) {
+  auto with_lens = [](const std::string& lens, const std::string& extra = "") {
+    std::string text = testing::small_scene_text(", make: Canon, name: Canon EOS 600D, lens_name: Canon EF-S 18-55mm f/3.5-5.6 IS" + extra);
+    const std::string pinhole = "lens: {model: LENSMODEL_PINHOLE, focal_px: 200}";
+    return text.replace(text.find(pinhole), pinhole.size(), "lens: " + lens);
+  };
+  const SynthScene s = parse_synth_scene(with_lens("{model: lensfun, focal_mm: 18}"), "s.yaml", ".");
+  const auto L = lensfun_lens("Canon", "Canon EOS 600D", "Canon EF-S 18-55mm f/3.5-5.6 IS", 18, 96, 72);
+  ASSERT_TRUE(L);
+  EXPECT_EQ(s.camera.lens.name(), L->lens.name());
+  EXPECT_EQ(s.camera.lens.intrinsics(), L->lens.intrinsics());
+  EXPECT_EQ(s.camera.exif_focal_mm, 18);
+  const auto v = lensfun_vignetting("Canon", "Canon EOS 600D", "Canon EF-S 18-55mm f/3.5-5.6 IS", 18, 8, 96, 72);
+  ASSERT_TRUE(v && s.camera.vignetting_poly);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ((*s.camera.vignetting_poly)[i], v->k[std::size_t(i)]);
+  EXPECT_LT(v->k[0], 0) << "the EF-S 18-55mm darkens toward the corners at 18 mm";
+  // A given vignetting wins; the profile may name another lens than the EXIF does.
+  const SynthScene g = parse_synth_scene(with_lens("{model: lensfun, focal_mm: 18}", ", vignetting: 0.1"), "s.yaml", ".");
+  EXPECT_FALSE(g.camera.vignetting_poly);
+  const SynthScene other = parse_synth_scene(
+      with_lens("{model: lensfun, focal_mm: 18, lens: Canon EF-S 18-55mm f/3.5-5.6 IS}"), "s.yaml", ".");
+  EXPECT_EQ(other.camera.lens.intrinsics(), L->lens.intrinsics());
+  auto error_of = [&](const std::string& lens) {
+    try {
+      parse_synth_scene(with_lens(lens), "s.yaml", ".");
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error_of("{model: lensfun}").find("focal_mm"), std::string::npos) << error_of("{model: lensfun}");
+  EXPECT_NE(error_of("{model: lensfun, focal_mm: 18, focal_px: 300}").find("not with model: lensfun"), std::string::npos);
+  EXPECT_NE(error_of("{model: LENSMODEL_PINHOLE, focal_px: 200, focal_mm: 18}").find("only with model: lensfun"),
+            std::string::npos);
+  EXPECT_NE(error_of("{model: lensfun, focal_mm: 18, lens: Acme Wonderlens}").find("does not know the lens"),
+            std::string::npos);
 }
 
 TEST(CameraPoses, RingCamerasSitAtTheDistanceAndLookAtTheTarget) {

@@ -481,7 +481,7 @@ assert abs(c['focal_px'] / 700 - 1) < c['focal_sigma_relative'], c"
 # No chessboards, but a camera and lens lensfun knows (named in the EXIF): the vignetting comes
 # from lensfun's profile, within 2% of the lens's that the shoot was rendered with (the database's
 # pa terms for the EF 50mm f/1.8 II wide open, focused at 10 m; lensfun's at the 1 m assumed here).
-sed -e '/^chessboards:/d' -e 's/  lens: {model: LENSMODEL_PINHOLE, focal_px: 700}/  lens: {model: LENSMODEL_PINHOLE, focal_px: 444.444444}\
+sed -e '/^chessboards:/d' -e 's/  lens: {model: LENSMODEL_PINHOLE, focal_px: 700}/  lens: {model: lensfun, focal_mm: 50}\
   make: Canon\
   name: Canon EOS 5D Mark II\
   lens_name: Canon EF 50mm f\/1.8 II\
@@ -495,6 +495,15 @@ import json; j = json.load(open('$work/plf.json')); assert all(s['ran'] for s in
 m = j['results']['hdr']['vignetting']['model']; assert m['source'].startswith('lensfun: '), m
 v = lambda k, r: 1 + k[0] * r**2 + k[1] * r**4 + k[2] * r**6
 assert all(abs(v(m['k'], r / 10) / v([-1.4745, 1.1285, -0.4284], r / 10) - 1) < 0.02 for r in range(11)), m"
+# The same shoot, rendered through lensfun's distortion profile of that lens: the calibrate step
+# finds it by the EXIF's names and gives the lens it was rendered with.
+check "process: no chessboards, a lens lensfun knows: its distortion profile is the lens" python3 -c "
+import json; j = json.load(open('$work/plf.json'))
+c = j['results']['calibrate']; assert c['source'] == 'lensfun' and c['model'].startswith('LENSMODEL_OPENCV'), c
+t = open('$work/plf/truth/camera.cameramodel').read()
+truth = [float(x) for x in t.split(\"'intrinsics':\")[1].split('[')[1].split(']')[0].split(',') if x.strip()]
+assert len(truth) == len(c['intrinsics']) and all(abs(a - b) <= 1e-6 * max(1, abs(b)) for a, b in zip(c['intrinsics'], truth)), (c, truth)
+assert 'Canon EF 50mm' in c['focal_from'], c"
 # One view is a shoot, as people bring them: JPEG brackets with EXIF, no chessboards, no poses. The
 # lens from EXIF, the chrome ball found within 1 px of the truth, the world levelled from that
 # camera (its stand line and the upright prior) within 1.5 degrees, the probe and its preview.
