@@ -63,8 +63,10 @@ void write_codes(const fs::path& file, const cv::Mat& codes, const std::string& 
 // length (fx over the sensor's width) and its 35 mm equivalent on the diagonal, in whole mm.
 void write_photo_exif(const fs::path& file, const SynthCamera& cam, double t, const SynthExposure& ex) {
   const double fx = cam.lens.intrinsics().at(0);
-  const double focal_mm = cam.exif_focal_mm > 0 ? cam.exif_focal_mm : fx * cam.sensor_width_mm / cam.lens.width();
-  const double f35 = std::round(fx * 43.266615305567875 / std::hypot(double(cam.lens.width()), double(cam.lens.height())));
+  const double focal_mm = cam.exif_focal_scale *
+                          (cam.exif_focal_mm > 0 ? cam.exif_focal_mm : fx * cam.sensor_width_mm / cam.lens.width());
+  const double f35 = std::round(cam.exif_focal_scale * fx * 43.266615305567875 /
+                                std::hypot(double(cam.lens.width()), double(cam.lens.height())));
   try {
     auto image = Exiv2::ImageFactory::open(file.string());
     image->readMetadata();
@@ -76,8 +78,10 @@ void write_photo_exif(const fs::path& file, const SynthCamera& cam, double t, co
     exif["Exif.Photo.ExposureTime"] = Exiv2::URational(std::uint32_t(std::lround(t * 1e6)), 1000000u);
     exif["Exif.Photo.FNumber"] = Exiv2::URational(std::uint32_t(std::lround(ex.aperture * 10)), 10u);
     exif["Exif.Photo.ISOSpeedRatings"] = std::uint16_t(std::lround(ex.iso));
-    exif["Exif.Photo.FocalLength"] = Exiv2::URational(std::uint32_t(std::lround(focal_mm * 100)), 100u);
-    exif["Exif.Photo.FocalLengthIn35mmFilm"] = std::uint16_t(f35);
+    if (cam.exif_focal_scale > 0) {  // 0: the focal lengths stripped (a messaging app, a scan)
+      exif["Exif.Photo.FocalLength"] = Exiv2::URational(std::uint32_t(std::lround(focal_mm * 100)), 100u);
+      exif["Exif.Photo.FocalLengthIn35mmFilm"] = std::uint16_t(f35);
+    }
     image->writeMetadata();
   } catch (const Exiv2::Error& e) {
     throw std::runtime_error(file.string() + ": cannot write EXIF: " + e.what());

@@ -149,7 +149,8 @@ CameraProcessing parse_processing(const YAML::Node& node, const std::string& pat
 SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const std::filesystem::path& folder) {
   const YamlMap m(node, path,
                   {"name", "width", "height", "lens", "response", "format", "jpeg_quality", "processing", "supersampling",
-                   "vignetting", "white_balance", "full_well", "read_noise", "gain", "sensor_width_mm", "make", "lens_name"});
+                   "vignetting", "white_balance", "full_well", "read_noise", "gain", "sensor_width_mm", "make", "lens_name",
+                   "exif_focal_scale"});
   SynthCamera c;
   const int w = int(spec_in_range(double(m.integer("width")), m.at("width"), 16, false, 16384, false));
   const int h = int(spec_in_range(double(m.integer("height")), m.at("height"), 16, false, 16384, false));
@@ -181,6 +182,11 @@ SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const 
     } else {
       c.vignetting = m.number_in("vignetting", 0, false, 1, true);
     }
+  }
+  if (m.has("exif_focal_scale")) {
+    c.exif_focal_scale = m.number_in("exif_focal_scale", 0, false, 2, false);
+    if (c.exif_focal_scale > 0 && c.exif_focal_scale < 0.5)
+      spec_fail(m.at("exif_focal_scale"), "0 (no focal length in the EXIF) or 0.5 to 2");
   }
   if (m.has("white_balance")) c.white_balance = vec3_in(m, "white_balance", 0, true);
   if (m.has("full_well")) c.full_well = m.number_in("full_well", 1, false, 1e9, false);

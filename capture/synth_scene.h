@@ -108,6 +108,8 @@ struct SynthCamera {
   std::string make = "rsibr";  // EXIF Make (with `name` as Model: a real pair lets lensfun find the camera)
   std::string lens_name;       // EXIF LensModel (empty: not written)
   double exif_focal_mm = 0;    // EXIF FocalLength; 0: fx * sensor_width_mm / width (a lensfun lens gives its own)
+  double exif_focal_scale = 1; // the EXIF's focal lengths over the lens's (a zoom's nominal focal length, focus
+                               // breathing); 0: none written (stripped by a messaging app)
   std::string lensfun_lens;    // the lensfun profile the lens came from (empty: none); its vignetting
                                // at the exposure's aperture is the camera's unless `vignetting` is given
 };

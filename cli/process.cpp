@@ -21,7 +21,7 @@ namespace {
 struct ProcessArgs {
   ProcessOptions o;
   std::string size = "320x240", json, up = "auto";
-  bool quiet = false, no_sources = false;
+  bool quiet = false, no_sources = false, no_self_calibration = false;
 };
 
 int run_process_verb(ProcessArgs a) {
@@ -37,6 +37,7 @@ int run_process_verb(ProcessArgs a) {
     a.o.up = parse_vec3(a.up, "--up");
   }
   a.o.recover_sources = !a.no_sources;
+  a.o.self_calibrate = !a.no_self_calibration;
   a.o.render_width = w;
   a.o.render_height = h;
   std::vector<std::filesystem::path> inputs = load_photo_set(a.o.photoset).files();
@@ -71,7 +72,9 @@ Runner add_process(CLI::App& app) {
   CLI::App* c = app.add_subcommand("process", "The whole job: photo set -> probe, captured vs computed maps, render, report");
   c->footer(
       "Steps (each skipped when its inputs and outputs hold what its record says and its settings are unchanged; records in "
-      "DIR/steps/<step>.json): calibrate (chessboards, or --lens) -> hdr (response, vignetting, merge per view) -> orient "
+      "DIR/steps/<step>.json): calibrate (chessboards, --lens, or the photos' EXIF and the lensfun database) -> hdr "
+      "(response, vignetting, merge per view) -> lens (a lens from the EXIF: its focal length refined from the balls' "
+      "outlines; --no-self-calibration: not) -> orient "
       "(solved from the chrome ball's features, world up estimated, or --poses) -> extract (every listed ball of every view, "
       "identified and checked across views; a ball not found in a view is left out and reported; chrome by reflection "
       "indexing with the other balls, stands and photographer masked, grey orthographic) -> probe "
@@ -100,6 +103,8 @@ Runner add_process(CLI::App& app) {
   c->add_option("--chrome-fresnel", a->o.chrome_fresnel,
                 "The chrome ball's Fresnel spec, divided out of the probe ('none': the probe holds F L)")
       ->capture_default_str();
+  c->add_flag("--no-self-calibration", a->no_self_calibration,
+              "Keep the focal length of a lens from the photos' EXIF as it is (no refinement from the balls' outlines)");
   c->add_flag("--no-sources", a->no_sources,
               "Do not recover light clipped in every chrome view from the grey and glossy balls (probe.exr is the measured probe)");
   c->add_option("--glossy-brdf", a->o.glossy_brdf, "The glossy balls' BRDF spec (YAML text): they then constrain the recovered sources");

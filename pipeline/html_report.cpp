@@ -261,6 +261,9 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
         << ") gives f = " << num(s.value("focal_px", 0.0), 4) << " px &plusmn; "
         << num(100 * s.value("focal_sigma_relative", 0.0), 2) << "% (1 sigma), " << html_escape(s.value("assumed", ""))
         << "; chessboards or --lens give a measured lens";
+    if (s.value("source", "") == "outlines")
+      h << ": no chessboards, no camera model and no focal length in the photos' metadata, so "
+        << html_escape(s.value("assumed", ""));
     if (s.contains("lensfun") && s["lensfun"].is_string())
       h << " (no distortion profile: " << html_escape(s["lensfun"].get<std::string>()) << ")";
     h << ".</p>";
@@ -270,6 +273,29 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
         h << "<tr><td>" << html_escape(m["model"].get<std::string>()) << "</td><td>" << jnum(m["held_out_rms_px"])
           << "</td><td>" << jnum(m["fit_rms_px"]) << "</td></tr>";
       h << "</table>";
+    }
+  }
+  if (rec.count("lens")) {
+    // The lens step (pipeline/lens_step.h): a metadata lens's focal length from the balls' outlines.
+    const auto& s = rec["lens"].summary;
+    if (s.value("refined", false) && s.value("source", "") == "outlines") {
+      h << "<p>Focal length measured from " << jnum(s["balls_used"]) << " ball outline(s) (" << jnum(s["points"])
+        << " points, RMS " << num(s.value("outline_rms_px", 0.0), 3) << " px): f = <b>" << num(s.value("focal_px", 0.0), 5)
+        << " &plusmn; " << num(s.value("sigma_px", 0.0), 3) << " px</b>.";
+      if (!s.value("note", "").empty()) h << " " << html_escape(s.value("note", "")) << ".";
+      h << "</p>";
+    } else if (s.value("refined", false)) {
+      h << "<p>Focal length refined from " << jnum(s["balls_used"]) << " ball outline(s) (" << jnum(s["points"])
+        << " points, RMS " << num(s.value("outline_rms_px", 0.0), 3) << " px): the outlines alone say "
+        << num(s.value("outline_focal_px", 0.0), 5) << " &plusmn; " << num(s.value("outline_sigma_px", 0.0), 3)
+        << " px, the metadata " << num(s.value("prior_focal_px", 0.0), 5) << " &plusmn; "
+        << num(s.value("prior_sigma_px", 0.0), 3) << " px; combined f = <b>" << num(s.value("focal_px", 0.0), 5)
+        << " &plusmn; " << num(s.value("sigma_px", 0.0), 3) << " px</b> (" << num(100 * s.value("change_relative", 0.0), 3)
+        << "% from the metadata's).";
+      if (!s.value("note", "").empty()) h << " " << html_escape(s.value("note", "")) << ".";
+      h << "</p>";
+    } else if (s.value("source", "") == "exif" || s.value("source", "") == "lensfun") {
+      h << "<p>The focal length was not refined from the balls' outlines: " << html_escape(s.value("why", "")) << ".</p>";
     }
   }
 

@@ -39,6 +39,7 @@
 #include "pipeline/ball_override.h"
 #include "pipeline/chessboard_problem.h"
 #include "pipeline/html_report.h"
+#include "pipeline/lens_step.h"
 #include "pipeline/light_sources_step.h"
 #include "pipeline/mask_picture.h"
 #include "pipeline/pose_input.h"
@@ -173,11 +174,22 @@ void step_calibrate(Context& c) {
       std::optional<OpticsLens> guess = lensfun_from_optics(optics, b.cols(), b.rows(), &lensfun_why);
       const bool from_lensfun = guess.has_value();
       if (!guess) guess = pinhole_from_optics(optics, b.cols(), b.rows());
-      if (!guess)
-        throw std::invalid_argument(inputs.front().string() +
-                                    ": no chessboards, no camera model and no usable focal length in the photo's "
-                                    "metadata (FocalLengthIn35mmFilm, or FocalLength of a camera lensfun knows); "
-                                    "give the lens with --lens FILE");
+      if (!guess) {
+        // No focal length in the metadata (stripped by an app, a scan): a pinhole of the image's
+        // diagonal (a normal lens) to start from; the lens step measures f from the balls' outlines.
+        const double f = std::hypot(double(b.cols()), double(b.rows()));
+        const LensModel lens = LensModel::pinhole(f, b.cols(), b.rows());
+        lens.write(out);
+        s = {{"source", "outlines"}, {"model", lens.name()}, {"intrinsics", lens.intrinsics()}, {"focal_px", f},
+             {"focal_from", "none: no usable focal length in the photos' metadata (FocalLengthIn35mmFilm, or "
+                            "FocalLength of a camera lensfun knows)"},
+             {"camera", optics.make + " " + optics.model}, {"lens", optics.lens}, {"lensfun", lensfun_why},
+             {"assumed", "a pinhole: principal point at the image centre, no distortion, the focal length from the "
+                         "balls' outlines (the lens step)"}};
+        r.outputs = {out};
+        r.summary = s;
+        return;
+      }
       guess->lens.write(out);
       s = {{"source", from_lensfun ? "lensfun" : "exif"}, {"model", guess->lens.name()},
            {"intrinsics", guess->lens.intrinsics()}, {"focal_px", guess->focal_px},
@@ -317,6 +329,34 @@ void step_hdr(Context& c) {
   });
 }
 
+// ---- lens: the calibrated lens, its focal length refined from the balls' outlines when it came
+// from the photos' metadata (pipeline/lens_step.h) -> DIR/lens.cameramodel, the lens of every
+// later step.
+void step_lens(Context& c) {
+  std::vector<fs::path> inputs = hdr_files(c);
+  inputs.push_back(c.dir / "camera.cameramodel");
+  const nlohmann::json& cal = c.result.summary["calibrate"];
+  LensStep s;
+  s.calibrated = c.dir / "camera.cameramodel";
+  s.source = cal.value("source", "");
+  s.prior_sigma_relative = cal.value("focal_sigma_relative", 0.0);
+  s.refine = c.o.self_calibrate;
+  s.balls = listed_balls(c.set);
+  s.out = c.dir / "lens.cameramodel";
+  for (const PhotoView& v : c.set.views) {
+    s.views.push_back(v.name);
+    s.merged.push_back(merged_path(c, v.name));
+  }
+  nlohmann::json balls = nlohmann::json::array();
+  for (const ListedBall& b : s.balls) balls.push_back({b.name, to_string(b.kind)});
+  const nlohmann::json settings = {{"refine", s.refine}, {"source", s.source},
+                                   {"prior_sigma_relative", s.prior_sigma_relative}, {"balls", balls}};
+  run_step(c, "lens", settings, inputs, [&](StepRecord& r) {
+    r.summary = run_lens_step(s);
+    r.outputs = {s.out};
+  });
+}
+
 // ---- orient: world_from_cam per view, solved from the chrome ball's reflected features
 // (calib/view_orientation.h; world +Y up: estimated from the views, or `up` given in the first
 // camera's frame), or given (--poses: the file's chrome balls, refined here by the features with
@@ -329,7 +369,7 @@ nlohmann::json world_up_json(const WorldUp& w) {
 
 void step_orient(Context& c) {
   std::vector<fs::path> inputs = hdr_files(c);
-  inputs.push_back(c.dir / "camera.cameramodel");
+  inputs.push_back(c.dir / "lens.cameramodel");
   if (!c.o.poses.empty()) {
     inputs.push_back(c.o.poses);
     const PoseSet given = read_given_poses(c.o.poses);
@@ -358,7 +398,7 @@ void step_orient(Context& c) {
     PoseSet poses;
     std::string source;
     nlohmann::json solve, left_out = nlohmann::json::array(), notes = nlohmann::json::array(), up = nullptr;
-    const LensModel lens = LensModel::read(c.dir / "camera.cameramodel");
+    const LensModel lens = LensModel::read(c.dir / "lens.cameramodel");
     std::vector<std::string> names;
     std::vector<ViewImage> images;
     auto load_images = [&] {
@@ -450,7 +490,7 @@ nlohmann::json finding_json(const std::string& ball, const BallFinding& f) {
 
 void step_extract(Context& c) {
   std::vector<fs::path> inputs = hdr_files(c);
-  inputs.push_back(c.dir / "camera.cameramodel");
+  inputs.push_back(c.dir / "lens.cameramodel");
   inputs.push_back(c.dir / "poses.yaml");
   const std::vector<BallOverride> overrides = parse_ball_overrides(c.o.ball_overrides, c.set);
   nlohmann::json balls = nlohmann::json::array(), given = nlohmann::json::array();
@@ -459,7 +499,7 @@ void step_extract(Context& c) {
   const nlohmann::json settings = {{"map_size", c.o.map_size}, {"balls", balls}, {"given", given}, {"identification", 4}};
   run_step(c, "extract", settings, inputs, [&](StepRecord& r) {
     if (c.set.balls.empty()) throw std::invalid_argument(c.o.photoset + ": balls: the photo set lists no ball");
-    const LensModel lens = LensModel::read(c.dir / "camera.cameramodel");
+    const LensModel lens = LensModel::read(c.dir / "lens.cameramodel");
     const PoseSet poses = read_pose_file((c.dir / "poses.yaml").string());
     const std::vector<ListedBall> listed = listed_balls(c.set);
     // World down for the stands and the photographer: -Y when the world is +Y up, else the first camera's +y.
@@ -948,15 +988,15 @@ void step_render(Context& c) {
 }  // namespace
 
 const std::vector<std::string>& process_steps() {
-  static const std::vector<std::string> steps = {"calibrate", "hdr",     "orient", "extract", "probe",
-                                                 "sources",   "bake",    "compare", "render", "report"};
+  static const std::vector<std::string> steps = {"calibrate", "hdr",  "lens",    "orient", "extract", "probe",
+                                                 "sources",   "bake", "compare", "render", "report"};
   return steps;
 }
 
 ProcessResult run_process(const ProcessOptions& o) {
   for (const std::string& f : o.force)
     if (f != "all" && std::find(process_steps().begin(), process_steps().end(), f) == process_steps().end())
-      throw std::invalid_argument("--force '" + f + "': not a step (calibrate, hdr, orient, extract, probe, sources, "
+      throw std::invalid_argument("--force '" + f + "': not a step (calibrate, hdr, lens, orient, extract, probe, sources, "
                                   "bake, compare, render, report, all)");
   if (!o.lens.empty() && !fs::is_regular_file(o.lens)) throw std::invalid_argument(o.lens + ": no such file");
   if (!o.mesh.empty() && !fs::is_regular_file(o.mesh)) throw std::invalid_argument(o.mesh + ": no such file");
@@ -992,6 +1032,7 @@ ProcessResult run_process(const ProcessOptions& o) {
 
   step_calibrate(c);
   step_hdr(c);
+  step_lens(c);
   step_orient(c);
   step_extract(c);
   step_probe(c);

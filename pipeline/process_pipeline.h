@@ -5,6 +5,9 @@
 //              or the photo set's model, or a pinhole from the photos' EXIF (calib/photo_optics.h)
 //   hdr        brackets -> DIR/hdr/<view>.exr, DIR/hdr/response.json (response recovered once),
 //              DIR/hdr/vignetting.json (estimated from the chessboards, divided out of every view)
+//   lens       the calibrated lens, its focal length refined from the balls' outlines when it came
+//              from the photos' metadata (pipeline/lens_step.h) -> DIR/lens.cameramodel, the lens
+//              of every later step
 //   orient     -> DIR/poses.yaml (world_from_cam per view: solved from the chrome ball's features,
 //              calib/view_orientation.h, world +Y up estimated from the views or given; or --poses,
 //              whose chrome balls are refined here when the file has none)
@@ -45,6 +48,7 @@ struct ProcessOptions {
   std::string photoset;      // photoset.yaml or its folder
   std::filesystem::path out; // DIR (created; its parent must exist)
   std::string lens;          // given .cameramodel (skips the chessboards)
+  bool self_calibrate = true; // lens step: refine a metadata lens's focal length from the balls' outlines
   std::string poses;         // given poses (pipeline/pose_input.h); empty: the orientation solve
   std::optional<Vec3> up;    // world up in the first camera's frame (e.g. 0,-1,0 for a levelled camera)
   bool estimate_up = true;   // without `up`: estimated from the views (calib/world_up.h); false: first-view gauge

@@ -477,7 +477,9 @@ grep -v '^chessboards:' "$pspec" >"$work/noboards.yaml"
 check "process: no chessboards, the lens from EXIF within its stated sigma" python3 -c "
 import json; j = json.load(open('$work/pnb.json')); assert all(s['ran'] for s in j['steps']), j['steps']
 c = j['results']['calibrate']; assert c['source'] == 'exif' and c['model'] == 'LENSMODEL_PINHOLE', c
-assert abs(c['focal_px'] / 700 - 1) < c['focal_sigma_relative'], c"
+assert abs(c['focal_px'] / 700 - 1) < c['focal_sigma_relative'], c
+l = j['results']['lens']; assert l['source'] == 'exif' and abs(l['prior_focal_px'] - c['focal_px']) < 1e-3, l
+assert not l['refined'] or abs(l['focal_px'] / 700 - 1) < 3 * l['sigma_relative'], l"
 # No chessboards, but a camera and lens lensfun knows (named in the EXIF): the vignetting comes
 # from lensfun's profile, within 2% of the lens's that the shoot was rendered with (the database's
 # pa terms for the EF 50mm f/1.8 II wide open, focused at 10 m; lensfun's at the 1 m assumed here).
@@ -504,6 +506,38 @@ t = open('$work/plf/truth/camera.cameramodel').read()
 truth = [float(x) for x in t.split(\"'intrinsics':\")[1].split('[')[1].split(']')[0].split(',') if x.strip()]
 assert len(truth) == len(c['intrinsics']) and all(abs(a - b) <= 1e-6 * max(1, abs(b)) for a, b in zip(c['intrinsics'], truth)), (c, truth)
 assert 'Canon EF 50mm' in c['focal_from'], c"
+# A kit zoom lensfun profiles whose EXIF states the focal length 4% short (a zoom's nominal focal
+# length, focus breathing): the lens step refines it from the balls' outlines to within its stated
+# sigma of the truth, smaller than the metadata's; --no-self-calibration keeps the EXIF's.
+sed -e '/^chessboards:/d' -e 's/  lens: {model: LENSMODEL_PINHOLE, focal_px: 700}/  lens: {model: lensfun, focal_mm: 18}\
+  make: Canon\
+  name: Canon EOS 600D\
+  lens_name: Canon EF-S 18-55mm f\/3.5-5.6 IS\
+  exif_focal_scale: 0.96/' -e 's/width: 320/width: 360/' -e 's/distance_m: 1.0/distance_m: 0.45/' "$pspec" >"$work/kit.yaml"
+"$rsibr" synth "$work/kit.yaml" --out "$work/pkit" -q
+"$rsibr" process "$work/pkit/photos" --out "$work/pkitout" --poses "$work/pkit/truth/truth.yaml" --chrome-fresnel "$fres" \
+  --map-size 32 --turntable 1 --size 64x48 --json "$work/pkit.json" -q >/dev/null 2>&1
+"$rsibr" process "$work/pkit/photos" --out "$work/pkitout2" --poses "$work/pkit/truth/truth.yaml" --chrome-fresnel "$fres" \
+  --map-size 32 --turntable 1 --size 64x48 --json "$work/pkit2.json" --no-self-calibration -q >/dev/null 2>&1 || true
+check "process: an EXIF focal length 4% off is refined from the balls' outlines" python3 -c "
+import json; j = json.load(open('$work/pkit.json')); assert all(s['ran'] for s in j['steps']), j['steps']
+t = open('$work/pkit/truth/camera.cameramodel').read()
+f = float(t.split(\"'intrinsics':\")[1].split('[')[1].split(',')[0])
+l = j['results']['lens']; assert l['source'] == 'lensfun' and l['refined'], l
+assert abs(l['prior_focal_px'] / f - 0.96) < 0.002, (l, f)
+assert abs(l['focal_px'] / f - 1) < 2 * l['sigma_relative'] and l['sigma_px'] < l['prior_sigma_px'], (l, f)
+k = json.load(open('$work/pkitout2/steps/lens.json'))['summary']; assert not k['refined'] and 'off' in k['why'], k"
+# No focal length in the EXIF at all (stripped by a messaging app): the balls' outlines measure it,
+# within 2 of their stated sigmas of the truth.
+sed -e '/^chessboards:/d' -e 's/  format: png/  format: png\
+  exif_focal_scale: 0/' "$pspec" >"$work/nofocal.yaml"
+"$rsibr" synth "$work/nofocal.yaml" --out "$work/pnf" -q
+"$rsibr" process "$work/pnf/photos" --out "$work/pnfout" --poses "$work/pnf/truth/truth.yaml" --chrome-fresnel "$fres" \
+  --map-size 32 --turntable 1 --size 64x48 --json "$work/pnf.json" -q >/dev/null 2>&1
+check "process: no focal length in the EXIF, the balls' outlines measure it" python3 -c "
+import json; j = json.load(open('$work/pnf.json')); assert all(s['ran'] for s in j['steps']), j['steps']
+assert j['results']['calibrate']['source'] == 'outlines', j['results']['calibrate']
+l = j['results']['lens']; assert l['refined'] and abs(l['focal_px'] / 700 - 1) < 2 * l['sigma_relative'] < 0.2, l"
 # One view is a shoot, as people bring them: JPEG brackets with EXIF, no chessboards, no poses. The
 # lens from EXIF, the chrome ball found within 1 px of the truth, the world levelled from that
 # camera (its stand line and the upright prior) within 1.5 degrees, the probe and its preview.
