@@ -65,17 +65,27 @@ Regions regions(const cv::Mat& truth, const cv::Mat& clipped_everywhere) {
   return g;
 }
 
-// Errors of `est` (CV_32FC3 RGB) against truth after fitting the global factor on mid-tones.
-nlohmann::json errors(const cv::Mat& est, const cv::Mat& truth, const Regions& g) {
+// Median of truth / estimate in channel c over mid-tone pixels.
+double median_ratio(const cv::Mat& est, const cv::Mat& truth, const Regions& g, int c) {
   std::vector<double> ratios;
   for (int r = 0; r < truth.rows; r += 2)
     for (int x = 0; x < truth.cols; x += 2)
       if (g.label.at<unsigned char>(r, x) == 2) {
-        const double e = est.at<cv::Vec3f>(r, x)[1];
-        if (e > 0 && std::isfinite(e)) ratios.push_back(truth.at<cv::Vec3d>(r, x)[1] / e);
+        const double e = est.at<cv::Vec3f>(r, x)[c];
+        if (e > 0 && std::isfinite(e)) ratios.push_back(truth.at<cv::Vec3d>(r, x)[c] / e);
       }
+  if (ratios.empty()) return 1.0;
   std::nth_element(ratios.begin(), ratios.begin() + long(ratios.size() / 2), ratios.end());
-  const double scale = ratios.empty() ? 1.0 : ratios[ratios.size() / 2];
+  return ratios[ratios.size() / 2];
+}
+
+// Errors of `est` (CV_32FC3 RGB) against truth after fitting the global factor on mid-tones
+// (green's), or with per_channel a factor per channel (a white balance: the channels' relative
+// scales are not observable from brackets, see the section's text).
+nlohmann::json errors(const cv::Mat& est, const cv::Mat& truth, const Regions& g, bool per_channel) {
+  double scales[3];
+  for (int c = 0; c < 3; ++c) scales[c] = median_ratio(est, truth, g, per_channel ? c : 1);
+  const double scale = scales[1];
   double se[4] = {0, 0, 0, 0}, n[4] = {0, 0, 0, 0}, sig = 0, noise = 0;
   long bad = 0;
   for (int r = 0; r < truth.rows; ++r)
@@ -85,7 +95,7 @@ nlohmann::json errors(const cv::Mat& est, const cv::Mat& truth, const Regions& g
       const double lum = luminance(truth.at<cv::Vec3d>(r, x));
       for (int c = 0; c < 3; ++c) {
         const double t = truth.at<cv::Vec3d>(r, x)[c];
-        const double e = double(est.at<cv::Vec3f>(r, x)[c]) * scale;
+        const double e = double(est.at<cv::Vec3f>(r, x)[c]) * scales[c];
         if (!std::isfinite(e)) { ++bad; continue; }
         if (lum > 0) se[k] += (e - t) * (e - t) / (lum * lum), n[k] += 1;
         if (g.darkest.at<unsigned char>(r, x)) sig += t * t, noise += (e - t) * (e - t);
@@ -96,6 +106,12 @@ nlohmann::json errors(const cv::Mat& est, const cv::Mat& truth, const Regions& g
           {"highlights", std::sqrt(se[3] / std::max(1.0, n[3]))},
           {"snr_darkest_decade_db", 10 * std::log10(sig / std::max(noise, 1e-300))},
           {"non_finite", bad}, {"scale", scale}};
+}
+
+nlohmann::json errors(const cv::Mat& est, const cv::Mat& truth, const Regions& g) {
+  nlohmann::json j = errors(est, truth, g, false);
+  j["per_channel"] = errors(est, truth, g, true);
+  return j;
 }
 
 std::vector<cv::Mat> to_bgr8(const BracketSet& b) {
@@ -190,8 +206,11 @@ int run(int argc, char** argv) {
   cv::Mat clipped_everywhere = (ours.flags & kClipped) != 0;
   const Regions g = regions(truth, clipped_everywhere);
   nlohmann::json cands = nlohmann::json::array();
-  for (const auto& c : rec.candidates) cands.push_back({{"model", c.model}, {"complexity", c.complexity}, {"held_out_error", c.held_out_error}, {"parameters", c.parameters}});
-  out["response"] = {{"chosen", rec.curve.model}, {"candidates", cands}, {"seconds", t_recover}};
+  for (const auto& c : rec.candidates)
+    cands.push_back({{"model", c.model}, {"shared", c.shared}, {"complexity", c.complexity},
+                     {"held_out_error", c.held_out_error}, {"tied", c.tied}, {"parameters", c.parameters}});
+  out["response"] = {{"chosen", rec.chosen}, {"candidates", cands}, {"seconds", t_recover},
+                     {"margin_sigmas", rec.margin_sigmas}, {"warning", rec.warning}};
   out["noise"] = {{"shot", noise.shot}, {"read", noise.read}, {"true_shot", cam.shot()}, {"true_read", cam.read()}, {"seconds", t_noise}};
   out["clipped_pixels"] = ours.clipped;
   out["ghost_pixels"] = ours.ghost;
@@ -210,6 +229,9 @@ int run(int argc, char** argv) {
     }
     return 0.5 * (lo + hi);
   });
+  // What a neutral records: the true curves' radiance at the middle code, over green's.
+  out["true_middle_code_ratio"] = {true_curve.linear(0, 127.5) / true_curve.linear(1, 127.5), 1.0,
+                                   true_curve.linear(2, 127.5) / true_curve.linear(1, 127.5)};
   NoiseModel true_noise;
   for (int c = 0; c < 3; ++c) true_noise.shot[std::size_t(c)] = cam.shot(), true_noise.read[std::size_t(c)] = cam.read();
   methods.push_back({{"method", "rsibr merge with the true curve and noise"}, {"errors", errors(merge_brackets(b, true_curve, true_noise).radiance, truth, g)}, {"seconds", nullptr}});

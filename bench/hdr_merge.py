@@ -85,33 +85,52 @@ def main():
              "Truth: `%s` resized to %dx%d as scene radiance. Capture: %d brackets two stops apart, Poisson shot noise "
              "(full well %.0f e-), read noise sigma %.1e of saturation, a film-like S-shaped response per channel, "
              "8-bit codes (OpenCV's MergeDebevec takes 8-bit only); the test synthesizer tests/hdr/bracket_synth.h. "
-             "Each output is fitted to the truth by one global factor (median ratio over mid-tones); errors are the "
+             "Each output is fitted to the truth by one global factor (median ratio over mid-tones), and again by "
+             "one factor per channel (a white balance); errors are the "
              "RMS of (estimate - truth) / truth luminance over RGB in shadows (truth luminance below the 10th percentile), "
              "mid-tones and highlights (above the 90th), leaving out pixels clipped in every bracket (%d, flagged). "
              "SNR: darkest decade of truth luminance [p0.1, 10 p0.1]." % (
                  sc["env"], sc["width"], sc["height"], len(sc["exposures"]), sc["full_well"], sc["read_sigma"], j["clipped_pixels"]), "",
-             "| method | shadows | mid-tones | highlights | SNR darkest decade | merge time (%dx%d) |" % (sc["width"], sc["height"]),
-             "|---|---|---|---|---|---|"]
+             "The channels' relative scales cannot be recovered from brackets (any per-channel factor fits them "
+             "equally well): rsibr ties them at the middle code, the camera's own white balance (a real camera "
+             "white-balances before one tone curve, so a neutral patch records equal codes), and OpenCV's "
+             "calibration pins each channel at code 128 too. This synthesizer's per-channel curves all meet at the "
+             "top instead (saturation): the middle code in each channel means radiances in the ratio %.2f : 1 : %.2f "
+             "(R : G : B), a cast the global-factor columns count as error; the per-channel ones measure the curves' "
+             "shapes alone." % (j["true_middle_code_ratio"][0], j["true_middle_code_ratio"][2]), "",
+             "| method | shadows | mid-tones | highlights | mid-tones, per-channel factors | highlights, per-channel factors | SNR darkest decade | merge time (%dx%d) |" % (sc["width"], sc["height"]),
+             "|---|---|---|---|---|---|---|---|"]
     for m in j["accuracy"]:
         e = m["errors"]
+        w = e["per_channel"]
         t = "-" if m.get("seconds") is None else ms(m["seconds"])
         if m.get("calibrate_seconds") is not None:
             t += " (+ %s calibration)" % ms(m["calibrate_seconds"])
-        trade.append("| %s | %.2f%% | %.2f%% | %.2f%% | %.1f dB | %s |" % (
-            m["method"], 100 * e["shadows"], 100 * e["midtones"], 100 * e["highlights"], e["snr_darkest_decade_db"], t))
+        trade.append("| %s | %.2f%% | %.2f%% | %.2f%% | %.2f%% | %.2f%% | %.1f dB | %s |" % (
+            m["method"], 100 * e["shadows"], 100 * e["midtones"], 100 * e["highlights"], 100 * w["midtones"],
+            100 * w["highlights"], e["snr_darkest_decade_db"], t))
     ours = j["accuracy"][0]["errors"]["snr_darkest_decade_db"]
     hat = j["accuracy"][1]["errors"]["snr_darkest_decade_db"]
     trade += ["", "Darkest-decade SNR, rsibr against Debevec hat weighting with the same curve: %+.1f dB (target >= 3 dB: %s)." % (
         ours - hat, "met" if ours - hat >= 3 else "not met"), "",
         "Response models (held-out half of the samples; error = RMS code error / 255 predicting each pixel's other "
-        "brackets from its best-exposed one; the simplest model within 5%% of the best is chosen, recovery %s):" % ms(j["response"]["seconds"]), "",
-        "| model | parameters per channel | held-out error | chosen |", "|---|---|---|---|"]
+        "brackets from its best-exposed one; tied: within the held-out noise of the best, where the simplest "
+        "tied model wins; recovery %s; chosen: %s, margin %.1f sigmas%s):" % (
+            ms(j["response"]["seconds"]), j["response"]["chosen"], j["response"]["margin_sigmas"],
+            "; " + j["response"]["warning"] if j["response"].get("warning") else ""), "",
+        "| model | channels | parameters | held-out error | tied |", "|---|---|---|---|---|"]
     cands = j["response"]["candidates"]
-    best = min(c["held_out_error"] for c in cands)
-    chosen = next(i for i, c in enumerate(cands) if c["held_out_error"] <= 1.05 * best)  # as recover_response
-    for i, c in enumerate(cands):
-        label = c["model"] + (" (degree %d)" % c["parameters"]["degree"] if c["model"] == "polynomial" else "")
-        trade.append("| %s | %d | %.5f | %s |" % (label, c["complexity"], c["held_out_error"], "yes" if i == chosen else ""))
+    for c in cands:
+        p = c.get("parameters") or {}
+        label = c["model"]
+        if c["model"] == "polynomial" and "degree" in p:
+            label += " (degree %d)" % p["degree"]
+        if c["model"] in ("debevec", "robertson") and "lambda" in p:
+            label += " (lambda %g)" % p["lambda"]
+        err = c["held_out_error"]
+        err_text = "%.5f" % err if err is not None and err == err and err != float("inf") else "rejected"
+        trade.append("| %s | %s | %d | %s | %s |" % (label, "shared" if c.get("shared") else "per channel",
+                                                     c["complexity"], err_text, "yes" if c.get("tied") else ""))
     n = j["noise"]
     trade += ["", "Noise model estimated from the brackets: shot %s (true %.2e), read %s (true %.2e)." % (
         " ".join("%.2e" % v for v in n["shot"]), n["true_shot"], " ".join("%.2e" % v for v in n["read"]), n["true_read"]),
