@@ -16,6 +16,7 @@
 #include "hdr/alignment.h"
 #include "hdr/bracket_set.h"
 #include "hdr/merge.h"
+#include "hdr/merged_colour.h"
 #include "hdr/merged_exr.h"
 #include "hdr/noise_model.h"
 #include "hdr/photo_set_merge.h"
@@ -113,19 +114,6 @@ std::string describe(const NoiseModel& n) {
   return s.str();
 }
 
-// The matrix of a linear OCIO conversion, from its action on the unit colours.
-cv::Matx33f conversion_matrix(const std::string& from, const std::string& to) {
-  cv::Mat basis(1, 3, CV_32FC3);
-  basis.at<cv::Vec3f>(0, 0) = {1, 0, 0};
-  basis.at<cv::Vec3f>(0, 1) = {0, 1, 0};
-  basis.at<cv::Vec3f>(0, 2) = {0, 0, 1};
-  convert_colour_space(basis, from, to);
-  cv::Matx33f m;
-  for (int col = 0; col < 3; ++col)
-    for (int row = 0; row < 3; ++row) m(row, col) = basis.at<cv::Vec3f>(0, col)[row];
-  return m;
-}
-
 // Preview exposure: the median luminance of unclipped pixels maps to 0.18.
 float unclipped_exposure(const MergedImage& m) {
   cv::Mat unclipped;
@@ -161,9 +149,9 @@ int run_hdr(const HdrArgs& a) {
       a.model != "robertson" && a.model != "debevec")
     throw std::invalid_argument("--model '" + a.model + "': expected auto, identity, gamma, polynomial, robertson or debevec");
   const std::string working = working_space();
-  std::optional<cv::Matx33f> to_working;
-  if (!a.input_colour_space.empty() && a.input_colour_space != working)
-    to_working = conversion_matrix(a.input_colour_space, working);
+  // The camera's colour space: --input-colorspace, else the photo set's camera.colour_space.
+  const std::string input_space = !a.input_colour_space.empty() ? a.input_colour_space : set.camera_colour_space;
+  if (!input_space.empty() && input_space != working) colour_conversion_matrix(input_space, working);  // errors first
 
   // Outputs: the folder may be new (its parent must exist); no output may name an input.
   const fs::path out_dir = fs::absolute(a.out);
@@ -275,19 +263,11 @@ int run_hdr(const HdrArgs& a) {
       const std::vector<cv::Point>& shifts = vm.shifts;
       const NoiseModel& noise = vm.noise;
       MergedImage& m = vm.image;
-      if (gains) {
-        // The user's white balance: gains on the camera's (the merge keeps the camera's own).
-        const cv::Vec3f g = *gains;
-        m.radiance.forEach<cv::Vec3f>([&](cv::Vec3f& p, const int*) { p = p.mul(g); });
-        m.variance.forEach<cv::Vec3f>([&](cv::Vec3f& p, const int*) { p = p.mul(g.mul(g)); });
-      }
-      if (to_working) {
-        convert_colour_space(m.radiance, a.input_colour_space, working);
-        // Variances through the squared matrix (channel covariances are not kept).
-        cv::Matx33f sq;
-        for (int i = 0; i < 9; ++i) sq.val[i] = (*to_working).val[i] * (*to_working).val[i];
-        cv::transform(m.variance, m.variance, sq);
-      }
+      // The user's white balance on the camera's (the merge keeps the camera's own), then the
+      // working space (hdr/merged_colour.h).
+      if (gains) apply_white_balance(m, *gains);
+      const std::string from = merged_colour_space(b.raw && a.input_colour_space.empty() ? "" : input_space, b.raw);
+      merged_to_working_space(m, from);
       const auto t2 = std::chrono::steady_clock::now();
       std::string files;
       for (const std::string& f : b.files) files += (files.empty() ? "" : ";") + relative_name(f, set.folder);
@@ -308,7 +288,7 @@ int run_hdr(const HdrArgs& a) {
           {"noiseModel", describe(noise)},
           {"radianceUnit", "X/e: signal over saturation per relative exposure t*iso/100/N^2"},
           {"colourSpace", working},
-          {"inputColourSpace", a.input_colour_space.empty() ? working : a.input_colour_space},
+          {"inputColourSpace", from.empty() ? working : from},
           {"alignment", alignment == Alignment::off ? "none" : std::string("MTB (") + to_string(alignment) + "), shifts " + shift_text},
           {"ghosts", a.deghost ? "flagged; longest usable bracket alone" : "flagged; merged as usual"},
           {"flags", "clipped: lower bound (saturated in every bracket); black: nothing recorded; ghost: brackets disagree"}};

@@ -92,6 +92,9 @@ Runner add_process(CLI::App& app) {
                               "first camera)")->capture_default_str();
   c->add_option("--ball", a->o.ball_overrides, "VIEW:BALL=X,Y,R: that ball of that view is at pixel (X, Y) with radius R "
                                                "(roughly), instead of the detection (repeatable)");
+  c->add_option("--input-colorspace", a->o.input_colour_space,
+                "OpenColorIO colour space of the linearised camera RGB (default: the photo set's camera.colour_space, "
+                "else the working space; $OCIO honoured)");
   c->add_option("--vignetting", a->o.vignetting, "'auto' (estimated from the chessboards), 'none', or a JSON model "
                                                  "(DIR/hdr/vignetting.json of another run)")->capture_default_str();
   c->add_option("--radiance", a->o.radiance_dir, "Use these linear EXRs (<view>_radiance.exr or <view>.exr) instead of the merge");

@@ -46,8 +46,9 @@ PhotoSet parse(const YAML::Node& root, const fs::path& folder) {
   YamlMap top(root, "photoset", {"rsibr_photoset", "camera", "balls", "views", "chessboards"});
   if (top.integer("rsibr_photoset") != 1) spec_fail(top.at("rsibr_photoset"), "unsupported version (expected 1)");
   if (top.has("camera")) {
-    YamlMap cam(top.get("camera"), top.at("camera"), {"name", "model"});
+    YamlMap cam(top.get("camera"), top.at("camera"), {"name", "model", "colour_space"});
     set.camera_name = valid_utf8(cam.optional_string("name").value_or(""));
+    set.camera_colour_space = valid_utf8(cam.optional_string("colour_space").value_or(""));
     if (cam.has("model")) set.camera_model = resolve(folder, cam.string("model"), cam.at("model"));
   }
   if (top.has("balls")) {
@@ -170,10 +171,12 @@ fs::path save_photo_set(const PhotoSet& set) {
   const fs::path folder = fs::absolute(set.folder).lexically_normal();
   YAML::Emitter out;
   out << YAML::BeginMap << YAML::Key << "rsibr_photoset" << YAML::Value << 1;
-  if (!set.camera_name.empty() || set.camera_model) {
+  if (!set.camera_name.empty() || set.camera_model || !set.camera_colour_space.empty()) {
     out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap;
     if (!set.camera_name.empty()) out << YAML::Key << "name" << YAML::Value << YAML::DoubleQuoted << set.camera_name;
     if (set.camera_model) out << YAML::Key << "model" << YAML::Value << relative_to(folder, *set.camera_model);
+    if (!set.camera_colour_space.empty())
+      out << YAML::Key << "colour_space" << YAML::Value << YAML::DoubleQuoted << set.camera_colour_space;
     out << YAML::EndMap;
   }
   if (!set.balls.empty()) {

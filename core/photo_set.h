@@ -5,6 +5,7 @@
 //   camera:                                  # all keys optional
 //     name: "Canon 5D Mk IV + 50mm"
 //     model: camera.cameramodel             # mrcal lens model (intrinsics), relative to the folder
+//     colour_space: lin_p3d65               # OCIO space of the linearised camera RGB [the working space]
 //   balls:                                   # what calibration looks for, left to right in the frame
 //     - {name: chrome, kind: chrome, diameter_m: 0.1}
 //     - {name: grey,   kind: grey,   diameter_m: 0.1}
@@ -67,6 +68,7 @@ struct ChessboardSet {
 struct PhotoSet {
   std::filesystem::path folder;  // holds photoset.yaml (absolute after loading)
   std::string camera_name;
+  std::string camera_colour_space;  // OCIO colour space of the linearised camera RGB; empty: the working space
   std::optional<std::filesystem::path> camera_model;  // absolute after loading
   std::vector<BallSpec> balls;
   std::vector<PhotoView> views;

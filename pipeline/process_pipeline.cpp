@@ -31,6 +31,7 @@
 #include "core/yaml_spec.h"
 #include "hdr/bracket_set.h"
 #include "hdr/merge.h"
+#include "hdr/merged_colour.h"
 #include "hdr/merged_exr.h"
 #include "hdr/noise_model.h"
 #include "hdr/photo_set_merge.h"
@@ -267,7 +268,11 @@ void step_hdr(Context& c) {
   // Vignetting (pipeline/vignetting_input.h): its inputs and the lens's principal point.
   for (const fs::path& f : vignetting_inputs(c.set, c.o.vignetting)) inputs.push_back(f);
   if (c.o.vignetting != "none") inputs.push_back(c.dir / "camera.cameramodel");
-  run_step(c, "hdr", {{"response", "auto"}, {"vignetting", c.o.vignetting}}, inputs, [&](StepRecord& r) {
+  // The camera's colour space (hdr/merged_colour.h): the option, else the photo set's; RAW views
+  // are developed to linear Rec.709 (hdr/raw_image.h) whatever the photo set says.
+  const std::string input_space = !c.o.input_colour_space.empty() ? c.o.input_colour_space : c.set.camera_colour_space;
+  run_step(c, "hdr", {{"response", "auto"}, {"vignetting", c.o.vignetting}, {"input_colour_space", input_space}}, inputs,
+           [&](StepRecord& r) {
     fs::create_directories(c.dir / "hdr");
     std::vector<const PhotoView*> all;
     for (const PhotoView& v : c.set.views) all.push_back(&v);
@@ -302,14 +307,17 @@ void step_hdr(Context& c) {
     Progress bar("hdr", c.o.progress);
     for (std::size_t i = 0; i < c.set.views.size(); ++i) {
       const PhotoView& v = c.set.views[i];
-      const ViewMerge vm = merge_photo_view(v, curve, psr.noise, Alignment::automatic, {}, &vig);
+      ViewMerge vm = merge_photo_view(v, curve, psr.noise, Alignment::automatic, {}, &vig);
       const BracketSet& b = vm.brackets;
       const NoiseModel& noise = vm.noise;
-      const MergedImage& m = vm.image;
+      MergedImage& m = vm.image;
+      const std::string from = merged_colour_space(b.raw && c.o.input_colour_space.empty() ? "" : input_space, b.raw);
+      merged_to_working_space(m, from);
       const fs::path exr = merged_path(c, v.name);
       write_merged_exr(exr.string(), m,
                        {{"version", RSIBR_VERSION}, {"view", v.name}, {"responseModel", curve.model},
                         {"responseFile", "response.json (next to this file)"}, {"colourSpace", working_space()},
+                        {"inputColourSpace", from.empty() ? working_space() : from},
                         {"radianceUnit", "X/e: signal over saturation per relative exposure t*iso/100/N^2"},
                         {"producer", "rsibr process (hdr step)"}});
       r.outputs.push_back(exr);
@@ -325,7 +333,8 @@ void step_hdr(Context& c) {
     bar.done();
     r.summary = {{"model", curve.model}, {"recovered_from", from}, {"candidates", cands}, {"recovery", recovery_json(rec)},
                  {"curve", plot}, {"max_code", curve.max_code}, {"views", views}, {"vignetting", vignetting},
-                 {"camera", c.set.camera_name}};
+                 {"camera", c.set.camera_name}, {"input_colour_space", input_space.empty() ? working_space() : input_space},
+                 {"colour_space", working_space()}};
   });
 }
 
@@ -1009,6 +1018,13 @@ ProcessResult run_process(const ProcessOptions& o) {
     photo_set_vignetting(PhotoSet{}, o.vignetting, ResponseCurve::identity(255), LensModel::pinhole(100, 64, 64), nullptr);
   }
   if (o.up && !(o.up->norm() > 0 && o.up->allFinite())) throw std::invalid_argument("--up: expected a non-zero direction");
+  if (!o.input_colour_space.empty() && o.input_colour_space != working_space()) {
+    try {
+      colour_conversion_matrix(o.input_colour_space, working_space());  // errors before any work
+    } catch (const std::runtime_error& e) {
+      throw std::invalid_argument(std::string("--input-colorspace: ") + e.what());
+    }
+  }
   parse_brdf(o.render_brdf);
   chrome_fresnel_from_spec(o.chrome_fresnel, "--chrome-fresnel");  // errors before any work
   if (!o.glossy_brdf.empty()) {

@@ -53,6 +53,7 @@ struct ProcessOptions {
   std::optional<Vec3> up;    // world up in the first camera's frame (e.g. 0,-1,0 for a levelled camera)
   bool estimate_up = true;   // without `up`: estimated from the views (calib/world_up.h); false: first-view gauge
   std::vector<std::string> ball_overrides;  // "VIEW:BALL=X,Y,R": that ball of that view located there (pipeline/ball_override.h)
+  std::string input_colour_space;  // OCIO space of the linearised camera RGB; empty: the photo set's camera.colour_space, else the working space
   std::string vignetting = "auto";  // "auto" (from the chessboards when there are 3 or more), "none", or a JSON file (hdr/vignetting.h)
   // Stages swapped for given data (the truth of a synthetic capture: the error budget):
   std::string radiance_dir;  // hdr: linear EXRs <view>_radiance.exr or <view>.exr instead of the merge

@@ -454,6 +454,17 @@ check "process prints the report's path" bash -c "[ \"\$(cat '$work/p1.out')\" =
 check "process: every step ran, captured grey within 10% of computed" python3 -c "
 import json; j = json.load(open('$work/p1.json')); assert all(s['ran'] for s in j['steps']), j['steps']
 b = j['results']['compare']['balls'][0]; assert b['ball'] == 'grey' and b['overall']['after']['relative_rms'] < 0.1, b['overall']"
+# The camera's colour space: process takes the merged radiance into the working space as hdr does
+# (a wide-gamut camera space mixes the channels); a display space is refused before any work.
+"$rsibr" process "$work/psyn/photos" --out "$work/pcs" --poses "$work/psyn/truth/truth.yaml" --chrome-fresnel "$fres" \
+  --input-colorspace lin_p3d65 --map-size 32 --turntable 1 --size 64x48 --json "$work/pcs.json" -q >/dev/null
+check "process: --input-colorspace converts the merge into the working space" python3 -c "
+import json; j = json.load(open('$work/pcs.json')); h = j['results']['hdr']
+assert h['input_colour_space'] == 'lin_p3d65' and h['colour_space'] == 'lin_rec709', h['input_colour_space']
+p = json.load(open('$work/p1.json'))['results']['hdr']; assert p['input_colour_space'] == 'lin_rec709', p['input_colour_space']"
+expect_error "process: a display space as the camera's colour space" "not a linear conversion" process "$work/psyn/photos" \
+  --out "$work/pcs2" --input-colorspace srgb_texture
+check "process: nothing written after the colour-space error" test ! -e "$work/pcs2"
 "$rsibr" process "$work/psyn/photos" --out "$work/pout" --poses "$work/psyn/truth/truth.yaml" --chrome-fresnel "$fres" \
   --map-size 32 --turntable 2 --size 64x48 --json "$work/p2.json" -q >/dev/null
 check "process: a second run skips every step" python3 -c "

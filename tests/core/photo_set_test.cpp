@@ -33,7 +33,7 @@ class PhotoSetTest : public ::testing::Test {
 };
 
 const char* kGood = R"(rsibr_photoset: 1
-camera: {name: test, model: cam.cameramodel}
+camera: {name: test, model: cam.cameramodel, colour_space: lin_p3d65}
 balls:
   - {name: chrome, kind: chrome, diameter_m: 0.1}
   - {name: grey, kind: grey}
@@ -49,6 +49,7 @@ TEST_F(PhotoSetTest, ReadsEveryFieldAndResolvesPathsAgainstTheFolder) {
   write(kGood);
   const PhotoSet s = load_photo_set(dir_ / "photoset.yaml");
   EXPECT_EQ(s.camera_name, "test");
+  EXPECT_EQ(s.camera_colour_space, "lin_p3d65");
   ASSERT_TRUE(s.camera_model);
   EXPECT_TRUE(fs::equivalent(*s.camera_model, dir_ / "cam.cameramodel"));
   ASSERT_EQ(s.balls.size(), 2u);
@@ -73,6 +74,7 @@ TEST_F(PhotoSetTest, SaveThenLoadGivesTheSameSet) {
   save_photo_set(a);
   const PhotoSet b = load_photo_set(dir_);
   EXPECT_EQ(b.camera_name, a.camera_name);
+  EXPECT_EQ(b.camera_colour_space, "lin_p3d65");
   EXPECT_EQ(*b.camera_model, *a.camera_model);
   ASSERT_EQ(b.views.size(), a.views.size());
   for (std::size_t i = 0; i < a.views[0].brackets.size(); ++i) {
