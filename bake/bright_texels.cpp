@@ -1,4 +1,5 @@
 #include "bake/bright_texels.h"
+#include "core/luminance.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,10 +9,7 @@
 namespace rsibr {
 
 namespace {
-double luminance(const float* p) {
-  auto pos = [](float v) { return std::isfinite(v) && v > 0 ? double(v) : 0.0; };
-  return 0.2126 * pos(p[0]) + 0.7152 * pos(p[1]) + 0.0722 * pos(p[2]);
-}
+double texel_luminance(const float* p) { return positive_luminance(p); }
 }  // namespace
 
 EnvironmentSplit split_bright_texels(const EnvMap& env, const BrightTexelOptions& options) {
@@ -34,7 +32,7 @@ EnvironmentSplit split_bright_texels(const EnvMap& env, const BrightTexelOptions
     const float* row = env.pixels.ptr<float>(r);
     for (int c = 0; c < w; ++c) {
       const double omega = env.layout.texel_solid_angle(c, r);
-      const double lum = luminance(row + c * ch);
+      const double lum = texel_luminance(row + c * ch);
       power += lum * omega;
       area += omega;
       all.push_back({long(r) * w + c, lum, omega});
@@ -94,7 +92,7 @@ EnvironmentSplit split_bright_texels(const EnvMap& env, const BrightTexelOptions
       for (std::size_t i : group) {
         const BrightTexel& b = out.bright[i];
         cl.power += b.radiance * b.solid_angle;
-        const double lum = 0.2126 * b.radiance[0] + 0.7152 * b.radiance[1] + 0.0722 * b.radiance[2];
+        const double lum = luminance(b.radiance);
         weighted += std::max(lum, 1e-30) * b.solid_angle * centres[i];
       }
       cl.dir = weighted.normalized();

@@ -1,4 +1,5 @@
 #include "bake/environment_distribution.h"
+#include "core/luminance.h"
 
 #include <algorithm>
 #include <cmath>
@@ -52,8 +53,7 @@ EnvironmentDistribution::EnvironmentDistribution(const EnvMap& env) : layout_(en
     for (int c = 0; c < w_; ++c) {
       const std::size_t i = std::size_t(r) * w_ + c;
       omega_[i] = layout_.texel_solid_angle(c, r);
-      auto pos = [](float v) { return std::isfinite(v) && v > 0 ? double(v) : 0.0; };
-      const double lum = 0.2126 * pos(row[c * ch]) + 0.7152 * pos(row[c * ch + 1]) + 0.0722 * pos(row[c * ch + 2]);
+      const double lum = positive_luminance(row + c * ch);
       weight[i] = lum * omega_[i];
       total += weight[i];
     }

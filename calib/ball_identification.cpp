@@ -1,4 +1,5 @@
 #include "calib/ball_identification.h"
+#include "core/luminance.h"
 
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
@@ -15,7 +16,7 @@ namespace rsibr {
 
 namespace {
 
-double lum_of(const cv::Vec3f& p) { return std::max(0.0, 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]); }
+double lum_of(const cv::Vec3f& p) { return std::max(0.0, luminance(p)); }
 
 std::string px_text(const Vec2& p, double r) {
   std::ostringstream s;

@@ -1,6 +1,7 @@
 #include "calib/lambert_consensus.h"
 
 #include "core/sphere_map.h"
+#include "core/luminance.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +10,7 @@ namespace rsibr {
 
 namespace {
 
-double lum(const cv::Vec3f& p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
+double lum(const cv::Vec3f& p) { return luminance(p); }
 
 // Bilinear luminance of view `mv` at world normal n, over confident taps only; false when it does
 // not see n with confidence.

@@ -2,6 +2,7 @@
 
 #include "core/parallel.h"
 #include "core/sphere_map.h"
+#include "core/luminance.h"
 
 #include <algorithm>
 #include <cmath>
@@ -20,7 +21,6 @@ struct Lookup {
   double clipped = 0, clipped_weight = 0;
 };
 
-double luminance(const Vec3& c) { return 0.2126 * c.x() + 0.7152 * c.y() + 0.0722 * c.z(); }
 
 Lookup look_up(const MapView& mv, const Vec3& r) {
   Lookup out;

@@ -2,6 +2,7 @@
 
 #include "core/parallel.h"
 #include "core/sphere_map.h"
+#include "core/luminance.h"
 
 #include <Eigen/Dense>
 
@@ -213,7 +214,7 @@ MapView extract_sphere_map(const cv::Mat& image, const cv::Mat& flags, const Len
             if ((cone.half_angle - angle_between(centre + t.n, axis)) * limb_scale < options.limb_margin_px) continue;
             clipped = read(t.px, &value) || clipped;
             sum += value;
-            const double y = 0.2126 * value[0] + 0.7152 * value[1] + 0.0722 * value[2];
+            const double y = luminance(value);
             lo = std::min(lo, y), hi = std::max(hi, y);
             ++count;
           }

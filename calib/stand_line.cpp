@@ -1,4 +1,5 @@
 #include "calib/stand_line.h"
+#include "core/luminance.h"
 
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
@@ -76,7 +77,8 @@ std::optional<StandLine> find_stand_line(const cv::Mat& image, const LensModel& 
   if (image.type() != CV_32FC3 || image.cols != lens.width() || image.rows != lens.height()) return std::nullopt;
   LogImage img;
   cv::Mat lum;
-  cv::transform(image, lum, cv::Matx13f(0.2126f, 0.7152f, 0.0722f));
+  const auto& w = luma_coefficients();
+  cv::transform(image, lum, cv::Matx13f(float(w[0]), float(w[1]), float(w[2])));
   cv::max(lum, 0.0, lum);
   cv::patchNaNs(lum, 0.0);
   const double eps = std::max(1e-3 * cv::mean(lum)[0], 1e-30);

@@ -2,6 +2,7 @@
 
 #include "core/mip_pyramid.h"
 #include "core/parallel.h"
+#include "core/luminance.h"
 
 #include <algorithm>
 #include <numeric>
@@ -9,7 +10,6 @@
 namespace rsibr {
 namespace {
 
-double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
 
 }  // namespace
 

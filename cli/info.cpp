@@ -5,6 +5,7 @@
 #include "core/exr_io.h"
 #include "core/map_set.h"
 #include "core/output_plan.h"
+#include "core/luminance.h"
 
 #include <algorithm>
 #include <cmath>
@@ -20,8 +21,6 @@ struct InfoArgs {
   std::string input, layout, json;
 };
 
-// Rec.709 luminance of linear RGB.
-double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
 
 nlohmann::json channel_stats(const cv::Mat& img) {
   std::vector<double> lo(3, INFINITY), hi(3, -INFINITY), sum(3, 0.0);

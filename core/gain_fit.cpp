@@ -1,4 +1,5 @@
 #include "core/gain_fit.h"
+#include "core/luminance.h"
 
 #include <ceres/ceres.h>
 
@@ -128,7 +129,7 @@ GainFit fit_gains(const std::vector<WeightedImages>& images, const GainFitOption
   for (double t : theta) finite = finite && std::isfinite(t) && std::isfinite(std::exp(t)) && std::exp(t) > 0;
   if (!finite) theta = start;  // the robust start is always finite
   for (int c = 0; c < 3; ++c) fit.gains[std::size_t(c)] = std::exp(theta[std::size_t(c)]);
-  const double y = 0.2126 * fit.gains[0] + 0.7152 * fit.gains[1] + 0.0722 * fit.gains[2];
+  const double y = luminance(fit.gains);
   fit.exposure_stops = std::log2(y);
   for (int c = 0; c < 3; ++c) fit.chroma[std::size_t(c)] = fit.gains[std::size_t(c)] / y;
   fit.texels_used = long(texels.size());

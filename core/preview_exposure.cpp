@@ -1,4 +1,5 @@
 #include "core/preview_exposure.h"
+#include "core/luminance.h"
 
 #include <algorithm>
 #include <cmath>
@@ -23,7 +24,7 @@ void collect(const cv::Mat& rgb, const cv::Mat& mask, int step, std::vector<floa
       if (m && !m[x]) continue;
       const float* v = p + std::size_t(x) * std::size_t(ch);
       if (ch == 4 && !(v[3] > 0)) continue;
-      const float l = 0.2126f * v[0] + 0.7152f * v[1] + 0.0722f * v[2];
+      const float l = float(luminance(v));
       if (std::isfinite(l) && l > 0) lum.push_back(l);
     }
   }
