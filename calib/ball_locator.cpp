@@ -11,7 +11,8 @@ namespace rsibr {
 
 namespace {
 
-cv::Mat luminance(const cv::Mat& image) {
+// Equal-weight channel mean (edges of any colour count alike), negative and NaN as 0.
+cv::Mat brightness_image(const cv::Mat& image) {
   cv::Mat lum;
   if (image.type() == CV_32FC3) {
     cv::transform(image, lum, cv::Matx13f(1.f / 3, 1.f / 3, 1.f / 3));
@@ -109,7 +110,7 @@ BallLocation locate_ball(const cv::Mat& image, const LensModel& lens, const Ball
                                 std::to_string(lens.height()));
   if (!(guess.radius_px > 1) || !guess.centre_px.allFinite())
     throw std::invalid_argument(where(guess) + ": the guessed radius must be > 1 px");
-  const cv::Mat lum = luminance(image);
+  const cv::Mat lum = brightness_image(image);
   // eps of the log: 1e-3 of the mean level, so noise in black areas makes no edges.
   const double eps = std::max(1e-3 * cv::mean(lum)[0], 1e-30);
   const int lines = options.lines > 0 ? options.lines
@@ -184,7 +185,7 @@ BallLocation locate_ball(const cv::Mat& image, const LensModel& lens, const Ball
 
 std::vector<BallGuess> detect_balls(const cv::Mat& image, double min_radius_px, double max_radius_px, int max_count,
                                     int per_band) {
-  const cv::Mat lum = luminance(image);
+  const cv::Mat lum = brightness_image(image);
   // Tone map: log luminance stretched between its 1st and 99th percentiles to 8 bits.
   cv::Mat lg;
   const double eps = std::max(1e-3 * cv::mean(lum)[0], 1e-30);
