@@ -102,6 +102,22 @@ std::optional<OpticsLens> lensfun_from_optics(const PhotoOptics& o, int width, i
   return out;
 }
 
+std::optional<MetadataLens> metadata_lens(const std::filesystem::path& photo, int width, int height) {
+  MetadataLens m;
+  m.optics = read_photo_optics(photo);
+  std::optional<OpticsLens> l = lensfun_from_optics(m.optics, width, height, &m.lensfun_why);
+  if (l) {
+    m.source = "lensfun";
+    m.lensfun_why.clear();
+  } else {
+    l = pinhole_from_optics(m.optics, width, height);
+    m.source = "exif";
+  }
+  if (!l) return std::nullopt;
+  m.lens = *l;
+  return m;
+}
+
 std::optional<OpticsLens> pinhole_from_optics(const PhotoOptics& o, int width, int height) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("pinhole_from_optics: the image size must be positive");
   OpticsLens out;

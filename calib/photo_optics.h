@@ -53,6 +53,17 @@ std::optional<OpticsLens> pinhole_from_optics(const PhotoOptics& optics, int wid
 std::optional<OpticsLens> lensfun_from_optics(const PhotoOptics& optics, int width, int height,
                                               std::string* why = nullptr);
 
+// The lens of a shoot with no chessboards and no model, from one photo's metadata: lensfun's
+// profile of the lens its EXIF names, else the EXIF pinhole. source "lensfun" or "exif";
+// lensfun_why: why lensfun's profile was not used (empty when it was). Nullopt when the metadata
+// has no usable focal length (read_photo_optics's errors propagate).
+struct MetadataLens {
+  OpticsLens lens;
+  std::string source, lensfun_why;
+  PhotoOptics optics;
+};
+std::optional<MetadataLens> metadata_lens(const std::filesystem::path& photo, int width, int height);
+
 // lensfun's vignetting of the photo's lens (core/lensfun_lens.h lensfun_vignetting) at the EXIF
 // focal length and aperture; nullopt when the EXIF lacks either or the lens model.
 std::optional<LensfunVignetting> lensfun_vignetting(const PhotoOptics& optics, int width, int height,

@@ -4,10 +4,12 @@
 #include "cli/verbs.h"
 
 #include "calib/intrinsics.h"
+#include "calib/photo_optics.h"
 #include "core/atomic_file.h"
 #include "core/output_plan.h"
 #include "core/photo_set.h"
 #include "core/progress.h"
+#include "hdr/bracket_set.h"
 #include "pipeline/chessboard_problem.h"
 
 #include <Eigen/Eigenvalues>
@@ -16,6 +18,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 namespace rsibr::cli {
@@ -47,10 +50,41 @@ void write_with_comment(const LensModel& lens, const std::string& out, const std
   if (!o) throw std::runtime_error(out + ": cannot write");
 }
 
+// No chessboards: the lens from the first photo's metadata (calib/photo_optics.h metadata_lens),
+// lensfun's profile of the lens its EXIF names, else the EXIF pinhole, with its stated sigma.
+int calibrate_from_metadata(const CalibrateArgs& a, const PhotoSet& set, OutputPlan& outputs, const std::string& model,
+                            const std::string& json) {
+  if (set.views.empty() || set.views[0].brackets.empty())
+    throw std::invalid_argument(a.photoset + ": no chessboards and no photos to read a focal length from");
+  const BracketSet b = load_brackets(set.views[0], true);
+  const std::filesystem::path photo = set.views[0].brackets[0].file;
+  const std::optional<MetadataLens> m = metadata_lens(photo, b.cols(), b.rows());
+  if (!m)
+    throw std::invalid_argument(photo.string() + ": no chessboards listed and no usable focal length in the photo's "
+                                "metadata (FocalLengthIn35mmFilm, or FocalLength of a camera lensfun knows)");
+  std::ostringstream comment;
+  comment << std::setprecision(4) << "# rsibr calibrate: no chessboards; " << m->source << " (" << m->lens.source
+          << ")\n# focal length " << m->lens.focal_px << " px, 1 sigma " << 100 * m->lens.sigma_relative << "%\n";
+  write_with_comment(m->lens.lens, model, comment.str());
+  nlohmann::json j = {{"photoset", a.photoset}, {"out", a.out}, {"image_size", {b.cols(), b.rows()}},
+                      {"source", m->source}, {"model", m->lens.lens.name()}, {"intrinsics", m->lens.lens.intrinsics()},
+                      {"focal_px", m->lens.focal_px}, {"focal_sigma_relative", m->lens.sigma_relative},
+                      {"focal_from", m->lens.source}, {"photo", photo.string()},
+                      {"camera", m->optics.make + " " + m->optics.model}, {"lens", m->optics.lens}};
+  if (!m->lensfun_why.empty()) j["lensfun"] = m->lensfun_why;
+  write_summary(json, j);
+  outputs.commit();
+  if (!a.quiet && a.json != "-")
+    std::cerr << m->lens.lens.name() << " from the photos' metadata (" << m->source << ", f " << m->lens.focal_px
+              << " px +- " << 100 * m->lens.sigma_relative << "%) -> " << a.out << "\n";
+  return 0;
+}
+
 int run_calibrate(const CalibrateArgs& a) {
   const PhotoSet set = load_photo_set(a.photoset);
   OutputPlan outputs(set.files());
   const std::string model = outputs.file(a.out), json = outputs.file(a.json);
+  if (!set.chessboards) return calibrate_from_metadata(a, set, outputs, model, json);
   std::vector<std::string> missed_files;
   IntrinsicsProblem p;
   {
@@ -191,7 +225,10 @@ Runner add_calibrate(CLI::App& app) {
       "marginalised) and the projection's 1-sigma at a 3x3 grid of pixels (also in the .cameramodel's comment "
       "header). The candidate 'splined' is LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=8 over the seed's field of "
       "view, fitted from a LENSMODEL_STEREOGRAPHIC core; it is skipped (with the reason in the JSON) when the boards "
-      "cover less than 60% of an 8x6 grid over the image or number fewer than 8.\n"
+      "cover less than 60% of an 8x6 grid over the image or number fewer than 8. With no chessboards listed, the lens "
+      "comes from the first photo's metadata: lensfun's distortion profile of the camera and lens its EXIF names, "
+      "else a pinhole from the 35 mm-equivalent focal length, with the focal length's stated 1-sigma in the JSON "
+      "(rsibr process then refines it from the balls' outlines).\n"
       "Example: rsibr calibrate shoot/photoset.yaml --out shoot/camera.cameramodel --json -");
   c->add_option("photoset", a->photoset, "photoset.yaml or the folder holding it")->required();
   c->add_option("--out", a->out, "Output .cameramodel")->required();

@@ -169,12 +169,13 @@ void step_calibrate(Context& c) {
     nlohmann::json s;
     if (settings["source"] == "exif") {
       const BracketSet b = load_brackets(c.set.views[0], true);
-      const PhotoOptics optics = read_photo_optics(inputs.front());
       // lensfun's profile of the lens the EXIF names (distortion included), else a pinhole.
-      std::string lensfun_why;
-      std::optional<OpticsLens> guess = lensfun_from_optics(optics, b.cols(), b.rows(), &lensfun_why);
-      const bool from_lensfun = guess.has_value();
-      if (!guess) guess = pinhole_from_optics(optics, b.cols(), b.rows());
+      const std::optional<MetadataLens> meta = metadata_lens(inputs.front(), b.cols(), b.rows());
+      const PhotoOptics optics = meta ? meta->optics : read_photo_optics(inputs.front());
+      const std::string lensfun_why =
+          meta ? meta->lensfun_why : "the photo's metadata has no usable focal length";
+      const bool from_lensfun = meta && meta->source == "lensfun";
+      const std::optional<OpticsLens> guess = meta ? std::optional<OpticsLens>(meta->lens) : std::nullopt;
       if (!guess) {
         // No focal length in the metadata (stripped by an app, a scan): a pinhole of the image's
         // diagonal (a normal lens) to start from; the lens step measures f from the balls' outlines.

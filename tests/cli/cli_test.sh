@@ -517,6 +517,13 @@ t = open('$work/plf/truth/camera.cameramodel').read()
 truth = [float(x) for x in t.split(\"'intrinsics':\")[1].split('[')[1].split(']')[0].split(',') if x.strip()]
 assert len(truth) == len(c['intrinsics']) and all(abs(a - b) <= 1e-6 * max(1, abs(b)) for a, b in zip(c['intrinsics'], truth)), (c, truth)
 assert 'Canon EF 50mm' in c['focal_from'], c"
+# rsibr calibrate on a photo set without chessboards: the lens from the photos' metadata, with its
+# sigma in the JSON and the .cameramodel's comment.
+"$rsibr" calibrate "$work/pnb/photos" --out "$work/pnb-lens.cameramodel" --json "$work/pnbcal.json" -q
+check "calibrate: no chessboards, the lens from EXIF within its stated sigma" python3 -c "
+import json; j = json.load(open('$work/pnbcal.json')); assert j['source'] == 'exif' and j['model'] == 'LENSMODEL_PINHOLE', j
+assert abs(j['focal_px'] / 700 - 1) < j['focal_sigma_relative'], j
+assert open('$work/pnb-lens.cameramodel').read().startswith('# rsibr calibrate: no chessboards; exif')"
 # A kit zoom lensfun profiles whose EXIF states the focal length 4% short (a zoom's nominal focal
 # length, focus breathing): the lens step refines it from the balls' outlines to within its stated
 # sigma of the truth, smaller than the metadata's; --no-self-calibration keeps the EXIF's.
@@ -549,6 +556,9 @@ check "process: no focal length in the EXIF, the balls' outlines measure it" pyt
 import json; j = json.load(open('$work/pnf.json')); assert all(s['ran'] for s in j['steps']), j['steps']
 assert j['results']['calibrate']['source'] == 'outlines', j['results']['calibrate']
 l = j['results']['lens']; assert l['refined'] and abs(l['focal_px'] / 700 - 1) < 2 * l['sigma_relative'] < 0.2, l"
+expect_error "calibrate: no chessboards and no focal length in the EXIF" "no usable focal length" calibrate "$work/pnf/photos" \
+  --out "$work/pnf-lens.cameramodel"
+check "calibrate: nothing written after that error" test ! -e "$work/pnf-lens.cameramodel"
 # One view is a shoot, as people bring them: JPEG brackets with EXIF, no chessboards, no poses. The
 # lens from EXIF, the chrome ball found within 1 px of the truth, the world levelled from that
 # camera (its stand line and the upright prior) within 1.5 degrees, the probe and its preview.
