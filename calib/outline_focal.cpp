@@ -14,7 +14,7 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// One ball's least-squares outline cost at focal f: sum of squared pixel residuals of its cone.
+// One ball's cone fitted by least squares to its (pre-filtered) outline points through `lens`.
 std::optional<ConeFit> least_squares_cone(const std::vector<Vec2>& px, const LensModel& lens) {
   std::vector<Vec3> rays(px.size());
   lens.unproject(px.data(), int(px.size()), rays.data());
@@ -30,12 +30,13 @@ std::optional<ConeFit> least_squares_cone(const std::vector<Vec2>& px, const Len
   }
 }
 
+// One ball's outline cost at the lens's focal length: the sum of squared pixel residuals.
 double ball_cost(const std::vector<Vec2>& px, const LensModel& lens) {
   const std::optional<ConeFit> fit = least_squares_cone(px, lens);
   return fit ? fit->rms_px * fit->rms_px * double(fit->inliers) : kInf;
 }
 
-// The systematic sigma of ln f from one ball: an outline shape error of kShapeSystematicPx on
+// The systematic sigma of ln f from one ball: an outline shape error of shape_px on
 // its minor semi-axis b (pixels) moves its elongation e = a/b - 1 by that over b, and
 //   e = cos(alpha) / sqrt(cos^2 theta - sin^2 alpha) - 1,   theta = atan(tan(theta_0) f_0 / f)
 //   de / d ln f = -cos(alpha) sin^2(theta) cos^2(theta) / (cos^2 theta - sin^2 alpha)^(3/2).
@@ -165,7 +166,7 @@ OutlineFocal focal_from_outlines(const std::vector<std::vector<Vec2>>& outlines,
                  " and " + std::to_string(int(f0 * options.max_scale)) + " px (balls near the image centre say little)";
       break;
     }
-    // A finer look near the minimum: the profile evaluated on a grid a tenth as wide.
+    // A finer look near the minimum: 9 samples a fifth of the coarse step apart.
     const double h = (u1 - u0) / (ng - 1) / 5;
     std::vector<double> uf(9), cf(9, 0.0);
     for (int k = 0; k < 9; ++k) uf[std::size_t(k)] = m->u + h * (k - 4);

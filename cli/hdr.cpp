@@ -151,7 +151,14 @@ int run_hdr(const HdrArgs& a) {
   const std::string working = working_space();
   // The camera's colour space: --input-colorspace, else the photo set's camera.colour_space.
   const std::string input_space = !a.input_colour_space.empty() ? a.input_colour_space : set.camera_colour_space;
-  if (!input_space.empty() && input_space != working) colour_conversion_matrix(input_space, working);  // errors first
+  if (!input_space.empty() && input_space != working) {
+    try {
+      colour_conversion_matrix(input_space, working);  // errors before any work
+    } catch (const std::runtime_error& e) {
+      throw std::invalid_argument((a.input_colour_space.empty() ? a.photoset + ": camera.colour_space: " : "--input-colorspace: ") +
+                                  e.what());
+    }
+  }
 
   // Outputs: the folder may be new (its parent must exist); no output may name an input.
   const fs::path out_dir = fs::absolute(a.out);

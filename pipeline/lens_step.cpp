@@ -65,15 +65,21 @@ nlohmann::json run_lens_step(const LensStep& s) {
   } catch (const std::invalid_argument& e) {
     return outlines_only ? unknown(e.what()) : keep(e.what());
   }
+  std::string left_out;
   for (std::size_t i = 0; i < found.size(); ++i) {
     const OutlineFocalBall& b = of.balls[i];
     found[i].update({{"focal_px", b.focal_px}, {"sigma_px", std::isfinite(b.sigma_px) ? b.sigma_px : -1.0},
                      {"points", b.points}, {"used", b.used}});
+    if (!b.used && b.points > 0)
+      left_out += (left_out.empty() ? "" : ", ") + found[i]["view"].get<std::string>() + ":" +
+                  found[i]["ball"].get<std::string>();
   }
+  // The outlines left out, by view and ball (the library's note names them by index).
+  const std::string note = left_out.empty() ? "" : "Left out (their own focal length disagrees): " + left_out;
   j.update({{"outlines", found}, {"outline_focal_px", of.focal_px},
             {"outline_sigma_px", std::isfinite(of.sigma_px) ? of.sigma_px : -1.0}, {"outline_rms_px", of.rms_px}, {"birge_ratio", of.birge_ratio},
             {"outline_systematic_px", std::isfinite(of.systematic_px) ? of.systematic_px : -1.0},
-            {"balls_used", of.balls_used}, {"points", of.points}, {"note", of.note}});
+            {"balls_used", of.balls_used}, {"points", of.points}, {"note", note}});
   if (!std::isfinite(of.sigma_px))
     return outlines_only ? unknown("the balls' outlines do not constrain it (" + of.note + ")")
                          : keep("the outlines do not constrain the focal length: " + of.note);

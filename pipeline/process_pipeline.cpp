@@ -1039,6 +1039,13 @@ ProcessResult run_process(const ProcessOptions& o) {
   Context c{o, fs::absolute(o.out).lexically_normal(), load_photo_set(o.photoset), result};
   if (c.set.views.empty()) throw std::invalid_argument(o.photoset + ": views: none");
   parse_ball_overrides(o.ball_overrides, c.set);  // errors before any work
+  if (o.input_colour_space.empty() && !c.set.camera_colour_space.empty() && c.set.camera_colour_space != working_space()) {
+    try {
+      colour_conversion_matrix(c.set.camera_colour_space, working_space());
+    } catch (const std::runtime_error& e) {
+      throw std::invalid_argument(o.photoset + ": camera.colour_space: " + e.what());
+    }
+  }
   if (fs::exists(c.dir) && !fs::is_directory(c.dir)) throw std::invalid_argument(o.out.string() + ": not a folder");
   if (!fs::is_directory(c.dir.parent_path()))
     throw std::invalid_argument(o.out.string() + ": its parent folder does not exist");

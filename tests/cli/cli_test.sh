@@ -465,6 +465,13 @@ p = json.load(open('$work/p1.json'))['results']['hdr']; assert p['input_colour_s
 expect_error "process: a display space as the camera's colour space" "not a linear conversion" process "$work/psyn/photos" \
   --out "$work/pcs2" --input-colorspace srgb_texture
 check "process: nothing written after the colour-space error" test ! -e "$work/pcs2"
+sed 's/^  name: "synthetic camera"/&\
+  colour_space: nospace/' "$work/psyn/photos/photoset.yaml" >"$work/psyn/photos/photoset-badspace.yaml"
+expect_error "process: an unknown camera.colour_space in the photo set, named" "photoset-badspace.yaml: camera.colour_space" \
+  process "$work/psyn/photos/photoset-badspace.yaml" --out "$work/pcs3"
+expect_error "hdr: an unknown camera.colour_space in the photo set, named" "photoset-badspace.yaml: camera.colour_space" \
+  hdr "$work/psyn/photos/photoset-badspace.yaml" --out "$work/hcs3"
+check "no output after the photo set's colour-space errors" bash -c "test ! -e '$work/pcs3' && test ! -e '$work/hcs3'"
 "$rsibr" process "$work/psyn/photos" --out "$work/pout" --poses "$work/psyn/truth/truth.yaml" --chrome-fresnel "$fres" \
   --map-size 32 --turntable 2 --size 64x48 --json "$work/p2.json" -q >/dev/null
 check "process: a second run skips every step" python3 -c "
