@@ -7,7 +7,9 @@
 //   BM_RemapThreeMaps: only three bare cv::remap calls with precomputed maps (no warp maths, no fades,
 //     no sum): a floor, not a blend.
 #include "core/patterns.h"
+#include "previous_blend.h"
 #include "runtime/blend.h"
+#include "runtime/blend_engine.h"
 #include "runtime/tessellated_warp.h"
 
 #include "core/sphere_map.h"
@@ -118,10 +120,11 @@ void BM_OpenCvBlend(benchmark::State& state) {
   state.SetLabel(std::to_string(n) + "^2, 3 sources: warp maps + remap + weighted sum");
 }
 
-void BM_Blend(benchmark::State& state) {
-  const int n = int(state.range(0));
-  const int kind = int(state.range(1));  // 0 exact, 1 precomputed, 2 tessellated (16 x 64)
-  const bool reference = state.range(2) != 0;  // the double reference path (the blend before the fast path)
+// One frame's blend of size^2 for warp kind 0 exact, 1 precomputed, 2 tessellated (16 x 64). Paths:
+// 0 the blend engine, built once (sources laid out once, as the renderer and the viewer hold it), one
+// map() per frame; 1 blend(), one call per frame (an engine per call: the located sources laid out
+// each time); 2 the tile path before the engine (bench/previous_blend.h).
+void blend_frames(benchmark::State& state, int n, int kind, int path) {
   const MapSet& set = mirror_set(n);
   const ViewSet views = set.view_set();
   const PrecomputedWarp table(n, n);
@@ -129,18 +132,34 @@ void BM_Blend(benchmark::State& state) {
   BlendOptions options;
   if (kind == 1) options.warp = &table;
   if (kind == 2) options.warp = &mesh;
-  options.reference = reference;
+  const BlendEngine engine(set, views, options);
+  engine.prepare_all();
   for (auto _ : state) {
-    BlendResult r = blend(set, views, kView, Vec3(0, 1, 0), options);
+    BlendResult r = path == 0   ? engine.map(kView, Vec3(0, 1, 0), options)
+                    : path == 1 ? blend(set, views, kView, Vec3(0, 1, 0), options)
+                                : previous::blend(set, views, kView, Vec3(0, 1, 0), options);
     benchmark::DoNotOptimize(r.rgb.data);
   }
   const char* names[] = {"exact warp", "precomputed directions", "tessellated disk 16x64"};
-  state.SetLabel(std::to_string(n) + "^2, " + names[kind] + (reference ? ", reference path (double)" : ""));
+  const char* paths[] = {"engine", "blend(), one call", "previous tile path"};
+  state.SetLabel(std::to_string(n) + "^2, " + names[kind] + ", " + paths[path]);
+}
+
+// Against the OpenCV baseline: the engine and the one-call form.
+void BM_Blend(benchmark::State& state) {
+  blend_frames(state, int(state.range(0)), int(state.range(1)), int(state.range(2)));
+}
+// Against the tile path before the engine, same size and warp.
+void BM_BlendEngine(benchmark::State& state) { blend_frames(state, int(state.range(0)), int(state.range(1)), 0); }
+void BM_PreviousTilePath(benchmark::State& state) {
+  blend_frames(state, int(state.range(0)), int(state.range(1)), 2);
 }
 
 BENCHMARK(BM_RemapThreeMaps)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_OpenCvBlend)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Blend)->ArgsProduct({{256, 512}, {0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PreviousTilePath)->ArgsProduct({{256, 512}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_BlendEngine)->ArgsProduct({{256, 512}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace rsibr

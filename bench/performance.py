@@ -23,12 +23,14 @@ PAIRS = {
     "BM_Locate": ("BM_NearestView", "brute-force nearest view"),
     "BM_Blend": ("BM_OpenCvBlend", "OpenCV per frame: exact-warp coordinate maps, remap of the three sources, weighted sum"),
     "BM_OpenCvBlend": ("BM_RemapThreeMaps", "three bare OpenCV remaps, maps precomputed"),
+    "BM_BlendEngine": ("BM_PreviousTilePath", "the blend's tile path before the blend engine, same size and warp"),
     "BM_Render": ("BM_RenderBaseline", "one rtcIntersect1 per pixel centre, no shading"),
     "BM_SynthBracket": ("BM_SynthBracketFromScratch", "every one of the 7 brackets rendered from scratch"),
 }
 # Section titles where the family name alone does not say it.
 TITLES = {"BM_Render": "Rendering (the bunny, 1280x720, 12-view 256^2 map set, turntable frames)",
           "BM_OpenCvBlend": "Blend baseline (issue 4's OpenCV blend against three bare remaps)",
+          "BM_BlendEngine": "Blend engine (512^2 and 256^2 maps from three sources)",
           "BM_SynthBracket": "Synthetic capture (one view, 2000x1500, OPENCV8, 4 samples per pixel, 7 brackets, PNG)"}
 
 
@@ -91,7 +93,9 @@ def main():
                 continue
             args_ = parts(name)
             arg = "/".join(args_)
-            ref = (plain.get(f"{base}/{args_[0]}") if args_ else None) or plain.get(base)
+            # The baseline with the longest common prefix of arguments (size, then size/warp, ...).
+            ref = next((plain[k] for k in ("/".join([base] + args_[:i]) for i in range(len(args_), -1, -1))
+                        if k in plain), None)
             if not ref or "error_message" in ref:
                 continue
             unit = b["time_unit"]
@@ -129,8 +133,11 @@ def main():
         "texels outside the disc) and normalises per texel. Its baseline (issue 4) does the same from OpenCV",
         "parts per frame: the exact warp's coordinate maps and fade weights (rows in parallel), cv::remap of",
         "each source, a weighted sum and a per-texel division (no tap dropping at the rim, no fallback).",
-        "Blend cases: size / warp (0 exact, 1 precomputed, 2 tessellated) / path (0 fast, 1 the double",
-        "reference path, BlendOptions::reference: the blend as it was before the fast path).",
+        "Blend cases: size / warp (0 exact, 1 precomputed, 2 tessellated) / path (0 the blend engine, built once",
+        "and called per frame, as the renderer and the viewer hold it; 1 blend(), one call per frame, which lays",
+        "out the three located sources each time). Blend engine cases: size / warp, against the tile path the",
+        "blend had before the engine (bench/previous_blend.cpp, frozen: warp in double, taps from the 3-channel",
+        "maps) in the same run.",
         "Rendering traces primary rays as Embree packets of 16 in 16x16 tiles, only inside the image rectangle",
         "the mesh's bounding box projects to, then shades the hits: paper mode blends one destination map per",
         "frame and reads it by normal; per-pixel mode blends the located sources for every hit's own view.",

@@ -1,5 +1,7 @@
 // Reflection-space blending: the radiance map for any view from a map set (the paper's section 3,
-// with per-texel singularity fades and per-texel normalisation; seeds/README.md).
+// with per-texel singularity fades and per-texel normalisation). This header defines it; the blend
+// engine (runtime/blend_engine.h) evaluates it in single precision (warp, taps, sums), and the
+// tests' oracle (tests/runtime/blend_oracle.h) evaluates it per texel in double.
 //
 // For a destination view d with frame T_d = world_from_view_for(d, up):
 //   1. (w_0, w_1, w_2) = spherical barycentric weights of d in its view-set triangle
@@ -51,29 +53,29 @@
 
 namespace rsibr {
 
-struct BlendOptions {
-  // Destination size; 0 x 0 = the map set's. Give both or neither.
-  int width = 0;
-  int height = 0;
+// The rule (steps 1, 3 and 5 above): what a blend engine is built with.
+struct BlendRule {
   // Width of the singularity fade in rho units (see the header comment); <= 0 disables the fade
   // (every source at full weight everywhere, the paper without its confidence fade: for tests).
   double rim_fade = 0.4;
   // Multiply each source's weight by its confidence channel (captured maps) when it has one.
   bool use_confidence = true;
   Barycentric barycentric = Barycentric::Gnomonic;
+};
+
+// What one destination map is asked for.
+struct MapRequest {
+  // Destination size; 0 x 0 = the map set's. Give both or neither.
+  int width = 0;
+  int height = 0;
   // The warp implementation; nullptr = ExactWarp. Not owned; must support the destination size.
   const Warp* warp = nullptr;
   // Also return each located source's per-texel weight a_i (BlendResult::source_weight).
   bool source_weights = false;
-  // The reference path: per texel, in double, through Warp::warp_row and sample_disc (the blend as
-  // first written). The default (fast) path computes the same definition in tiles of texels with
-  // vectorised row loops: the warp in double (exact and precomputed warps: computed in the loop,
-  // runtime/warp.h's row forms; other warps: Warp::warp_row), bilinear taps and sums in float, the
-  // taps near a source's rim and the fallback through the reference code. It agrees with the
-  // reference path within 5e-6 relative in colour and 1e-6 in weight (measured 8.9e-7, 1.2e-7;
-  // tests/runtime/blend_test.cpp, FastPathMatchesTheReferencePath).
-  bool reference = false;
 };
+
+// Both, for the one-call form blend() below.
+struct BlendOptions : BlendRule, MapRequest {};
 
 struct BlendResult {
   cv::Mat rgb;              // CV_32FC3, RGB, sphere-map layout; 0 outside the disc
@@ -83,18 +85,21 @@ struct BlendResult {
   std::array<cv::Mat, 3> source_weight;  // when requested: a_i per texel (CV_32FC1) for located.views[i]
 };
 
-// The fade of step 3 (exposed for tests and for the tessellated-disk warp to come).
+// The fade of step 3, in double (the blend engine evaluates the same formula in float).
 double rim_fade_weight(double rho, double rim_fade);
 
-// The input checks blend() makes, shared with runtime/direction_lookup.h: the map set is not empty
-// and view_set has its views (throws std::invalid_argument); and view `index`'s map is a CV_32FC3 of
-// at least 2 x 2 with an empty or matching CV_32FC1 confidence.
+// The input checks of the blend engine (runtime/blend_engine.h): the map set is not empty and
+// view_set has its views (throws std::invalid_argument); and view `index`'s map is a CV_32FC3 of at
+// least 2 x 2 with an empty or matching CV_32FC1 confidence.
 void check_blend_inputs(const MapSet& maps, const ViewSet& view_set);
 void check_blend_source(const MapSet& maps, int index);
 
-// Throws std::invalid_argument when view_set does not have the map set's views, when a located
-// source's map is not CV_32FC3 (or its confidence not CV_32FC1 of the same size), for a bad size, a
-// zero or non-finite view_dir, or a warp that does not support the destination size.
+// One destination map: BlendEngine(maps, view_set, options).map(view_dir, up, options)
+// (runtime/blend_engine.h; only the located sources are put in the kernel's layout). Callers that
+// blend many views of one set keep an engine instead. Throws std::invalid_argument when view_set
+// does not have the map set's views, when a located source's map is not CV_32FC3 (or its confidence
+// not CV_32FC1 of the same size), for a bad size, a zero or non-finite view_dir, or a warp that does
+// not support the destination size.
 BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_dir, const Vec3& up,
                   const BlendOptions& options = {});
 

@@ -1,6 +1,7 @@
-// Bilinear sampling of one sphere map inside its disc: the lookup every runtime path shares
-// (runtime/blend.h's sources, runtime/direction_lookup.h, the renderer's destination maps), so that
-// they agree to the last bit.
+// Bilinear sampling of one sphere map inside its disc, in double: the definition of a blend tap.
+// The blend engine (runtime/blend_engine.h) computes the same in float from its own layout and
+// falls back to this where none of a footprint's taps is valid; the renderer reads its destination
+// maps with it; the tests' oracle (tests/runtime/blend_oracle.h) uses it throughout.
 //
 // Contract: xy are disc coordinates (x right, y up; core/sphere_map.h) of a width x height map. The
 // four bilinear taps around xy's continuous pixel position are clamped to the image; taps whose

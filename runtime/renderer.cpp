@@ -1,6 +1,6 @@
 #include "runtime/renderer.h"
 
-#include "runtime/direction_lookup.h"
+#include "runtime/blend_engine.h"
 #include "runtime/disc_sampler.h"
 #include "runtime/make_warp.h"
 #include "runtime/warp.h"
@@ -113,7 +113,7 @@ void trace_samples(const RayScene& scene, const Camera& cam, const ImageRect& re
 struct RenderSet {
   const MapSet* maps = nullptr;
   std::unique_ptr<ViewSet> views;
-  std::unique_ptr<DirectionLookup> lookup;
+  std::unique_ptr<BlendEngine> engine;
 };
 
 struct Renderer::Impl {
@@ -135,7 +135,8 @@ Renderer::Renderer(const Mesh& mesh, const std::vector<const MapSet*>& sets, con
     RenderSet s;
     s.maps = sets[i];
     s.views = std::make_unique<ViewSet>(sets[i]->view_set());
-    s.lookup = std::make_unique<DirectionLookup>(*s.maps, *s.views, options.blend);
+    s.engine = std::make_unique<BlendEngine>(*s.maps, *s.views, options.blend);
+    if (options.mode == RenderMode::PerPixel) s.engine->prepare_all();  // every view may be hit; checks them now
     impl_->sets.push_back(std::move(s));
   }
   impl_->map_size = options.map_size > 0 ? options.map_size : sets.front()->width();
@@ -193,12 +194,11 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
   };
   std::vector<Dest> dests(paper ? nsets : 0);
   if (paper) {
-    BlendOptions bo = options_.blend;
-    bo.width = bo.height = impl_->map_size;
-    bo.warp = impl_->warp.get();
-    bo.source_weights = false;
+    MapRequest request;
+    request.width = request.height = impl_->map_size;
+    request.warp = impl_->warp.get();
     for (std::size_t s = 0; s < nsets; ++s) {
-      BlendResult b = blend(*impl_->sets[s].maps, *impl_->sets[s].views, camera.view_direction(), camera.up(), bo);
+      BlendResult b = impl_->sets[s].engine->map(camera.view_direction(), camera.up(), request);
       dests[s].rgb = b.rgb;
       dests[s].map = DiscMap{&dests[s].rgb, nullptr, b.rgb.cols, b.rgb.rows};
       dests[s].view_from_world = b.world_from_view.transpose();
@@ -266,8 +266,8 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
                     L[1] += Ls[1];
                     L[2] += Ls[2];
                   } else {
-                    const DirectionLookup& lookup = *impl_->sets[s].lookup;
-                    const Vec3 Ls = lookup.radiance(lookup.locate(v, &hints[s]), v, nrm);
+                    const BlendEngine& engine = *impl_->sets[s].engine;
+                    const Vec3 Ls = engine.radiance(engine.locate(v, &hints[s]), v, nrm);
                     L[0] += Ls.x();
                     L[1] += Ls.y();
                     L[2] += Ls.z();

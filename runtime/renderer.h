@@ -17,7 +17,7 @@
 //     normal inverse). v_px is ignored: the error grows with the angle between v_px and v, i.e. with
 //     the field of view and toward the image's edges. The destination map is a second resampling, so
 //     paper mode also blurs by one bilinear pass at map_size.
-//   Per-pixel mode (RenderMode::PerPixel, exact): the value of runtime/direction_lookup.h for
+//   Per-pixel mode (RenderMode::PerPixel, exact): BlendEngine::radiance (runtime/blend_engine.h) for
 //     (v_px, n): v_px located in the view set, each located source warped from the pixel's own
 //     central direction (mirror r = 2(n.v)n - v, or n), faded, sampled as blend() samples, normalised.
 //     No destination map, so no second resampling and no field-of-view error.

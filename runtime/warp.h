@@ -55,21 +55,22 @@ WarpSample warp_direction(WarpKind kind, const Vec3& dir_in_source);
 // empty (first == second) when none.
 std::pair<int, int> disc_span(int row, int width, int height);
 
-// Structure-of-arrays forms of the exact warp, for fused row loops (runtime/blend.cpp) that the
-// compiler vectorises (no branches, no calls per texel).
+// Structure-of-arrays forms of the exact warp in single precision, for the blend engine's row loops
+// (runtime/blend_engine.h) that the compiler vectorises (no branches, no calls per texel; 8 texels a
+// vector with AVX2).
 //   central_directions_row: the central directions of `kind` (the destination's own frame) of the
-//     destination texels (c, row), c in [c_begin, c_end): out_x/y/z[c - c_begin], the same arithmetic
-//     as g_normal / g_mirror. The texel centres must lie inside the disc (within disc_span).
+//     destination texels (c, row), c in [c_begin, c_end): out_x/y/z[c - c_begin], the arithmetic of
+//     g_normal / g_mirror in float. The texel centres must lie inside the disc (within disc_span).
 //   warp_directions: warp_direction for the n unit directions (x, y, z) rotated by m (row-major 3x3,
 //     the source_from_dest rotation): the source disc point (disc_x, disc_y) and rim value. The
 //     rotated direction is taken as unit (no renormalisation: the input is unit and m a rotation);
 //     r = -z exactly (mirror) and a normal straight behind give (0, -1) with rim 0, as warp_direction
-//     does. Agrees with warp_direction to ~1e-15 (conditioned by 1/rim near the singularity;
-//     tests/runtime/warp_test.cpp).
-void central_directions_row(WarpKind kind, int width, int height, int row, int c_begin, int c_end, double* out_x,
-                            double* out_y, double* out_z);
-void warp_directions(WarpKind kind, const double m[9], int n, const double* x, const double* y, const double* z,
-                     double* disc_x, double* disc_y, double* rim);
+//     does. Agrees with warp_direction to float rounding: ~1e-7 in the rim value, ~1e-7 / rim in the
+//     disc point near the mirror singularity (tests/runtime/warp_test.cpp).
+void central_directions_row(WarpKind kind, int width, int height, int row, int c_begin, int c_end, float* out_x,
+                            float* out_y, float* out_z);
+void warp_directions(WarpKind kind, const float m[9], int n, const float* x, const float* y, const float* z,
+                     float* disc_x, float* disc_y, float* rim);
 
 // The interface of the warp implementations (a speed/accuracy knob). Implementations are immutable
 // after construction and safe to call from many threads at once.
@@ -79,45 +80,52 @@ class Warp {
   virtual const char* name() const = 0;
   // Whether warp_row may be called for a width x height destination.
   virtual bool supports(int width, int height) const { return width > 0 && height > 0; }
-  // True when warp_row is ExactWarp's map (the same arithmetic): a caller may then compute the warp
-  // itself, fused with its own per-texel work (runtime/blend.cpp does, in float32).
-  virtual bool exact() const { return false; }
-  // For destination texels (c, row), c in [c_begin, c_end), of a width x height destination map,
-  // writes out[c - c_begin] = where that texel's central direction of the given kind lands in a
-  // source whose frame relates to the destination's by source_from_dest = T_s^T T_d (a rotation).
   virtual void warp_row(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
                         int c_end, WarpSample* out) const = 0;
+  // The same map in single precision, structure of arrays (the blend engine's form): for texels
+  // (c, row), c in [c_begin, c_end), disc_x/disc_y/rim[c - c_begin]. The default converts warp_row's
+  // samples; the exact and precomputed warps compute it in vectorised float loops.
+  virtual void warp_block(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
+                          int c_end, float* disc_x, float* disc_y, float* rim) const;
 };
 
 // Per texel, from scratch: disc coordinates, g, rotation, g^-1.
 class ExactWarp final : public Warp {
  public:
   const char* name() const override { return "exact"; }
-  bool exact() const override { return true; }
   void warp_row(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
                 WarpSample* out) const override;
+  // central_directions_row then warp_directions, in blocks of 64 texels on the stack.
+  void warp_block(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
+                  float* disc_x, float* disc_y, float* rim) const override;
 };
 
 // The destination texels' central directions (g_mirror and g_normal of every texel centre, in the
 // destination's own view frame) do not depend on the view, so they are tabulated once for one
 // destination size (seed 002's table idea); a frame then costs one 3x3 rotation and one g^-1 per texel
-// and source. Results equal ExactWarp's (same arithmetic, read from the table). Throws
-// std::invalid_argument when called for another size than it was built for.
+// and source. Results equal ExactWarp's (same arithmetic, read from the table; warp_block reads a
+// float table, computed as central_directions_row does, so it equals ExactWarp's warp_block to the
+// bit). Throws std::invalid_argument when called for another size than it was built for.
 class PrecomputedWarp final : public Warp {
  public:
   PrecomputedWarp(int width, int height);
   const char* name() const override { return "precomputed"; }
-  bool exact() const override { return true; }
   int width() const { return width_; }
   int height() const { return height_; }
   bool supports(int width, int height) const override { return width == width_ && height == height_; }
   void warp_row(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
                 WarpSample* out) const override;
+  void warp_block(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
+                  float* disc_x, float* disc_y, float* rim) const override;
 
  private:
+  void check_size(int width, int height) const;
   int width_, height_;
   std::vector<Vec3> mirror_;  // row-major, width_ * height_
   std::vector<Vec3> normal_;
+  // Single precision, structure of arrays: planes x, y, z of the mirror, then of the normal
+  // directions, each row-major width_ * height_ (0 outside the disc).
+  std::vector<float> planes_;
 };
 
 }  // namespace rsibr

@@ -32,6 +32,7 @@ GlMapSet::GlMapSet(const MapSet& maps, const BlendOptions& blend, const std::str
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(std::string("viewer: ") + e.what());
   }
+  engine_ = std::make_unique<BlendEngine>(maps_, view_set_, blend_);
   const int W = maps.width(), H = maps.height(), N = int(maps.views.size());
   glGenTextures(6, textures_);
 
@@ -124,13 +125,18 @@ GlMapSet::GlMapSet(const MapSet& maps, const BlendOptions& blend, const std::str
 
 GlMapSet::~GlMapSet() { glDeleteTextures(6, textures_); }
 
+void GlMapSet::set_rim_fade(double rim_fade) {
+  if (rim_fade == blend_.rim_fade) return;
+  blend_.rim_fade = rim_fade;
+  engine_ = std::make_unique<BlendEngine>(maps_, view_set_, blend_);
+}
+
 const BlendResult& GlMapSet::update_destination(const Vec3& view, const Vec3& up) {
   const auto t0 = std::chrono::steady_clock::now();
-  BlendOptions bo = blend_;
-  bo.width = bo.height = map_size_;
-  bo.warp = warp_.get();
-  bo.source_weights = false;
-  destination_ = blend(maps_, view_set_, view, up, bo);
+  MapRequest request;
+  request.width = request.height = map_size_;
+  request.warp = warp_.get();
+  destination_ = engine_->map(view, up, request);
   cv::Mat rgba(map_size_, map_size_, CV_32FC4);
   const cv::Mat parts[] = {destination_.rgb, destination_.weight};
   const int from_to[] = {0, 0, 1, 1, 2, 2, 3, 3};

@@ -2,12 +2,14 @@
 // in one RGBA32F texture array (RGB, A = confidence, 1 without one or when confidence is off), the
 // view frames and warps, the view-set triangulation (core/view_set.h), its edge planes and, for a
 // set that does not surround the sphere, the boundary arcs of the covered region. Also the
-// CPU engine of paper mode: one destination map per frame (runtime/blend.h) with the chosen warp.
+// CPU engine of paper mode: one destination map per frame (runtime/blend_engine.h) with the chosen
+// warp.
 #pragma once
 
 #include "core/map_set.h"
 #include "core/view_set.h"
 #include "runtime/blend.h"
+#include "runtime/blend_engine.h"
 #include "runtime/warp.h"
 
 #include <epoxy/gl.h>
@@ -32,8 +34,9 @@ class GlMapSet {
   const MapSet& maps() const { return maps_; }
   const ViewSet& view_set() const { return view_set_; }
   const BlendOptions& blend_options() const { return blend_; }
-  // The singularity fade's width (a uniform of the shader, an option of the CPU blend).
-  void set_rim_fade(double rim_fade) { blend_.rim_fade = rim_fade; }
+  // The singularity fade's width (a uniform of the shader, part of the CPU engine's rule: a new
+  // engine, whose sources are laid out again as paper mode uses them).
+  void set_rim_fade(double rim_fade);
   const std::string& warp_name() const { return warp_name_; }
   int map_size() const { return map_size_; }
 
@@ -56,6 +59,7 @@ class GlMapSet {
   std::string warp_name_;
   int map_size_;
   std::unique_ptr<Warp> warp_;
+  std::unique_ptr<BlendEngine> engine_;
   BlendResult destination_;
   double blend_seconds_ = 0;
   int arc_count_ = 0;

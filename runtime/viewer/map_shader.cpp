@@ -136,7 +136,7 @@ vec3 triangle_weights(vec3 p, vec3 a, vec3 b, vec3 c) {
   return w / s;
 }
 
-// runtime/direction_lookup.h, radiance(v, n); weight in .a
+// runtime/blend_engine.h, BlendEngine::radiance(v, n); weight in .a
 vec4 lookup(vec3 v, vec3 n) {
   float nv = dot(n, v);
   if (nv < 0.0) {

@@ -9,11 +9,12 @@
 // gl_FrontFacing (counter-clockwise front, core/mesh.h) is the renderer's back-face test
 // (runtime/renderer.h: the shading normal is flipped where the geometric normal faces away).
 //
-// Fragment stage, the same definitions as the CPU engine (in float32 instead of double):
+// Fragment stage, the same definitions as the CPU engine (runtime/blend_engine.h; float32 there too,
+// but its warp into a source is double in radiance()):
 //   v = -(ray direction through the pixel centre)         (Camera::ray_direction, not the
 //                                                          interpolated position: the same ray)
 //   n = normalise(interpolated vertex normal), flipped on back faces
-//   per-pixel mode: runtime/direction_lookup.h, steps 0-5: n clamped to v's hemisphere,
+//   per-pixel mode: runtime/blend_engine.h, radiance(v, n): n clamped to v's hemisphere,
 //     r = 2 (n.v) n - v; v located in the view set (core/view_set.cpp: the spherical triangle with
 //     the largest margin; outside a non-surrounding set, the nearest point of the nearest boundary
 //     arc with its triangle's weights there,

@@ -1,6 +1,7 @@
 #include "runtime/blend.h"
 
 #include "analytic_map_set.h"
+#include "blend_oracle.h"
 #include "core/sphere_map.h"
 #include "runtime/tessellated_warp.h"
 
@@ -74,7 +75,8 @@ TEST(Blend, BlendingAtASourceViewReproducesThatSource) {
       for (const Vec3& up : {Vec3(0, 1, 0), Vec3(src.world_from_view.col(1))}) {
         const BlendResult b = blend(set, views, src.view, up);
         ASSERT_EQ(b.located.weights[0] + b.located.weights[1] + b.located.weights[2], 1.0);
-        EXPECT_LE(max_relative_difference(b.rgb, src.rgb), 1e-6) << warp << " view " << i;
+        // 1e-5: the engine's float warp lands within ~1e-7 of the texel centre (Blend.EngineMatches...).
+        EXPECT_LE(max_relative_difference(b.rgb, src.rgb), 1e-5) << warp << " view " << i;
         for (int r = 0; r < 64; ++r)
           for (int c = 0; c < 64; ++c) {
             if (sphere_map::disc_from_pixel(Vec2(c, r), 64, 64).squaredNorm() > 1.0) continue;
@@ -86,7 +88,7 @@ TEST(Blend, BlendingAtASourceViewReproducesThatSource) {
       const BlendResult b = blend(set, views, src.view, src.world_from_view.col(0));
       cv::Mat turned;
       cv::rotate(src.rgb, turned, cv::ROTATE_90_COUNTERCLOCKWISE);
-      EXPECT_LE(max_relative_difference(b.rgb, turned), 1e-6) << warp << " view " << i << " turned";
+      EXPECT_LE(max_relative_difference(b.rgb, turned), 1e-5) << warp << " view " << i << " turned";
     }
   }
 }
@@ -497,8 +499,9 @@ namespace {
 
 using namespace rsibr::testing;
 
-// The fast path against the reference path (BlendOptions::reference): largest difference of colour
-// (relative to max(|reference|, 1e-3), as max_relative_difference) and of the weights over every texel.
+// The engine against the oracle (tests/runtime/blend_oracle.h: the definition per texel in double):
+// largest difference of colour (relative to max(|oracle|, 1e-3), as max_relative_difference) and of
+// the weights over every texel.
 struct PathDifference {
   double colour = 0, weight = 0, source_weight = 0;
   int worst_r = -1, worst_c = -1;
@@ -506,10 +509,8 @@ struct PathDifference {
 PathDifference path_difference(const MapSet& set, const ViewSet& views, const Vec3& d, const Vec3& up,
                                BlendOptions o) {
   o.source_weights = true;
-  o.reference = false;
   const BlendResult fast = blend(set, views, d, up, o);
-  o.reference = true;
-  const BlendResult ref = blend(set, views, d, up, o);
+  const BlendResult ref = blend_oracle(set, views, d, up, o);
   PathDifference p;
   for (int r = 0; r < ref.rgb.rows; ++r)
     for (int c = 0; c < ref.rgb.cols; ++c) {
@@ -529,9 +530,23 @@ PathDifference path_difference(const MapSet& set, const ViewSet& views, const Ve
   return p;
 }
 
-TEST(Blend, FastPathMatchesTheReferencePath) {
+void keep_worst(PathDifference& worst, const PathDifference& p) {
+  if (p.colour > worst.colour) {
+    worst.colour = p.colour;
+    worst.worst_r = p.worst_r;
+    worst.worst_c = p.worst_c;
+  }
+  worst.weight = std::max(worst.weight, p.weight);
+  worst.source_weight = std::max(worst.source_weight, p.source_weight);
+}
+
+// The engine warps, taps and sums in float: its disc points are the double ones to ~3e-7 disc units
+// (~1e-7 relative, times 1/rim near a source's singularity), i.e. ~2e-5 texel at 129^2, so the
+// differences are that shift times the maps' change per texel. Smooth maps (the analytic sets)
+// change by up to ~1 per texel near a mirror set's rim; the noise confidence below by up to 1.2.
+TEST(Blend, EngineMatchesTheDefinitionEvaluatedInDouble) {
   const ViewSet views = ViewSet::geodesic(1);
-  PathDifference worst;
+  PathDifference smooth, noisy;
   for (const auto& [warp, f] : {std::pair{"mirror", TexelFunction(fresnel_mirror_texel)},
                                 std::pair{"normal", TexelFunction(lambert_texel)}})
     for (const int size : {64, 129}) {
@@ -539,17 +554,14 @@ TEST(Blend, FastPathMatchesTheReferencePath) {
       std::vector<std::pair<Vec3, Vec3>> cases;
       for (const Vec3& d : random_directions(6, 31)) cases.push_back({d, Vec3(0, 1, 0)});
       cases.push_back({set.views[3].view, Vec3(0, 1, 0)});  // at a source
-      // Every warp: exact and precomputed (fused in the fast path), tessellated (through warp_row).
+      // Every warp: exact and precomputed (their own float forms), tessellated (through warp_row).
       const PrecomputedWarp pre(size, size);
       const TessellatedWarp mesh(size, size);
       for (const Warp* w : {static_cast<const Warp*>(nullptr), static_cast<const Warp*>(&pre), static_cast<const Warp*>(&mesh)})
         for (const auto& [d, up] : cases) {
           BlendOptions o;
           o.warp = w;
-          const PathDifference p = path_difference(set, views, d, up, o);
-          if (p.colour > worst.colour) worst = p;
-          worst.weight = std::max(worst.weight, p.weight);
-          worst.source_weight = std::max(worst.source_weight, p.source_weight);
+          keep_worst(smooth, path_difference(set, views, d, up, o));
         }
       // With confidence channels (noise, some negative), with and without the fade.
       for (std::size_t i = 0; i < set.views.size(); ++i) {
@@ -558,19 +570,18 @@ TEST(Blend, FastPathMatchesTheReferencePath) {
       }
       BlendOptions no_fade;
       no_fade.rim_fade = 0;
-      for (const BlendOptions& o : {BlendOptions{}, no_fade}) {
-        const PathDifference p = path_difference(set, views, Vec3(0.2, -0.4, 0.7).normalized(), Vec3(0, 1, 0), o);
-        if (p.colour > worst.colour) worst = p;
-        worst.weight = std::max(worst.weight, p.weight);
-        worst.source_weight = std::max(worst.source_weight, p.source_weight);
-      }
+      for (const BlendOptions& o : {BlendOptions{}, no_fade})
+        keep_worst(noisy, path_difference(set, views, Vec3(0.2, -0.4, 0.7).normalized(), Vec3(0, 1, 0), o));
     }
-  std::printf("[ fast vs reference ] colour %.2e (relative, texel %d,%d), weight %.2e, source weight %.2e\n", worst.colour,
-              worst.worst_c, worst.worst_r, worst.weight, worst.source_weight);
-  // Measured: colour 8.9e-7, weight 1.2e-7, source weight 9e-8 (float sampling and sums).
-  EXPECT_LE(worst.colour, 5e-6);
-  EXPECT_LE(worst.weight, 1e-6);
-  EXPECT_LE(worst.source_weight, 1e-6);
+  for (const auto& [name, p] : {std::pair{"smooth maps", smooth}, std::pair{"noise confidence", noisy}})
+    std::printf("[ engine vs oracle, %s ] colour %.2e (relative, texel %d,%d), weight %.2e, source weight %.2e\n", name,
+                p.colour, p.worst_c, p.worst_r, p.weight, p.source_weight);
+  EXPECT_LE(smooth.colour, 1e-4);  // the rim of a mirror set changes fastest per texel
+  EXPECT_LE(smooth.weight, 2e-6);
+  EXPECT_LE(smooth.source_weight, 2e-6);
+  EXPECT_LE(noisy.colour, 2e-4);
+  EXPECT_LE(noisy.weight, 1e-4);
+  EXPECT_LE(noisy.source_weight, 1e-4);
 }
 
 }  // namespace

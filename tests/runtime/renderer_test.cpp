@@ -1,7 +1,7 @@
 #include "runtime/renderer.h"
 
 #include "analytic_map_set.h"
-#include "runtime/direction_lookup.h"
+#include "runtime/blend_engine.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -206,7 +206,7 @@ TEST(Renderer, BothModesAgreeAtTheCentrePixelOfAFarNarrowCamera) {
     ASSERT_EQ(a.at<cv::Vec4f>(16, 16)[3], 1.f);
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(pa[k], pb[k], 1e-5 * std::max(1.0, std::abs(pa[k])));
     // ... and both are the lookup at (v, v).
-    const DirectionLookup lookup(set, views);
+    const BlendEngine lookup(set, views);
     const Vec3 L = lookup.radiance(v, v);
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(pa[k], L[k], 1e-5);
   }

@@ -20,7 +20,7 @@
 #include "bake/test_meshes.h"
 #include "core/test_data.h"
 #include "runtime/analytic_map_set.h"
-#include "runtime/direction_lookup.h"
+#include "runtime/blend_engine.h"
 #include "runtime/renderer.h"
 
 #include "viewer/gl_test_context.h"
@@ -189,7 +189,7 @@ TEST(MeshPass, WeightViewIsTheSumOfFadedWeights) {
     ro.blend.rim_fade = fade;
     const cv::Mat w = gpu_frame(cam, mesh, maps, ro, {RenderMode::PerPixel, true});
     const ViewSet vs = maps.view_set();
-    const DirectionLookup lookup(maps, vs, ro.blend);
+    const BlendEngine lookup(maps, vs, ro.blend);
     long covered = 0, faded = 0;
     double worst = 0;
     for (int r = 0; r < w.rows; ++r)

@@ -1,0 +1,496 @@
+#include "runtime/blend_engine.h"
+
+#include "core/albedo_normalisation.h"
+#include "core/sphere_map.h"
+#include "runtime/disc_sampler.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+
+// Vectorised row loops are also built for AVX2 and chosen at load time (x86-64 GCC/Clang; no FMA,
+// so both builds give the same bits).
+#if defined(__x86_64__) && defined(__GNUC__)
+#define RSIBR_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define RSIBR_AVX2_CLONES
+#endif
+
+namespace rsibr {
+
+// One view in the kernel's layout. texels: (height + 2) rows of (width + 2) RGBA texels, the map
+// with a one-texel border; a texel whose centre lies inside the disc (sample_disc's test, the same
+// double arithmetic) holds (R, G, B, 1), every other texel and the border (0, 0, 0, 0). A bilinear
+// footprint's sum then carries the valid taps' weight in its fourth lane, which is sample_disc's
+// renormalisation, and every disc point |xy| <= 1 has its four taps inside the padded image.
+// confidence: the same grid, the confidence where the tap is valid, else 0 (empty: no channel used).
+struct BlendEngine::Source {
+  DiscMap original;  // sample_disc's inward steps where no tap is valid (beyond the disc's edge)
+  WarpKind kind = WarpKind::Mirror;
+  Mat3 view_from_world = Mat3::Identity();
+  std::vector<float> texels, confidence;
+  struct Grid {
+    int stride = 0;  // floats per padded row of texels (4 (width + 2))
+    // Padded pixel position of disc point (x, y): (x scale_x + offset_x, offset_y - y scale_y),
+    // clamped to [0, max_x] x [0, max_y] so that the footprint stays in the padded image.
+    float scale_x = 0, offset_x = 0, scale_y = 0, offset_y = 0, max_x = 0, max_y = 0;
+    // Squared disc radius inside which a point's four taps are all valid (-1: nowhere).
+    float interior2 = -1;
+  } grid;
+  int conf_stride = 0;  // floats per padded row of confidence (width + 2)
+};
+
+struct BlendEngine::Cache {
+  std::vector<std::unique_ptr<Source>> sources;
+  std::unique_ptr<std::once_flag[]> once;
+};
+
+namespace {
+
+using Source = BlendEngine::Source;
+
+Source make_source(const MapView& v, bool use_confidence) {
+  Source s;
+  const int W = v.rgb.cols, H = v.rgb.rows;
+  s.original = DiscMap{&v.rgb, use_confidence && !v.confidence.empty() ? &v.confidence : nullptr, W, H};
+  s.kind = warp_kind_from_string(v.warp);
+  s.view_from_world = v.world_from_view.transpose();
+  const std::size_t PW = std::size_t(W) + 2, PH = std::size_t(H) + 2;
+  s.grid.stride = int(4 * PW);
+  s.conf_stride = int(PW);
+  s.texels.assign(4 * PW * PH, 0.0f);
+  if (s.original.confidence) s.confidence.assign(PW * PH, 0.0f);
+  for (int r = 0; r < H; ++r) {
+    const double y = 1.0 - (2.0 * r + 1.0) / H;
+    const float* in = v.rgb.ptr<float>(r);
+    const float* cin = s.original.confidence ? s.original.confidence->ptr<float>(r) : nullptr;
+    float* out = s.texels.data() + (std::size_t(r) + 1) * 4 * PW + 4;
+    float* cout = s.confidence.empty() ? nullptr : s.confidence.data() + (std::size_t(r) + 1) * PW + 1;
+    for (int c = 0; c < W; ++c) {
+      const double x = (2.0 * c + 1.0) / W - 1.0;
+      if (x * x + y * y > 1.0) continue;
+      std::memcpy(out + 4 * c, in + 3 * c, 3 * sizeof(float));
+      out[4 * c + 3] = 1.0f;
+      if (cout) cout[c] = cin[c];
+    }
+  }
+  s.grid.scale_x = float(0.5 * W);
+  s.grid.offset_x = float(0.5 * (W + 1));  // pixel_from_disc's (W - 1)/2, plus the border
+  s.grid.scale_y = float(0.5 * H);
+  s.grid.offset_y = float(0.5 * (H + 1));
+  s.grid.max_x = float(W) + 0.5f;  // floor <= W: the right tap at W + 1, the padded image's last column
+  s.grid.max_y = float(H) + 0.5f;
+  // A footprint's taps lie within one texel of the point in x and in y: within a disc-unit distance
+  // sqrt((2/W)^2 + (2/H)^2); points inside radius 1 - that (less a margin for float rounding) have
+  // all four inside the disc.
+  const double radius = 1.0 - std::sqrt(4.0 / (double(W) * W) + 4.0 / (double(H) * H)) - 1e-4;
+  s.grid.interior2 = radius > 0 ? float(radius * radius) : -1.0f;
+  return s;
+}
+
+// Four floats (GCC/Clang vector extension): one texel's RGBA, or R, G, B and the weight sum.
+typedef float v4f __attribute__((vector_size(16)));
+inline v4f load4(const float* p) {
+  v4f v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+// Eight floats: two horizontally adjacent texels (passed by reference: no vector ABI question for
+// the builds without AVX).
+typedef float v8f __attribute__((vector_size(32)));
+inline void load8(const float* p, v8f& v) { std::memcpy(&v, p, sizeof v); }
+inline v4f halves_sum(const v8f& v) {
+  v4f lo, hi;
+  std::memcpy(&lo, &v, sizeof lo);
+  std::memcpy(&hi, reinterpret_cast<const char*>(&v) + sizeof lo, sizeof hi);
+  return lo + hi;
+}
+
+// --- The kernel: fade, footprint, tap and sum of one (texel, source), and the texel's result. ---
+
+// a = weight * fade(rim): rim_fade_weight's formula in float.
+inline float faded(float weight, float rim, float inv_fade) {
+  if (!(inv_fade > 0.0f)) return weight;
+  const float t = std::min(rim * inv_fade, 1.0f);
+  return rim > 0.0f ? weight * (t * t * (3.0f - 2.0f * t)) : 0.0f;
+}
+
+// The bilinear footprint of disc point (x, y): the offset of its top-left tap in floats and the
+// fractions. NaN goes to the corner (0, 0).
+inline void footprint(const Source::Grid& s, float x, float y, int& offset, float& fx, float& fy) {
+  float px = x * s.scale_x + s.offset_x, py = s.offset_y - y * s.scale_y;
+  px = px > 0.0f ? px : 0.0f;
+  py = py > 0.0f ? py : 0.0f;
+  px = px < s.max_x ? px : s.max_x;
+  py = py < s.max_y ? py : s.max_y;
+  const int c0 = int(px), r0 = int(py);  // >= 0: truncation is floor
+  fx = px - float(c0);
+  fy = py - float(r0);
+  offset = r0 * s.stride + 4 * c0;
+}
+
+// Adds source s's contribution at weight a (> 0) to acc (R, G, B, total); returns the contribution
+// a c (0: none). (x, y) are only read where no tap is valid (sample_disc's inward steps).
+inline float accumulate(const Source& s, float a, int offset, float fx, float fy, float x, float y, v4f& acc) {
+  const float w00 = (1.0f - fx) * (1.0f - fy), w01 = fx * (1.0f - fy), w10 = (1.0f - fx) * fy, w11 = fx * fy;
+  const float* t0 = s.texels.data() + offset;
+  const float* t1 = t0 + s.grid.stride;
+  v4f S = w00 * load4(t0) + w01 * load4(t0 + 4) + w10 * load4(t1) + w11 * load4(t1 + 4);
+  float valid = S[3];
+  float conf = 1.0f;
+  if (valid > 0.0f) {
+    if (!s.confidence.empty()) {
+      const float* k0 = s.confidence.data() + offset / 4;
+      const float* k1 = k0 + s.conf_stride;
+      // The same products in the same order as S[3]: exactly 1 for a confidence of 1.
+      const float c = (w00 * k0[0] + w01 * k0[1] + w10 * k1[0] + w11 * k1[1]) / valid;
+      conf = c > 0.0f ? c : 0.0f;  // negative or NaN counts as 0
+    }
+  } else {
+    double L[3], cd;
+    if (!sample_disc(s.original, Vec2(x, y), L, &cd)) return 0.0f;
+    S = v4f{float(L[0]), float(L[1]), float(L[2]), 1.0f};
+    valid = 1.0f;
+    conf = float(cd);
+  }
+  a *= conf;
+  if (!(a > 0.0f)) return 0.0f;
+  acc += (a / valid) * S;  // fourth lane: a
+  return a;
+}
+
+// out = acc / total (RGB), weight = total (at most 1: the float sum of barycentric weights may
+// round above it); false where total is 0 (the fallback decides).
+inline bool finish(const v4f& acc, float* out, float* weight) {
+  const float total = acc[3];
+  if (!(total > 0.0f)) return false;
+  const float inv = 1.0f / total;
+  out[0] = acc[0] * inv;
+  out[1] = acc[1] * inv;
+  out[2] = acc[2] * inv;
+  *weight = total < 1.0f ? total : 1.0f;
+  return true;
+}
+
+// The fallback (step 5): the least-faded located source (largest rim, ties to the first) at its disc
+// point, through sample_disc. warp_of(k) gives located source k's WarpSample. Writes 0 when even that
+// has no valid tap.
+template <class WarpOf>
+void fallback(const Source* const* sources, int n, const WarpOf& warp_of, float* out) {
+  int best = -1;
+  WarpSample best_sample;
+  for (int k = 0; k < n; ++k) {
+    const WarpSample ws = warp_of(k);
+    if (best < 0 || ws.rim > best_sample.rim) {
+      best = k;
+      best_sample = ws;
+    }
+  }
+  double L[3], conf;
+  const bool ok = best >= 0 && sample_disc(sources[best]->original, best_sample.disc, L, &conf);
+  for (int j = 0; j < 3; ++j) out[j] = ok ? float(L[j]) : 0.0f;
+}
+
+// --- Row forms of the kernel's first steps (vectorised, also for AVX2). ---
+
+RSIBR_AVX2_CLONES void fade_row(int n, float weight, float inv_fade, const float* __restrict rim, float* __restrict a) {
+  for (int i = 0; i < n; ++i) a[i] = faded(weight, rim[i], inv_fade);
+}
+
+// The footprint of disc point (x, y) for a source weight a: the offset, the four tap weights times
+// a, and whether all four taps are valid (inside the grid's interior radius).
+struct Taps {
+  int offset, interior;
+  float w00, w01, w10, w11;
+};
+inline Taps taps(const Source::Grid& g, float x, float y, float a) {
+  Taps t;
+  float fx, fy;
+  footprint(g, x, y, t.offset, fx, fy);
+  t.w00 = a * ((1.0f - fx) * (1.0f - fy));
+  t.w01 = a * (fx * (1.0f - fy));
+  t.w10 = a * ((1.0f - fx) * fy);
+  t.w11 = a * (fx * fy);
+  t.interior = x * x + y * y <= g.interior2;
+  return t;
+}
+
+// Adds source s's contribution at weight a (> 0) to acc (R, G, B, total) and returns it (a c; 0:
+// none). Interior footprints: the four taps times the premultiplied weights (every tap valid, so no
+// renormalisation: the weights sum to 1 up to rounding), times the confidence c = sum w k / sum w
+// (the same products in the same order, so exactly 1 for a confidence of 1). Others: accumulate().
+inline float contribute(const Source& s, float a, const Taps& t, float x, float y, v4f& acc) {
+  if (!t.interior) {
+    int o;
+    float fx, fy;
+    footprint(s.grid, x, y, o, fx, fy);
+    return accumulate(s, a, o, fx, fy, x, y, acc);
+  }
+  const float* t0 = s.texels.data() + t.offset;
+  const float* t1 = t0 + s.grid.stride;
+  const v8f top = {t.w00, t.w00, t.w00, t.w00, t.w01, t.w01, t.w01, t.w01};
+  const v8f bottom = {t.w10, t.w10, t.w10, t.w10, t.w11, t.w11, t.w11, t.w11};
+  v8f T0, T1;
+  load8(t0, T0);
+  load8(t1, T1);
+  const v4f S = halves_sum(top * T0 + bottom * T1);
+  if (s.confidence.empty()) {
+    acc += S;
+    return a;
+  }
+  const float* k0 = s.confidence.data() + t.offset / 4;
+  const float* k1 = k0 + s.conf_stride;
+  const float c = (t.w00 * k0[0] + t.w01 * k0[1] + t.w10 * k1[0] + t.w11 * k1[1]) / (t.w00 + t.w01 + t.w10 + t.w11);
+  const float conf = c > 0.0f ? c : 0.0f;  // negative or NaN counts as 0
+  if (!(conf > 0.0f)) return 0.0f;
+  acc += conf * S;
+  return a * conf;
+}
+
+// taps() for a row of points, structure of arrays (so that the loop vectorises, also for AVX2).
+constexpr int kTileCols = 64;  // destination texels per tile row
+struct TapRows {
+  int offset[kTileCols], interior[kTileCols];
+  float w00[kTileCols], w01[kTileCols], w10[kTileCols], w11[kTileCols];
+  Taps at(int i) const { return {offset[i], interior[i], w00[i], w01[i], w10[i], w11[i]}; }
+};
+RSIBR_AVX2_CLONES void taps_row(const Source::Grid& grid, int n, const float* __restrict x, const float* __restrict y,
+                                const float* __restrict a, TapRows& out) {
+  const Source::Grid g = grid;  // a local: the stores below could otherwise alias it
+  for (int i = 0; i < n; ++i) {
+    const Taps t = taps(g, x[i], y[i], a[i]);
+    out.offset[i] = t.offset;
+    out.interior[i] = t.interior;
+    out.w00[i] = t.w00;
+    out.w01[i] = t.w01;
+    out.w10[i] = t.w10;
+    out.w11[i] = t.w11;
+  }
+}
+
+// contribute() for a row of texels (acc and source_weight per texel; source_weight may be null).
+RSIBR_AVX2_CLONES void gather_row(const Source& s, int n, const float* a, const float* x, const float* y,
+                                  const TapRows& t, v4f* acc, float* source_weight) {
+  for (int i = 0; i < n; ++i) {
+    if (!(a[i] > 0.0f)) continue;
+    const float c = contribute(s, a[i], t.at(i), x[i], y[i], acc[i]);
+    if (source_weight) source_weight[i] = c;
+  }
+}
+
+double det3(const Vec3& a, const Vec3& b, const Vec3& c) { return a.dot(b.cross(c)); }
+
+// v / |v|, as core/view_set.cpp's locate normalises (so the hinted weights are bitwise its weights).
+Vec3 unit(const Vec3& v) {
+  const double sq = v.squaredNorm();
+  if (sq > 1e-290 && sq < 1e290) return v.normalized();
+  return (v / v.cwiseAbs().maxCoeff()).normalized();
+}
+
+}  // namespace
+
+BlendEngine::BlendEngine(const MapSet& maps, const ViewSet& view_set, const BlendRule& rule)
+    : maps_(maps), view_set_(view_set), rule_(rule), cache_(std::make_unique<Cache>()) {
+  check_blend_inputs(maps, view_set);
+  cache_->sources.resize(maps.views.size());
+  cache_->once = std::make_unique<std::once_flag[]>(maps.views.size());
+  const auto& views = view_set.views();
+  for (const auto& T : view_set.triangles()) {
+    const Vec3 &a = views[std::size_t(T[0])], &b = views[std::size_t(T[1])], &c = views[std::size_t(T[2])];
+    edge_norms_.push_back({a.cross(b).norm(), b.cross(c).norm(), c.cross(a).norm()});
+  }
+}
+
+BlendEngine::~BlendEngine() = default;
+
+const BlendEngine::Source& BlendEngine::source(int index) const {
+  const std::size_t i = std::size_t(index);
+  std::call_once(cache_->once[i], [&] {
+    check_blend_source(maps_, index);
+    cache_->sources[i] = std::make_unique<Source>(make_source(maps_.views[i], rule_.use_confidence));
+  });
+  return *cache_->sources[i];
+}
+
+void BlendEngine::prepare_all() const {
+  for (std::size_t i = 0; i < maps_.views.size(); ++i) source(int(i));
+}
+
+ViewWeights BlendEngine::locate(const Vec3& v, int* hint) const {
+  if (hint && *hint >= 0 && std::size_t(*hint) < view_set_.triangles().size() && v.allFinite() &&
+      v.cwiseAbs().maxCoeff() > 0) {
+    const auto& T = view_set_.triangles()[std::size_t(*hint)];
+    const auto& views = view_set_.views();
+    const Vec3 &a = views[std::size_t(T[0])], &b = views[std::size_t(T[1])], &c = views[std::size_t(T[2])];
+    const Vec3 p = unit(v);
+    // The triangles of a view set do not overlap, so a point this far inside one is in no other.
+    constexpr double kInside = 1e-9;
+    const auto& e = edge_norms_[std::size_t(*hint)];
+    if (det3(a, b, p) > kInside * e[0] && det3(b, c, p) > kInside * e[1] && det3(c, a, p) > kInside * e[2]) {
+      ViewWeights out;
+      out.count = 3;
+      out.views = T;
+      out.weights = triangle_weights(p, a, b, c, rule_.barycentric);
+      out.triangle = *hint;
+      out.inside = true;
+      out.distance = 0;
+      return out;
+    }
+  }
+  ViewWeights out = view_set_.locate(v, rule_.barycentric);
+  if (hint) *hint = out.triangle;
+  return out;
+}
+
+Vec3 BlendEngine::radiance(const ViewWeights& located, const Vec3& v, const Vec3& n_in, double* weight) const {
+  // 0. Clamp n to v's hemisphere (the nearest rim normal).
+  Vec3 n = n_in;
+  double nv = n.dot(v);
+  if (nv < 0) {
+    n -= nv * v;
+    const double len = n.norm();
+    n = len > 0 ? Vec3(n / len) : Vec3(-world_from_view_for(v).col(1));
+    nv = 0;
+  }
+  const Vec3 r = 2.0 * nv * n - v;
+  // Albedo-normalised sets: the blend of stored texels times A(n.v) (core/albedo_normalisation.h).
+  const std::vector<float>& albedo = maps_.views.front().albedo;
+  const Vec3 A = albedo.empty() ? Vec3(1, 1, 1) : albedo_at(albedo, float(nv));
+
+  const Source* sources[3];
+  WarpSample samples[3];
+  const float inv_fade = rule_.rim_fade > 0 ? float(1.0 / rule_.rim_fade) : 0.0f;
+  v4f acc = {0.0f, 0.0f, 0.0f, 0.0f};
+  for (int k = 0; k < located.count; ++k) {
+    const Source& s = source(located.views[std::size_t(k)]);
+    sources[k] = &s;
+    samples[k] = warp_direction(s.kind, s.view_from_world * (s.kind == WarpKind::Mirror ? r : n));
+    const double w = located.weights[std::size_t(k)];
+    if (!(w > 0)) continue;
+    const float a = faded(float(w), float(samples[k].rim), inv_fade);
+    if (!(a > 0.0f)) continue;
+    const float x = float(samples[k].disc.x()), y = float(samples[k].disc.y());
+    contribute(s, a, taps(s.grid, x, y, a), x, y, acc);
+  }
+  float out[3], total = 0;
+  if (!finish(acc, out, &total)) fallback(sources, located.count, [&](int k) { return samples[k]; }, out);
+  if (weight) *weight = total;
+  return Vec3(out[0], out[1], out[2]).cwiseProduct(A);
+}
+
+BlendResult BlendEngine::map(const Vec3& view_dir, const Vec3& up, const MapRequest& request) const {
+  if (!view_dir.allFinite() || !(view_dir.norm() > 0))
+    throw std::invalid_argument("blend: view direction must be finite and non-zero");
+  if ((request.width > 0) != (request.height > 0) || request.width < 0 || request.height < 0)
+    throw std::invalid_argument("blend: give both width and height (> 0), or neither");
+  const int W = request.width > 0 ? request.width : maps_.width();
+  const int H = request.height > 0 ? request.height : maps_.height();
+  if (W < 1 || H < 1) throw std::invalid_argument("blend: empty destination size");
+  static const ExactWarp exact;
+  const Warp& warp = request.warp ? *request.warp : exact;
+  if (!warp.supports(W, H))
+    throw std::invalid_argument(std::string("blend: the ") + warp.name() + " warp does not support " +
+                                std::to_string(W) + "x" + std::to_string(H));
+
+  BlendResult result;
+  result.world_from_view = world_from_view_for(view_dir, up);
+  result.located = locate(view_dir);
+  const ViewWeights& located = result.located;
+  const Mat3& T_d = result.world_from_view;
+  const int n = located.count;
+  const Source* sources[3] = {nullptr, nullptr, nullptr};
+  Mat3 source_from_dest[3];
+  int active[3], m = 0;
+  for (int k = 0; k < n; ++k) {
+    sources[k] = &source(located.views[std::size_t(k)]);
+    source_from_dest[k] = sources[k]->view_from_world * T_d;
+    if (located.weights[std::size_t(k)] > 0) active[m++] = k;
+  }
+  const float inv_fade = rule_.rim_fade > 0 ? float(1.0 / rule_.rim_fade) : 0.0f;
+
+  result.rgb.create(H, W, CV_32FC3);
+  result.weight.create(H, W, CV_32FC1);
+  if (request.source_weights)
+    for (int k = 0; k < 3; ++k) result.source_weight[std::size_t(k)] = cv::Mat::zeros(H, W, CV_32FC1);
+
+  // Tiles of kTileRows x kTileCols destination texels: a tile's footprint in each source is compact
+  // (tens of KiB for three sources), so the bilinear taps hit the cache and the TLB; a whole
+  // destination row sweeps a curve across hundreds of source rows. Per tile row and source: the warp,
+  // the fades and the footprints as vectorised row loops, then the taps added to the row's sums; then
+  // the normalisation per texel.
+  // Per texel the arithmetic does not depend on the tiling or the threads.
+  constexpr int kTileRows = 16;
+  const auto tile_row = [&](int r, int c0, int c1) {
+    const int span = c1 - c0;
+    // Per source: warp, fades, footprints, and a prefetch of every footprint's two rows, so that
+    // the next source's warp runs while the taps are fetched; then the taps of all sources.
+    float x[3][kTileCols], y[3][kTileCols], rim[kTileCols], a[3][kTileCols];
+    TapRows t[3];
+    v4f acc[kTileCols];
+    for (int i = 0; i < span; ++i) acc[i] = v4f{0.0f, 0.0f, 0.0f, 0.0f};
+    for (int j = 0; j < m; ++j) {
+      const int k = active[j];
+      const Source& s = *sources[k];
+      warp.warp_block(s.kind, source_from_dest[k], W, H, r, c0, c1, x[j], y[j], rim);
+      fade_row(span, float(located.weights[std::size_t(k)]), inv_fade, rim, a[j]);
+      taps_row(s.grid, span, x[j], y[j], a[j], t[j]);
+      const float* base = s.texels.data();
+      for (int i = 0; i < span; ++i) {
+        __builtin_prefetch(base + t[j].offset[i]);
+        __builtin_prefetch(base + t[j].offset[i] + s.grid.stride);
+      }
+    }
+    for (int j = 0; j < m; ++j) {
+      const int k = active[j];
+      float* sw = request.source_weights ? result.source_weight[std::size_t(k)].ptr<float>(r) + c0 : nullptr;
+      gather_row(*sources[k], span, a[j], x[j], y[j], t[j], acc, sw);
+    }
+    float* out = result.rgb.ptr<float>(r) + 3 * c0;
+    float* out_w = result.weight.ptr<float>(r) + c0;
+    for (int i = 0; i < span; ++i) {
+      if (finish(acc[i], out + 3 * i, out_w + i)) continue;
+      out_w[i] = 0.0f;
+      const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c0 + i, r), W, H);
+      fallback(sources, n, [&](int k) {
+        return warp_direction(sources[k]->kind, source_from_dest[k] * central_direction(sources[k]->kind, xy));
+      }, out + 3 * i);
+    }
+  };
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, H, kTileRows),
+      [&](const tbb::blocked_range<int>& rows) {
+        std::pair<int, int> spans[kTileRows];
+        for (int r = rows.begin(); r != rows.end(); ++r) {
+          const auto span = disc_span(r, W, H);
+          spans[r - rows.begin()] = span;
+          // Outside the disc: 0 (the outputs are not zero-initialised).
+          float* o = result.rgb.ptr<float>(r);
+          float* w = result.weight.ptr<float>(r);
+          const int c0 = span.second > span.first ? span.first : W, c1 = span.second > span.first ? span.second : W;
+          std::fill(o, o + 3 * c0, 0.0f);
+          std::fill(o + 3 * c1, o + 3 * W, 0.0f);
+          std::fill(w, w + c0, 0.0f);
+          std::fill(w + c1, w + W, 0.0f);
+        }
+        for (int cb = 0; cb < W; cb += kTileCols)
+          for (int r = rows.begin(); r != rows.end(); ++r) {
+            const int c0 = std::max(spans[r - rows.begin()].first, cb);
+            const int c1 = std::min(spans[r - rows.begin()].second, cb + kTileCols);
+            if (c1 > c0) tile_row(r, c0, c1);
+          }
+      },
+      tbb::simple_partitioner());
+
+  // Albedo-normalised sets: the destination texel p has n.d = g_normal(p).z in d's own frame.
+  const std::vector<float>& albedo = maps_.views.front().albedo;
+  if (!albedo.empty()) denormalise_by_albedo(result.rgb, albedo);
+  return result;
+}
+
+}  // namespace rsibr
