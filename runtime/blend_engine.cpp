@@ -225,13 +225,15 @@ inline Taps taps(const Source::Grid& g, float x, float y, float a) {
 // none). Interior footprints: the four taps times the premultiplied weights (every tap valid, so no
 // renormalisation: the weights sum to 1 up to rounding), times the confidence c = sum w k / sum w
 // (the same products in the same order, so exactly 1 for a confidence of 1). Others: accumulate().
+// Out of line: the rare path stays out of the hot loops' registers.
+__attribute__((noinline)) float contribute_rim(const Source& s, float a, float x, float y, v4f& acc) {
+  int o;
+  float fx, fy;
+  footprint(s.grid, x, y, o, fx, fy);
+  return accumulate(s, a, o, fx, fy, x, y, acc);
+}
 inline float contribute(const Source& s, float a, const Taps& t, float x, float y, v4f& acc) {
-  if (!t.interior) {
-    int o;
-    float fx, fy;
-    footprint(s.grid, x, y, o, fx, fy);
-    return accumulate(s, a, o, fx, fy, x, y, acc);
-  }
+  if (!t.interior) return contribute_rim(s, a, x, y, acc);
   const float* t0 = s.texels.data() + t.offset;
   const float* t1 = t0 + s.grid.stride;
   const v8f top = {t.w00, t.w00, t.w00, t.w00, t.w01, t.w01, t.w01, t.w01};
@@ -428,8 +430,8 @@ BlendResult BlendEngine::map(const Vec3& view_dir, const Vec3& up, const MapRequ
   constexpr int kTileRows = 16;
   const auto tile_row = [&](int r, int c0, int c1) {
     const int span = c1 - c0;
-    // Per source: warp, fades, footprints, and a prefetch of every footprint's two rows, so that
-    // the next source's warp runs while the taps are fetched; then the taps of all sources.
+    // Per source: warp, fades and footprints as row loops, then its taps added to the row's sums
+    // (one source at a time: measured faster than all sources per texel, 2.3 vs 2.6 ms at 512^2).
     float x[3][kTileCols], y[3][kTileCols], rim[kTileCols], a[3][kTileCols];
     TapRows t[3];
     v4f acc[kTileCols];
@@ -440,11 +442,6 @@ BlendResult BlendEngine::map(const Vec3& view_dir, const Vec3& up, const MapRequ
       warp.warp_block(s.kind, source_from_dest[k], W, H, r, c0, c1, x[j], y[j], rim);
       fade_row(span, float(located.weights[std::size_t(k)]), inv_fade, rim, a[j]);
       taps_row(s.grid, span, x[j], y[j], a[j], t[j]);
-      const float* base = s.texels.data();
-      for (int i = 0; i < span; ++i) {
-        __builtin_prefetch(base + t[j].offset[i]);
-        __builtin_prefetch(base + t[j].offset[i] + s.grid.stride);
-      }
     }
     for (int j = 0; j < m; ++j) {
       const int k = active[j];
