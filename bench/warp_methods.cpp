@@ -8,6 +8,7 @@
 #include "core/sphere_map.h"
 #include "core/view_set.h"
 #include "runtime/blend.h"
+#include "runtime/blend_engine.h"
 #include "runtime/double_indirection_warp.h"
 #include "runtime/make_warp.h"
 #include "runtime/tessellated_warp.h"
@@ -70,12 +71,14 @@ std::vector<Mat3> sources_of(bool ring, int frame, Mat3* dest) {
   return out;
 }
 
-// One destination map's warps for the given sources, all disc rows, this thread.
-void warp_map(const Warp& w, WarpKind kind, const std::vector<Mat3>& sources, int n, std::vector<WarpSample>& buf) {
+// One destination map's warps for the given sources, all disc rows, this thread, in the form the
+// blend engine uses (Warp::warp_block: single precision, structure of arrays).
+void warp_map(const Warp& w, WarpKind kind, const std::vector<Mat3>& sources, int n, std::vector<float>& buf) {
+  const std::size_t row = std::size_t(n) + 1;
   for (const Mat3& m : sources)
     for (int r = 0; r < n; ++r) {
       const auto [c0, c1] = disc_span(r, n, n);
-      if (c0 < c1) w.warp_row(kind, m, n, n, r, c0, c1, buf.data());
+      if (c0 < c1) w.warp_block(kind, m, n, n, r, c0, c1, buf.data(), buf.data() + row, buf.data() + 2 * row);
     }
 }
 
@@ -103,7 +106,7 @@ MapSet ring_set(int n) {
 
 int run(const std::vector<int>& sizes, int reps) {
   for (int n : sizes) {
-    std::vector<WarpSample> buf(std::size_t(n) + 1);
+    std::vector<float> buf(3 * (std::size_t(n) + 1));
     Mat3 dest0;
     sources_of(true, 0, &dest0);
     const Vec3 axis = dest0.transpose() * Vec3(0, 1, 0);
@@ -129,9 +132,12 @@ int run(const std::vector<int>& sizes, int reps) {
                       n, ring ? "ring" : "general", to_string(kind), m.name.c_str(), m.knob, best, max_t, rms_t);
           std::fflush(stdout);
         }
-    // The blend (all threads) to destinations on the upper ring of a two-ring set, with each warp.
+    // The blend (all threads) to destinations on the upper ring of a two-ring set, with each warp,
+    // through one engine (its sources laid out once, as the renderer and the viewer hold it).
     const MapSet set = ring_set(n);
     const ViewSet views = set.view_set();
+    const BlendEngine engine(set, views);
+    engine.prepare_all();
     const std::vector<Method> bm = methods(n, axis_in_views(set, Vec3(0, 1, 0)));
     for (const Method& m : bm) {
       BlendOptions o;
@@ -142,7 +148,7 @@ int run(const std::vector<int>& sizes, int reps) {
       int frame = 0;
       for (int rep = 0; rep < reps; ++rep) {
         const auto t0 = Clock::now();
-        for (int f = 0; f < frames; ++f) blend(set, views, ring_frame(20, 5.0 + 1.3 * frame++).col(2), Vec3(0, 1, 0), o);
+        for (int f = 0; f < frames; ++f) engine.map(ring_frame(20, 5.0 + 1.3 * frame++).col(2), Vec3(0, 1, 0), o);
         best = std::min(best, since(t0) / frames);
       }
       std::printf("{\"what\": \"blend\", \"size\": %d, \"warp\": \"%s\", \"knob\": %d, \"seconds_per_frame\": %.6g}\n", n,

@@ -61,7 +61,9 @@ def main():
         "**general**: three sources 25-40 degrees away in general directions (the rotation's swing needs a "
         "table of its own per frame and source, its nodes warped exactly). Error: source-position error "
         "against the exact warp in source texels (max / RMS over texels whose exact rim value is >= 0.1); "
-        "exact and precomputed give the exact warp's samples.",
+        "exact and precomputed give the exact warp's samples. Times are of `Warp::warp_block`, the "
+        "single-precision rows the blend engine asks for (exact and precomputed: vectorised float loops; "
+        "tessellated and double-indirection: their double rows, converted).",
         "",
     ]
     for case in ("ring", "general"):
@@ -84,7 +86,8 @@ def main():
                 body.append(f"| {name} | " + " | ".join(cells) + " |")
             body.append("")
     body += ["**Blend** (`runtime/blend.h`, all threads): ms per frame to a destination on the upper ring of "
-             "a two-ring set; the exact and precomputed warps take the blend's fused float32 path.", ""]
+             "a two-ring set, one `BlendEngine::map` per frame (the engine built once, as the renderer and the "
+             "viewer hold it).", ""]
     body.append("| warp | " + " | ".join(f"{s}^2" for s in sizes) + " |")
     body.append("|---|" + "---|" * len(sizes))
     names = []
@@ -135,8 +138,9 @@ def wins(warps, blends, sizes):
         lines.append(f"- Against the tessellated warp with 32 rings (the other approximation), {case}: "
                      f"{min(e):.0f}-{max(e):.0f}x smaller max error at {min(t):.2f}-{max(t):.2f}x its time.")
     lines.append("- Memory: its screen tables hold 16 bytes per destination texel (two float pairs, mirror and "
-                 "normal) and the shared table 12 bytes per node, against the precomputed warp's 48 bytes per "
-                 "destination texel (two double-precision directions).")
+                 "normal) and the shared table 12 bytes per node, against the precomputed warp's 72 bytes per "
+                 "destination texel (mirror and normal directions, in double for its exact rows and in float for the "
+                 "blend engine's).")
     cases = 4 * len(sizes)
     lines.append("- Use it for rings and turntables of views where the tessellated warp's error (up to several "
                  "source texels at the rim) shows and the precomputed warp's tables do not fit; otherwise the "

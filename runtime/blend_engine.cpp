@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -62,24 +63,33 @@ Source make_source(const MapView& v, bool use_confidence) {
   s.kind = warp_kind_from_string(v.warp);
   s.view_from_world = v.world_from_view.transpose();
   const std::size_t PW = std::size_t(W) + 2, PH = std::size_t(H) + 2;
+  if (4 * PW * PH > std::size_t(std::numeric_limits<int>::max()))  // tap offsets are int
+    throw std::invalid_argument("blend: a " + std::to_string(W) + "x" + std::to_string(H) + " map is too large");
   s.grid.stride = int(4 * PW);
   s.conf_stride = int(PW);
   s.texels.assign(4 * PW * PH, 0.0f);
   if (s.original.confidence) s.confidence.assign(PW * PH, 0.0f);
-  for (int r = 0; r < H; ++r) {
-    const double y = 1.0 - (2.0 * r + 1.0) / H;
-    const float* in = v.rgb.ptr<float>(r);
-    const float* cin = s.original.confidence ? s.original.confidence->ptr<float>(r) : nullptr;
-    float* out = s.texels.data() + (std::size_t(r) + 1) * 4 * PW + 4;
-    float* cout = s.confidence.empty() ? nullptr : s.confidence.data() + (std::size_t(r) + 1) * PW + 1;
-    for (int c = 0; c < W; ++c) {
-      const double x = (2.0 * c + 1.0) / W - 1.0;
-      if (x * x + y * y > 1.0) continue;
-      std::memcpy(out + 4 * c, in + 3 * c, 3 * sizeof(float));
-      out[4 * c + 3] = 1.0f;
-      if (cout) cout[c] = cin[c];
+  // Rows in parallel; per row the texels inside the disc are disc_span's columns (the same test).
+  const cv::Mat* conf = s.original.confidence;
+  float* texels = s.texels.data();
+  float* confidence = s.confidence.empty() ? nullptr : s.confidence.data();
+  tbb::parallel_for(tbb::blocked_range<int>(0, H, 16), [&](const tbb::blocked_range<int>& rows) {
+    for (int r = rows.begin(); r != rows.end(); ++r) {
+      const auto [c0, c1] = disc_span(r, W, H);
+      const float* in = v.rgb.ptr<float>(r);
+      float* out = texels + (std::size_t(r) + 1) * 4 * PW + 4;
+      for (int c = c0; c < c1; ++c) {
+        out[4 * c] = in[3 * c];
+        out[4 * c + 1] = in[3 * c + 1];
+        out[4 * c + 2] = in[3 * c + 2];
+        out[4 * c + 3] = 1.0f;
+      }
+      if (confidence) {
+        const float* cin = conf->ptr<float>(r);
+        std::copy(cin + c0, cin + c1, confidence + (std::size_t(r) + 1) * PW + 1 + c0);
+      }
     }
-  }
+  });
   s.grid.scale_x = float(0.5 * W);
   s.grid.offset_x = float(0.5 * (W + 1));  // pixel_from_disc's (W - 1)/2, plus the border
   s.grid.scale_y = float(0.5 * H);

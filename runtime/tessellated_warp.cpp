@@ -55,8 +55,13 @@ TessellatedWarp::TessellatedWarp(int width, int height, const TessellationOption
 }
 
 std::shared_ptr<const TessellatedWarp::Frame> TessellatedWarp::frame(WarpKind kind, const Mat3& m) const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  for (const auto& f : cache_)
+  {
+    std::shared_lock<std::shared_mutex> lock(mutex_);
+    for (const auto& f : cache_)
+      if (f->kind == kind && f->source_from_dest == m) return f;
+  }
+  std::unique_lock<std::shared_mutex> lock(mutex_);
+  for (const auto& f : cache_)  // another thread may have built it meanwhile
     if (f->kind == kind && f->source_from_dest == m) return f;
   auto f = std::make_shared<Frame>();
   f->kind = kind;

@@ -25,6 +25,7 @@
 #include <array>
 #include <memory>
 #include <mutex>
+#include <shared_mutex>
 #include <vector>
 
 namespace rsibr {
@@ -71,7 +72,7 @@ class TessellatedWarp final : public Warp {
   std::vector<std::array<int, 4>> cell_vertices_;
 
   // A few recent frames (three sources per blend, mirror and normal kinds), newest last.
-  mutable std::mutex mutex_;
+  mutable std::shared_mutex mutex_;  // readers share it: a frame is looked up once per row
   mutable std::vector<std::shared_ptr<const Frame>> cache_;
 };
 
