@@ -4,6 +4,7 @@
 
 #include "core/map_set.h"
 #include "runtime/blend.h"
+#include "runtime/blend_engine.h"
 #include "runtime/make_warp.h"
 #include "runtime/warp.h"
 
@@ -12,8 +13,79 @@
 
 #include <memory>
 #include <optional>
+#include <string>
+
+#include <tbb/parallel_for.h>
 
 namespace rsibr::python {
+
+namespace {
+
+// A blend engine for Python: owns its view set (the MapSet is kept alive by pybind11) and the last
+// warp it built, so that a turntable of map() calls lays out the sources and builds a warp once.
+class PyBlendEngine {
+ public:
+  PyBlendEngine(const MapSet& maps, double rim_fade, bool use_confidence, const std::optional<ViewSet>& view_set)
+      : maps_(maps), view_set_(view_set ? *view_set : maps.view_set()) {
+    BlendRule rule;
+    rule.rim_fade = rim_fade;
+    rule.use_confidence = use_confidence;
+    engine_ = std::make_unique<BlendEngine>(maps_, view_set_, rule);
+  }
+  BlendResult map(const Vec3& view, const Vec3& up, int size, const std::string& warp_name, int rings,
+                  bool source_weights) {
+    if (!view.allFinite() || !(view.norm() > 0)) throw py::value_error("blend: view must be a non-zero direction");
+    MapRequest request;
+    request.width = size > 0 ? size : maps_.width();
+    request.height = size > 0 ? size : maps_.height();
+    request.source_weights = source_weights;
+    py::gil_scoped_release release;
+    const std::string key = warp_name + "/" + std::to_string(rings) + "/" + std::to_string(request.width) + "x" +
+                            std::to_string(request.height);
+    if (!warp_ || key != warp_key_) {
+      try {
+        warp_ = make_warp({warp_name, rings, axis_in_views(maps_, up)}, request.width, request.height);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string("blend: ") + e.what());
+      }
+      warp_key_ = key;
+    }
+    request.warp = warp_.get();
+    return engine_->map(view, up, request);
+  }
+  // Per row of v (N x 3) and n (N x 3), world, unit: the radiance (N x 3) and the weight (N).
+  py::tuple radiance(const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& v,
+                     const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& n) const {
+    if (v.rows() != n.rows()) throw py::value_error("radiance: v and n must have the same number of rows");
+    if (!v.allFinite() || !n.allFinite()) throw py::value_error("radiance: v and n must be finite");
+    Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> L(v.rows(), 3);
+    Eigen::VectorXd w(v.rows());
+    {
+      py::gil_scoped_release release;
+      engine_->prepare_all();
+      tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, v.rows(), 256), [&](const auto& range) {
+        int hint = -1;
+        for (Eigen::Index i = range.begin(); i != range.end(); ++i) {
+          const Vec3 vi = v.row(i).transpose().normalized(), ni = n.row(i).transpose().normalized();
+          double wi = 0;
+          L.row(i) = engine_->radiance(engine_->locate(vi, &hint), vi, ni, &wi).transpose();
+          w[i] = wi;
+        }
+      });
+    }
+    return py::make_tuple(L, w);
+  }
+  ViewWeights locate(const Vec3& v) const { return engine_->locate(v); }
+
+ private:
+  const MapSet& maps_;
+  ViewSet view_set_;
+  std::unique_ptr<BlendEngine> engine_;
+  std::unique_ptr<Warp> warp_;
+  std::string warp_key_;
+};
+
+}  // namespace
 
 void bind_blend(py::module_& m) {
   py::class_<BlendResult>(m, "BlendResult", "The blended radiance map of a destination view.")
@@ -63,6 +135,22 @@ void bind_blend(py::module_& m) {
       "normalised per texel. size: the output's side (0: the set's size). warp: 'exact', 'precomputed' (same "
       "result, cached directions), 'tessellated' (the paper's disc mesh of `rings` rings) or 'double-indirection' "
       "(screen and parametric tables; a rotation about `up` is an offset into them). Releases the GIL.");
+
+  py::class_<PyBlendEngine>(m, "BlendEngine",
+                            "A map set and its blend rule, held for many blends: each source is laid out once "
+                            "(the first time it is used) and the warp of the last map() is kept, so a turntable "
+                            "of views costs one blend a frame. The same results as blend(). Keeps `maps` alive.")
+      .def(py::init<const MapSet&, double, bool, const std::optional<ViewSet>&>(), py::arg("maps"),
+           py::arg("rim_fade") = 0.4, py::arg("use_confidence") = true, py::arg("view_set") = py::none(),
+           py::keep_alive<1, 2>())
+      .def("map", &PyBlendEngine::map, py::arg("view"), py::arg("up") = Vec3(0, 1, 0), py::arg("size") = 0,
+           py::arg("warp") = "precomputed", py::arg("rings") = 16, py::arg("source_weights") = false,
+           "The destination map of `view` (as blend()). Releases the GIL.")
+      .def("radiance", &PyBlendEngine::radiance, py::arg("v"), py::arg("n"),
+           "Radiance toward viewer directions v (N x 3, world, from the surface to the viewer) from normals "
+           "n (N x 3, world): the blend for each (v, n) pair without a destination map (the renderer's "
+           "per-pixel mode). Returns (radiance N x 3, weight N). Rows are normalised. Releases the GIL.")
+      .def("locate", &PyBlendEngine::locate, py::arg("v"), "The view set's triangle and weights for direction v.");
 }
 
 }  // namespace rsibr::python
