@@ -102,8 +102,8 @@ def novel_section(j, wall):
         "",
         "**How the maps are baked, and why not with MIS.** Map sets and direct bakes use the reference "
         "integrator: a deterministic quadrature over every texel of a MIP level of the environment "
-        "(exact energy), so they carry no noise and the floor of this measurement is exactly 0 (checked: "
-        "blend() at a source view against a direct bake there). MIS noise would hide the blend error: "
+        "(exact energy), so they carry no noise and the floor of this measurement is the blend's float "
+        "rounding alone (checked: blend() at a source view against a direct bake there, below 1e-6). MIS noise would hide the blend error: "
         "the table shows MIS at 64 and 256 samples on the full 512x256 environment against the full "
         f"quadrature, at {p0['probes']} random texels of the 64^2 map of novel view 0; its noise is "
         "above the 42- and 162-view blend errors, and driving it well below them would cost more than the "
