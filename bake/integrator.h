@@ -1,5 +1,5 @@
 // Lighting integrators: the radiance sphere map of a BRDF under a distant environment, for one
-// view (DESIGN.md "Light"; core/map_set.h).
+// view (docs/conventions.md, "Light"; core/map_set.h).
 //
 // Contract of a texel (what every integrator computes). For the view v (world, unit, toward the
 // viewer), the map's world_from_view T and texel p = (c, r) of a size x size sphere map whose
@@ -43,8 +43,7 @@ struct IntegratorOptions {
   // at most this. Cost per texel: the level's texel count.
   int reference_width = 0;
   // Filtered importance sampling: added to 0.5*log2(Omega_sample / Omega_texel). 0 since the sun is
-  // split off (bake/bright_texels.h): measured on esplanade at 1024 x 512, GGX 0.2, 32 samples,
-  // relative RMS 0.79% / 1.3% / 2.3% for bias 0 / 0.5 / 1.
+  // split off (bake/bright_texels.h). Why 0: measured in docs/tradeoffs.md, "Measured choices in the code".
   double fis_lod_bias = 0.0;
   // Compute only the texels where this CV_8UC1 size x size mask is non-zero (others are 0); empty:
   // every texel. For error estimates on a subset (bench/bake_tradeoff.cpp): a texel's value does not

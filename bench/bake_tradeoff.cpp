@@ -123,7 +123,7 @@ nlohmann::json sweep(const std::vector<std::string>& envs, int size, int probes,
 }
 
 nlohmann::json target(const std::string& env_path, int size, int probes) {
-  // 1024 x 512 as the issue asks (the CC0 maps are 512 x 256: bilinear enlargement, no new detail).
+  // 1024 x 512 as the bake speed target specifies (the CC0 maps are 512 x 256: bilinear enlargement, no new detail).
   const EnvMap env = resample(load_sanitized(env_path), Layout(LayoutKind::LatLong, 1024, 512));
   const auto brdf = parse_brdf(brdfs()[2].second);
   const ViewSet views = ViewSet::named("icosa");

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Multi-lobe maps against one mirror-warped map set at the same number of maps (issue 4, item 3).
+"""Multi-lobe maps against one mirror-warped map set at the same number of maps.
 
 Runs build/release/rsibr_multi_lobe (bench/multi_lobe.cpp) for the clear-coat BRDF under CC0
 environments and writes the section "Multi-lobe maps (clear coat)" of docs/tradeoffs.md: for each

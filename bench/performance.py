@@ -29,7 +29,7 @@ PAIRS = {
 }
 # Section titles where the family name alone does not say it.
 TITLES = {"BM_Render": "Rendering (the bunny, 1280x720, 12-view 256^2 map set, turntable frames)",
-          "BM_OpenCvBlend": "Blend baseline (issue 4's OpenCV blend against three bare remaps)",
+          "BM_OpenCvBlend": "Blend baseline (the OpenCV per-frame blend against three bare remaps)",
           "BM_BlendEngine": "Blend engine (512^2 and 256^2 maps from three sources)",
           "BM_SynthBracket": "Synthetic capture (one view, 2000x1500, OPENCV8, 4 samples per pixel, 7 brackets, PNG)"}
 
@@ -130,7 +130,7 @@ def main():
         "shrinking) and extra taps where a sun holds energy, so its cost buys accuracy (docs/tradeoffs.md).",
         "Point location finds the triangle and its weights; the baseline only finds one view.",
         "A blend warps three sources per texel (rotation, g^-1, singularity fade, bilinear taps that skip",
-        "texels outside the disc) and normalises per texel. Its baseline (issue 4) does the same from OpenCV",
+        "texels outside the disc) and normalises per texel. Its baseline does the same from OpenCV",
         "parts per frame: the exact warp's coordinate maps and fade weights (rows in parallel), cv::remap of",
         "each source, a weighted sum and a per-texel division (no tap dropping at the rim, no fallback).",
         "Blend cases: size / warp (0 exact, 1 precomputed, 2 tessellated) / path (0 the blend engine, built once",

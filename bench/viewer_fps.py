@@ -83,7 +83,7 @@ def main():
         "shader locates, warps, fades, samples and normalises three sources for every covered pixel; paper "
         "mode blends one destination map on the CPU and the shader reads it by normal. With llvmpipe every "
         "fragment runs on the same CPU cores as the CPU renderer, so this measures software rasterisation "
-        "against Embree ray casting. No GPU figure: this machine has no display GPU (the issue's >= 60 frames/s "
+        "against Embree ray casting. No GPU figure: this machine has no display GPU (the >= 60 frames/s "
         "target on a GPU is not measured here).",
         "",
     ]

@@ -1,5 +1,5 @@
 // Extraction: one view's linear (HDR) image + its lens model + the ball's cone (calib/ball_cone.h)
-// -> an ideal sphere map of the ball in that view's frame (core/sphere_map.h, DESIGN.md), with a
+// -> an ideal sphere map of the ball in that view's frame (core/sphere_map.h, docs/conventions.md), with a
 // confidence channel: a captured map view (core/map_set.h) in the same format as computed ones.
 //
 // View frame: z from the ball centre toward the camera centre (-axis in the camera frame), y up as
@@ -12,7 +12,7 @@
 //   orthographic   n = g_normal(p): the point whose normal is the texel's. Exact for a Lambertian
 //                  (grey) ball, whose radiance depends on the normal only. For a mirror it shows the
 //                  reflection of the camera ray w = -P/|P| instead of the viewer at infinity, off by
-//                  up to asin(R / D) (the perspective error of DESIGN.md).
+//                  up to asin(R / D) (the perspective error: a sphere map is orthographic, a photograph is not).
 //   reflection     n such that the camera ray to P reflects into the texel's mirror direction
 //                  r = g_mirror(p): n = (w(n) + r) / |w(n) + r|, Alhazen's problem, solved per
 //                  texel by a guarded Newton iteration on the tangent plane (start: the orthographic

@@ -13,8 +13,8 @@
 //             outline's error (up to 2 px of radius, which distorts the faces) cancels.
 //   minimise  sum_i (g L_B(m_i + t) + b + c . x_i - T_i)^2   over the shift t (texels), gain g, bias
 //             b and ramp c (log luminance: exposure, and the mirror's Fresnel, which grows toward
-//             the rim: without the ramp a shift took up its gradient, and 12 views around a ball
-//             drifted by 0.02 degrees, chi2 6.8)
+//             the rim: without the ramp a shift took up its gradient and the views drifted around
+//             the ball; measured in docs/tradeoffs.md, "Measured choices in the code")
 //
 // by Gauss-Newton from B's own keypoint; B's observation becomes m_0 + t, turned into its pixel,
 // ray and direction through the ball (calib/ball_cube_features.h ball_pixel_of). The reference keeps

@@ -37,9 +37,8 @@ namespace rsibr {
 // Where features are detected: `cube` resamples the world reflected in the ball onto gnomonic cube
 // faces first (calib/ball_cube_features.h; matches across wide baselines, and its tracks are
 // re-located by patch alignment, calib/track_refinement.h), `image` runs SIFT on the ball's image
-// directly (calib/ball_features.h; views < ~20-30 degrees apart only). Measured (docs/tradeoffs.md
-// "Orientation"): `cube` finds 1.2-14x the tracks and the lower error in all 9 two-view cases
-// (3 environments x 20, 60, 90 degrees apart).
+// directly (calib/ball_features.h; views < ~20-30 degrees apart only). Why `cube` is the default:
+// measured in docs/tradeoffs.md, "Orientation".
 enum class FeatureDomain { cube, image };
 
 struct ViewOrientationOptions {
@@ -56,8 +55,7 @@ struct ViewOrientationOptions {
   std::vector<Mat3> known_world_from_cam;
   // Denser than BallFeatureOptions' defaults: weaker SIFT features (contrast 0.01) and out to 0.95 of
   // the ball's angular radius. The rim's features are what separates a ball-centre error from a
-  // rotation; on rendered views (bench/orientation_accuracy) this halves the mean error (0.96 -> 0.53
-  // degrees, 120-px ball, 3 seeds) with ~2.5x the tracks.
+  // rotation. Why these settings: measured in docs/tradeoffs.md, "Measured choices in the code".
   BallFeatureOptions features = {800, 0.3, 0.95, 25, 0.01};
   FeatureDomain domain = FeatureDomain::cube;
   CubeFeatureOptions cube;
@@ -70,9 +68,8 @@ struct ViewOrientationOptions {
   double ball_prior_px = 0.25;
   double ball_radius_prior_px = 2;
   // Cube domain: after a first solve, every track re-located by patch alignment against its
-  // sharpest observation (calib/track_refinement.h), then solved again. On 12 rendered views
-  // around a 400-px ball (1% noise) the median error falls from ~0.05 to ~0.008 degrees, the
-  // centres' from 0.075 to 0.017 px; the second solve and the alignments add ~5% to the time.
+  // sharpest observation (calib/track_refinement.h), then solved again. Why on by default: measured
+  // in docs/tradeoffs.md, "Orientation" and "Measured choices in the code".
   bool refine_tracks = true;
   TrackRefinementOptions tracks;
   OrientationOptions solve;            // its first_world_from_cam is set from the gauge

@@ -1,5 +1,5 @@
 // The true sphere map of one ball seen from one camera (the truth that extraction is tested
-// against), in the view frame of DESIGN.md: v = unit vector from the ball centre toward the camera
+// against), in the view frame of docs/conventions.md: v = unit vector from the ball centre toward the camera
 // centre, world_from_view = world_from_view_for(v) (core/vec.h). Texel p (centre inside the disc):
 //   chrome   F(n.v) * L_env(2 (n.v) n - v),  n = world_from_view * g_normal(p)   (a perfect mirror
 //            with the ball's Fresnel; the environment sampled bilinearly as the renderer does)

@@ -1,4 +1,4 @@
-// Sphere-map coordinates of the paper (seeds/001), as fixed in DESIGN.md / docs/conventions.md.
+// Sphere-map coordinates of the paper, as fixed in docs/conventions.md.
 //
 // (s,t) in [0,1]^2, s to the right, t up. Texel (column c, row r, row 0 at the top) of a W x H
 // map has its centre at s = (c+0.5)/W, t = 1 - (r+0.5)/H. With x = 2s-1, y = 2t-1 (the "disc"

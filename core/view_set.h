@@ -1,4 +1,4 @@
-// View sets: the unit view directions of a map set and their triangulation (DESIGN.md, "View sets").
+// View sets: the unit view directions of a map set and their triangulation (docs/conventions.md, "View sets").
 //
 // Any set is triangulated by the convex hull of its unit view vectors (qhull), recomputed
 // deterministically from the vectors alone. A hull face whose plane has the origin strictly on its
@@ -31,8 +31,8 @@ enum class Barycentric {
   // The paper's: w_a : w_b : w_c = Omega(p,b,c) : Omega(a,p,c) : Omega(a,b,p), the solid angles of
   // the sub-triangles (computed with the stable atan2 formula, not the paper's acos dihedral
   // angles). Equals the areal definition exactly, but jumps across edges shared by triangles of
-  // different shape (measured in tests/core/view_set_test.cpp: max 4e-5 on the 42 set, whose
-  // triangles are nearly congruent, but 0.11 on a random 30-view set).
+  // different shape: slightly where neighbours are nearly congruent, much more on arbitrary sets
+  // (how much: docs/conventions.md, "Barycentric weights").
   SolidAngle,
 };
 

@@ -23,11 +23,9 @@
 //      0 only at the singular direction itself (mirror) or on/behind the silhouette (normal).
 //      Why rho: a source's radial resolution there is proportional to rho (d theta/d radius = 2/rho for
 //      the mirror warp, 1/rho for the normal warp), so the fade trusts each source as far as it resolves
-//      the direction. Choice of width (tests/runtime/blend_test.cpp, DISABLED_FadeWidthSweep, 128^2,
-//      8 random views, icosahedron): view-independent max error 1.2e-1 / 6.1e-2 / 3.5e-2 / 1.8e-2 for
-//      rim_fade 0 (no fade) / 0.25 / 0.4 / 1.0 (mirror set), while a Fresnel mirror set's RMS error
-//      grows slightly with the width (4.8e-2 / 5.0e-2 / 5.4e-2 / 5.9e-2: the fade biases the
-//      barycentric interpolation of view-dependent values toward sources seeing the texel head-on).
+//      the direction. A wider fade removes more of the stretched rim but biases the barycentric
+//      interpolation of view-dependent values toward sources seeing the texel head-on; the default
+//      balances the two (measured in docs/tradeoffs.md, "Measured choices in the code").
 //   4. out(p) = sum_i a_i L_i(p) / sum_i a_i (normalised PER TEXEL), weight(p) = sum_i a_i in [0, 1].
 //      L_i(p) is bilinear in the source map; taps whose centres lie outside the source disc are dropped
 //      and the rest renormalised.

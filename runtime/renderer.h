@@ -1,9 +1,9 @@
-// Rendering meshes with map sets (issue 4, item 4): every pixel shows the radiance a map set gives
+// Rendering meshes with map sets: every pixel shows the radiance a map set gives
 // for the visible surface's normal and the direction to the eye.
 //
 // Semantics. A map for view v (world, toward the viewer) with frame T = world_from_view holds at
 // texel p the radiance leaving a surface with normal n = T g_normal(p) toward a viewer at infinity
-// along v (seeds/README.md). A pixel sample is a primary ray through the camera (core/camera.h, mrcal
+// along v (docs/conventions.md). A pixel sample is a primary ray through the camera (core/camera.h, mrcal
 // pixel convention: (0,0) is the centre of the top-left pixel) traced against the mesh with Embree
 // (core/ray_scene.h, both faces). At a hit, n is the interpolated shading normal, flipped when the
 // hit triangle's geometric normal faces away from the eye (meshes are two-sided), and v_px = -ray
@@ -53,8 +53,8 @@ RenderMode render_mode_from_string(const std::string& name);
 const char* to_string(RenderMode mode);
 
 struct RenderOptions {
-  // Per-pixel by default: exact (no field-of-view error, no second resampling) at 1.2-1.4x paper
-  // mode's time on the bunny (bench/render_bench.cpp; both well above 20 frames/s at 1280x720).
+  // Per-pixel by default: exact (no field-of-view error, no second resampling) at a small cost over
+  // paper mode. Why per-pixel: measured in docs/tradeoffs.md, "Measured choices in the code".
   RenderMode mode = RenderMode::PerPixel;
   // Paper mode: the destination map is map_size x map_size (0: the first map set's width), blended
   // with this warp (runtime/make_warp.h: "exact", "precomputed", "tessellated" with `rings` rings and

@@ -1,4 +1,4 @@
-// Sphere-map coordinates (DESIGN.md conventions, seeds/README.md pitfalls).
+// Sphere-map coordinates (docs/conventions.md), including the paper's misprinted g_mirror^-1 (squared divisor).
 #include "core/sphere_map.h"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // Property tests for view sets: triangulation, point location, spherical barycentric weights,
-// sets that do not surround the sphere, degenerate sets and parsing (DESIGN.md, "View sets").
+// sets that do not surround the sphere, degenerate sets and parsing (docs/conventions.md, "View sets").
 #include "core/view_set.h"
 
 #include "core/spherical_triangle.h"
