@@ -28,7 +28,7 @@ class BlinnPhongBrdf final : public Brdf {
   // Midpoint rule over the sampler's unit square (256^2 points): error <= 4e-4, worst at grazing
   // wo where cos_i / max(cos_o, cos_i) ramps within a thin band (measured in brdf_test.cpp).
   Vec3 albedo(const Vec3& wo) const override;
-  Lobe central_direction() const override { return Lobe::Mirror; }
+  CentralDirection central_direction() const override { return CentralDirection::Mirror; }
   // At normal incidence wi is at 2 theta_h from r = n; energy within theta_h of n:
   // 1 - cos^(e+1) theta_h = 0.9  =>  width = 2 acos(0.1^(1/(e+1))).
   double lobe_width(const Vec3& wo) const override;

@@ -13,6 +13,7 @@
 // For wo on or below the horizon every sample is invalid (wi = 0, pdf = 0) and pdf() is 0.
 #pragma once
 
+#include "core/central_direction.h"
 #include "core/vec.h"
 
 #include <string>
@@ -21,7 +22,6 @@ namespace rsibr {
 
 // The direction a lobe follows when the view changes: the runtime warps maps of Normal-lobe
 // BRDFs with the normal warp and of Mirror-lobe BRDFs with the mirror warp.
-enum class Lobe { Normal, Mirror };
 
 struct BrdfSample {
   Vec3 wi = Vec3::Zero();      // proposed direction (unit), possibly below the horizon; 0 if none
@@ -57,7 +57,7 @@ class Brdf {
   // Closed form where exact, otherwise a deterministic quadrature (accuracy stated per class).
   virtual Vec3 albedo(const Vec3& wo) const = 0;
 
-  virtual Lobe central_direction() const = 0;
+  virtual CentralDirection central_direction() const = 0;
 
   // Angular width of the lobe, radians: the half-angle of the cone about the lobe's central
   // direction (n for Normal lobes, the mirror direction of wo for Mirror lobes) that holds 90% of
@@ -78,13 +78,13 @@ class Brdf {
   // Defaults: the whole BRDF is its central_direction() part and the other part is empty.
   // has_lobe(part) is false when the part is identically zero (then eval_lobe and albedo_lobe
   // return 0 and lobe_width_of is meaningless).
-  virtual bool has_lobe(Lobe part) const { return part == central_direction(); }
-  virtual Vec3 eval_lobe(Lobe part, const Vec3& wo, const Vec3& wi) const {
+  virtual bool has_lobe(CentralDirection part) const { return part == central_direction(); }
+  virtual Vec3 eval_lobe(CentralDirection part, const Vec3& wo, const Vec3& wi) const {
     return has_lobe(part) ? eval(wo, wi) : Vec3::Zero();
   }
-  virtual Vec3 albedo_lobe(Lobe part, const Vec3& wo) const { return has_lobe(part) ? albedo(wo) : Vec3::Zero(); }
+  virtual Vec3 albedo_lobe(CentralDirection part, const Vec3& wo) const { return has_lobe(part) ? albedo(wo) : Vec3::Zero(); }
   // lobe_width() of the part alone, about the part's own central direction.
-  virtual double lobe_width_of(Lobe part, const Vec3& wo) const {
+  virtual double lobe_width_of(CentralDirection part, const Vec3& wo) const {
     (void)part;
     return lobe_width(wo);
   }

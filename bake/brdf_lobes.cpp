@@ -6,15 +6,7 @@
 
 namespace rsibr {
 
-const char* to_string(Lobe lobe) { return lobe == Lobe::Normal ? "normal" : "mirror"; }
-
-Lobe lobe_from_string(const std::string& name) {
-  if (name == "normal") return Lobe::Normal;
-  if (name == "mirror") return Lobe::Mirror;
-  throw std::invalid_argument("unknown lobe '" + name + "' (expected normal or mirror)");
-}
-
-BrdfLobe::BrdfLobe(std::shared_ptr<const Brdf> parent, Lobe part) : parent_(std::move(parent)), part_(part) {
+BrdfLobe::BrdfLobe(std::shared_ptr<const Brdf> parent, CentralDirection part) : parent_(std::move(parent)), part_(part) {
   if (!parent_) throw std::invalid_argument("lobe: the parent BRDF is missing");
   if (!parent_->has_lobe(part_))
     throw std::invalid_argument(std::string("lobe: the BRDF has no ") + to_string(part_) + " lobe: " + parent_->spec());
@@ -46,7 +38,7 @@ std::string BrdfLobe::spec() const {
 std::vector<std::shared_ptr<const Brdf>> split_lobes(const std::shared_ptr<const Brdf>& brdf) {
   if (!brdf) throw std::invalid_argument("split_lobes: the BRDF is missing");
   std::vector<std::shared_ptr<const Brdf>> parts;
-  for (const Lobe part : {Lobe::Normal, Lobe::Mirror})
+  for (const CentralDirection part : {CentralDirection::Normal, CentralDirection::Mirror})
     if (brdf->has_lobe(part)) parts.push_back(std::make_shared<BrdfLobe>(brdf, part));
   return parts;
 }

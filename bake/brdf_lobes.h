@@ -1,4 +1,4 @@
-// Multi-lobe maps (the paper's future work; issue 4, item 3): a BRDF split into a Normal-centred
+// Multi-lobe maps (the paper's future work): a BRDF split into a Normal-centred
 // and a Mirror-centred part, each a Brdf of its own, so that each can be baked as its own map set
 // (MapView::warp from the part's central direction) and the runtime sums the two warped blends
 // (runtime/renderer.h sums map sets). The split itself is the BRDF's (Brdf::eval_lobe and friends,
@@ -21,16 +21,12 @@
 
 namespace rsibr {
 
-// "normal" / "mirror" (the spelling of MapView::warp and of lobe specs).
-const char* to_string(Lobe lobe);
-// Throws std::invalid_argument for anything but "normal" and "mirror".
-Lobe lobe_from_string(const std::string& name);
 
 // One part of a BRDF. Spec: {type: lobe, part: normal|mirror, of: <the parent's spec>}.
 class BrdfLobe final : public Brdf {
  public:
   // Throws std::invalid_argument when parent is null or has no such part (!has_lobe(part)).
-  BrdfLobe(std::shared_ptr<const Brdf> parent, Lobe part);
+  BrdfLobe(std::shared_ptr<const Brdf> parent, CentralDirection part);
 
   // parent.eval_lobe(part, wo, wi): cosine included, 0 below the horizon.
   Vec3 eval(const Vec3& wo, const Vec3& wi) const override;
@@ -40,17 +36,17 @@ class BrdfLobe final : public Brdf {
   Vec3 eval_pdf(const Vec3& wo, const Vec3& wi, double* pdf_out) const override;
   // parent.albedo_lobe(part, wo) (the parent's accuracy).
   Vec3 albedo(const Vec3& wo) const override;
-  Lobe central_direction() const override { return part_; }
+  CentralDirection central_direction() const override { return part_; }
   // parent.lobe_width_of(part, wo).
   double lobe_width(const Vec3& wo) const override;
   std::string spec() const override;
 
   const Brdf& parent() const { return *parent_; }
-  Lobe part() const { return part_; }
+  CentralDirection part() const { return part_; }
 
  private:
   std::shared_ptr<const Brdf> parent_;
-  Lobe part_;
+  CentralDirection part_;
 };
 
 // The non-empty parts of brdf (has_lobe), Normal first, then Mirror. Their evals sum to brdf's.

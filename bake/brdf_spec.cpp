@@ -70,8 +70,8 @@ std::unique_ptr<Brdf> make_brdf(const YAML::Node& spec, const std::string& path)
     const std::string part = m.string("part");
     if (part != "normal" && part != "mirror") fail(m.at("part"), "expected normal or mirror, got '" + part + "'");
     std::shared_ptr<const Brdf> parent = make_brdf(m.get("of"), m.at("of"));
-    if (!parent->has_lobe(lobe_from_string(part))) fail(m.at("part"), "the BRDF in 'of' has no " + part + " lobe");
-    return std::make_unique<BrdfLobe>(std::move(parent), lobe_from_string(part));
+    if (!parent->has_lobe(central_direction_from_string(part))) fail(m.at("part"), "the BRDF in 'of' has no " + part + " lobe");
+    return std::make_unique<BrdfLobe>(std::move(parent), central_direction_from_string(part));
   }
   if (type == "lambert") {
     MapSpec m(spec, path, {"type", "albedo"});

@@ -91,29 +91,29 @@ double ClearCoatBrdf::pdf(const Vec3& wo, const Vec3& wi) const {
 }
 
 Vec3 ClearCoatBrdf::albedo(const Vec3& wo) const {
-  return albedo_lobe(Lobe::Mirror, wo) + albedo_lobe(Lobe::Normal, wo);
+  return albedo_lobe(CentralDirection::Mirror, wo) + albedo_lobe(CentralDirection::Normal, wo);
 }
 
-bool ClearCoatBrdf::has_lobe(Lobe part) const {
-  if (part == Lobe::Mirror) return true;  // the coat (ior > 1) always reflects
+bool ClearCoatBrdf::has_lobe(CentralDirection part) const {
+  if (part == CentralDirection::Mirror) return true;  // the coat (ior > 1) always reflects
   return p_.flake_coverage < 1.0 && p_.base_albedo.maxCoeff() > 0.0;
 }
 
-Vec3 ClearCoatBrdf::eval_lobe(Lobe part, const Vec3& wo, const Vec3& wi) const {
+Vec3 ClearCoatBrdf::eval_lobe(CentralDirection part, const Vec3& wo, const Vec3& wi) const {
   if (!(wo.z() > 0 && wi.z() > 0)) return Vec3::Zero();
   const double c = p_.flake_coverage;
   const double tt = transmittance(wo.z()) * transmittance(wi.z());
-  if (part == Lobe::Normal) return tt * ((1.0 - c) * p_.base_albedo * (wi.z() / kPi));
+  if (part == CentralDirection::Normal) return tt * ((1.0 - c) * p_.base_albedo * (wi.z() / kPi));
   Vec3 f = coat_.eval(wo, wi);
   if (c > 0) f += tt * (c * flakes_.eval(wo, wi));
   return f;
 }
 
-Vec3 ClearCoatBrdf::albedo_lobe(Lobe part, const Vec3& wo) const {
+Vec3 ClearCoatBrdf::albedo_lobe(CentralDirection part, const Vec3& wo) const {
   if (!(wo.z() > 0)) return Vec3::Zero();
   const double t_o = transmittance(wo.z());
   const double c = p_.flake_coverage;
-  if (part == Lobe::Normal) return (t_o * (1.0 - c) * mean_transmittance_) * p_.base_albedo;
+  if (part == CentralDirection::Normal) return (t_o * (1.0 - c) * mean_transmittance_) * p_.base_albedo;
   Vec3 a = coat_.albedo(wo);
   if (c > 0) {
     a += (t_o * c) * warp::square_graded_mean(256, [&](const Vec2& u) -> Vec3 {
@@ -124,8 +124,8 @@ Vec3 ClearCoatBrdf::albedo_lobe(Lobe part, const Vec3& wo) const {
   return a;
 }
 
-double ClearCoatBrdf::lobe_width_of(Lobe part, const Vec3& wo) const {
-  if (part == Lobe::Normal) return std::asin(std::sqrt(kLobeEnergyFraction));
+double ClearCoatBrdf::lobe_width_of(CentralDirection part, const Vec3& wo) const {
+  if (part == CentralDirection::Normal) return std::asin(std::sqrt(kLobeEnergyFraction));
   // lobe_width()'s rule over coat and flakes: the narrowest carrying >= 1% of the part's estimate.
   const auto e = albedo_estimates(wo.z() > 0 ? wo : Vec3(0, 0, 1));
   const double sum = e[0] + e[1];

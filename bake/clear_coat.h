@@ -52,7 +52,7 @@ class ClearCoatBrdf final : public Brdf {
   // Coat: GgxBrdf::albedo; flakes: graded midpoint rule of T(wi) times the flake sample weights;
   // binder: rho (1-c) T(wo) <T>, <T> the cosine-weighted mean of T (tabulated at construction).
   Vec3 albedo(const Vec3& wo) const override;
-  Lobe central_direction() const override { return Lobe::Mirror; }
+  CentralDirection central_direction() const override { return CentralDirection::Mirror; }
   // The width (GgxBrdf / LambertBrdf measures) of the narrowest lobe that carries at least 1% of
   // the estimated albedo at wo: the coat's highlight usually, which sets the map resolution.
   double lobe_width(const Vec3& wo) const override;
@@ -63,13 +63,13 @@ class ClearCoatBrdf final : public Brdf {
   //   Normal part = T(wo) T(wi) (1 - c) rho / pi            (the binder, centred on n)
   // times cos theta_i, as eval. The Normal part exists when (1 - c) rho is not zero. albedo() is
   // the sum of the two parts' albedos; each part's width is lobe_width()'s rule over its own terms.
-  bool has_lobe(Lobe part) const override;
-  Vec3 eval_lobe(Lobe part, const Vec3& wo, const Vec3& wi) const override;
-  Vec3 albedo_lobe(Lobe part, const Vec3& wo) const override;
-  double lobe_width_of(Lobe part, const Vec3& wo) const override;
+  bool has_lobe(CentralDirection part) const override;
+  Vec3 eval_lobe(CentralDirection part, const Vec3& wo, const Vec3& wi) const override;
+  Vec3 albedo_lobe(CentralDirection part, const Vec3& wo) const override;
+  double lobe_width_of(CentralDirection part, const Vec3& wo) const override;
 
   const ClearCoatParams& params() const { return p_; }
-  // Lobe selection probabilities at wo: coat, flakes, binder (sum to 1).
+  // CentralDirection selection probabilities at wo: coat, flakes, binder (sum to 1).
   std::array<double, 3> lobe_probabilities(const Vec3& wo) const;
 
  private:

@@ -35,7 +35,7 @@ class GgxBrdf final : public Brdf {
   // horizon; tests/bake/brdf_test.cpp measures its error against an independent hemisphere
   // quadrature of eval.
   Vec3 albedo(const Vec3& wo) const override;
-  Lobe central_direction() const override { return Lobe::Mirror; }
+  CentralDirection central_direction() const override { return CentralDirection::Mirror; }
   // At normal incidence the reflected energy within theta_h of n is (ignoring G and F) the CDF
   // of D(m) m.z:  tan^2 / (a^2 + tan^2) = 0.9  =>  tan theta_h = 3 a; wi is at 2 theta_h from r:
   // width = 2 atan(3 alpha).

@@ -17,7 +17,7 @@ class LambertBrdf final : public Brdf {
   double pdf(const Vec3& wo, const Vec3& wi) const override;
   // Exactly rho for every wo above the horizon (0 below).
   Vec3 albedo(const Vec3& wo) const override;
-  Lobe central_direction() const override { return Lobe::Normal; }
+  CentralDirection central_direction() const override { return CentralDirection::Normal; }
   // Energy within theta of n: int_0^theta 2 cos sin dtheta = sin^2 theta  =>  asin(sqrt(0.9)),
   // exact for every wo (about 71.6 degrees).
   double lobe_width(const Vec3& wo) const override;

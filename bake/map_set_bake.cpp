@@ -31,7 +31,6 @@ MapSet computed_map_set(const Brdf& brdf, const Integrator& integrator, const Vi
                                 std::to_string(views.views().size()) + " views");
   const std::string method = integrator.name();
   const std::vector<float> albedo = options.normalise_albedo ? albedo_table(brdf) : std::vector<float>{};
-  const std::string warp = brdf.central_direction() == Lobe::Normal ? "normal" : "mirror";
   const bool stochastic = method == "mis" || method == "fis";
   const IntegratorOptions& io = options.integrator;
   MapSet set;
@@ -42,8 +41,8 @@ MapSet computed_map_set(const Brdf& brdf, const Integrator& integrator, const Vi
     MapView mv;
     mv.view = v;
     mv.world_from_view = world_from_view_for(v);
-    mv.warp = warp;
-    mv.source = "computed";
+    mv.warp = brdf.central_direction();
+    mv.source = MapSource::Computed;
     mv.material = brdf.spec();
     mv.attributes["version"] = RSIBR_VERSION;
     if (!options.environment_name.empty()) mv.attributes["environment"] = options.environment_name;

@@ -24,7 +24,7 @@ class PhongBrdf final : public Brdf {
   double pdf(const Vec3& wo, const Vec3& wi) const override;
   // One-dimensional quadrature (4096 points) of the closed-form azimuthal integral.
   Vec3 albedo(const Vec3& wo) const override;
-  Lobe central_direction() const override { return Lobe::Mirror; }
+  CentralDirection central_direction() const override { return CentralDirection::Mirror; }
   // At normal incidence theta_i = alpha, so the energy within alpha of r = n is
   // int_0^alpha cos^(e+1) sin / int_0^pi/2 (same) = 1 - cos^(e+2) alpha = 0.9
   //   =>  alpha = acos(0.1^(1/(e+2)))   (exact there; wo-independent measure elsewhere).

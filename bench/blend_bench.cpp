@@ -1,6 +1,6 @@
 // Reflection-space blend of a destination map (runtime/blend.h), per frame, against two OpenCV
 // baselines measured in the same run:
-//   BM_OpenCvBlend (issue 4's baseline): per frame, compute the three coordinate maps (map_x, map_y,
+//   BM_OpenCvBlend (the OpenCV blend baseline): per frame, compute the three coordinate maps (map_x, map_y,
 //     CV_32FC1) with the exact warp (runtime/warp.h, every destination texel inside the disc, rows in
 //     parallel), cv::remap (INTER_LINEAR) each source, and sum with per-texel weights (barycentric
 //     weight x rim fade), normalised per texel. No tap dropping at the source rim, no fallback.
@@ -77,7 +77,7 @@ void BM_OpenCvBlend(benchmark::State& state) {
     for (int k = 0; k < located.count; ++k) {
       const MapView& v = set.views[std::size_t(located.views[std::size_t(k)])];
       const Mat3 M = v.world_from_view.transpose() * T_d;
-      const WarpKind kind = warp_kind_from_string(v.warp);
+      const CentralDirection kind = v.warp;
       const double w = located.weights[std::size_t(k)];
       map_x[k].create(n, n, CV_32FC1);
       map_y[k].create(n, n, CV_32FC1);

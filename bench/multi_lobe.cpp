@@ -1,6 +1,5 @@
-// Multi-lobe maps against one mirror-warped map set at the same number of maps (issue 4, item 3;
-// bake/brdf_lobes.h). For one BRDF (default: the clear coat of docs/tradeoffs.md) and each
-// environment:
+// Multi-lobe maps against one mirror-warped map set at the same number of maps (bake/brdf_lobes.h).
+// For one BRDF (default: the clear coat of docs/tradeoffs.md) and each environment:
 //   truth   the whole BRDF baked directly (MIS, --truth-samples) at --novel view directions that are
 //           in no view set (and twice with another seed: the truth's own noise)
 //   single  "A":   the whole BRDF baked at view set A, mirror warp (today's rsibr bake)
@@ -90,7 +89,7 @@ int run(int argc, char** argv) {
   const std::shared_ptr<const Brdf> brdf = parse_brdf(brdf_text);
   const auto parts = split_lobes(brdf);
   std::shared_ptr<const Brdf> normal_part, mirror_part;
-  for (const auto& p : parts) (p->central_direction() == Lobe::Normal ? normal_part : mirror_part) = p;
+  for (const auto& p : parts) (p->central_direction() == CentralDirection::Normal ? normal_part : mirror_part) = p;
   const cv::Mat disc = disc_mask(res);
   // The inner disc: normals within 60 degrees of the view (radius sin 60), away from the grazing rim
   // where the coat's Fresnel reflectance rises toward 1 and dominates the whole disc's error.
@@ -166,7 +165,7 @@ int run(int argc, char** argv) {
         MapView mv;
         mv.view = v;
         mv.world_from_view = world_from_view_for(v);
-        mv.warp = to_string(b.central_direction());
+        mv.warp = b.central_direction();
         mv.material = b.spec();
         mv.rgb = bake(b, v, samples, 7);
         if (normalised) {

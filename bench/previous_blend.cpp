@@ -27,14 +27,14 @@ namespace rsibr::previous {
 namespace {
 
 RSIBR_AVX2_CLONES void central_directions_row(
-    WarpKind kind, int width, int height, int row, int c_begin, int c_end, double* __restrict out_x,
+    CentralDirection kind, int width, int height, int row, int c_begin, int c_end, double* __restrict out_x,
     double* __restrict out_y, double* __restrict out_z) {
   const double y = 1.0 - (2.0 * row + 1.0) / height;
   const int n = c_end - c_begin;
   for (int i = 0; i < n; ++i) {
     const double x = (2.0 * (c_begin + i) + 1.0) / width - 1.0;
     const double z = std::sqrt(std::max(0.0, 1.0 - (x * x + y * y)));  // g_normal inside the disc
-    if (kind == WarpKind::Mirror) {
+    if (kind == CentralDirection::Mirror) {
       out_x[i] = 2 * x * z;
       out_y[i] = 2 * y * z;
       out_z[i] = 2 * z * z - 1.0;
@@ -49,11 +49,11 @@ RSIBR_AVX2_CLONES void central_directions_row(
 // Branch-free forms of mirror_inverse / normal_inverse (selects, not jumps, so the loops vectorise).
 // Also built for AVX2 (4 doubles a vector; chosen at load time where the CPU has it). No FMA: the
 // results are the same to the bit on either path.
-RSIBR_AVX2_CLONES void warp_directions(WarpKind kind, const double m[9], int n, const double* __restrict x,
+RSIBR_AVX2_CLONES void warp_directions(CentralDirection kind, const double m[9], int n, const double* __restrict x,
                                        const double* __restrict y, const double* __restrict z,
                                        double* __restrict disc_x, double* __restrict disc_y, double* __restrict rim) {
   const double m0 = m[0], m1 = m[1], m2 = m[2], m3 = m[3], m4 = m[4], m5 = m[5], m6 = m[6], m7 = m[7], m8 = m[8];
-  if (kind == WarpKind::Mirror) {
+  if (kind == CentralDirection::Mirror) {
     for (int i = 0; i < n; ++i) {
       const double rx = m0 * x[i] + m1 * y[i] + m2 * z[i];
       const double ry = m3 * x[i] + m4 * y[i] + m5 * z[i];
@@ -92,7 +92,7 @@ RSIBR_AVX2_CLONES void warp_directions(WarpKind kind, const double m[9], int n, 
 
 // One located source, ready to sample.
 struct Source : DiscMap {
-  WarpKind kind = WarpKind::Mirror;
+  CentralDirection kind = CentralDirection::Mirror;
   Mat3 source_from_dest = Mat3::Identity();
   double weight = 0;  // barycentric
 };
@@ -345,7 +345,7 @@ BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_
     s.confidence = options.use_confidence && !v.confidence.empty() ? &v.confidence : nullptr;
     s.width = v.rgb.cols;
     s.height = v.rgb.rows;
-    s.kind = warp_kind_from_string(v.warp);
+    s.kind = v.warp;
     s.source_from_dest = v.world_from_view.transpose() * T_d;
     s.weight = located.weights[std::size_t(k)];
   }
@@ -376,7 +376,7 @@ BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_
     if (fused)
       for (int kind = 0; kind < 2; ++kind)
         if (kinds[kind])
-          central_directions_row(WarpKind(kind), W, H, r, c0, c1, s.dir[kind][0], s.dir[kind][1], s.dir[kind][2]);
+          central_directions_row(CentralDirection(kind), W, H, r, c0, c1, s.dir[kind][0], s.dir[kind][1], s.dir[kind][2]);
     int active[3], m = 0;
     for (int k = 0; k < n; ++k) {
       const Source& src = sources[k];

@@ -1,4 +1,4 @@
-// Measured accuracy of the runtime (issue 4, items 5 and 6): error against time of the warp-and-blend
+// Measured accuracy of the runtime: error against time of the warp-and-blend
 // for novel views (warp method x view count x map resolution), and of rendering against the reference
 // render (paper mode and per-pixel mode). Writes JSON that bench/runtime_tradeoff.py turns into
 // docs/tradeoffs.md sections and docs/figures/ plots. Not Google Benchmark: each row is a few timed
@@ -146,7 +146,7 @@ struct Baker {
     MapView mv;
     mv.view = v.normalized();
     mv.world_from_view = world_from_view_for(mv.view);
-    mv.warp = brdf.central_direction() == Lobe::Normal ? "normal" : "mirror";
+    mv.warp = brdf.central_direction();
     mv.material = brdf.spec();
     mv.attributes["method"] = method.key();
     IntegratorOptions o;

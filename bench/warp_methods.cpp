@@ -73,7 +73,7 @@ std::vector<Mat3> sources_of(bool ring, int frame, Mat3* dest) {
 
 // One destination map's warps for the given sources, all disc rows, this thread, in the form the
 // blend engine uses (Warp::warp_block: single precision, structure of arrays).
-void warp_map(const Warp& w, WarpKind kind, const std::vector<Mat3>& sources, int n, std::vector<float>& buf) {
+void warp_map(const Warp& w, CentralDirection kind, const std::vector<Mat3>& sources, int n, std::vector<float>& buf) {
   const std::size_t row = std::size_t(n) + 1;
   for (const Mat3& m : sources)
     for (int r = 0; r < n; ++r) {
@@ -95,7 +95,7 @@ MapSet ring_set(int n) {
     MapView v;
     v.view = T.col(2);
     v.world_from_view = T;
-    v.warp = "mirror";
+    v.warp = CentralDirection::Mirror;
     v.rgb = cv::Mat(n, n, CV_32FC3);
     for (int r = 0; r < n; ++r)
       for (int c = 0; c < n; ++c) v.rgb.at<cv::Vec3f>(r, c) = cv::Vec3f(u(rng), u(rng), u(rng));
@@ -112,7 +112,7 @@ int run(const std::vector<int>& sizes, int reps) {
     const Vec3 axis = dest0.transpose() * Vec3(0, 1, 0);
     const std::vector<Method> ms = methods(n, axis);
     for (bool ring : {true, false})
-      for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal})
+      for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal})
         for (const Method& m : ms) {
           Mat3 dest;
           const std::vector<Mat3> src = sources_of(ring, 0, &dest);

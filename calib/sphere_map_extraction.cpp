@@ -99,8 +99,8 @@ MapView extract_sphere_map(const cv::Mat& image, const cv::Mat& flags, const Len
   MapView mv;
   mv.world_from_view = world_from_cam * cam_from_view;
   mv.view = mv.world_from_view.col(2);
-  mv.warp = options.mirror ? "mirror" : "normal";
-  mv.source = "captured";
+  mv.warp = options.mirror ? CentralDirection::Mirror : CentralDirection::Normal;
+  mv.source = MapSource::Captured;
   mv.material = options.material;
   mv.attributes["indexing"] = options.indexing == SphereIndexing::reflection ? "reflection" : "orthographic";
   mv.rgb = cv::Mat(size, size, CV_32FC3, cv::Scalar::all(0));

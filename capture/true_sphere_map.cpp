@@ -15,13 +15,13 @@ MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const 
   MapView mv;
   mv.view = (camera_centre - ball.centre).normalized();
   mv.world_from_view = world_from_view_for(mv.view);
-  mv.source = "computed";
+  mv.source = MapSource::Computed;
   mv.attributes["version"] = RSIBR_VERSION;
   mv.attributes["ball"] = ball.name;
   mv.attributes["kind"] = ball.kind;
   mv.attributes["truth"] = "synthetic capture";
   if (ball.kind == "chrome") {
-    mv.warp = "mirror";
+    mv.warp = CentralDirection::Mirror;
     mv.material = "{type: mirror, fresnel: " + ball.fresnel + "}";
     const auto fresnel = make_fresnel(YAML::Load(ball.fresnel));
     mv.rgb = cv::Mat::zeros(size, size, CV_32FC3);
@@ -42,7 +42,7 @@ MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const 
   } else if (ball.kind == "glossy") {
     const auto brdf = parse_brdf(ball.brdf);
     mv.material = brdf->spec();
-    mv.warp = brdf->central_direction() == Lobe::Normal ? "normal" : "mirror";
+    mv.warp = brdf->central_direction();
     std::unique_ptr<Integrator> own;
     if (!fis) own = make_integrator("fis", env);
     IntegratorOptions options;
@@ -52,7 +52,7 @@ MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const 
     mv.attributes["method"] = "fis";
     mv.attributes["samples"] = "64";
   } else {
-    mv.warp = "normal";
+    mv.warp = CentralDirection::Normal;
     std::ostringstream spec;
     spec.precision(17);
     spec << "{type: lambert, albedo: [" << ball.albedo.x() << ", " << ball.albedo.y() << ", " << ball.albedo.z() << "]}";

@@ -51,7 +51,7 @@ BakeInputs read_bake_inputs(const BakeArgs& a) {
   BakeInputs in{read_environment_input(a.env, a.layout, a.sanitize), load_brdf(a.brdf), ViewSet::named(a.views), {}};
   // --lobe: the whole BRDF, or one part of it (bake/brdf_lobes.h) with its own central direction.
   if (a.lobe != "all") {
-    const Lobe part = lobe_from_string(a.lobe);
+    const CentralDirection part = central_direction_from_string(a.lobe);
     if (!in.brdf->has_lobe(part))
       throw std::invalid_argument(a.brdf + ": --lobe " + a.lobe + ": the BRDF has no " + a.lobe + " lobe");
     in.brdf = std::make_shared<BrdfLobe>(in.brdf, part);
@@ -96,7 +96,7 @@ int run_bake(const BakeArgs& a) {
   bake_options.integrator = options;
   bake_options.normalise_albedo = a.normalise == "albedo";
   bake_options.environment_name = std::filesystem::path(a.env).filename().string();
-  const std::string warp = brdf->central_direction() == Lobe::Normal ? "normal" : "mirror";
+  const std::string warp = to_string(brdf->central_direction());
   const bool stochastic = a.method == "mis" || a.method == "fis";
   Progress bar("bake", session.is_root() && !a.quiet && Progress::stderr_is_terminal());
   cluster::DistributedBakeTimes times;

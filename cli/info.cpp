@@ -159,8 +159,8 @@ int info_map_set(const InfoArgs& a) {
     for (int r = 0; r < 3; ++r) T.push_back({v.world_from_view(r, 0), v.world_from_view(r, 1), v.world_from_view(r, 2)});
     jv["world_from_view"] = T;
     jv["channels"] = v.confidence.empty() ? "R G B" : "R G B confidence";
-    jv["warp"] = v.warp;
-    jv["source"] = v.source;
+    jv["warp"] = to_string(v.warp);
+    jv["source"] = to_string(v.source);
     jv["material"] = v.material;
     jv["confidence"] = !v.confidence.empty();
     jv["albedo_normalised"] = !v.albedo.empty();
@@ -170,8 +170,8 @@ int info_map_set(const InfoArgs& a) {
     std::ostringstream line;
     line << std::fixed << std::setprecision(4) << "  view." << std::setw(3) << std::setfill('0') << i
          << std::setfill(' ') << "  v=(" << v.view.x() << ", " << v.view.y() << ", " << v.view.z() << ")  up=("
-         << v.world_from_view(0, 1) << ", " << v.world_from_view(1, 1) << ", " << v.world_from_view(2, 1) << ")  " << v.warp
-         << "  " << v.source << (v.confidence.empty() ? "" : "  +confidence")
+         << v.world_from_view(0, 1) << ", " << v.world_from_view(1, 1) << ", " << v.world_from_view(2, 1) << ")  " << to_string(v.warp)
+         << "  " << to_string(v.source) << (v.confidence.empty() ? "" : "  +confidence")
          << (v.albedo.empty() ? "" : "  albedo-normalised");
     const std::string first_line = v.material.substr(0, v.material.find('\n'));
     if (!first_line.empty()) line << "  material: " << first_line;

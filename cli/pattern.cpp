@@ -52,8 +52,8 @@ int run_pattern(const PatternArgs& a) {
       MapView mv;
       mv.view = v;
       mv.world_from_view = world_from_view_for(v);
-      mv.warp = "mirror";
-      mv.source = "computed";
+      mv.warp = CentralDirection::Mirror;
+      mv.source = MapSource::Computed;
       mv.material = "type: mirror  # perfect mirror, no Fresnel (rsibr pattern " + a.kind + ")";
       mv.attributes["version"] = RSIBR_VERSION;
       const Mat3 T = mv.world_from_view;

@@ -31,7 +31,7 @@ struct ProbeArgs {
 MapSet read_ball_maps(const std::string& path, const std::string& option) {
   MapSet s = read_map_set(path);
   for (std::size_t v = 0; v < s.views.size(); ++v)
-    if (s.views[v].confidence.empty() || s.views[v].source != "captured" || s.views[v].warp != "normal")
+    if (s.views[v].confidence.empty() || s.views[v].source != MapSource::Captured || s.views[v].warp != CentralDirection::Normal)
       throw std::invalid_argument(path + ": view." + std::to_string(v) + " is not a captured grey or glossy map (" + option + ")");
   return s;
 }
@@ -60,7 +60,7 @@ int run_probe(const ProbeArgs& a) {
     sanitized += zeroed;
     for (std::size_t v = 0; v < s.views.size(); ++v) {
       const MapView& mv = s.views[v];
-      if (mv.confidence.empty() || mv.source != "captured")
+      if (mv.confidence.empty() || mv.source != MapSource::Captured)
         throw std::invalid_argument(path + ": view." + std::to_string(v) + " is not a captured map (no confidence channel)");
       if (!all.views.empty() && (mv.rgb.size() != all.views.front().rgb.size()))
         throw std::invalid_argument(path + ": maps are " + std::to_string(mv.rgb.cols) + "x" + std::to_string(mv.rgb.rows) +

@@ -29,6 +29,15 @@
 #include <stdexcept>
 
 namespace rsibr {
+
+const char* to_string(MapSource source) { return source == MapSource::Captured ? "captured" : "computed"; }
+
+MapSource map_source_from_string(const std::string& name) {
+  if (name == "computed") return MapSource::Computed;
+  if (name == "captured") return MapSource::Captured;
+  throw std::invalid_argument("'" + name + "' is neither computed nor captured");
+}
+
 namespace {
 
 // A sphere map wider than this is a corrupt or hostile header, not a map (rsibr bake --res stops
@@ -69,9 +78,6 @@ void validate(const MapSet& set) {
       throw std::invalid_argument(who + "worldFromView is not a rotation");
     if ((T.col(2) - v.view).norm() > 1e-5)
       throw std::invalid_argument(who + "worldFromView's third column is not the view direction");
-    if (v.warp != "mirror" && v.warp != "normal") throw std::invalid_argument(who + "warp must be 'mirror' or 'normal'");
-    if (v.source != "computed" && v.source != "captured")
-      throw std::invalid_argument(who + "source must be 'computed' or 'captured'");
     if (v.albedo != set.views.front().albedo)
       throw std::invalid_argument(who + "albedo table differs from view.000's (a set shares one BRDF)");
     if (!v.albedo.empty()) {
@@ -110,8 +116,8 @@ void write_map_set(const std::string& path, const MapSet& set) {
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) m[r][c] = float(v.world_from_view(r, c));
     h.insert("rsibr.worldFromView", Imf::M33fAttribute(m));
-    h.insert("rsibr.warp", Imf::StringAttribute(v.warp));
-    h.insert("rsibr.source", Imf::StringAttribute(v.source));
+    h.insert("rsibr.warp", Imf::StringAttribute(to_string(v.warp)));
+    h.insert("rsibr.source", Imf::StringAttribute(to_string(v.source)));
     h.insert("rsibr.material", Imf::StringAttribute(valid_utf8(v.material)));
     if (!v.albedo.empty()) h.insert("rsibr.albedo", Imf::FloatVectorAttribute(v.albedo));
     for (const auto& [key, value] : v.attributes) h.insert("rsibr." + key, Imf::StringAttribute(valid_utf8(value)));
@@ -183,8 +189,16 @@ MapSet read_map_set(const std::string& path, BadTexels bad, long* zeroed) {
       v.view = Vec3(view->value().x, view->value().y, view->value().z);
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) v.world_from_view(r, c) = T->value()[r][c];
-      v.warp = warp->value();
-      v.source = source->value();
+      try {
+        v.warp = central_direction_from_string(warp->value());
+      } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(who + "rsibr.warp: " + e.what());
+      }
+      try {
+        v.source = map_source_from_string(source->value());
+      } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(who + "rsibr.source: " + e.what());
+      }
       if (const auto* m = h.findTypedAttribute<Imf::StringAttribute>("rsibr.material")) v.material = m->value();
       if (const auto* a = h.findTypedAttribute<Imf::FloatVectorAttribute>("rsibr.albedo")) v.albedo = a->value();
       for (auto it = h.begin(); it != h.end(); ++it) {

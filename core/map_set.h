@@ -1,5 +1,5 @@
 // Map sets: radiance environment maps, one sphere map per view, captured or computed alike
-// (DESIGN.md, "File formats"). On disk: one multi-part OpenEXR file, part "view.NNN" per view, with
+// (docs/conventions.md). On disk: one multi-part OpenEXR file, part "view.NNN" per view, with
 //   rsibr.view           V3f   view direction (world, unit, toward the viewer)
 //   rsibr.worldFromView  M33f  the paper's T: columns are the view frame's axes in world
 //                              (stored as Imath m[row][col] = T(row, col))
@@ -16,6 +16,7 @@
 // along v (core/sphere_map.h).
 #pragma once
 
+#include "core/central_direction.h"
 #include "core/view_set.h"
 
 #include <opencv2/core.hpp>
@@ -26,14 +27,19 @@
 
 namespace rsibr {
 
+// Where a map's radiance came from: a bake (computed) or photographs (captured).
+enum class MapSource { Computed, Captured };
+const char* to_string(MapSource source);                    // "computed" / "captured"
+MapSource map_source_from_string(const std::string& name);  // std::invalid_argument for others
+
 struct MapView {
   Vec3 view = Vec3(0, 0, 1);          // world, unit; stored as float on disk
   Mat3 world_from_view = Mat3::Identity();
-  std::string warp = "mirror";        // "mirror" | "normal"
-  std::string source = "computed";    // "computed" | "captured"
+  CentralDirection warp = CentralDirection::Mirror;  // which central direction the runtime warps
+  MapSource source = MapSource::Computed;
   std::string material;
   // Empty, or the albedo table of albedo-normalised maps (core/albedo_normalisation.h): rgb then holds
-  // L / A(n.v) and the runtime (runtime/blend.h, direction_lookup.h) multiplies A back at the destination.
+  // L / A(n.v) and the runtime (runtime/blend_engine.h) multiplies A back at the destination.
   std::vector<float> albedo;
   std::map<std::string, std::string> attributes;  // provenance, written as rsibr.<key>
   cv::Mat rgb;                        // CV_32FC3, RGB order, sphere-map layout (square or not)
@@ -54,7 +60,7 @@ struct MapSet {
 };
 
 // Checks the invariants (non-empty, equal sizes, unit views, world_from_view a rotation whose
-// third column is the view, known warp/source values); throws std::invalid_argument naming the
+// third column is the view); throws std::invalid_argument naming the
 // view and the problem.
 void validate(const MapSet& set);
 

@@ -411,7 +411,7 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
             t.gain = Vec3::Ones();
             t.brdf = brdf;
             t.mirror = 2 * t.n.dot(t.v) * t.n - t.v;
-            if (brdf->central_direction() == Lobe::Mirror) {
+            if (brdf->central_direction() == CentralDirection::Mirror) {
               const Mat3 frame = shading::frame_around(t.n);
               t.lobe = brdf->lobe_width(frame.transpose() * t.v);
             }

@@ -832,8 +832,8 @@ void step_bake(Context& c) {
         MapView mv;
         mv.view = cv.view;
         mv.world_from_view = cv.world_from_view;
-        mv.warp = "normal";
-        mv.source = "computed";
+        mv.warp = CentralDirection::Normal;
+        mv.source = MapSource::Computed;
         mv.material = brdf->spec();
         mv.attributes = {{"version", RSIBR_VERSION}, {"environment", "probe.exr"}, {"method", c.o.bake_method},
                          {"samples", std::to_string(c.o.bake_samples)}, {"seed", std::to_string(c.o.seed)},
@@ -948,13 +948,12 @@ void step_render(Context& c) {
     io.seed = c.o.seed;
     MapSet maps;
     const ViewSet views = ViewSet::named("icosa");
-    const std::string warp = brdf->central_direction() == Lobe::Normal ? "normal" : "mirror";
     for (const Vec3& v : views.views()) {
       MapView mv;
       mv.view = v;
       mv.world_from_view = world_from_view_for(v);
-      mv.warp = warp;
-      mv.source = "computed";
+      mv.warp = brdf->central_direction();
+      mv.source = MapSource::Computed;
       mv.material = brdf->spec();
       mv.attributes = {{"version", RSIBR_VERSION}, {"environment", "probe.exr"}, {"method", "fis"},
                        {"samples", "32"}, {"seed", std::to_string(c.o.seed)}};

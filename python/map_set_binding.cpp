@@ -21,8 +21,8 @@ void bind_map_set(py::module_& m) {
              v.rgb = to_mat(rgb, 3, "rgb");
              v.view = view.normalized();
              v.world_from_view = world_from_view ? *world_from_view : world_from_view_for(v.view);
-             v.warp = std::move(warp);
-             v.source = std::move(source);
+             v.warp = central_direction_from_string(warp);
+             v.source = map_source_from_string(source);
              v.material = std::move(material);
              v.confidence = to_mat(confidence, 1, "confidence");
              v.clipped = to_mat(clipped, 1, "clipped");
@@ -41,8 +41,14 @@ void bind_map_set(py::module_& m) {
       .def_readwrite("view", &MapView::view, "View direction (world, unit, toward the viewer).")
       .def_readwrite("world_from_view", &MapView::world_from_view,
                      "3x3 view frame: columns x right, y up, z = view, in world (the paper's T).")
-      .def_readwrite("warp", &MapView::warp, "'mirror' or 'normal': the central direction the runtime warps.")
-      .def_readwrite("source", &MapView::source, "'computed' or 'captured'.")
+      .def_property(
+          "warp", [](const MapView& v) { return std::string(to_string(v.warp)); },
+          [](MapView& v, const std::string& name) { v.warp = central_direction_from_string(name); },
+          "'mirror' or 'normal': the central direction the runtime warps.")
+      .def_property(
+          "source", [](const MapView& v) { return std::string(to_string(v.source)); },
+          [](MapView& v, const std::string& name) { v.source = map_source_from_string(name); },
+          "'computed' or 'captured'.")
       .def_readwrite("material", &MapView::material, "The BRDF spec as YAML text.")
       .def_readwrite("albedo", &MapView::albedo,
                      "Empty, or the albedo table of albedo-normalised maps: N rows of (r, g, b) at cos = (k+0.5)/N, "
@@ -64,7 +70,7 @@ void bind_map_set(py::module_& m) {
       .def("__repr__", [](const MapView& v) {
         return "MapView(" + std::to_string(v.rgb.cols) + " x " + std::to_string(v.rgb.rows) + ", view (" +
                std::to_string(v.view.x()) + ", " + std::to_string(v.view.y()) + ", " + std::to_string(v.view.z()) +
-               "), " + v.warp + ", " + v.source + ")";
+               "), " + to_string(v.warp) + ", " + to_string(v.source) + ")";
       });
 
   py::class_<MapSet>(m, "MapSet", "Radiance environment maps, one MapView per view; a sequence of MapViews.")

@@ -33,7 +33,7 @@ namespace rsibr {
 // confidence: the same grid, the confidence where the tap is valid, else 0 (empty: no channel used).
 struct BlendEngine::Source {
   DiscMap original;  // sample_disc's inward steps where no tap is valid (beyond the disc's edge)
-  WarpKind kind = WarpKind::Mirror;
+  CentralDirection kind = CentralDirection::Mirror;
   Mat3 view_from_world = Mat3::Identity();
   std::vector<float> texels, confidence;
   struct Grid {
@@ -60,7 +60,7 @@ Source make_source(const MapView& v, bool use_confidence) {
   Source s;
   const int W = v.rgb.cols, H = v.rgb.rows;
   s.original = DiscMap{&v.rgb, use_confidence && !v.confidence.empty() ? &v.confidence : nullptr, W, H};
-  s.kind = warp_kind_from_string(v.warp);
+  s.kind = v.warp;
   s.view_from_world = v.world_from_view.transpose();
   const std::size_t PW = std::size_t(W) + 2, PH = std::size_t(H) + 2;
   if (4 * PW * PH > std::size_t(std::numeric_limits<int>::max()))  // tap offsets are int
@@ -386,7 +386,7 @@ Vec3 BlendEngine::radiance(const ViewWeights& located, const Vec3& v, const Vec3
   for (int k = 0; k < located.count; ++k) {
     const Source& s = source(located.views[std::size_t(k)]);
     sources[k] = &s;
-    samples[k] = warp_direction(s.kind, s.view_from_world * (s.kind == WarpKind::Mirror ? r : n));
+    samples[k] = warp_direction(s.kind, s.view_from_world * (s.kind == CentralDirection::Mirror ? r : n));
     const double w = located.weights[std::size_t(k)];
     if (!(w > 0)) continue;
     const float a = faded(float(w), float(samples[k].rim), inv_fade);

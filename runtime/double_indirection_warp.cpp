@@ -15,7 +15,7 @@ namespace {
 constexpr std::size_t kCacheTables = 8;
 constexpr double kMaxNodes = double(1 << 24);  // 200 MB of nodes per table
 
-int kind_index(WarpKind kind) { return kind == WarpKind::Mirror ? 0 : 1; }
+int kind_index(CentralDirection kind) { return kind == CentralDirection::Mirror ? 0 : 1; }
 
 // Rows e1, e2, a: an orthonormal frame whose third axis is a (unit).
 Mat3 axis_frame(const Vec3& a) {
@@ -46,7 +46,7 @@ DoubleIndirectionWarp::DoubleIndirectionWarp(int width, int height, const Double
 
   // Screen tables: each texel's central direction (clamped to the disc) as table coordinates.
   const double to_u = lon_ / (2 * kPi), to_v = (lat_ - 1) / kPi;
-  for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal}) {
+  for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal}) {
     std::vector<float>& s = screen_[kind_index(kind)];
     s.resize(std::size_t(width) * std::size_t(height) * 2);
     for (int r = 0; r < height; ++r)
@@ -64,7 +64,7 @@ DoubleIndirectionWarp::DoubleIndirectionWarp(int width, int height, const Double
   for (int j = 0; j < lat_; ++j)
     for (int i = 0; i < lon_; ++i)
       node_dirs_[std::size_t(j) * std::size_t(lon_) + std::size_t(i)] = direction(2 * kPi * i / lon_, kPi * j / (lat_ - 1));
-  for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal}) base_[kind_index(kind)] = build(kind, Mat3::Identity());
+  for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal}) base_[kind_index(kind)] = build(kind, Mat3::Identity());
 }
 
 std::pair<double, double> DoubleIndirectionWarp::address(const Vec3& dir) const {
@@ -101,7 +101,7 @@ DoubleIndirectionWarp::Split DoubleIndirectionWarp::split(const Mat3& m) const {
 
 bool DoubleIndirectionWarp::offset_only(const Mat3& source_from_dest) const { return split(source_from_dest).twist_only; }
 
-std::shared_ptr<const DoubleIndirectionWarp::Table> DoubleIndirectionWarp::build(WarpKind kind, const Mat3& swing) const {
+std::shared_ptr<const DoubleIndirectionWarp::Table> DoubleIndirectionWarp::build(CentralDirection kind, const Mat3& swing) const {
   auto t = std::make_shared<Table>();
   t->kind = kind;
   t->swing = swing;
@@ -126,14 +126,14 @@ std::shared_ptr<const DoubleIndirectionWarp::Table> DoubleIndirectionWarp::build
       // point) and jumps only straight behind, which the spread catches; the mirror warp's
       // coordinates jump across the whole rim near its singular direction.
       const bool safe = std::max(hi_x - lo_x, hi_y - lo_y) <= options_.max_spread &&
-                        (kind == WarpKind::Normal || rim >= options_.min_rim);
+                        (kind == CentralDirection::Normal || rim >= options_.min_rim);
       t->safe[std::size_t(j * lon_ + i)] = safe;
       t->exact_cells += !safe;
     }
   return t;
 }
 
-std::shared_ptr<const DoubleIndirectionWarp::Table> DoubleIndirectionWarp::table(WarpKind kind, const Split& s) const {
+std::shared_ptr<const DoubleIndirectionWarp::Table> DoubleIndirectionWarp::table(CentralDirection kind, const Split& s) const {
   if (s.twist_only) return base_[kind_index(kind)];
   std::lock_guard<std::mutex> lock(mutex_);
   for (const auto& t : cache_)
@@ -145,7 +145,7 @@ std::shared_ptr<const DoubleIndirectionWarp::Table> DoubleIndirectionWarp::table
   return t;
 }
 
-int DoubleIndirectionWarp::exact_cells(WarpKind kind, const Mat3& source_from_dest) const {
+int DoubleIndirectionWarp::exact_cells(CentralDirection kind, const Mat3& source_from_dest) const {
   return table(kind, split(source_from_dest))->exact_cells;
 }
 
@@ -181,7 +181,7 @@ float DoubleIndirectionWarp::wrapped(double u) const {
   return w < float(lon_) ? w : 0.f;
 }
 
-WarpSample DoubleIndirectionWarp::lookup(WarpKind kind, const Mat3& source_from_dest, double lon, double lat) const {
+WarpSample DoubleIndirectionWarp::lookup(CentralDirection kind, const Mat3& source_from_dest, double lon, double lat) const {
   const Split s = split(source_from_dest);
   WarpSample o;
   const float v = float(std::clamp(lat, 0.0, kPi) * (lat_ - 1) / kPi);
@@ -190,7 +190,7 @@ WarpSample DoubleIndirectionWarp::lookup(WarpKind kind, const Mat3& source_from_
   return warp_direction(kind, source_from_dest * direction(lon, lat));
 }
 
-void DoubleIndirectionWarp::warp_row(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row,
+void DoubleIndirectionWarp::warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row,
                                      int c_begin, int c_end, WarpSample* out) const {
   if (width != width_ || height != height_)
     throw std::invalid_argument("DoubleIndirectionWarp: built for " + std::to_string(width_) + "x" +

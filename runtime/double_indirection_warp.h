@@ -50,14 +50,14 @@ class DoubleIndirectionWarp final : public Warp {
   DoubleIndirectionWarp(int width, int height, const DoubleIndirectionOptions& options = {});
   const char* name() const override { return "double-indirection"; }
   bool supports(int width, int height) const override { return width == width_ && height == height_; }
-  void warp_row(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
+  void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
                 WarpSample* out) const override;
 
   int longitudes() const { return lon_; }
   int latitudes() const { return lat_; }
   // The second indirection alone: the sample at axis-frame address (lon, lat) (radians) for a source
   // related by source_from_dest, i.e. the table read at (lon + delta, lat).
-  WarpSample lookup(WarpKind kind, const Mat3& source_from_dest, double lon, double lat) const;
+  WarpSample lookup(CentralDirection kind, const Mat3& source_from_dest, double lon, double lat) const;
   // The axis-frame address (lon in [0, 2 pi), lat in [0, pi]) of a view-frame direction (length > 0)
   // and the unit view-frame direction of an address.
   std::pair<double, double> address(const Vec3& dir) const;
@@ -67,7 +67,7 @@ class DoubleIndirectionWarp final : public Warp {
   // Whether source_from_dest is a rotation about the axis (within 1e-9): the shared table serves it.
   bool offset_only(const Mat3& source_from_dest) const;
   // Cells warped per texel (straddling the singularity) for this kind and rotation.
-  int exact_cells(WarpKind kind, const Mat3& source_from_dest) const;
+  int exact_cells(CentralDirection kind, const Mat3& source_from_dest) const;
   // Swing tables built so far (frames that were not a rotation about the axis).
   int tables_built() const;
 
@@ -76,7 +76,7 @@ class DoubleIndirectionWarp final : public Warp {
     float x, y, rim;
   };
   struct Table {
-    WarpKind kind;
+    CentralDirection kind;
     Mat3 swing;
     std::vector<Node> nodes;          // row-major, latitudes x longitudes
     std::vector<unsigned char> safe;  // per cell (latitudes - 1) x longitudes
@@ -88,8 +88,8 @@ class DoubleIndirectionWarp final : public Warp {
     bool twist_only;
   };
   Split split(const Mat3& source_from_dest) const;
-  std::shared_ptr<const Table> build(WarpKind kind, const Mat3& swing) const;
-  std::shared_ptr<const Table> table(WarpKind kind, const Split& s) const;
+  std::shared_ptr<const Table> build(CentralDirection kind, const Mat3& swing) const;
+  std::shared_ptr<const Table> table(CentralDirection kind, const Split& s) const;
   // The bilinear read of a table (nodes, per-cell safe flags, columns x rows) at u (columns, in
   // [0, 2 columns)) and v (rows, in [0, rows - 1]); false (and o untouched) when the cell is not safe.
   static bool interpolate(const Node* nodes, const unsigned char* safe, int columns, int rows, float u, float v,

@@ -259,7 +259,7 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
                 double L[3] = {0, 0, 0};
                 for (std::size_t s = 0; s < nsets; ++s) {
                   if (paper) {
-                    const WarpSample ws = warp_direction(WarpKind::Normal, dests[s].view_from_world * nrm);
+                    const WarpSample ws = warp_direction(CentralDirection::Normal, dests[s].view_from_world * nrm);
                     double Ls[3], conf;
                     if (!sample_disc(dests[s].map, ws.disc, Ls, &conf)) continue;
                     L[0] += Ls[0];

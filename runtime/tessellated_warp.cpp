@@ -54,7 +54,7 @@ TessellatedWarp::TessellatedWarp(int width, int height, const TessellationOption
     }
 }
 
-std::shared_ptr<const TessellatedWarp::Frame> TessellatedWarp::frame(WarpKind kind, const Mat3& m) const {
+std::shared_ptr<const TessellatedWarp::Frame> TessellatedWarp::frame(CentralDirection kind, const Mat3& m) const {
   {
     std::shared_lock<std::shared_mutex> lock(mutex_);
     for (const auto& f : cache_)
@@ -88,11 +88,11 @@ std::shared_ptr<const TessellatedWarp::Frame> TessellatedWarp::frame(WarpKind ki
   return f;
 }
 
-int TessellatedWarp::exact_cells(WarpKind kind, const Mat3& source_from_dest) const {
+int TessellatedWarp::exact_cells(CentralDirection kind, const Mat3& source_from_dest) const {
   return frame(kind, source_from_dest)->exact_cells;
 }
 
-void TessellatedWarp::warp_row(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row,
+void TessellatedWarp::warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row,
                                int c_begin, int c_end, WarpSample* out) const {
   if (width != width_ || height != height_)
     throw std::invalid_argument("TessellatedWarp: built for " + std::to_string(width_) + "x" + std::to_string(height_) +

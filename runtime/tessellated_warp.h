@@ -1,4 +1,4 @@
-// The paper's fast approximation of the warp (seeds/001 section 4, seeds/000 "tessellated disk"):
+// The paper's fast approximation of the warp (the "tessellated disk" of the paper and its patent):
 // warp only the vertices of a mesh over the destination disc and interpolate the source texture
 // coordinates in between, as texture-mapping hardware would.
 //
@@ -17,7 +17,7 @@
 // singularity fade's input) is interpolated like the coordinates.
 //
 // Error against ExactWarp: measured by tests/runtime/tessellated_warp_test.cpp and in
-// docs/performance.md; it falls as rings * segments grows.
+// docs/tradeoffs.md, "Warp methods"; it falls as rings * segments grows.
 #pragma once
 
 #include "runtime/warp.h"
@@ -42,12 +42,12 @@ class TessellatedWarp final : public Warp {
   TessellatedWarp(int width, int height, const TessellationOptions& options = {});
   const char* name() const override { return "tessellated"; }
   bool supports(int width, int height) const override { return width == width_ && height == height_; }
-  void warp_row(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
+  void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
                 WarpSample* out) const override;
 
   int vertex_count() const { return int(vertices_.size()); }
   // Cells warped per texel (singular) in the last frame computed for this kind and rotation.
-  int exact_cells(WarpKind kind, const Mat3& source_from_dest) const;
+  int exact_cells(CentralDirection kind, const Mat3& source_from_dest) const;
 
  private:
   struct Corners {
@@ -56,13 +56,13 @@ class TessellatedWarp final : public Warp {
     int cell;                  // cell index for the safety flag
   };
   struct Frame {
-    WarpKind kind;
+    CentralDirection kind;
     Mat3 source_from_dest;
     std::vector<WarpSample> samples;  // per vertex
     std::vector<unsigned char> safe;  // per cell
     int exact_cells = 0;
   };
-  std::shared_ptr<const Frame> frame(WarpKind kind, const Mat3& source_from_dest) const;
+  std::shared_ptr<const Frame> frame(CentralDirection kind, const Mat3& source_from_dest) const;
 
   int width_, height_;
   TessellationOptions options_;

@@ -16,16 +16,8 @@
 
 namespace rsibr {
 
-WarpKind warp_kind_from_string(const std::string& name) {
-  if (name == "mirror") return WarpKind::Mirror;
-  if (name == "normal") return WarpKind::Normal;
-  throw std::invalid_argument("warp: unknown warp '" + name + "' (expected mirror or normal)");
-}
-
-const char* to_string(WarpKind kind) { return kind == WarpKind::Mirror ? "mirror" : "normal"; }
-
-Vec3 central_direction(WarpKind kind, const Vec2& xy) {
-  return kind == WarpKind::Mirror ? sphere_map::g_mirror(xy) : sphere_map::g_normal(xy);
+Vec3 central_direction(CentralDirection kind, const Vec2& xy) {
+  return kind == CentralDirection::Mirror ? sphere_map::g_mirror(xy) : sphere_map::g_normal(xy);
 }
 
 // g_mirror^-1 with the half vector's z as the rim value:
@@ -56,8 +48,8 @@ static inline WarpSample normal_inverse(const Vec3& n) {
   return {xy, rim};
 }
 
-WarpSample warp_direction(WarpKind kind, const Vec3& dir_in_source) {
-  return kind == WarpKind::Mirror ? mirror_inverse(dir_in_source) : normal_inverse(dir_in_source);
+WarpSample warp_direction(CentralDirection kind, const Vec3& dir_in_source) {
+  return kind == CentralDirection::Mirror ? mirror_inverse(dir_in_source) : normal_inverse(dir_in_source);
 }
 
 // The inside test is monotone in |x| along a row, so the span is found from the analytic guess
@@ -81,7 +73,7 @@ std::pair<int, int> disc_span(int row, int width, int height) {
 // Computed in double and rounded once: for texels near the rim, z = sqrt(1 - x^2 - y^2) cancels, and
 // float's x alone would move z (and the mirror direction) by ~1e-5 at 129^2.
 RSIBR_AVX2_CLONES void central_directions_row(
-    WarpKind kind, int width, int height, int row, int c_begin, int c_end, float* __restrict out_x,
+    CentralDirection kind, int width, int height, int row, int c_begin, int c_end, float* __restrict out_x,
     float* __restrict out_y, float* __restrict out_z) {
   const double y = 1.0 - (2.0 * row + 1.0) / height;
   const double inv_w = 1.0 / width;
@@ -89,7 +81,7 @@ RSIBR_AVX2_CLONES void central_directions_row(
   for (int i = 0; i < n; ++i) {
     const double x = (2.0 * (c_begin + i) + 1.0) * inv_w - 1.0;
     const double z = std::sqrt(std::max(0.0, 1.0 - (x * x + y * y)));  // g_normal inside the disc
-    if (kind == WarpKind::Mirror) {
+    if (kind == CentralDirection::Mirror) {
       out_x[i] = float(2 * x * z);
       out_y[i] = float(2 * y * z);
       out_z[i] = float(2 * z * z - 1.0);
@@ -104,11 +96,11 @@ RSIBR_AVX2_CLONES void central_directions_row(
 // Branch-free forms of mirror_inverse / normal_inverse (selects, not jumps, so the loops vectorise).
 // Also built for AVX2 (8 floats a vector; chosen at load time where the CPU has it). No FMA: the
 // results are the same to the bit on either path.
-RSIBR_AVX2_CLONES void warp_directions(WarpKind kind, const float m[9], int n, const float* __restrict x,
+RSIBR_AVX2_CLONES void warp_directions(CentralDirection kind, const float m[9], int n, const float* __restrict x,
                                        const float* __restrict y, const float* __restrict z,
                                        float* __restrict disc_x, float* __restrict disc_y, float* __restrict rim) {
   const float m0 = m[0], m1 = m[1], m2 = m[2], m3 = m[3], m4 = m[4], m5 = m[5], m6 = m[6], m7 = m[7], m8 = m[8];
-  if (kind == WarpKind::Mirror) {
+  if (kind == CentralDirection::Mirror) {
     for (int i = 0; i < n; ++i) {
       const float rx = m0 * x[i] + m1 * y[i] + m2 * z[i];
       const float ry = m3 * x[i] + m4 * y[i] + m5 * z[i];
@@ -149,7 +141,7 @@ void to_floats(const Mat3& M, float m[9]) {
 constexpr int kBlock = 64;  // texels per stack block of the single-precision forms
 }  // namespace
 
-void Warp::warp_block(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
+void Warp::warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
                       int c_end, float* disc_x, float* disc_y, float* rim) const {
   WarpSample samples[kBlock];
   for (int c = c_begin; c < c_end; c += kBlock) {
@@ -163,7 +155,7 @@ void Warp::warp_block(WarpKind kind, const Mat3& source_from_dest, int width, in
   }
 }
 
-void ExactWarp::warp_block(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
+void ExactWarp::warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
                            int c_end, float* disc_x, float* disc_y, float* rim) const {
   float m[9];
   to_floats(source_from_dest, m);
@@ -175,7 +167,7 @@ void ExactWarp::warp_block(WarpKind kind, const Mat3& source_from_dest, int widt
   }
 }
 
-void ExactWarp::warp_row(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
+void ExactWarp::warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
                          int c_end, WarpSample* out) const {
   for (int c = c_begin; c < c_end; ++c) {
     const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, row), width, height);
@@ -199,7 +191,7 @@ PrecomputedWarp::PrecomputedWarp(int width, int height) : width_(width), height_
     const auto [c0, c1] = disc_span(r, width, height);
     const std::size_t at = std::size_t(r) * std::size_t(width) + std::size_t(c0);
     for (int k = 0; k < 2; ++k)
-      central_directions_row(WarpKind(k), width, height, r, c0, c1, planes_.data() + (3 * k) * count + at,
+      central_directions_row(CentralDirection(k), width, height, r, c0, c1, planes_.data() + (3 * k) * count + at,
                              planes_.data() + (3 * k + 1) * count + at, planes_.data() + (3 * k + 2) * count + at);
   }
 }
@@ -210,18 +202,18 @@ void PrecomputedWarp::check_size(int width, int height) const {
                                 ", asked for " + std::to_string(width) + "x" + std::to_string(height));
 }
 
-void PrecomputedWarp::warp_row(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row,
+void PrecomputedWarp::warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row,
                                int c_begin, int c_end, WarpSample* out) const {
   check_size(width, height);
-  const Vec3* table = (kind == WarpKind::Mirror ? mirror_.data() : normal_.data()) + std::size_t(row) * std::size_t(width);
-  if (kind == WarpKind::Mirror) {
+  const Vec3* table = (kind == CentralDirection::Mirror ? mirror_.data() : normal_.data()) + std::size_t(row) * std::size_t(width);
+  if (kind == CentralDirection::Mirror) {
     for (int c = c_begin; c < c_end; ++c) out[c - c_begin] = mirror_inverse(source_from_dest * table[c]);
   } else {
     for (int c = c_begin; c < c_end; ++c) out[c - c_begin] = normal_inverse(source_from_dest * table[c]);
   }
 }
 
-void PrecomputedWarp::warp_block(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row,
+void PrecomputedWarp::warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row,
                                  int c_begin, int c_end, float* disc_x, float* disc_y, float* rim) const {
   check_size(width, height);
   float m[9];

@@ -1,6 +1,6 @@
 // Reflection-space warps: where a destination texel's central direction lands in a source map.
 //
-// Derived from the invariant of seeds/README.md (docs/conventions.md), NOT from the paper's printed
+// Derived from the meaning of a texel (docs/conventions.md), NOT from the paper's printed
 // chains: texel p of the map for view v, whose frame is T_v = world_from_view, holds the radiance
 // leaving a surface with normal n = T_v g_normal(p) toward a viewer at infinity along v, i.e. with
 // mirror direction r = T_v g_mirror(p). A destination texel p_d and a source texel p_s show the same
@@ -21,6 +21,7 @@
 // The blend (runtime/blend.h) fades each source's weight to 0 as rim -> 0.
 #pragma once
 
+#include "core/central_direction.h"
 #include "core/vec.h"
 
 #include <string>
@@ -29,11 +30,6 @@
 
 namespace rsibr {
 
-enum class WarpKind { Mirror, Normal };
-
-// "mirror" / "normal" (MapView::warp); throws std::invalid_argument for anything else.
-WarpKind warp_kind_from_string(const std::string& name);
-const char* to_string(WarpKind kind);
 
 // Where one central direction lands in a source map.
 struct WarpSample {
@@ -42,13 +38,13 @@ struct WarpSample {
 };
 
 // The central direction (view frame, unit) of disc point xy: g_mirror or g_normal.
-Vec3 central_direction(WarpKind kind, const Vec2& xy);
+Vec3 central_direction(CentralDirection kind, const Vec2& xy);
 
 // The inverse for a direction expressed in the source's view frame (any length > 0): the source disc
 // point and its rim value. Mirror: the disc point is bitwise sphere_map::g_mirror_inv(dir); dir = -z
 // exactly gives (0,-1) with rim 0. Normal: sphere_map::g_normal_inv(dir) (nearest rim point for
 // dir.z < 0; dir = -z exactly gives (0,-1)). A zero or non-finite dir gives the centre with rim 0.
-WarpSample warp_direction(WarpKind kind, const Vec3& dir_in_source);
+WarpSample warp_direction(CentralDirection kind, const Vec3& dir_in_source);
 
 // Destination texels of a width x height sphere map whose centre lies inside the unit disc
 // (x^2 + y^2 <= 1, the same test core's sphere-map sampling uses): columns [first, second) of `row`;
@@ -67,9 +63,9 @@ std::pair<int, int> disc_span(int row, int width, int height);
 //     r = -z exactly (mirror) and a normal straight behind give (0, -1) with rim 0, as warp_direction
 //     does. Agrees with warp_direction to float rounding: ~1e-7 in the rim value, ~1e-7 / rim in the
 //     disc point near the mirror singularity (tests/runtime/warp_test.cpp).
-void central_directions_row(WarpKind kind, int width, int height, int row, int c_begin, int c_end, float* out_x,
+void central_directions_row(CentralDirection kind, int width, int height, int row, int c_begin, int c_end, float* out_x,
                             float* out_y, float* out_z);
-void warp_directions(WarpKind kind, const float m[9], int n, const float* x, const float* y, const float* z,
+void warp_directions(CentralDirection kind, const float m[9], int n, const float* x, const float* y, const float* z,
                      float* disc_x, float* disc_y, float* rim);
 
 // The interface of the warp implementations (a speed/accuracy knob). Implementations are immutable
@@ -80,12 +76,12 @@ class Warp {
   virtual const char* name() const = 0;
   // Whether warp_row may be called for a width x height destination.
   virtual bool supports(int width, int height) const { return width > 0 && height > 0; }
-  virtual void warp_row(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
+  virtual void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
                         int c_end, WarpSample* out) const = 0;
   // The same map in single precision, structure of arrays (the blend engine's form): for texels
   // (c, row), c in [c_begin, c_end), disc_x/disc_y/rim[c - c_begin]. The default converts warp_row's
   // samples; the exact and precomputed warps compute it in vectorised float loops.
-  virtual void warp_block(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
+  virtual void warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
                           int c_end, float* disc_x, float* disc_y, float* rim) const;
 };
 
@@ -93,10 +89,10 @@ class Warp {
 class ExactWarp final : public Warp {
  public:
   const char* name() const override { return "exact"; }
-  void warp_row(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
+  void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
                 WarpSample* out) const override;
   // central_directions_row then warp_directions, in blocks of 64 texels on the stack.
-  void warp_block(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
+  void warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
                   float* disc_x, float* disc_y, float* rim) const override;
 };
 
@@ -113,9 +109,9 @@ class PrecomputedWarp final : public Warp {
   int width() const { return width_; }
   int height() const { return height_; }
   bool supports(int width, int height) const override { return width == width_ && height == height_; }
-  void warp_row(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
+  void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
                 WarpSample* out) const override;
-  void warp_block(WarpKind kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
+  void warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
                   float* disc_x, float* disc_y, float* rim) const override;
 
  private:

@@ -65,7 +65,7 @@ GlMapSet::GlMapSet(const MapSet& maps, const BlendOptions& blend, const std::str
     const MapView& v = maps.views[std::size_t(i)];
     for (int row = 0; row < 3; ++row)
       for (int k = 0; k < 3; ++k) data[(std::size_t(row) * N + i) * 4 + k] = float(v.world_from_view(k, row));
-    data[std::size_t(i) * 4 + 3] = warp_kind_from_string(v.warp) == WarpKind::Mirror ? 0.f : 1.f;
+    data[std::size_t(i) * 4 + 3] = v.warp == CentralDirection::Mirror ? 0.f : 1.f;
     const Vec3& u = view_set_.views()[std::size_t(i)];
     for (int k = 0; k < 3; ++k) data[(std::size_t(3) * N + i) * 4 + k] = float(u[k]);
   }

@@ -179,7 +179,7 @@ void draw_globe(const ViewSet& views, const ViewWeights& located, const Camera& 
 
 std::string describe(const MapSet& m) {
   const MapView& v = m.views.front();
-  std::string warps = v.warp, sources = v.source;
+  std::string warps = to_string(v.warp), sources = to_string(v.source);
   for (const MapView& w : m.views) {
     if (w.warp != v.warp) warps = "mixed";
     if (w.source != v.source) sources = "mixed";

@@ -38,19 +38,19 @@ const std::string kPaint =
 TEST(BrdfLobes, SplitFollowsTheBrdfsLobes) {
   const auto lambert = split_lobes(std::make_shared<LambertBrdf>(Vec3(0.5, 0.5, 0.5)));
   ASSERT_EQ(lambert.size(), 1u);
-  EXPECT_EQ(lambert[0]->central_direction(), Lobe::Normal);
+  EXPECT_EQ(lambert[0]->central_direction(), CentralDirection::Normal);
   const auto g = split_lobes(ggx(0.2));
   ASSERT_EQ(g.size(), 1u);
-  EXPECT_EQ(g[0]->central_direction(), Lobe::Mirror);
+  EXPECT_EQ(g[0]->central_direction(), CentralDirection::Mirror);
   const auto paint = split_lobes(car_paint());
   ASSERT_EQ(paint.size(), 2u);
-  EXPECT_EQ(paint[0]->central_direction(), Lobe::Normal);
-  EXPECT_EQ(paint[1]->central_direction(), Lobe::Mirror);
+  EXPECT_EQ(paint[0]->central_direction(), CentralDirection::Normal);
+  EXPECT_EQ(paint[1]->central_direction(), CentralDirection::Mirror);
   // Full flake coverage or a black binder: no diffuse part.
   EXPECT_EQ(split_lobes(car_paint(0.05, 1.0)).size(), 1u);
   EXPECT_EQ(split_lobes(car_paint(0.05, 0.3, 0.3, Vec3::Zero())).size(), 1u);
-  EXPECT_THROW(BrdfLobe(ggx(0.2), Lobe::Normal), std::invalid_argument);
-  EXPECT_THROW(BrdfLobe(nullptr, Lobe::Normal), std::invalid_argument);
+  EXPECT_THROW(BrdfLobe(ggx(0.2), CentralDirection::Normal), std::invalid_argument);
+  EXPECT_THROW(BrdfLobe(nullptr, CentralDirection::Normal), std::invalid_argument);
 }
 
 TEST(BrdfLobes, PartsSumToTheParentEval) {

@@ -28,7 +28,7 @@ bool starts_with(const std::string& s, const std::string& prefix) { return s.rfi
 
 TEST(BrdfSpec, ParsesTheDocumentedExamples) {
   auto g = parse_brdf("{type: ggx, roughness: 0.3, fresnel: {type: conductor, eta: [0.2,0.9,1.1], k: [3.9,2.4,2.2]}}");
-  EXPECT_EQ(g->central_direction(), Lobe::Mirror);
+  EXPECT_EQ(g->central_direction(), CentralDirection::Mirror);
   auto l = parse_brdf("{type: lambert, albedo: [0.18,0.18,0.18]}");
   EXPECT_EQ(l->albedo(Vec3(0, 0, 1)), Vec3::Constant(0.18));
   auto c = parse_brdf(

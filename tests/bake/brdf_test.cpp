@@ -347,8 +347,8 @@ TEST(LobeWidth, LobeWidthGrowsWithRoughness) {
     EXPECT_GT(wb, 0.0);
     prev = w;
   }
-  EXPECT_EQ(LambertBrdf(Vec3::Ones()).central_direction(), Lobe::Normal);
-  EXPECT_EQ(GgxBrdf(0.1, none).central_direction(), Lobe::Mirror);
+  EXPECT_EQ(LambertBrdf(Vec3::Ones()).central_direction(), CentralDirection::Normal);
+  EXPECT_EQ(GgxBrdf(0.1, none).central_direction(), CentralDirection::Mirror);
   // The clear coat's width is its sharpest significant lobe: the coat.
   EXPECT_NEAR(car_paint(0.05)->lobe_width(dir(0.7)), ggx_lobe_width(0.05), 1e-15);
 }

@@ -19,8 +19,8 @@ MapView grey_view(const Vec3& v, int size = 48) {
   MapView mv;
   mv.world_from_view = world_from_view_for(v);
   mv.view = mv.world_from_view.col(2);
-  mv.warp = "normal";
-  mv.source = "captured";
+  mv.warp = CentralDirection::Normal;
+  mv.source = MapSource::Captured;
   mv.rgb = cv::Mat(size, size, CV_32FC3, cv::Scalar::all(0));
   mv.confidence = cv::Mat(size, size, CV_32FC1, cv::Scalar(0));
   for (int y = 0; y < size; ++y)

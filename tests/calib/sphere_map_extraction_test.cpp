@@ -90,8 +90,8 @@ TEST(SphereMapExtraction, ExactIndexingMatchesTheTrueChromeMap) {
   EXPECT_LT(e.exact.log_rms_stops, 0.03);
   EXPECT_LT(e.exact.relative_rms, 0.01);
   EXPECT_LT(e.exact.relative_rms, 0.5 * e.ortho.relative_rms);
-  EXPECT_EQ(e.map.source, "captured");
-  EXPECT_EQ(e.map.warp, "mirror");
+  EXPECT_EQ(e.map.source, MapSource::Captured);
+  EXPECT_EQ(e.map.warp, CentralDirection::Mirror);
 }
 
 // A Lambertian ball's radiance depends on the normal only: orthographic indexing is exact for it.

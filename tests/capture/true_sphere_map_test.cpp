@@ -24,7 +24,7 @@ TEST(TrueSphereMap, GreyMapIsAlbedoTimesExactIrradianceOverPiInTheViewFrame) {
   const int size = 16;
   const MapView mv = true_sphere_map(grey, eye, env, size);
   EXPECT_LT((mv.view - (eye - grey.centre).normalized()).norm(), 1e-12);
-  EXPECT_EQ(mv.warp, "normal");
+  EXPECT_EQ(mv.warp, CentralDirection::Normal);
   double worst = 0;
   for (int r = 0; r < size; ++r)
     for (int c = 0; c < size; ++c) {
@@ -91,7 +91,7 @@ TEST(TrueSphereMap, ChromeMapIsFresnelTimesTheEnvironmentSeenInTheMirror) {
   const SynthBall& chrome = scene.balls[0];
   const MapView mv = true_sphere_map(chrome, Vec3(0, 1.3, 2), env, 32);
   const auto f = make_fresnel(YAML::Load(chrome.fresnel));
-  EXPECT_EQ(mv.warp, "mirror");
+  EXPECT_EQ(mv.warp, CentralDirection::Mirror);
   for (int r = 0; r < 32; ++r)
     for (int c = 0; c < 32; ++c) {
       const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), 32, 32);

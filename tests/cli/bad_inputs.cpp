@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
   write_environment((out / "env-negative.exr").string(), negative);
   MapSet conf = icosa(8);
   for (MapView& v : conf.views) {
-    v.source = "captured";
+    v.source = MapSource::Captured;
     v.confidence = cv::Mat(8, 8, CV_32FC1, cv::Scalar(1.f));
   }
   conf.views[2].confidence.at<float>(1, 1) = 2.f;

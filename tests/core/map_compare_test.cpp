@@ -64,7 +64,7 @@ TEST(MapCompare, ZeroConfidenceTexelsAreExcluded) {
   const MapSet b = normal_set(8);
   // Garbage (including NaN) wherever A's confidence is zero: the left half of every view.
   for (MapView& v : a.views) {
-    v.source = "captured";
+    v.source = MapSource::Captured;
     v.confidence = cv::Mat(8, 8, CV_32FC1, cv::Scalar(1));
     for (int r = 0; r < 8; ++r)
       for (int c = 0; c < 4; ++c) {

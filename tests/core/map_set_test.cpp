@@ -52,14 +52,14 @@ MapSet make_set(unsigned seed = 1, int size = 33) {
     MapView v;
     v.view = vs.views()[i];
     v.world_from_view = world_from_view_for(v.view);
-    v.warp = i % 3 == 0 ? "normal" : "mirror";
-    v.source = i % 2 ? "captured" : "computed";
+    v.warp = i % 3 == 0 ? CentralDirection::Normal : CentralDirection::Mirror;
+    v.source = i % 2 ? MapSource::Captured : MapSource::Computed;
     v.material = "brdf: ggx\nroughness: 0.3\n# view " + std::to_string(i) + "\n";
     v.attributes = {{"tool", "rsibr bake"}, {"seed", std::to_string(seed)}, {"note", "line 1\nline 2\t\"quoted\""}};
     v.rgb = cv::Mat(size, size, CV_32FC3);
     for (float* p = v.rgb.ptr<float>(), *e = p + size * size * 3; p != e; ++p) *p = u(rng);
     v.rgb.at<cv::Vec3f>(0, 0) = cv::Vec3f(1e9f, 1e-30f, -0.f);
-    if (v.source == "captured") {
+    if (v.source == MapSource::Captured) {
       v.confidence = cv::Mat(size, size, CV_32FC1);
       for (int r = 0; r < size; ++r)
         for (int c = 0; c < size; ++c) v.confidence.at<float>(r, c) = float((r * size + c + i) % 17) / 16.f;
@@ -184,8 +184,6 @@ TEST(MapSet, ValidationRejectsBadSets) {
       {"view.008", "rotation", [](MapView& v) { v.world_from_view.col(0) *= -1.0; }},  // reflection
       {"view.009", "third column", [](MapView& v) { v.world_from_view = world_from_view_for(-v.view); }},
       {"view.010", "third column", [](MapView& v) { v.world_from_view.transposeInPlace(); }},
-      {"view.001", "warp", [](MapView& v) { v.warp = "foo"; }},
-      {"view.006", "source", [](MapView& v) { v.source = "guessed"; }},
       {"view.011", "reserved", [](MapView& v) { v.attributes["view"] = "x"; }},
       {"view.000", "reserved", [](MapView& v) { v.attributes["material"] = "x"; }},
       {"view.011", "31", [](MapView& v) { v.attributes[std::string(26, 'a')] = "x"; }},
@@ -211,7 +209,7 @@ TEST(MapSet, ValidationRejectsBadSets) {
   write_map_set(path, good);
   const std::string bytes = read_bytes(path);
   MapSet bad = good;
-  bad.views[1].warp = "foo";
+  bad.views[1].world_from_view.col(0) *= 1.1;
   EXPECT_THROW(write_map_set(path, bad), std::runtime_error);
   EXPECT_TRUE(bytes == read_bytes(path));
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"keep.exr"});
@@ -270,6 +268,42 @@ TEST(MapSet, AHeaderAttributeClaimingMoreBytesThanTheFileIsRefusedBeforeOpenExrA
   EXPECT_FALSE(is_map_set_file(bad));
 }
 
+// The warp and the source are enums in memory; a file with any other value is refused when read,
+// naming the file, the part and the attribute.
+TEST(MapSet, AnUnknownWarpOrSourceInAFileIsAClearError) {
+  TempDir dir;
+  const std::string maps = dir.file("maps.exr");
+  MapSet set = make_set(4, 4);
+  for (MapView& v : set.views) {
+    v.warp = CentralDirection::Mirror;
+    v.source = MapSource::Computed;
+    v.confidence.release();
+  }
+  write_map_set(maps, set);
+  const std::string good = read_bytes(maps);
+  for (const auto& [attribute, value, replacement] :
+       {std::tuple{"rsibr.warp", "mirror", "mirrox"}, std::tuple{"rsibr.source", "computed", "guessed!"}}) {
+    std::string bytes = good;
+    const std::string key = std::string(attribute) + '\0' + "string" + '\0';
+    const std::size_t at = bytes.find(key);
+    ASSERT_NE(at, std::string::npos);
+    const std::size_t value_at = at + key.size() + 4;  // after the 4-byte size
+    ASSERT_EQ(bytes.compare(value_at, std::strlen(value), value), 0) << attribute;
+    bytes.replace(value_at, std::strlen(value), replacement);  // same length
+    const std::string bad = dir.file(std::string("bad-") + attribute + ".exr");
+    std::ofstream(bad, std::ios::binary) << bytes;
+    try {
+      read_map_set(bad);
+      ADD_FAILURE() << attribute << ": no error";
+    } catch (const std::runtime_error& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind(bad + ": ", 0), 0u) << msg;
+      EXPECT_NE(msg.find(std::string(attribute) + ": '" + replacement + "' is neither"), std::string::npos) << msg;
+      EXPECT_NE(msg.find("part 0"), std::string::npos) << msg;
+    }
+  }
+}
+
 TEST(MapSet, PartsAreNamedInOrder) {
   TempDir dir;
   const MapSet set = make_set(5, 6);
@@ -292,8 +326,8 @@ TEST(MapSet, PartsAreNamedInOrder) {
     EXPECT_EQ(view->value(), Imath::V3f(float(v.view.x()), float(v.view.y()), float(v.view.z())));
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) EXPECT_EQ(T->value()[r][c], float(v.world_from_view(r, c))) << r << c;
-    EXPECT_EQ(warp->value(), v.warp);
-    EXPECT_EQ(source->value(), v.source);
+    EXPECT_EQ(warp->value(), to_string(v.warp));
+    EXPECT_EQ(source->value(), to_string(v.source));
     EXPECT_EQ(material->value(), v.material);
     for (const auto& [key, value] : v.attributes) {
       const auto* a = h.findTypedAttribute<Imf::StringAttribute>("rsibr." + key);
@@ -313,10 +347,10 @@ TEST(MapSet, PartsAreNamedInOrder) {
       ASSERT_TRUE(ch) << name;
       EXPECT_EQ(ch->type, Imf::FLOAT);
     }
-    EXPECT_EQ(h.channels().findChannel("confidence") != nullptr, v.source == "captured");
+    EXPECT_EQ(h.channels().findChannel("confidence") != nullptr, v.source == MapSource::Captured);
     int n = 0;
     for (auto it = h.channels().begin(); it != h.channels().end(); ++it) ++n;
-    EXPECT_EQ(n, v.source == "captured" ? 4 : 3);
+    EXPECT_EQ(n, v.source == MapSource::Captured ? 4 : 3);
   }
 }
 

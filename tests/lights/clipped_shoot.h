@@ -96,8 +96,8 @@ inline ClippedShoot clipped_shoot(const EnvMap& env, double clip, int views = 6,
     MapView c;
     c.view = view;
     c.world_from_view = world_from_view_for(view);
-    c.source = "captured";
-    c.warp = "mirror";
+    c.source = MapSource::Captured;
+    c.warp = CentralDirection::Mirror;
     c.attributes["image"] = "view" + std::to_string(v);
     c.rgb = cv::Mat(size, size, CV_32FC3, cv::Scalar::all(0));
     c.confidence = cv::Mat(size, size, CV_32FC1, cv::Scalar(0));
@@ -132,8 +132,8 @@ inline ClippedShoot clipped_shoot(const EnvMap& env, double clip, int views = 6,
     shoot.chrome.views.push_back(std::move(c));
 
     auto captured = [&](MapView g) {
-      g.source = "captured";
-      g.warp = "normal";
+      g.source = MapSource::Captured;
+      g.warp = CentralDirection::Normal;
       g.attributes["image"] = "view" + std::to_string(v);
       g.confidence = cv::Mat(size, size, CV_32FC1, cv::Scalar(0));
       for (int r = 0; r < size; ++r)

@@ -1,5 +1,5 @@
 // Map sets with a known answer at every view, built texel by texel from the invariant
-// (seeds/README.md): texel p of the map for view v (frame T = world_from_view_for(v)) holds the
+// (docs/conventions.md): texel p of the map for view v (frame T = world_from_view_for(v)) holds the
 // radiance leaving a surface with normal T g_normal(p) toward a viewer along v.
 #pragma once
 
@@ -40,7 +40,7 @@ inline MapSet analytic_map_set(const ViewSet& views, int width, int height, cons
     MapView mv;
     mv.view = v;
     mv.world_from_view = world_from_view_for(v);
-    mv.warp = warp;
+    mv.warp = central_direction_from_string(warp);
     mv.rgb = analytic_map(f, mv.world_from_view, width, height);
     set.views.push_back(std::move(mv));
   }

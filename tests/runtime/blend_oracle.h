@@ -28,7 +28,7 @@ inline BlendResult blend_oracle(const MapSet& maps, const ViewSet& view_set, con
   result.located = view_set.locate(view_dir, options.barycentric);
   const ViewWeights& located = result.located;
   struct Source : DiscMap {
-    WarpKind kind = WarpKind::Mirror;
+    CentralDirection kind = CentralDirection::Mirror;
     Mat3 source_from_dest = Mat3::Identity();
     double weight = 0;
   };
@@ -43,7 +43,7 @@ inline BlendResult blend_oracle(const MapSet& maps, const ViewSet& view_set, con
     s.confidence = options.use_confidence && !v.confidence.empty() ? &v.confidence : nullptr;
     s.width = v.rgb.cols;
     s.height = v.rgb.rows;
-    s.kind = warp_kind_from_string(v.warp);
+    s.kind = v.warp;
     s.source_from_dest = v.world_from_view.transpose() * result.world_from_view;
     s.weight = located.weights[std::size_t(k)];
   }

@@ -469,8 +469,6 @@ TEST(Blend, BadInputIsAnError) {
   BlendOptions half;
   half.width = 32;
   EXPECT_THROW(blend(set, views, Vec3(0, 0, 1), Vec3(0, 1, 0), half), std::invalid_argument);
-  for (MapView& v : set.views) v.warp = "phong";
-  EXPECT_THROW(blend(set, views, Vec3(0, 0, 1), Vec3(0, 1, 0)), std::invalid_argument);
   EXPECT_THROW(blend(MapSet{}, views, Vec3(0, 0, 1), Vec3(0, 1, 0)), std::invalid_argument);
 }
 

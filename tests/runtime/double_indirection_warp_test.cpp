@@ -51,7 +51,7 @@ TEST(DoubleIndirectionWarp, AtTableNodesItIsTheExactWarpOfTheNodeDirection) {
   std::vector<Mat3> ms;
   for (double deg : {0.0, 7.5, 90.0, 180.0, -133.0}) ms.push_back(Eigen::AngleAxisd(deg * kPi / 180, o.axis.normalized()).toRotationMatrix());
   for (const Mat3& m : general_rotations(3)) ms.push_back(m);
-  for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal})
+  for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal})
     for (const Mat3& m : ms) {
       // The address whose offset lands on node (i, j): lon_i - delta, delta the twist of m about the axis.
       double worst = 0;
@@ -91,13 +91,13 @@ TEST(DoubleIndirectionWarp, ARotationAboutTheAxisIsAnOffsetAndBuildsNoTable) {
   for (std::size_t s = 1; s < ring.size(); ++s) {
     const Mat3 m = ring[s].transpose() * ring[0];
     EXPECT_TRUE(warp.offset_only(m));
-    EXPECT_EQ(testing::compare_to_exact(warp, WarpKind::Mirror, m, n, 0.2).bad, 0);
+    EXPECT_EQ(testing::compare_to_exact(warp, CentralDirection::Mirror, m, n, 0.2).bad, 0);
   }
   EXPECT_EQ(warp.tables_built(), 0);
   const Mat3 general = general_rotations(1)[0];
   EXPECT_FALSE(warp.offset_only(general));
-  EXPECT_EQ(testing::compare_to_exact(warp, WarpKind::Mirror, general, n, 0.2).bad, 0);
-  EXPECT_EQ(testing::compare_to_exact(warp, WarpKind::Mirror, general, n, 0.2).bad, 0);  // reuses the table
+  EXPECT_EQ(testing::compare_to_exact(warp, CentralDirection::Mirror, general, n, 0.2).bad, 0);
+  EXPECT_EQ(testing::compare_to_exact(warp, CentralDirection::Mirror, general, n, 0.2).bad, 0);  // reuses the table
   EXPECT_EQ(warp.tables_built(), 1);
 }
 
@@ -110,7 +110,7 @@ TEST(DoubleIndirectionWarp, WithinItsResamplingErrorOfTheExactWarpForRingsAndGen
   std::vector<std::pair<std::string, Mat3>> cases;
   for (std::size_t s = 1; s < 4; ++s) cases.push_back({"ring", ring[s].transpose() * ring[0]});
   for (const Mat3& m : general_rotations(4)) cases.push_back({"general", m});
-  for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal})
+  for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal})
     for (const auto& [what, m] : cases) {
       const testing::WarpError e = testing::compare_to_exact(warp, kind, m, n, 0.1);
       EXPECT_EQ(e.bad, 0);
@@ -125,7 +125,7 @@ TEST(DoubleIndirectionWarp, WithinItsResamplingErrorOfTheExactWarpForRingsAndGen
 TEST(DoubleIndirectionWarp, ALargerTableHasASmallerError) {
   const int n = 128;
   const Mat3 m = general_rotations(2)[1];
-  for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal}) {
+  for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal}) {
     double previous = INFINITY;
     for (int columns : {32, 64, 128, 256}) {
       DoubleIndirectionOptions o;
@@ -155,7 +155,7 @@ TEST(DoubleIndirectionWarp, NoNaNAtTheSingularityThePolesOrTheLongitudeSeam) {
     DoubleIndirectionOptions o;
     o.axis = axis;
     const DoubleIndirectionWarp warp(n, n, o);
-    for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal}) {
+    for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal}) {
       const testing::WarpError e = testing::compare_to_exact(warp, kind, m, n, 0.1);
       EXPECT_EQ(e.bad, 0);  // every sample finite and in the disc
       EXPECT_LT(e.max_texels, 1.0);
@@ -218,7 +218,7 @@ TEST(DoubleIndirectionWarp, BadSettingsAndAnotherSizeAreRefused) {
   const DoubleIndirectionWarp warp(8, 8);
   EXPECT_FALSE(warp.supports(16, 16));
   std::vector<WarpSample> out(16);
-  EXPECT_THROW(warp.warp_row(WarpKind::Mirror, Mat3::Identity(), 16, 16, 8, 0, 16, out.data()), std::invalid_argument);
+  EXPECT_THROW(warp.warp_row(CentralDirection::Mirror, Mat3::Identity(), 16, 16, 8, 0, 16, out.data()), std::invalid_argument);
 }
 
 TEST(MakeWarp, EveryNameGivesThatWarpAndAnUnknownOneListsThem) {

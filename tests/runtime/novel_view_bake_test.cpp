@@ -47,7 +47,7 @@ MapSet bake_set(const Integrator& integrator, const Brdf& brdf, const ViewSet& v
     MapView mv;
     mv.view = v;
     mv.world_from_view = world_from_view_for(v);
-    mv.warp = brdf.central_direction() == Lobe::Normal ? "normal" : "mirror";
+    mv.warp = brdf.central_direction();
     mv.rgb = integrator.radiance_map(brdf, v, mv.world_from_view, kSize, {});
     if (normalised) {
       normalise_by_albedo(mv.rgb, albedo);
@@ -109,7 +109,7 @@ const char* kClearCoat =
 TEST(NovelViewAgainstBake, ClearCoatNormalPartIsViewIndependentOnceNormalised) {
   const EnvMap env = sun_and_sky();
   const auto integrator = make_integrator("reference", env);
-  const auto brdf = std::make_shared<BrdfLobe>(parse_brdf(kClearCoat), Lobe::Normal);
+  const auto brdf = std::make_shared<BrdfLobe>(parse_brdf(kClearCoat), CentralDirection::Normal);
   const std::vector<Vec3> novel = testing::random_directions(4, 13);
   const ViewSet views = ViewSet::icosahedron();
   const double plain = novel_view_error(*integrator, *brdf, views, novel, false);

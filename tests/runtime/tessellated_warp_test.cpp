@@ -26,7 +26,7 @@ std::vector<Mat3> rotations(int count) {
 
 TEST(TessellatedWarp, ApproachesTheExactWarpAsTheMeshRefines) {
   const int n = 256;
-  for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal}) {
+  for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal}) {
     double previous = INFINITY;
     for (int rings : {8, 16, 32}) {
       const TessellatedWarp warp(n, n, {rings, 4 * rings});
@@ -54,15 +54,15 @@ TEST(TessellatedWarp, CellsStraddlingTheSingularityAreWarpedExactly) {
   const Mat3 Td = world_from_view_for(Vec3(0, 0, 1)), Ts = world_from_view_for(Vec3(0.2, 0.1, -1).normalized());
   const Mat3 m = Ts.transpose() * Td;
   const TessellatedWarp warp(n, n);
-  EXPECT_GT(warp.exact_cells(WarpKind::Mirror, m), 0);
+  EXPECT_GT(warp.exact_cells(CentralDirection::Mirror, m), 0);
   const ExactWarp exact;
   std::vector<WarpSample> a(static_cast<std::size_t>(n)), e(static_cast<std::size_t>(n));
   int singular = 0;
   for (int r = 0; r < n; ++r) {
     const auto [c0, c1] = disc_span(r, n, n);
     if (c0 == c1) continue;
-    warp.warp_row(WarpKind::Mirror, m, n, n, r, c0, c1, a.data());
-    exact.warp_row(WarpKind::Mirror, m, n, n, r, c0, c1, e.data());
+    warp.warp_row(CentralDirection::Mirror, m, n, n, r, c0, c1, a.data());
+    exact.warp_row(CentralDirection::Mirror, m, n, n, r, c0, c1, e.data());
     for (int i = 0; i < c1 - c0; ++i) {
       ASSERT_TRUE(a[std::size_t(i)].disc.allFinite());
       ASSERT_LE(a[std::size_t(i)].disc.norm(), 1.0 + 1e-12);
@@ -106,7 +106,7 @@ TEST(TessellatedWarp, RejectsOtherSizesAndBadMeshes) {
   const TessellatedWarp warp(32, 32);
   EXPECT_FALSE(warp.supports(64, 64));
   std::vector<WarpSample> out(8);
-  EXPECT_THROW(warp.warp_row(WarpKind::Mirror, Mat3::Identity(), 64, 64, 0, 0, 8, out.data()), std::invalid_argument);
+  EXPECT_THROW(warp.warp_row(CentralDirection::Mirror, Mat3::Identity(), 64, 64, 0, 0, 8, out.data()), std::invalid_argument);
   EXPECT_THROW(TessellatedWarp(32, 32, {0, 8}), std::invalid_argument);
   EXPECT_THROW(TessellatedWarp(32, 32, {4, 2}), std::invalid_argument);
 }

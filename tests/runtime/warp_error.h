@@ -18,7 +18,7 @@ struct WarpError {
 
 // Pooled over the sources (source_from_dest rotations): the error over destination texels whose exact
 // sample has rim >= rim_min, and every sample of `approx` checked for finiteness and the disc.
-inline WarpError compare_to_exact(const Warp& approx, WarpKind kind, const std::vector<Mat3>& sources, int n,
+inline WarpError compare_to_exact(const Warp& approx, CentralDirection kind, const std::vector<Mat3>& sources, int n,
                                   double rim_min) {
   const ExactWarp exact;
   std::vector<WarpSample> a(static_cast<std::size_t>(n)), e(static_cast<std::size_t>(n));
@@ -44,7 +44,7 @@ inline WarpError compare_to_exact(const Warp& approx, WarpKind kind, const std::
   return out;
 }
 
-inline WarpError compare_to_exact(const Warp& approx, WarpKind kind, const Mat3& m, int n, double rim_min) {
+inline WarpError compare_to_exact(const Warp& approx, CentralDirection kind, const Mat3& m, int n, double rim_min) {
   return compare_to_exact(approx, kind, std::vector<Mat3>{m}, n, rim_min);
 }
 

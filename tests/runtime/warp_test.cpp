@@ -20,13 +20,13 @@ Mat3 random_frame(std::mt19937& rng) {
 
 TEST(Warp, WarpDirectionAgreesBitwiseWithCoreInverses) {
   for (const Vec3& d : random_directions(2000, 1)) {
-    const WarpSample m = warp_direction(WarpKind::Mirror, d);
+    const WarpSample m = warp_direction(CentralDirection::Mirror, d);
     const Vec2 core_m = sphere_map::g_mirror_inv(d);
     EXPECT_EQ(m.disc.x(), core_m.x());
     EXPECT_EQ(m.disc.y(), core_m.y());
     // rim = z of the half vector = sqrt(1 - |disc|^2) = sin(phi/2), phi = angle(d, -z).
     EXPECT_NEAR(m.rim, std::sin(0.5 * angle_between(d, Vec3(0, 0, -1))), 1e-12);
-    const WarpSample n = warp_direction(WarpKind::Normal, d);
+    const WarpSample n = warp_direction(CentralDirection::Normal, d);
     const Vec2 core_n = sphere_map::g_normal_inv(d);
     EXPECT_EQ(n.disc.x(), core_n.x());
     EXPECT_EQ(n.disc.y(), core_n.y());
@@ -35,13 +35,13 @@ TEST(Warp, WarpDirectionAgreesBitwiseWithCoreInverses) {
 }
 
 TEST(Warp, SingularDirectionsGiveAFixedRimPointWithZeroRim) {
-  const WarpSample m = warp_direction(WarpKind::Mirror, Vec3(0, 0, -1));
+  const WarpSample m = warp_direction(CentralDirection::Mirror, Vec3(0, 0, -1));
   EXPECT_EQ(m.disc, Vec2(0, -1));
   EXPECT_EQ(m.rim, 0.0);
-  const WarpSample n = warp_direction(WarpKind::Normal, Vec3(0, 0, -2));
+  const WarpSample n = warp_direction(CentralDirection::Normal, Vec3(0, 0, -2));
   EXPECT_EQ(n.disc, Vec2(0, -1));
   EXPECT_EQ(n.rim, -1.0);
-  const WarpSample z = warp_direction(WarpKind::Mirror, Vec3(0, 0, 0));
+  const WarpSample z = warp_direction(CentralDirection::Mirror, Vec3(0, 0, 0));
   EXPECT_TRUE(z.disc.allFinite());
   EXPECT_EQ(z.rim, 0.0);
 }
@@ -54,7 +54,7 @@ TEST(Warp, ExactWarpLandsWhereTheSourceShowsTheSameCentralDirection) {
   const int W = 48, H = 48;
   for (int trial = 0; trial < 20; ++trial) {
     const Mat3 T_d = random_frame(rng), T_s = random_frame(rng);
-    for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal}) {
+    for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal}) {
       for (int r = 0; r < H; ++r) {
         const auto [c0, c1] = disc_span(r, W, H);
         std::vector<WarpSample> out(std::size_t(std::max(0, c1 - c0)));
@@ -75,7 +75,7 @@ TEST(Warp, ExactWarpLandsWhereTheSourceShowsTheSameCentralDirection) {
 TEST(Warp, IdentityFrameMapsEveryTexelCentreToItself) {
   const ExactWarp warp;
   const int W = 64, H = 64;
-  for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal})
+  for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal})
     for (int r = 0; r < H; ++r) {
       const auto [c0, c1] = disc_span(r, W, H);
       std::vector<WarpSample> out(std::size_t(std::max(0, c1 - c0)));
@@ -109,7 +109,7 @@ TEST(Warp, PrecomputedWarpMatchesExactWarp) {
     double worst = 0;
     for (int trial = 0; trial < 10; ++trial) {
       const Mat3 M = random_frame(rng).transpose() * random_frame(rng);
-      for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal})
+      for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal})
         for (int r = 0; r < H; ++r) {
           const auto [c0, c1] = disc_span(r, W, H);
           std::vector<WarpSample> a(std::size_t(std::max(0, c1 - c0))), b(a.size());
@@ -122,14 +122,14 @@ TEST(Warp, PrecomputedWarpMatchesExactWarp) {
     }
     EXPECT_LE(worst, 1e-12) << W << "x" << H;  // same arithmetic: bitwise in practice
     std::vector<WarpSample> out(4);
-    EXPECT_THROW(pre.warp_row(WarpKind::Mirror, Mat3::Identity(), W + 2, H, 0, 0, 1, out.data()), std::invalid_argument);
+    EXPECT_THROW(pre.warp_row(CentralDirection::Mirror, Mat3::Identity(), W + 2, H, 0, 0, 1, out.data()), std::invalid_argument);
   }
 }
 
 TEST(Warp, UnknownWarpNameIsAnError) {
-  EXPECT_EQ(warp_kind_from_string("mirror"), WarpKind::Mirror);
-  EXPECT_EQ(warp_kind_from_string("normal"), WarpKind::Normal);
-  EXPECT_THROW(warp_kind_from_string("Mirror"), std::invalid_argument);
+  EXPECT_EQ(central_direction_from_string("mirror"), CentralDirection::Mirror);
+  EXPECT_EQ(central_direction_from_string("normal"), CentralDirection::Normal);
+  EXPECT_THROW(central_direction_from_string("Mirror"), std::invalid_argument);
 }
 
 }  // namespace
@@ -152,7 +152,7 @@ TEST(Warp, RowWarpAgreesWithWarpDirectionToFloatRounding) {
       const Mat3 M = random_frame(rng).transpose() * random_frame(rng);
       float m[9];
       for (int i = 0; i < 9; ++i) m[i] = float(M(i / 3, i % 3));
-      for (WarpKind kind : {WarpKind::Mirror, WarpKind::Normal})
+      for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal})
         for (int r = 0; r < H; ++r) {
           const auto [c0, c1] = disc_span(r, W, H);
           const int n = c1 - c0;
@@ -166,7 +166,7 @@ TEST(Warp, RowWarpAgreesWithWarpDirectionToFloatRounding) {
             const WarpSample s = warp_direction(kind, M * dir);
             worst_rim = std::max(worst_rim, std::abs(s.rim - rim[std::size_t(i)]));
             // Conditioning: d disc / d direction ~ 1 / (2 rim) (mirror), 1 / |n_xy| (normal behind).
-            const double cond = std::max(kind == WarpKind::Normal && s.rim < 0 ? (M * dir).head<2>().norm() : std::abs(s.rim), 1e-3);
+            const double cond = std::max(kind == CentralDirection::Normal && s.rim < 0 ? (M * dir).head<2>().norm() : std::abs(s.rim), 1e-3);
             worst_disc = std::max(worst_disc, cond * (s.disc - Vec2(dx[std::size_t(i)], dy[std::size_t(i)])).norm());
           }
           std::vector<float> ex(count), ey(count), er(count), px(count), py(count), pr(count);
