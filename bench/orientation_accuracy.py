@@ -128,7 +128,7 @@ def main():
         "|---|---|---|---|---|---|---|---|---|---|---|\n"
         + "\n".join(ring) + "\n\n"
         "(one seed each, noise 0.01, centres and radii refined.) With SIFT's keypoints as they are, 400 px and 12\n"
-        "views reach about the issue's 0.05 degrees (0.048-0.058 over three seeds): the keypoints' own noise, ~0.25 px.\n"
+        "views reach about the 0.05-degree target (0.048-0.058 over three seeds): the keypoints' own noise, ~0.25 px.\n"
         "Re-located by patch alignment, the tracks agree to a few hundredths of a pixel and the median error falls\n"
         "4-9x, the centres and radii to hundredths of a pixel, at honest sigmas; the alignment models a brightness\n"
         "gain, bias and ramp across the patch (the mirror's Fresnel grows toward the rim: without the ramp a shift\n"
