@@ -4,6 +4,7 @@
 // float. Not used by rsibr itself; kept so that the engine's speed-up is measured in the same run.
 #include "previous_blend.h"
 
+#include "core/avx2_clones.h"
 #include "core/sphere_map.h"
 #include "runtime/disc_sampler.h"
 
@@ -15,12 +16,6 @@
 #include <cstring>
 #include <string>
 #include <vector>
-
-#if defined(__x86_64__) && defined(__GNUC__)
-#define RSIBR_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define RSIBR_AVX2_CLONES
-#endif
 
 namespace rsibr::previous {
 

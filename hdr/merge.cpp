@@ -1,5 +1,6 @@
 #include "hdr/merge.h"
 
+#include "core/avx2_clones.h"
 #include "core/parallel.h"
 #include "hdr/bracket_statistics.h"
 #include "hdr/saturation_level.h"
@@ -9,14 +10,6 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-
-// Row kernels are also built for AVX2 and chosen at load time (x86-64 GCC; no FMA, so both builds
-// give the same bits).
-#if defined(__x86_64__) && defined(__GNUC__)
-#define RSIBR_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define RSIBR_AVX2_CLONES
-#endif
 
 namespace rsibr {
 namespace {

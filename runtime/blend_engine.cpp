@@ -1,6 +1,7 @@
 #include "runtime/blend_engine.h"
 
 #include "core/albedo_normalisation.h"
+#include "core/avx2_clones.h"
 #include "core/sphere_map.h"
 #include "runtime/disc_sampler.h"
 
@@ -14,14 +15,6 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
-
-// Vectorised row loops are also built for AVX2 and chosen at load time (x86-64 GCC/Clang; no FMA,
-// so both builds give the same bits).
-#if defined(__x86_64__) && defined(__GNUC__)
-#define RSIBR_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define RSIBR_AVX2_CLONES
-#endif
 
 namespace rsibr {
 

@@ -1,0 +1,10 @@
+// RSIBR_AVX2_CLONES: marks a vectorised row loop to be built twice, for AVX2 and for the baseline
+// x86-64, with the choice made at load time (GCC/Clang target_clones; elsewhere a single build).
+// No FMA in either clone, so both give the same bits.
+#pragma once
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define RSIBR_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define RSIBR_AVX2_CLONES
+#endif
