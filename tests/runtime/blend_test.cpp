@@ -538,6 +538,29 @@ void keep_worst(PathDifference& worst, const PathDifference& p) {
   worst.source_weight = std::max(worst.source_weight, p.source_weight);
 }
 
+// Tiny sources (2x2 up to 5x4): no interior at all, so every tap goes through the rim path, with
+// footprints whose taps are all outside the disc (sample_disc's inward steps) and destination sizes
+// unlike the sources'. Equal to the oracle up to float rounding, finite everywhere.
+TEST(Blend, TinySourcesTakeTheRimPathAndMatchTheDefinition) {
+  const ViewSet views = ViewSet::icosahedron();
+  double worst = 0;
+  for (const auto& [w, h] : {std::pair{2, 2}, std::pair{3, 3}, std::pair{5, 4}})
+    for (const char* warp : {"mirror", "normal"}) {
+      const MapSet set = analytic_map_set(views, w, h, warp, warp[0] == 'm' ? TexelFunction(fresnel_mirror_texel)
+                                                                          : TexelFunction(lambert_texel));
+      for (const Vec3& d : random_directions(4, 17)) {
+        BlendOptions o;
+        o.width = 17;
+        o.height = 13;
+        const PathDifference p = path_difference(set, views, d, Vec3(0, 1, 0), o);
+        worst = std::max({worst, p.colour, p.weight});
+        expect_sane(blend(set, views, d, Vec3(0, 1, 0), o), set, std::to_string(w) + "x" + std::to_string(h));
+      }
+    }
+  std::printf("[ tiny sources vs oracle ] worst colour or weight difference %.2e\n", worst);
+  EXPECT_LE(worst, 1e-4);
+}
+
 // The engine warps, taps and sums in float: its disc points are the double ones to ~3e-7 disc units
 // (~1e-7 relative, times 1/rim near a source's singularity), i.e. ~2e-5 texel at 129^2, so the
 // differences are that shift times the maps' change per texel. Smooth maps (the analytic sets)
