@@ -19,7 +19,7 @@
 //                occlusion included, and none of the pipeline's errors): the grey maps against that
 //                run's, per view after the gain fit: the pipeline's own error
 #include "calib/pose_file.h"
-#include "core/map_compare.h"
+#include "compare/map_compare.h"
 #include "core/map_set.h"
 #include "hdr/vignetting.h"
 #include "pipeline/pose_input.h"

@@ -12,7 +12,7 @@
 //   probe_ratio[c]          int probe.exr / (u_c int L_true), per channel (1: the light is all there)
 //   measured_ratio[c]       the same for probe-measured.exr (before the recovery)
 //   computed_vs_truth       computed grey maps / u against the true grey maps: relative RMS after
-//                           the global gain fit (core/map_compare.h) and without it (calibrated)
+//                           the global gain fit (compare/map_compare.h) and without it (calibrated)
 //   sun                     the truth's brightest source (its power-weighted centroid within 3
 //                           degrees of the brightest texel; `power` there) and the most powerful
 //                           recovered source: angle (degrees) and its sigma; `needed`, the truth
@@ -25,7 +25,7 @@
 #include "capture/synth_capture.h"
 #include "capture/synth_scene.h"
 #include "core/exr_io.h"
-#include "core/map_compare.h"
+#include "compare/map_compare.h"
 #include "core/map_set.h"
 #include "core/truth_image.h"
 

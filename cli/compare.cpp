@@ -6,9 +6,9 @@
 
 #include "core/atomic_file.h"
 #include "core/atomic_folder.h"
-#include "core/compare_pictures.h"
+#include "compare/compare_pictures.h"
 #include "core/exr_io.h"
-#include "core/map_compare.h"
+#include "compare/map_compare.h"
 #include "core/output_plan.h"
 #include "core/preview_exposure.h"
 #include "core/progress.h"

@@ -2,7 +2,7 @@
 
 #include "core/atomic_file.h"
 #include "core/colour.h"
-#include "core/compare_pictures.h"
+#include "compare/compare_pictures.h"
 #include "core/exr_io.h"
 #include "core/preview_exposure.h"
 #include "core/text.h"

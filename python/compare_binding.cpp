@@ -1,8 +1,8 @@
-// Comparing two map sets or two environments (core/map_compare.h): the numbers `rsibr compare` reports.
+// Comparing two map sets or two environments (compare/map_compare.h): the numbers `rsibr compare` reports.
 #include "python/bindings.h"
 #include "python/numpy_mat.h"
 
-#include "core/map_compare.h"
+#include "compare/map_compare.h"
 
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>

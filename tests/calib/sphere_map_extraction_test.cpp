@@ -1,11 +1,11 @@
 // calib/sphere_map_extraction.h: extracted sphere maps against the true maps of capture/
-// (core/map_compare.h), the reflection solve against the law of reflection, the confidence channel.
+// (compare/map_compare.h), the reflection solve against the law of reflection, the confidence channel.
 #include "calib/sphere_map_extraction.h"
 
 #include "calib/ball_locator.h"
 #include "calib_cases.h"
 #include "capture/true_sphere_map.h"
-#include "core/map_compare.h"
+#include "compare/map_compare.h"
 #include "core/sphere_map.h"
 
 #include <gtest/gtest.h>

@@ -11,7 +11,7 @@
 #include "capture/synth_capture.h"
 #include "capture/synth_scene.h"
 #include "core/exr_io.h"
-#include "core/map_compare.h"
+#include "compare/map_compare.h"
 #include "core/map_set.h"
 #include "pipeline/step_record.h"
 

@@ -10,7 +10,7 @@
 #include "capture/synth_capture.h"
 #include "capture/synth_scene.h"
 #include "core/exr_io.h"
-#include "core/map_compare.h"
+#include "compare/map_compare.h"
 #include "core/map_set.h"
 #include "core/resample.h"
 #include "calib/pose_file.h"

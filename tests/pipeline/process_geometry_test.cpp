@@ -12,7 +12,7 @@
 #include "calib/pose_file.h"
 #include "capture/synth_capture.h"
 #include "capture/synth_scene.h"
-#include "core/map_compare.h"
+#include "compare/map_compare.h"
 #include "core/map_set.h"
 #include "hdr/vignetting.h"
 #include "pipeline/pose_input.h"

@@ -1,4 +1,4 @@
-#include "core/gain_fit.h"
+#include "compare/gain_fit.h"
 
 #include <gtest/gtest.h>
 

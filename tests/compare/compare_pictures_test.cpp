@@ -1,4 +1,4 @@
-#include "core/compare_pictures.h"
+#include "compare/compare_pictures.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "core/map_compare.h"
+#include "compare/map_compare.h"
 
 #include "core/sphere_map.h"
 

@@ -6,7 +6,7 @@
 //   residual_pc = ln(g_c a'_pc + eps) - ln(b'_pc + eps),   x' = max(x, 0),   g_c = exp(theta_c)
 //   cost        = sum_p (w_p / mean w) rho( sum_c residual_pc^2 ),   rho(s) = k^2 ln(1 + s / k^2)
 // The log residual weighs a dark and a bright texel alike (HDR); eps is the log error's
-// (core/image_error.h). On noiseless data (b = g* a) every residual vanishes at g = g*, so the fit
+// (compare/image_error.h). On noiseless data (b = g* a) every residual vanishes at g = g*, so the fit
 // recovers g* to the solver's tolerance. theta starts at each channel's weighted median of
 // ln(b/a) over texels where both are positive (robust already, and right even when A is many
 // stops off B, where eps would flatten the cost); the loss then refines it.

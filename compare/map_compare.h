@@ -7,13 +7,13 @@
 // (bilinear; texels whose taps leave B's disc get no weight). Texel weights: sphere maps count the texels whose centres lie
 // inside the unit disc (image-plane area, as the camera sees the ball), times the confidence of
 // each map that has one (captured maps); environments in other layouts weigh texels by solid
-// angle. Metrics (core/image_error.h) per pair and pooled over all pairs, before and after the
-// global gain fit (core/gain_fit.h); the log error's eps and the PSNR's peak are the same for all.
+// angle. Metrics (compare/image_error.h) per pair and pooled over all pairs, before and after the
+// global gain fit (compare/gain_fit.h); the log error's eps and the PSNR's peak are the same for all.
 #pragma once
 
 #include "core/env_map.h"
-#include "core/gain_fit.h"
-#include "core/image_error.h"
+#include "compare/gain_fit.h"
+#include "compare/image_error.h"
 #include "core/map_set.h"
 
 #include <optional>
