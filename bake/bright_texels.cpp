@@ -111,16 +111,16 @@ const BrightClusterLevel* cluster_level_for(const EnvironmentSplit& split, doubl
   return level;
 }
 
-Vec3 bright_texel_radiance(const Brdf& brdf, const Vec3& wo, const Mat3& frame, const EnvironmentSplit& split,
+Vec3 bright_texel_radiance(const Brdf& brdf, const shading::Frame& frame, const Vec3& wo, const EnvironmentSplit& split,
                            const Layout& cells) {
   const std::vector<BrightTexel>& bright = split.bright;
   if (bright.empty()) return Vec3::Zero();
-  const Vec3 n = frame.col(2);
+  const Vec3 n = frame.normal();
   const double lobe = std::max(brdf.lobe_width(wo), 1e-6);
   Vec3 sum = Vec3::Zero();
   if (const BrightClusterLevel* level = cluster_level_for(split, lobe)) {
     for (const BrightCluster& cl : level->clusters) {
-      const Vec3 wi = frame.transpose() * cl.dir;
+      const Vec3 wi = frame.to_local(cl.dir);
       if (wi.z() > 0) sum += brdf.eval(wo, wi).cwiseProduct(cl.power);
     }
     return sum;
@@ -134,7 +134,7 @@ Vec3 bright_texel_radiance(const Brdf& brdf, const Vec3& wo, const Mat3& frame, 
     for (int i = 0; i < k; ++i)
       for (int j = 0; j < k; ++j) {
         const Vec3 w = k == 1 ? centre : latlong_cell_direction(cells, b.texel, Vec2((i + 0.5) / k, (j + 0.5) / k));
-        const Vec3 wi = frame.transpose() * w;
+        const Vec3 wi = frame.to_local(w);
         if (wi.z() > 0) cell += brdf.eval(wo, wi);
       }
     sum += b.radiance.cwiseProduct(cell) * (b.solid_angle / (k * k));

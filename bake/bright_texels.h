@@ -28,6 +28,7 @@
 
 #include "bake/brdf.h"
 #include "bake/environment_distribution.h"
+#include "bake/shading_frame.h"
 #include "core/env_map.h"
 
 #include <vector>
@@ -76,12 +77,12 @@ EnvironmentSplit split_bright_texels(const EnvMap& latlong, const BrightTexelOpt
 const BrightClusterLevel* cluster_level_for(const EnvironmentSplit& split, double lobe_width);
 
 // The first term of the split for one map texel: with the coarsest cluster level allowed by the
-// lobe width at wo, sum over clusters of eval(wo, frame^T dir) * power (clusters whose centroid is
+// lobe width at wo, sum over clusters of eval(wo, frame.to_local(dir)) * power (clusters whose centroid is
 // below the horizon contribute 0); without one, sum over the bright texels of
-// L(q) int_{cell q} eval(wo, frame^T w) dw by a k x k midpoint rule per cell,
+// L(q) int_{cell q} eval(wo, frame.to_local(w)) dw by a k x k midpoint rule per cell,
 // k = clamp(ceil(4 * angular_size / lobe_width(wo)), 1, 8), cells entirely below the horizon
-// skipped. frame has columns (t, b, n); `cells` is the lat-long layout the texels belong to.
-Vec3 bright_texel_radiance(const Brdf& brdf, const Vec3& wo, const Mat3& frame, const EnvironmentSplit& split,
+// skipped. frame: around the normal n; `cells` is the lat-long layout the texels belong to.
+Vec3 bright_texel_radiance(const Brdf& brdf, const shading::Frame& frame, const Vec3& wo, const EnvironmentSplit& split,
                            const Layout& cells);
 
 }  // namespace rsibr

@@ -32,18 +32,20 @@ cv::Mat FilteredImportanceIntegrator::radiance_map(const Brdf& brdf, const Vec3&
   for (int i = 0; i < n; ++i) points[std::size_t(i)] = integrator_detail::rotated_hammersley(i, n, shift);
   return integrator_detail::for_each_texel(
       size, view, world_from_view, options.texel_mask,
-      [&](long, const Vec3&, const Mat3& frame, const Vec3& wo) {
+      [&](long, const integrator_detail::TexelFrame& t) {
+        const shading::Frame& frame = t.frame;
+        const Vec3& wo = t.wo;
         Vec3 sum = Vec3::Zero();
         float L[kMaxChannels];
         for (const Vec2& u : points) {
           const BrdfSample s = brdf.sample(wo, u);
           if (!s.valid || !(s.pdf > 0)) continue;
-          const Vec3 w = frame * s.wi;
+          const Vec3 w = frame.to_world(s.wi);
           const double lod = pyramid_.lod_for_solid_angle(w, 1.0 / (n * s.pdf)) + options.fis_lod_bias;
           pyramid_.sample(w, lod, L);
           sum += s.weight.cwiseProduct(Vec3(L[0], L[1], L[2]));
         }
-        return Vec3(sum / n + bright_texel_radiance(brdf, wo, frame, split_, latlong_));
+        return Vec3(sum / n + bright_texel_radiance(brdf, frame, wo, split_, latlong_));
       },
       progress);
 }

@@ -26,16 +26,14 @@ namespace integrator_detail {
 std::optional<TexelFrame> texel_frame(int c, int r, int size, const Vec3& view, const Mat3& world_from_view) {
   const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), size, size);
   if (!(xy.squaredNorm() < 1.0)) return std::nullopt;  // centre outside the disc: 0
-  TexelFrame t;
-  t.n = (world_from_view * sphere_map::g_normal(xy)).normalized();
-  t.frame = shading::frame_around(t.n);
-  t.wo = t.frame.transpose() * view.normalized();
-  if (!(t.wo.z() > 0)) return std::nullopt;  // viewer on or below the local horizon (the rim): 0
-  return t;
+  const shading::Frame frame = shading::Frame::around((world_from_view * sphere_map::g_normal(xy)).normalized());
+  const Vec3 wo = frame.to_local(view.normalized());
+  if (!(wo.z() > 0)) return std::nullopt;  // viewer on or below the local horizon (the rim): 0
+  return TexelFrame{frame, wo};
 }
 
 cv::Mat for_each_texel(int size, const Vec3& view, const Mat3& world_from_view, const cv::Mat& mask,
-                       const std::function<Vec3(long, const Vec3&, const Mat3&, const Vec3&)>& texel,
+                       const std::function<Vec3(long, const TexelFrame&)>& texel,
                        const std::function<void(int)>& progress) {
   if (size < 1) throw std::invalid_argument("radiance map size must be >= 1");
   if (!mask.empty() && (mask.type() != CV_8UC1 || mask.rows != size || mask.cols != size))
@@ -50,7 +48,7 @@ cv::Mat for_each_texel(int size, const Vec3& view, const Mat3& world_from_view, 
       if (keep && !keep[c]) continue;
       const auto t = texel_frame(c, r, size, v, world_from_view);
       if (!t) continue;
-      const Vec3 L = texel(long(r) * size + c, t->n, t->frame, t->wo);
+      const Vec3 L = texel(long(r) * size + c, *t);
       for (int k = 0; k < 3; ++k) row[3 * c + k] = float(L[k]);
     }
     const int done = ++rows_done;

@@ -9,7 +9,7 @@
 //   L_o = int_S2 L_i(w) f_r(v, w) max(0, n.w) dw  =  int_S2 L_i(w) eval(wo, wi) dw
 //
 // where L_i(w) is the environment radiance arriving FROM w, and wo = B^T v, wi = B^T w are v and
-// w in the local frame B = shading::frame_around(n) (n = +z, as bake/brdf.h wants; eval includes
+// w in the local frame B = shading::Frame::around(n) (n = +z, as bake/brdf.h wants; eval includes
 // the cosine). Texels whose centre is outside the disc are 0. When the viewer is on or below the
 // local horizon (wo.z <= 0, which happens only exactly at the rim) the texel is 0 by definition.
 //
@@ -20,6 +20,7 @@
 #pragma once
 
 #include "bake/brdf.h"
+#include "bake/shading_frame.h"
 #include "core/env_map.h"
 
 #include <opencv2/core.hpp>
@@ -95,9 +96,8 @@ class TexelRng {
 // The local frame of texel (c, r) of a size x size map: nullopt when the texel is 0 by contract
 // (centre outside the disc, or the viewer on or below the local horizon).
 struct TexelFrame {
-  Vec3 n;      // world normal
-  Mat3 frame;  // columns (t, b, n): local = frame^T world
-  Vec3 wo;     // the view in the local frame
+  shading::Frame frame;  // around the texel's world normal
+  Vec3 wo;               // the view in the local frame (wo.z > 0)
 };
 std::optional<TexelFrame> texel_frame(int c, int r, int size, const Vec3& view, const Mat3& world_from_view);
 
@@ -155,12 +155,12 @@ inline Vec2 rotated_hammersley(int i, int n, const Vec2& shift) {
   return u;
 }
 
-// Runs texel(index, n_world, frame, wo_local) -> RGB over every texel of a size x size map whose
-// centre is inside the disc and whose wo is above the local horizon; others stay 0. frame has
-// columns (t, b, n): local = frame^T world. Rows in parallel; result independent of the split.
+// Runs texel(index, frame) -> RGB over every texel of a size x size map whose centre is inside the
+// disc and whose wo is above the local horizon; others stay 0. Rows in parallel; result
+// independent of the split.
 // Texels where `mask` (IntegratorOptions::texel_mask) is zero are skipped.
 cv::Mat for_each_texel(int size, const Vec3& view, const Mat3& world_from_view, const cv::Mat& mask,
-                       const std::function<Vec3(long, const Vec3&, const Mat3&, const Vec3&)>& texel,
+                       const std::function<Vec3(long, const TexelFrame&)>& texel,
                        const std::function<void(int)>& progress);
 
 }  // namespace integrator_detail

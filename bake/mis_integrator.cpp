@@ -31,7 +31,9 @@ cv::Mat MisIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Ma
   const int n = options.samples;
   return integrator_detail::for_each_texel(
       size, view, world_from_view, options.texel_mask,
-      [&](long index, const Vec3&, const Mat3& frame, const Vec3& wo) {
+      [&](long index, const integrator_detail::TexelFrame& t) {
+        const shading::Frame& frame = t.frame;
+        const Vec3& wo = t.wo;
         // Stratified: a Hammersley set per sampler, rotated by the texel's own random shifts.
         integrator_detail::TexelRng rng(options.seed, std::uint64_t(index));
         const Vec2 shift_b = rng.uniform2(), shift_e = rng.uniform2();
@@ -40,14 +42,14 @@ cv::Mat MisIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Ma
           // BRDF sample: f = weight * pdf (sample() has evaluated it already).
           const BrdfSample b = brdf.sample(wo, integrator_detail::rotated_hammersley(i, n, shift_b));
           if (b.valid) {
-            const long t = dist_.texel_of(frame * b.wi);
-            const double pe = dist_.texel_pdf(t);
-            sum += (b.weight * b.pdf).cwiseProduct(radiance_[std::size_t(t)]) / (b.pdf + pe);
+            const long q = dist_.texel_of(frame.to_world(b.wi));
+            const double pe = dist_.texel_pdf(q);
+            sum += (b.weight * b.pdf).cwiseProduct(radiance_[std::size_t(q)]) / (b.pdf + pe);
           }
           // Environment sample.
           const EnvironmentDistribution::Sample e = dist_.sample(integrator_detail::rotated_hammersley(i, n, shift_e));
           if (e.pdf > 0) {
-            const Vec3 wi = frame.transpose() * e.dir;
+            const Vec3 wi = frame.to_local(e.dir);
             if (wi.z() > 0) {
               double pb = 0;
               const Vec3 f = brdf.eval_pdf(wo, wi, &pb);
@@ -55,7 +57,7 @@ cv::Mat MisIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Ma
             }
           }
         }
-        return Vec3(sum / n + bright_texel_radiance(brdf, wo, frame, split_, env_.layout));
+        return Vec3(sum / n + bright_texel_radiance(brdf, frame, wo, split_, env_.layout));
       },
       progress);
 }

@@ -31,7 +31,7 @@ BrdfSample PhongBrdf::sample(const Vec3& wo, const Vec2& u) const {
   Sample s;
   if (!(wo.z() > 0)) return s;
   const Vec3 r = mirror_of(wo).normalized();
-  s.wi = (shading::frame_around(r) * warp::square_to_power_cosine(u, e_)).normalized();
+  s.wi = (shading::Frame::around(r).to_world(warp::square_to_power_cosine(u, e_))).normalized();
   s.pdf = pdf(wo, s.wi);
   s.valid = s.wi.z() > 0 && s.pdf > 0;
   if (s.valid) s.weight = rho_ * ((e_ + 2.0) / (e_ + 1.0) * s.wi.z());

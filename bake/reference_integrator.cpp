@@ -47,11 +47,12 @@ cv::Mat ReferenceIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, co
   const std::vector<Texel>& texels = level_for(options.reference_width);
   return integrator_detail::for_each_texel(
       size, view, world_from_view, options.texel_mask,
-      [&](long, const Vec3& n, const Mat3& frame, const Vec3& wo) {
+      [&](long, const integrator_detail::TexelFrame& f) {
+        const Vec3 n = f.frame.normal();
         Vec3 sum = Vec3::Zero();
         for (const Texel& t : texels) {
           if (!(n.dot(t.dir) > 0)) continue;
-          sum += brdf.eval(wo, frame.transpose() * t.dir).cwiseProduct(t.radiance);
+          sum += brdf.eval(f.wo, f.frame.to_local(t.dir)).cwiseProduct(t.radiance);
         }
         return sum;
       },

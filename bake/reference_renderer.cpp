@@ -60,7 +60,7 @@ namespace {
 struct Surface {
   Vec3 x;      // position (world)
   Vec3 ng;     // geometric normal turned toward the viewer (world, unit)
-  Mat3 frame;  // columns (t, b, n): local = frame^T world
+  shading::Frame frame;  // around the shading normal
   Vec3 wo;     // v in the local frame; wo.z >= kMinViewCosine except when n had to fall back to n_g
 };
 
@@ -82,8 +82,8 @@ Surface surface_at(const RayScene& scene, const RayHit& hit, const Vec3& v) {
       n = s.ng;
     n.normalize();
   }
-  s.frame = shading::frame_around(n);
-  s.wo = s.frame.transpose() * v;
+  s.frame = shading::Frame::around(n);
+  s.wo = s.frame.to_local(v);
   return s;
 }
 
@@ -161,7 +161,7 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
           };
           if (level) {
             for (const BrightCluster& cl : level->clusters) {
-              const Vec3 wi = S.frame.transpose() * cl.dir;
+              const Vec3 wi = S.frame.to_local(cl.dir);
               if (!(wi.z() > 0)) continue;
               const Vec3 f = brdf.eval(S.wo, wi);
               if (f == Vec3::Zero()) continue;
@@ -193,7 +193,7 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
             // BRDF sample: L(w) eval / (p_b + p_e).
             const BrdfSample b = brdf.sample(S.wo, ub);
             if (b.valid) {
-              const Vec3 w = S.frame * b.wi;
+              const Vec3 w = S.frame.to_world(b.wi);
               bool escapes = true;
               if (shadows) {
                 if (w.dot(S.ng) <= 0) {
@@ -222,7 +222,7 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
             // Environment sample: L(w) eval / (p_b + p_e).
             const EnvironmentDistribution::Sample e = dist.sample(ue);
             if (e.pdf > 0) {
-              const Vec3 wi = S.frame.transpose() * e.dir;
+              const Vec3 wi = S.frame.to_local(e.dir);
               if (wi.z() > 0) {
                 const Vec3 f = brdf.eval(S.wo, wi);
                 if (f != Vec3::Zero()) {

@@ -46,7 +46,7 @@ cv::Mat ShIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Mat
   const Vec3 rho = lambert->rho();
   return integrator_detail::for_each_texel(
       size, view, world_from_view, options.texel_mask,
-      [&](long, const Vec3& n, const Mat3&, const Vec3&) { return Vec3(rho.cwiseProduct(irradiance(n)) / kPi); },
+      [&](long, const integrator_detail::TexelFrame& t) { return Vec3(rho.cwiseProduct(irradiance(t.frame.normal())) / kPi); },
       progress);
 }
 

@@ -24,19 +24,32 @@ inline Vec3 half_vector_up(const Vec3& wo, const Vec3& wi) {
   return h.z() < 0 ? Vec3(-h) : h;
 }
 
-// Orthonormal basis (columns t, b, a) with third column the unit axis a (Duff et al. 2017,
-// "Building an orthonormal basis, revisited"): continuous except across a.z = 0 sign flips,
-// exact for a = +-z.
-inline Mat3 frame_around(const Vec3& a) {
-  const double sign = std::copysign(1.0, a.z());
-  const double p = -1.0 / (sign + a.z());
-  const double q = a.x() * a.y() * p;
-  Mat3 m;
-  m.col(0) = Vec3(1.0 + sign * a.x() * a.x() * p, sign * q, -sign * a.x());
-  m.col(1) = Vec3(q, sign + a.y() * a.y() * p, -a.y());
-  m.col(2) = a;
-  return m;
-}
+// A shading basis: the rotation whose columns are (t, b, n), n the unit normal (the local +z that
+// bake/brdf.h wants). to_local(world) = [t b n]^T world; to_world is its inverse. Built by
+// Frame::around (Duff et al. 2017, "Building an orthonormal basis, revisited"): continuous except
+// where n.z changes sign, exact for n = +-z.
+class Frame {
+ public:
+  Frame() = default;  // the identity: around(+z)
+  static Frame around(const Vec3& n) {
+    const double sign = std::copysign(1.0, n.z());
+    const double p = -1.0 / (sign + n.z());
+    const double q = n.x() * n.y() * p;
+    Mat3 m;
+    m.col(0) = Vec3(1.0 + sign * n.x() * n.x() * p, sign * q, -sign * n.x());
+    m.col(1) = Vec3(q, sign + n.y() * n.y() * p, -n.y());
+    m.col(2) = n;
+    return Frame(m);
+  }
+  Vec3 to_local(const Vec3& world) const { return world_from_local_.transpose() * world; }
+  Vec3 to_world(const Vec3& local) const { return world_from_local_ * local; }
+  Vec3 normal() const { return world_from_local_.col(2); }
+  const Mat3& world_from_local() const { return world_from_local_; }
+
+ private:
+  explicit Frame(const Mat3& world_from_local) : world_from_local_(world_from_local) {}
+  Mat3 world_from_local_ = Mat3::Identity();
+};
 
 // Unit direction from (cos theta, phi) about +z; cos theta is clamped to [-1, 1].
 inline Vec3 spherical_direction(double cos_t, double phi) {

@@ -71,15 +71,15 @@ Vec3 glossy_kernel(const Texel& t, const Vec3& d, double rho) {
   // A mirror lobe far from the disc (more than 4 lobe widths past its edge): its tail, below 1e-3
   // of the highlight for the BRDFs of bake/, is left out.
   if (t.lobe > 0 && angle_between(t.mirror, d) > rho + 4 * t.lobe) return Vec3::Zero();
-  const Mat3 frame = shading::frame_around(t.n);
-  const Vec3 wo = frame.transpose() * t.v;
+  const shading::Frame frame = shading::Frame::around(t.n);
+  const Vec3 wo = frame.to_local(t.v);
   if (!(wo.z() > 0)) return Vec3::Zero();
   const double lobe = std::max(t.lobe > 0 ? t.lobe : t.brdf->lobe_width(wo), 1e-4);
   const int rings = std::clamp(int(std::ceil(2 * rho / lobe)), 1, 4);
   const std::vector<Vec3> pts = light_kernels::cap_points(d, rho, rings);
   Vec3 sum = Vec3::Zero();
   for (const Vec3& w : pts) {
-    const Vec3 wi = frame.transpose() * w;
+    const Vec3 wi = frame.to_local(w);
     if (wi.z() > 0) sum += t.brdf->eval(wo, wi);
   }
   return sum / double(pts.size());
@@ -412,8 +412,7 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
             t.brdf = brdf;
             t.mirror = 2 * t.n.dot(t.v) * t.n - t.v;
             if (brdf->central_direction() == CentralDirection::Mirror) {
-              const Mat3 frame = shading::frame_around(t.n);
-              t.lobe = brdf->lobe_width(frame.transpose() * t.v);
+              t.lobe = brdf->lobe_width(shading::Frame::around(t.n).to_local(t.v));
             }
           } else {
             t.gain = albedo / kPi;

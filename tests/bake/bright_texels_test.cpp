@@ -80,7 +80,7 @@ TEST(BrightTexels, QuadratureAgreesWithTheReferenceOverTheBrightTexels) {
       for (int c = 0; c < size; ++c) {
         const auto t = integrator_detail::texel_frame(c, r, size, view, T);
         if (!t) continue;
-        const Vec3 L = bright_texel_radiance(*brdf, t->wo, t->frame, split, env.layout);
+        const Vec3 L = bright_texel_radiance(*brdf, t->frame, t->wo, split, env.layout);
         got.at<cv::Vec3f>(r, c) = cv::Vec3f(float(L[0]), float(L[1]), float(L[2]));
       }
     const double err = test::relative_rms(got, ref);

@@ -302,15 +302,15 @@ TEST(ReferenceRenderer, SameSeedSameBytesWhateverTheThreadCount) {
 
 // Texel quadrature of int L_i eval dw at normal n seen from v (environment texel centres).
 Vec3 quadrature(const EnvMap& env, const Brdf& brdf, const Vec3& n, const Vec3& v) {
-  const Mat3 B = shading::frame_around(n);
-  const Vec3 wo = B.transpose() * v;
+  const shading::Frame B = shading::Frame::around(n);
+  const Vec3 wo = B.to_local(v);
   const cv::Mat omega = texel_solid_angles(env.layout);
   Vec3 sum = Vec3::Zero();
   for (int r = 0; r < env.layout.height(); ++r)
     for (int c = 0; c < env.layout.width(); ++c) {
       const std::optional<Vec3> w = env.layout.texel_direction(c, r);
       if (!w) continue;
-      const Vec3 wi = B.transpose() * *w;
+      const Vec3 wi = B.to_local(*w);
       if (wi.z() <= 0) continue;
       sum += brdf.eval(wo, wi).cwiseProduct(at3(env.pixels, r, c)) * omega.at<double>(r, c);
     }
