@@ -103,7 +103,7 @@ Runner add_blend(CLI::App& app) {
             "(each with its own mirror or normal warp), fades each near its singularity and normalises per "
             "texel. The output is a one-view map set; its confidence channel is the blend's total weight.\n"
             "Example: rsibr blend maps.exr novel.exr --view 0.3 0.5 0.8 --preview novel.png");
-  c->add_option("maps", a->maps, "Map set (.exr)")->required()->check(CLI::ExistingFile);
+  c->add_option("maps", a->maps, "Map set (.exr)")->required();
   c->add_option("output", a->output, "Output one-view map set (.exr)")->required();
   c->add_option("--view", a->view, "View direction (world, toward the viewer)")->expected(3);
   c->add_option("--up", a->up, "Up hint for the view frame (world)")->expected(3);

@@ -2,6 +2,7 @@
 
 #include "cli/verbs.h"
 #include "cluster/session.h"
+#include "core/file_error.h"
 #include "core/output_plan.h"
 
 #include <tbb/global_control.h>
@@ -102,8 +103,9 @@ CommandResult run_command_line(const std::vector<std::string>& args) {
   try {
     app.parse(int(argv.size()), argv.data());
   } catch (const CLI::ParseError& e) {
-    if (!speaks) return {e.get_exit_code(), ""};
-    const int code = app.exit(e);
+    // CLI11's own exit codes (100 and up, one per kind of parse error) become 2: the command is refused.
+    if (!speaks) return {e.get_exit_code() == 0 ? 0 : 2, ""};
+    const int code = app.exit(e) == 0 ? 0 : 2;
     return {code, code == 0 ? std::string() : parse_failure};
   }
   std::optional<tbb::global_control> thread_limit;
@@ -115,10 +117,18 @@ CommandResult run_command_line(const std::vector<std::string>& args) {
     if (session.size() > 1 && name != "bake" && name != "batch")
       return fail(2, "rsibr " + name + ": error: runs as one process, not over " + std::to_string(session.size()) +
                          " MPI ranks (only bake and batch are split over ranks; run it without mpirun)");
+    // Exit status: 2 when the command is refused (the command line, or an input that is missing,
+    // unreadable or inconsistent: the caller's to fix), 1 when the work failed (an output that
+    // cannot be written, a solve that does not converge, anything else).
+    const std::string who = "rsibr " + name + ": error: ";
     try {
       return {run(), ""};
+    } catch (const FileError& e) {
+      return fail(e.role() == FileRole::Input ? 2 : 1, who + OutputPlan::naming_targets(e.what()));
+    } catch (const std::invalid_argument& e) {
+      return fail(2, who + OutputPlan::naming_targets(e.what()));
     } catch (const std::exception& e) {
-      return fail(1, "rsibr " + name + ": error: " + OutputPlan::naming_targets(e.what()));
+      return fail(1, who + OutputPlan::naming_targets(e.what()));
     }
   }
   return {2, ""};

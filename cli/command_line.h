@@ -12,8 +12,9 @@ struct CommandResult {
 };
 
 // args: the words after "rsibr" (a verb and its options, or a global option such as --help).
-// Prints what the verb prints; an error is one line on standard error (exit code 1, or 2 for a
-// command line that does not parse). Under more than one MPI rank only `bake` and `batch` run
+// Prints what the verb prints; an error is one line on standard error. Exit status 2: the command
+// is refused (a command line that does not parse, an option value or an input file that is
+// missing, unreadable or inconsistent); 1: the work failed (an output, a solve, anything else). Under more than one MPI rank only `bake` and `batch` run
 // (cluster/session.h), and only the root prints errors.
 CommandResult run_command_line(const std::vector<std::string>& args);
 

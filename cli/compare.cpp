@@ -9,6 +9,7 @@
 #include "compare/compare_pictures.h"
 #include "core/exr_io.h"
 #include "compare/map_compare.h"
+#include "core/input_file.h"
 #include "core/output_plan.h"
 #include "core/preview_exposure.h"
 #include "core/progress.h"
@@ -78,6 +79,9 @@ int run_compare(const CompareArgs& a) {
   o.fit_options.loss_scale = a.loss_scale;
   o.fit_options.max_texels = a.fit_texels;
 
+  // A missing or unreadable input is named as such, before either is classified.
+  require_regular_file(a.a);
+  require_regular_file(a.b);
   const bool set_a = is_map_set_file(a.a), set_b = is_map_set_file(a.b);
   if (set_a != set_b)
     throw std::invalid_argument((set_a ? a.b : a.a) + ": is an environment but " + (set_a ? a.a : a.b) +
@@ -251,8 +255,8 @@ Runner add_compare(CLI::App& app) {
       "bar) and contact.png, all or nothing. Exit status: 0 done, 3 when --fail-above is exceeded, other "
       "non-zero values on errors.\n"
       "Example: rsibr compare captured.exr computed.exr --out cmp --json cmp.json");
-  c->add_option("a", a->a, "Map set or environment A (e.g. captured)")->required()->check(CLI::ExistingFile);
-  c->add_option("b", a->b, "Map set or environment B, the reference (e.g. computed)")->required()->check(CLI::ExistingFile);
+  c->add_option("a", a->a, "Map set or environment A (e.g. captured)")->required();
+  c->add_option("b", a->b, "Map set or environment B, the reference (e.g. computed)")->required();
   c->add_option("--out", a->out, "Folder for the pictures (created if missing; its parent must exist)");
   c->add_option("--json", a->json, "Write the metrics as JSON to FILE ('-' for stdout)");
   c->add_flag("--no-fit", a->no_fit, "Skip the exposure / white-balance fit (after = before)");

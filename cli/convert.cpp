@@ -123,7 +123,7 @@ Runner add_convert(CLI::App& app) {
       "centre), sphere (mirror ball seen from +Z). Shrinking is area-weighted (no aliasing); enlarging is "
       "bilinear. The solid-angle-weighted integral of the input and output is reported.\n"
       "Example: rsibr convert sky.exr sky-cube.exr --to cube --size 256 --preview sky-cube.png");
-  c->add_option("input", a->input, "Environment map (.exr, or Radiance .hdr)")->required()->check(CLI::ExistingFile);
+  c->add_option("input", a->input, "Environment map (.exr, or Radiance .hdr)")->required();
   c->add_option("output", a->output, "Output .exr (written atomically; never the input)")->required();
   c->add_option("--to", a->to, "Target layout: latlong, cube, octahedral or sphere")->required();
   c->add_option("--size", a->size,

@@ -190,7 +190,7 @@ Runner add_info(CLI::App& app) {
   CLI::App* c = app.add_subcommand("info", "Show the header and a value summary of an environment map or a map set");
   c->footer("For an environment: layout, channels, compression, colour, per-channel range, NaN/Inf/negative counts, "
             "mean radiance, peak and dynamic range. For a map set: views, frames, warp, source, material.");
-  c->add_option("input", a->input, "Environment (.exr, .hdr) or map set (.exr)")->required()->check(CLI::ExistingFile);
+  c->add_option("input", a->input, "Environment (.exr, .hdr) or map set (.exr)")->required();
   c->add_option("--layout", a->layout, "Layout of an environment whose header and shape do not tell");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   return [a] {

@@ -17,15 +17,6 @@
 #include "core/progress.h"
 #include "core/ray_scene.h"
 
-#include <OpenEXR/ImfChannelList.h>
-#include <OpenEXR/ImfFrameBuffer.h>
-#include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfIntAttribute.h>
-#include <OpenEXR/ImfMatrixAttribute.h>
-#include <OpenEXR/ImfOutputFile.h>
-#include <OpenEXR/ImfStandardAttributes.h>
-#include <OpenEXR/ImfStringAttribute.h>
-#include <OpenEXR/ImfVecAttribute.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include <atomic>

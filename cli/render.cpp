@@ -18,14 +18,6 @@
 #include "runtime/make_warp.h"
 #include "runtime/renderer.h"
 
-#include <OpenEXR/ImfChannelList.h>
-#include <OpenEXR/ImfFrameBuffer.h>
-#include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfMatrixAttribute.h>
-#include <OpenEXR/ImfOutputFile.h>
-#include <OpenEXR/ImfStandardAttributes.h>
-#include <OpenEXR/ImfStringAttribute.h>
-#include <OpenEXR/ImfVecAttribute.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
@@ -191,8 +183,8 @@ Runner add_render(CLI::App& app) {
       "Output: .exr (RGBA float32, premultiplied, camera in the header) or .png (OpenColorIO display transform, "
       "$OCIO honoured; straight alpha). Misses are black with alpha 0 unless --env is given.\n"
       "Example: rsibr render --maps maps.exr --mesh cache/assets/models/bunny.glb bunny.png --turntable 36");
-  c->add_option("--maps", a->maps, "Map set (.exr); repeat to sum several sets")->required()->check(CLI::ExistingFile);
-  c->add_option("--mesh", a->mesh, "Mesh (.glb, .gltf, .obj)")->required()->check(CLI::ExistingFile);
+  c->add_option("--maps", a->maps, "Map set (.exr); repeat to sum several sets")->required();
+  c->add_option("--mesh", a->mesh, "Mesh (.glb, .gltf, .obj)")->required();
   c->add_option("output,--out", a->output, "Output image (.png or .exr); numbered with --turntable")->required();
   add_camera_options(c, a->camera);
   c->add_option("--mode", a->mode, "per-pixel (exact) or paper (one destination map per frame)")->capture_default_str();
@@ -203,7 +195,7 @@ Runner add_render(CLI::App& app) {
   c->add_option("--rings", a->rings, "tessellated: rings of the disc mesh (4x as many segments)")->check(CLI::Range(1, 1024));
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--spp", a->spp, "Samples per pixel: a perfect square (1, 4, 9, ...)")->check(CLI::Range(1, 1024));
-  c->add_option("--env", a->env, "Environment map shown where rays miss (alpha 1)")->check(CLI::ExistingFile);
+  c->add_option("--env", a->env, "Environment map shown where rays miss (alpha 1)");
   c->add_option("--exposure", a->exposure, "PNG: exposure in stops before the display transform (default: the first frame's median luminance at mid-grey)");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "

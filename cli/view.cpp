@@ -199,9 +199,9 @@ Runner add_view(CLI::App& app) {
       "prints frame times. Needs a display: use `xvfb-run -a rsibr view ...` on a machine without one.\n"
       "Example: rsibr view --maps maps.exr --mesh cache/assets/models/bunny.glb";
   c->footer(footer);
-  c->add_option("--maps", a->maps, "Map set (.exr)")->required()->check(CLI::ExistingFile);
-  c->add_option("--maps2", a->maps2, "A second map set to compare (wipe or side by side)")->check(CLI::ExistingFile);
-  c->add_option("--mesh", a->mesh, "Mesh (.glb, .gltf, .obj)")->required()->check(CLI::ExistingFile);
+  c->add_option("--maps", a->maps, "Map set (.exr)")->required();
+  c->add_option("--maps2", a->maps2, "A second map set to compare (wipe or side by side)");
+  c->add_option("--mesh", a->mesh, "Mesh (.glb, .gltf, .obj)")->required();
   add_camera_options(c, a->camera);
   c->remove_option(c->get_option("--turntable"));  // --orbit here
   c->add_option("--mode", a->mode, "per-pixel (fragment shader) or paper (CPU destination map)")->capture_default_str();

@@ -6,8 +6,8 @@
 
 namespace rsibr {
 
-// Throws std::invalid_argument("<path>: no such file" | "<path>: is a folder, expected a file" |
-// "<path>: not a regular file (a FIFO, a socket or a device)"). Symlinks are followed.
+// Throws FileError(path, "no such file" | "is a folder, expected a file" | "not a regular file (a
+// FIFO, a socket or a device)"): one message for a missing input in every verb. Symlinks are followed.
 void require_regular_file(const std::filesystem::path& path);
 
 }  // namespace rsibr

@@ -3,25 +3,12 @@
 #include "core/albedo_normalisation.h"
 #include "core/atomic_file.h"
 #include "core/colour.h"
+#include "core/exr_file.h"
 #include "core/exr_io.h"
 #include "core/input_file.h"
 #include "core/texel_audit.h"
 #include "core/text.h"
 
-#include <OpenEXR/ImfChannelList.h>
-#include <OpenEXR/ImfChromaticitiesAttribute.h>
-#include <OpenEXR/ImfFloatVectorAttribute.h>
-#include <OpenEXR/ImfFrameBuffer.h>
-#include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfInputPart.h>
-#include <OpenEXR/ImfMatrixAttribute.h>
-#include <OpenEXR/ImfMultiPartInputFile.h>
-#include <OpenEXR/ImfMultiPartOutputFile.h>
-#include <OpenEXR/ImfOutputPart.h>
-#include <OpenEXR/ImfPartType.h>
-#include <OpenEXR/ImfStandardAttributes.h>
-#include <OpenEXR/ImfStringAttribute.h>
-#include <OpenEXR/ImfVecAttribute.h>
 
 #include <algorithm>
 #include <cmath>
@@ -100,181 +87,115 @@ void write_map_set(const std::string& path, const MapSet& set) {
   try {
     validate(set);
   } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
+    throw FileError(path, e.what(), {}, FileRole::Output);
   }
-  const int W = set.width(), H = set.height();
-  std::vector<Imf::Header> headers;
+  std::vector<ExrPartOut> parts;
   for (std::size_t i = 0; i < set.views.size(); ++i) {
     const MapView& v = set.views[i];
-    Imf::Header h(W, H);
-    h.setName(part_name(i));
-    h.setType(Imf::SCANLINEIMAGE);
-    h.compression() = Imf::ZIP_COMPRESSION;
-    Imf::addChromaticities(h, Imf::Chromaticities());
-    h.insert("rsibr.view", Imf::V3fAttribute(Imath::V3f(float(v.view.x()), float(v.view.y()), float(v.view.z()))));
-    Imath::M33f m;
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) m[r][c] = float(v.world_from_view(r, c));
-    h.insert("rsibr.worldFromView", Imf::M33fAttribute(m));
-    h.insert("rsibr.warp", Imf::StringAttribute(to_string(v.warp)));
-    h.insert("rsibr.source", Imf::StringAttribute(to_string(v.source)));
-    h.insert("rsibr.material", Imf::StringAttribute(valid_utf8(v.material)));
-    if (!v.albedo.empty()) h.insert("rsibr.albedo", Imf::FloatVectorAttribute(v.albedo));
-    for (const auto& [key, value] : v.attributes) h.insert("rsibr." + key, Imf::StringAttribute(valid_utf8(value)));
-    for (const char* c : {"R", "G", "B"}) h.channels().insert(c, Imf::Channel(Imf::FLOAT));
-    if (!v.confidence.empty()) h.channels().insert("confidence", Imf::Channel(Imf::FLOAT));
-    if (!v.clipped.empty()) h.channels().insert("clipped", Imf::Channel(Imf::FLOAT));
-    headers.push_back(h);
+    ExrPartOut part;
+    part.name = part_name(i);
+    for (int k = 0; k < 3; ++k) part.channels.push_back({std::string(1, "RGB"[k]), v.rgb, k});
+    if (!v.confidence.empty()) part.channels.push_back({"confidence", v.confidence, 0});
+    if (!v.clipped.empty()) part.channels.push_back({"clipped", v.clipped, 0});
+    part.attributes = {{"rsibr.view", v.view},
+                       {"rsibr.worldFromView", v.world_from_view},
+                       {"rsibr.warp", std::string(to_string(v.warp))},
+                       {"rsibr.source", std::string(to_string(v.source))},
+                       {"rsibr.material", v.material}};
+    if (!v.albedo.empty()) part.attributes.emplace_back("rsibr.albedo", v.albedo);
+    for (const auto& [key, value] : v.attributes) part.attributes.emplace_back("rsibr." + key, value);
+    parts.push_back(std::move(part));
   }
-  try {
-    write_atomically(path, [&](const std::string& tmp) {
-      Imf::MultiPartOutputFile file(tmp.c_str(), headers.data(), int(headers.size()));
-      for (std::size_t i = 0; i < set.views.size(); ++i) {
-        const MapView& v = set.views[i];
-        const cv::Mat rgb = v.rgb.isContinuous() ? v.rgb : v.rgb.clone();
-        const cv::Mat conf = v.confidence.empty() || v.confidence.isContinuous() ? v.confidence : v.confidence.clone();
-        const cv::Mat clip = v.clipped.empty() || v.clipped.isContinuous() ? v.clipped : v.clipped.clone();
-        Imf::FrameBuffer fb;
-        char* base = reinterpret_cast<char*>(rgb.data);
-        const char* names[] = {"R", "G", "B"};
-        for (int k = 0; k < 3; ++k)
-          fb.insert(names[k], Imf::Slice(Imf::FLOAT, base + k * sizeof(float), 3 * sizeof(float), 3 * sizeof(float) * std::size_t(W)));
-        if (!conf.empty())
-          fb.insert("confidence", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(conf.data), sizeof(float), sizeof(float) * std::size_t(W)));
-        if (!clip.empty())
-          fb.insert("clipped", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(clip.data), sizeof(float), sizeof(float) * std::size_t(W)));
-        Imf::OutputPart part(file, int(i));
-        part.setFrameBuffer(fb);
-        part.writePixels(H);
-      }
-    });
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
+  write_exr(path, parts);
 }
 
 bool is_map_set_file(const std::string& path) {
+  // Not a probe by exception: the file's kind is read from its first bytes and part names.
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return false;
+  if (!std::filesystem::is_regular_file(path, ec) || !looks_like_exr(path)) return false;
   try {
-    check_exr_before_reading(path);
-    Imf::MultiPartInputFile file(path.c_str());
-    return file.parts() >= 1 && file.header(0).hasName() && file.header(0).name() == "view.000";
-  } catch (...) {
-    return false;
+    const ExrFileIn file(path);
+    return file.parts().front().name == "view.000";
+  } catch (const FileError&) {
+    return false;  // an EXR file whose header does not read is not a map set either
   }
 }
 
 MapSet read_map_set(const std::string& path, BadTexels bad, long* zeroed) {
   MapSet set;
   long changed = 0;
-  try {
-    require_regular_file(path);
-    check_exr_before_reading(path);
-    Imf::MultiPartInputFile file(path.c_str());
-    for (int i = 0; i < file.parts(); ++i) {
-      const Imf::Header& h = file.header(i);
-      const std::string who = "part " + std::to_string(i) + ": ";
-      if (!h.hasName() || h.name() != part_name(std::size_t(i)))
-        throw std::runtime_error(who + "expected a part named " + part_name(std::size_t(i)) + " (not a map set?)");
-      const auto* view = h.findTypedAttribute<Imf::V3fAttribute>("rsibr.view");
-      const auto* T = h.findTypedAttribute<Imf::M33fAttribute>("rsibr.worldFromView");
-      const auto* warp = h.findTypedAttribute<Imf::StringAttribute>("rsibr.warp");
-      const auto* source = h.findTypedAttribute<Imf::StringAttribute>("rsibr.source");
-      if (!view || !T || !warp || !source)
-        throw std::runtime_error(who + "missing rsibr.view, rsibr.worldFromView, rsibr.warp or rsibr.source");
-      if (!h.channels().findChannel("R") || !h.channels().findChannel("G") || !h.channels().findChannel("B"))
-        throw std::runtime_error(who + "missing an R, G or B channel");
-      MapView v;
-      v.view = Vec3(view->value().x, view->value().y, view->value().z);
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) v.world_from_view(r, c) = T->value()[r][c];
-      try {
-        v.warp = central_direction_from_string(warp->value());
-      } catch (const std::invalid_argument& e) {
-        throw std::runtime_error(who + "rsibr.warp: " + e.what());
-      }
-      try {
-        v.source = map_source_from_string(source->value());
-      } catch (const std::invalid_argument& e) {
-        throw std::runtime_error(who + "rsibr.source: " + e.what());
-      }
-      if (const auto* m = h.findTypedAttribute<Imf::StringAttribute>("rsibr.material")) v.material = m->value();
-      if (const auto* a = h.findTypedAttribute<Imf::FloatVectorAttribute>("rsibr.albedo")) v.albedo = a->value();
-      for (auto it = h.begin(); it != h.end(); ++it) {
-        const std::string name = it.name();
-        if (name.rfind("rsibr.", 0) != 0) continue;
-        const std::string key = name.substr(6);
-        bool reserved = false;
-        for (const std::string& r : kReserved) reserved = reserved || key == r;
-        if (reserved) continue;
-        if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) v.attributes[key] = s->value();
-      }
-      const Imath::Box2i dw = h.dataWindow();
-      const long long W64 = (long long)dw.max.x - dw.min.x + 1, H64 = (long long)dw.max.y - dw.min.y + 1;
-      if (W64 < 1 || H64 < 1 || W64 > kMaxMapSize || H64 > kMaxMapSize)
-        throw std::runtime_error(who + "a data window of " + std::to_string(W64) + "x" + std::to_string(H64) +
-                                 " texels (at most " + std::to_string(kMaxMapSize) + " a side)");
-      const int W = int(W64), H = int(H64);
-      v.rgb = cv::Mat(H, W, CV_32FC3);
-      Imf::FrameBuffer fb;
-      char* base = reinterpret_cast<char*>(v.rgb.data);
-      const char* names[] = {"R", "G", "B"};
-      for (int k = 0; k < 3; ++k)
-        fb.insert(names[k], Imf::Slice::Make(Imf::FLOAT, base + k * sizeof(float), dw, 3 * sizeof(float), 3 * sizeof(float) * std::size_t(W)));
-      if (h.channels().findChannel("confidence")) {
-        v.confidence = cv::Mat(H, W, CV_32FC1);
-        fb.insert("confidence", Imf::Slice::Make(Imf::FLOAT, v.confidence.data, dw, sizeof(float), sizeof(float) * std::size_t(W)));
-      }
-      if (h.channels().findChannel("clipped")) {
-        v.clipped = cv::Mat(H, W, CV_32FC1);
-        fb.insert("clipped", Imf::Slice::Make(Imf::FLOAT, v.clipped.data, dw, sizeof(float), sizeof(float) * std::size_t(W)));
-      }
-      Imf::InputPart part(file, i);
-      part.setFrameBuffer(fb);
-      part.readPixels(dw.min.y, dw.max.y);
-      // Pixels in other primaries (a map set written by another tool) go to the working space.
-      if (Imf::hasChromaticities(h)) {
-        const Imf::Chromaticities c = Imf::chromaticities(h), rec709;
-        auto close = [](const Imath::V2f& p, const Imath::V2f& q) { return (p - q).length() < 1e-4f; };
-        if (!(close(c.red, rec709.red) && close(c.green, rec709.green) && close(c.blue, rec709.blue) &&
-              close(c.white, rec709.white))) {
-          const Eigen::Matrix3f m = working_from_chromaticities(c).cast<float>();
-          v.rgb.forEach<cv::Vec3f>([&](cv::Vec3f& p, const int*) {
-            const Eigen::Vector3f q = m * Eigen::Vector3f(p[0], p[1], p[2]);
-            p = cv::Vec3f(q.x(), q.y(), q.z());
-          });
-        }
-      }
-      // Values no computation can use: refused, or zeroed on request.
-      const TexelAudit rgb = audit_texels(v.rgb);
-      long outside = 0;  // confidences that are not finite or not in [0, 1]
-      for (int r = 0; r < v.confidence.rows; ++r) {
-        float* w = v.confidence.ptr<float>(r);
-        for (int x = 0; x < v.confidence.cols; ++x) {
-          if (std::isfinite(w[x]) && w[x] >= 0 && w[x] <= 1) continue;
-          ++outside;
-          if (bad == BadTexels::zero) w[x] = std::isnan(w[x]) ? 0.f : std::clamp(w[x], 0.f, 1.f);
-        }
-      }
-      if (bad == BadTexels::refuse) {
-        if (rgb.bad()) throw std::runtime_error(part_name(std::size_t(i)) + ": " + rgb.describe() + " in R, G, B");
-        if (outside)
-          throw std::runtime_error(part_name(std::size_t(i)) + ": " + std::to_string(outside) +
-                                   " confidence values that are not in [0, 1]");
-      } else {
-        changed += sanitize_texels(v.rgb) + outside;
-      }
-      set.views.push_back(std::move(v));
+  const ExrFileIn file(path);
+  for (int i = 0; i < int(file.parts().size()); ++i) {
+    const ExrPartIn& h = file.parts()[std::size_t(i)];
+    const std::string who = "part " + std::to_string(i);
+    auto fail = [&](const std::string& problem) { throw FileError(path, problem, who); };
+    if (h.name != part_name(std::size_t(i))) fail("expected a part named " + part_name(std::size_t(i)) + " (not a map set?)");
+    const auto view = h.get<Vec3>("rsibr.view");
+    const auto T = h.get<Mat3>("rsibr.worldFromView");
+    const auto warp = h.get<std::string>("rsibr.warp");
+    const auto source = h.get<std::string>("rsibr.source");
+    if (!view || !T || !warp || !source) fail("missing rsibr.view, rsibr.worldFromView, rsibr.warp or rsibr.source");
+    if (!h.has_channel("R") || !h.has_channel("G") || !h.has_channel("B")) fail("missing an R, G or B channel");
+    if (h.width > kMaxMapSize || h.height > kMaxMapSize)
+      fail("a data window of " + std::to_string(h.width) + "x" + std::to_string(h.height) + " texels (at most " +
+           std::to_string(kMaxMapSize) + " a side)");
+    MapView v;
+    v.view = *view;
+    v.world_from_view = *T;
+    try {
+      v.warp = central_direction_from_string(*warp);
+    } catch (const std::invalid_argument& e) {
+      fail(std::string("rsibr.warp: ") + e.what());
     }
-    if (zeroed) *zeroed = changed;
+    try {
+      v.source = map_source_from_string(*source);
+    } catch (const std::invalid_argument& e) {
+      fail(std::string("rsibr.source: ") + e.what());
+    }
+    if (const auto m = h.get<std::string>("rsibr.material")) v.material = *m;
+    if (const auto a = h.get<std::vector<float>>("rsibr.albedo")) v.albedo = *a;
+    for (const auto& [key, value] : h.strings_with_prefix("rsibr.")) {
+      bool reserved = false;
+      for (const std::string& r : kReserved) reserved = reserved || key == r;
+      if (!reserved) v.attributes[key] = value;
+    }
+    v.rgb = file.read(i, {"R", "G", "B"});
+    if (h.has_channel("confidence")) v.confidence = file.read(i, {"confidence"});
+    if (h.has_channel("clipped")) v.clipped = file.read(i, {"clipped"});
+    // Pixels in other primaries (a map set written by another tool) go to the working space.
+    if (h.working_from_file) {
+      const Eigen::Matrix3f m = h.working_from_file->cast<float>();
+      v.rgb.forEach<cv::Vec3f>([&](cv::Vec3f& p, const int*) {
+        const Eigen::Vector3f q = m * Eigen::Vector3f(p[0], p[1], p[2]);
+        p = cv::Vec3f(q.x(), q.y(), q.z());
+      });
+    }
+    // Values no computation can use: refused, or zeroed on request.
+    const TexelAudit rgb = audit_texels(v.rgb);
+    long outside = 0;  // confidences that are not finite or not in [0, 1]
+    for (int r = 0; r < v.confidence.rows; ++r) {
+      float* w = v.confidence.ptr<float>(r);
+      for (int x = 0; x < v.confidence.cols; ++x) {
+        if (std::isfinite(w[x]) && w[x] >= 0 && w[x] <= 1) continue;
+        ++outside;
+        if (bad == BadTexels::zero) w[x] = std::isnan(w[x]) ? 0.f : std::clamp(w[x], 0.f, 1.f);
+      }
+    }
+    if (bad == BadTexels::refuse) {
+      if (rgb.bad()) throw FileError(path, rgb.describe() + " in R, G, B", part_name(std::size_t(i)));
+      if (outside)
+        throw FileError(path, std::to_string(outside) + " confidence values that are not in [0, 1]",
+                        part_name(std::size_t(i)));
+    } else {
+      changed += sanitize_texels(v.rgb) + outside;
+    }
+    set.views.push_back(std::move(v));
+  }
+  if (zeroed) *zeroed = changed;
+  with_file(path, [&] {
     validate(set);
     set.view_set();  // views that coincide cannot be triangulated: refused here, naming the file
-  } catch (const std::exception& e) {
-    const std::string what = e.what();
-    if (what.rfind(path + ": ", 0) == 0) throw std::runtime_error(what);
-    throw std::runtime_error(path + ": " + what);
-  }
+  });
   return set;
 }
 

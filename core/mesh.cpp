@@ -10,6 +10,9 @@
 // the indices come from the Draco stream), and the Draco buffer view is decoded here.
 #include "core/mesh.h"
 
+#include "core/file_error.h"
+#include "core/input_file.h"
+
 #include "core/text.h"
 
 #include <draco/compression/decode.h>
@@ -625,10 +628,8 @@ Mesh load_mesh(const std::string& path, MeshLoadReport* report) {
   MeshLoadReport& rep = report ? *report : local;
   rep = MeshLoadReport{};
   const std::string ext = lower_extension(path);
-  try {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw std::runtime_error("no such file");
-    if (!std::filesystem::is_regular_file(path, ec)) throw std::runtime_error("not a regular file");
+  require_regular_file(path);
+  return with_file(path, [&] {
     if (ext == ".obj") {
       rep.format = "obj";
       return load_obj(path, rep);
@@ -638,9 +639,7 @@ Mesh load_mesh(const std::string& path, MeshLoadReport* report) {
       return load_gltf(path, ext == ".glb", rep);
     }
     throw std::runtime_error("unsupported mesh format '" + ext + "' (expected .obj, .gltf or .glb)");
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": " + one_line(e.what()));
-  }
+  });
 }
 
 }  // namespace rsibr

@@ -13,7 +13,7 @@
 
 namespace rsibr {
 
-// `rgb` CV_32FC3 (RGB order) or CV_32FC1 (written as Y). Atomic; throws std::runtime_error("<path>: ...").
+// `rgb` CV_32FC3 (RGB order) or CV_32FC1 (written as Y). Atomic; throws FileError (core/file_error.h).
 void write_truth_image(const std::filesystem::path& path, const cv::Mat& rgb, const CameraPose* pose,
                        const std::map<std::string, std::string>& attributes);
 // Reads what write_truth_image wrote (R, G, B or Y float channels) as CV_32FC3 / CV_32FC1.

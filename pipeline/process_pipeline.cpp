@@ -16,6 +16,7 @@
 #include "core/atomic_file.h"
 #include "core/atomic_folder.h"
 #include "core/camera.h"
+#include "core/file_error.h"
 #include "core/colour.h"
 #include "compare/compare_pictures.h"
 #include "core/exr_io.h"
@@ -113,6 +114,8 @@ void run_step(Context& c, const std::string& step, const nlohmann::json& setting
     body(r);
   } catch (const std::invalid_argument&) {
     throw;
+  } catch (const FileError& e) {
+    throw e.in_step(step);
   } catch (const std::exception& e) {
     throw std::runtime_error(step + ": " + e.what());
   }

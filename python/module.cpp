@@ -4,6 +4,7 @@
 // starts with the file's path) -> RuntimeError; missing inputs are OSErrors (python/bindings.h).
 #include "python/bindings.h"
 
+#include "core/file_error.h"
 #include "core/input_file.h"
 
 #include <cerrno>
@@ -14,7 +15,7 @@ namespace rsibr::python {
 void check_input_file(const std::string& path) {
   try {
     require_regular_file(path);
-  } catch (const std::invalid_argument& e) {
+  } catch (const FileError& e) {
     std::error_code ec;
     const auto status = std::filesystem::status(path, ec);
     PyObject* type = PyExc_OSError;

@@ -1,6 +1,9 @@
 #pragma once
-// The message of the std::invalid_argument a call throws, or "" when it throws none: tests of
-// refusals compare against the one line a user would read.
+// The message of the refusal a call throws (std::invalid_argument, or a FileError: a missing or
+// unreadable input), or "" when it throws none: tests of refusals compare against the one line a
+// user would read.
+#include "core/file_error.h"
+
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -11,6 +14,8 @@ inline std::string error_of(const std::function<void()>& f) {
   try {
     f();
   } catch (const std::invalid_argument& e) {
+    return e.what();
+  } catch (const FileError& e) {
     return e.what();
   }
   return "";

@@ -2,6 +2,8 @@
 // and the key).
 #include "calib/pose_file.h"
 
+#include "core/file_error.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -24,6 +26,8 @@ std::string error_of(const std::string& path) {
   try {
     read_pose_file(path);
   } catch (const std::invalid_argument& e) {
+    return e.what();
+  } catch (const FileError& e) {  // a missing or unreadable file
     return e.what();
   }
   return "";

@@ -607,4 +607,26 @@ cp -r "$work/pout" "$work/pout-copy"
 check "process: a copied run folder skips every step" python3 -c "
 import json; j = json.load(open('$work/p3.json')); assert not any(s['ran'] for s in j['steps']), j['steps']"
 
+# Exit status says whose move it is, the same in every verb: 2 for a refused command (a missing
+# input: one message everywhere), 1 for work that failed (an output that cannot be written).
+status_is() {  # status_is NAME WANT-STATUS WANT-LINE ARGS...
+  local name=$1 want=$2 line=$3; shift 3
+  "$rsibr" "$@" >/dev/null 2>"$work/err"
+  local rc=$?
+  if [ "$rc" -eq "$want" ] && [ "$(cat "$work/err")" = "$line" ]; then pass=$((pass + 1)); else
+    fail=$((fail + 1)); echo "FAILED: $name (exit $rc, want $want):"; cat "$work/err"; fi
+}
+gone=$work/gone.exr
+status_is "convert: missing input" 2 "rsibr convert: error: $gone: no such file" convert "$gone" "$work/s1.exr" --to cube
+status_is "info: missing input" 2 "rsibr info: error: $gone: no such file" info "$gone"
+status_is "blend: missing input" 2 "rsibr blend: error: $gone: no such file" blend "$gone" "$work/s2.exr"
+status_is "bake: missing input" 2 "rsibr bake: error: $gone: no such file" bake --env "$gone" --brdf "$work/ggx.yaml" --res 8 "$work/s3.exr"
+status_is "compare: missing input" 2 "rsibr compare: error: $gone: no such file" compare "$work/mirror.exr" "$gone"
+status_is "probe: missing input" 2 "rsibr probe: error: $gone: no such file" probe "$gone" --out "$work/s4.exr"
+status_is "render: missing input" 2 "rsibr render: error: $gone: no such file" render --maps "$gone" --mesh "$work/cube.obj" "$work/s5.png"
+status_is "bake: a value out of range" 2 "rsibr bake: error: --res: expected a value from 1 to 8192, got '0' (see --help)" bake --env "$work/sky.exr" --brdf "$work/ggx.yaml" --res 0 "$work/s6.exr"
+"$rsibr" convert "$work/sky.exr" "$work/half-probe.exr" --to cube --half >/dev/null 2>"$work/err"
+check "convert: an output that cannot be written is exit 1" test $? -eq 1
+check "no outputs after refused commands" bash -c "! ls '$work'/s[1-6].* 2>/dev/null | grep -q ."
+
 finish cli

@@ -38,7 +38,7 @@ jobs = j["jobs"]
 assert j["ok"] == ok and j["failed"] == failed and j["ranks"] == ranks, (j["ok"], j["failed"], j["ranks"])
 assert [x["index"] for x in jobs] == list(range(1, 21))
 bad = [x for x in jobs if x["status"] != "ok"]
-assert [x["index"] for x in bad] == [7] and "missing.exr" in bad[0]["error"] and bad[0]["exit_code"] == 1, bad
+assert [x["index"] for x in bad] == [7] and "missing.exr" in bad[0]["error"] and bad[0]["exit_code"] == 2, bad
 assert sorted({x["rank"] for x in jobs}) == list(range(ranks))
 assert all(x["rank"] == (x["index"] - 1) % ranks for x in jobs)
 PY

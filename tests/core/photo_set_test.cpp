@@ -1,5 +1,6 @@
 #include "core/photo_set.h"
 
+#include "core/file_error.h"
 #include "core/text.h"
 
 #include <gtest/gtest.h>
@@ -25,6 +26,8 @@ class PhotoSetTest : public ::testing::Test {
     try {
       load_photo_set(dir_);
     } catch (const std::invalid_argument& e) {
+      return e.what();
+    } catch (const FileError& e) {  // a missing or unreadable file
       return e.what();
     }
     return "";
