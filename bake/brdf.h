@@ -82,7 +82,9 @@ class Brdf {
   virtual Vec3 eval_lobe(CentralDirection part, const Vec3& wo, const Vec3& wi) const {
     return has_lobe(part) ? eval(wo, wi) : Vec3::Zero();
   }
-  virtual Vec3 albedo_lobe(CentralDirection part, const Vec3& wo) const { return has_lobe(part) ? albedo(wo) : Vec3::Zero(); }
+  virtual Vec3 albedo_lobe(CentralDirection part, const Vec3& wo) const {
+    return has_lobe(part) ? albedo(wo) : Vec3::Zero();
+  }
   // lobe_width() of the part alone, about the part's own central direction.
   virtual double lobe_width_of(CentralDirection part, const Vec3& wo) const {
     (void)part;

@@ -6,7 +6,8 @@
 
 namespace rsibr {
 
-BrdfLobe::BrdfLobe(std::shared_ptr<const Brdf> parent, CentralDirection part) : parent_(std::move(parent)), part_(part) {
+BrdfLobe::BrdfLobe(std::shared_ptr<const Brdf> parent, CentralDirection part)
+    : parent_(std::move(parent)), part_(part) {
   if (!parent_) throw std::invalid_argument("lobe: the parent BRDF is missing");
   if (!parent_->has_lobe(part_))
     throw std::invalid_argument(std::string("lobe: the BRDF has no ") + to_string(part_) + " lobe: " + parent_->spec());

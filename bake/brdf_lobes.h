@@ -21,7 +21,6 @@
 
 namespace rsibr {
 
-
 // One part of a BRDF. Spec: {type: lobe, part: normal|mirror, of: <the parent's spec>}.
 class BrdfLobe final : public Brdf {
  public:

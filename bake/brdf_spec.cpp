@@ -70,7 +70,8 @@ std::unique_ptr<Brdf> make_brdf(const YAML::Node& spec, const std::string& path)
     const std::string part = m.string("part");
     if (part != "normal" && part != "mirror") fail(m.at("part"), "expected normal or mirror, got '" + part + "'");
     std::shared_ptr<const Brdf> parent = make_brdf(m.get("of"), m.at("of"));
-    if (!parent->has_lobe(central_direction_from_string(part))) fail(m.at("part"), "the BRDF in 'of' has no " + part + " lobe");
+    if (!parent->has_lobe(central_direction_from_string(part)))
+      fail(m.at("part"), "the BRDF in 'of' has no " + part + " lobe");
     return std::make_unique<BrdfLobe>(std::move(parent), central_direction_from_string(part));
   }
   if (type == "lambert") {
@@ -109,9 +110,7 @@ std::unique_ptr<Brdf> make_brdf(const YAML::Node& spec, const std::string& path)
   return std::make_unique<ClearCoatBrdf>(std::move(p));
 }
 
-std::unique_ptr<Brdf> parse_brdf(const std::string& yaml_text) {
-  return make_brdf(parse_yaml(yaml_text, "brdf"));
-}
+std::unique_ptr<Brdf> parse_brdf(const std::string& yaml_text) { return make_brdf(parse_yaml(yaml_text, "brdf")); }
 
 std::unique_ptr<Brdf> load_brdf(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);

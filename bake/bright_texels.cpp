@@ -13,7 +13,8 @@ double texel_luminance(const float* p) { return positive_luminance(p); }
 }  // namespace
 
 EnvironmentSplit split_bright_texels(const EnvMap& env, const BrightTexelOptions& options) {
-  if (env.layout.kind() != LayoutKind::LatLong) throw std::invalid_argument("bright texels: the environment must be lat-long");
+  if (env.layout.kind() != LayoutKind::LatLong)
+    throw std::invalid_argument("bright texels: the environment must be lat-long");
   if (env.pixels.depth() != CV_32F || env.channels() < 3)
     throw std::invalid_argument("bright texels: the environment must be CV_32F with >= 3 channels");
   EnvironmentSplit out;

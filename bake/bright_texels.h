@@ -41,7 +41,7 @@ struct BrightTexelOptions {
 };
 
 struct BrightTexel {
-  long texel = 0;           // r * width + c of the lat-long map
+  long texel = 0;                // r * width + c of the lat-long map
   Vec3 radiance = Vec3::Zero();  // L (RGB), not multiplied by the solid angle
   double solid_angle = 0;
   double angular_size = 0;  // sqrt(solid angle), radians
@@ -63,10 +63,10 @@ struct BrightClusterLevel {
 inline constexpr double kClusterFraction = 0.05;
 
 struct EnvironmentSplit {
-  EnvMap remainder;                // the lat-long environment with the bright texels zeroed
+  EnvMap remainder;  // the lat-long environment with the bright texels zeroed
   std::vector<BrightTexel> bright;
   std::vector<BrightClusterLevel> levels;  // ascending max_radius; empty when bright is
-  double bright_share = 0;         // their share of the luminance integral
+  double bright_share = 0;                 // their share of the luminance integral
 };
 
 // env must be lat-long (bake/mis_integrator.h: as_latlong).

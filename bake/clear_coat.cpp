@@ -10,7 +10,8 @@ namespace rsibr {
 
 namespace {
 ClearCoatParams validated(ClearCoatParams p) {
-  if (!(p.coat_ior > 1.0 && std::isfinite(p.coat_ior))) throw std::invalid_argument("clearcoat: coat ior must be finite and > 1");
+  if (!(p.coat_ior > 1.0 && std::isfinite(p.coat_ior)))
+    throw std::invalid_argument("clearcoat: coat ior must be finite and > 1");
   if (!(p.flake_coverage >= 0.0 && p.flake_coverage <= 1.0))
     throw std::invalid_argument("clearcoat: flake coverage must be in [0,1]");
   if (!(p.base_albedo.minCoeff() >= 0.0 && p.base_albedo.maxCoeff() <= 1.0))
@@ -44,8 +45,8 @@ Vec3 ClearCoatBrdf::eval(const Vec3& wo, const Vec3& wi) const {
 std::array<double, 3> ClearCoatBrdf::albedo_estimates(const Vec3& wo) const {
   const double t = transmittance(wo.z());
   const double c = p_.flake_coverage;
-  return {1.0 - t,                                                  // coat ~ F_c(wo)
-          t * t * c * p_.flake_fresnel->eval(wo.z()).mean(),         // flakes: wi ~ mirror of wo
+  return {1.0 - t,                                                       // coat ~ F_c(wo)
+          t * t * c * p_.flake_fresnel->eval(wo.z()).mean(),             // flakes: wi ~ mirror of wo
           t * mean_transmittance_ * (1.0 - c) * p_.base_albedo.mean()};  // binder
 }
 
@@ -117,9 +118,9 @@ Vec3 ClearCoatBrdf::albedo_lobe(CentralDirection part, const Vec3& wo) const {
   Vec3 a = coat_.albedo(wo);
   if (c > 0) {
     a += (t_o * c) * warp::square_graded_mean(256, [&](const Vec2& u) -> Vec3 {
-      const Sample smp = flakes_.sample(wo, u);
-      return smp.valid ? Vec3(smp.weight * transmittance(smp.wi.z())) : Vec3::Zero();
-    });
+           const Sample smp = flakes_.sample(wo, u);
+           return smp.valid ? Vec3(smp.weight * transmittance(smp.wi.z())) : Vec3::Zero();
+         });
   }
   return a;
 }
@@ -149,10 +150,10 @@ double ClearCoatBrdf::lobe_width(const Vec3& wo) const {
 
 std::string ClearCoatBrdf::spec() const {
   using spec_text::number;
-  return spec_text::cat({"{type: clearcoat, coat: {ior: ", number(p_.coat_ior), ", roughness: ",
-                         number(p_.coat_roughness), "}, flakes: {coverage: ", number(p_.flake_coverage),
-                         ", roughness: ", number(p_.flake_roughness), ", fresnel: ", p_.flake_fresnel->spec(),
-                         "}, base: {albedo: ", spec_text::rgb(p_.base_albedo), "}}"});
+  return spec_text::cat(
+      {"{type: clearcoat, coat: {ior: ", number(p_.coat_ior), ", roughness: ", number(p_.coat_roughness),
+       "}, flakes: {coverage: ", number(p_.flake_coverage), ", roughness: ", number(p_.flake_roughness),
+       ", fresnel: ", p_.flake_fresnel->spec(), "}, base: {albedo: ", spec_text::rgb(p_.base_albedo), "}}"});
 }
 
 }  // namespace rsibr

@@ -32,10 +32,10 @@
 namespace rsibr {
 
 struct ClearCoatParams {
-  double coat_ior = 1.5;         // relative index of the coat, > 1
-  double coat_roughness = 0.05;  // GGX alpha of the coat, (0, 1]
-  double flake_coverage = 0.3;   // c, [0, 1]
-  double flake_roughness = 0.3;  // GGX alpha of the flakes, (0, 1]
+  double coat_ior = 1.5;                         // relative index of the coat, > 1
+  double coat_roughness = 0.05;                  // GGX alpha of the coat, (0, 1]
+  double flake_coverage = 0.3;                   // c, [0, 1]
+  double flake_roughness = 0.3;                  // GGX alpha of the flakes, (0, 1]
   std::shared_ptr<const Fresnel> flake_fresnel;  // non-null
   Vec3 base_albedo = Vec3::Constant(0.5);        // rho, [0, 1]
 };

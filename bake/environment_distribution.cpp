@@ -14,7 +14,7 @@ int find_bin(const double* cdf, int n, double u) {
   const double* it = std::upper_bound(cdf, cdf + n + 1, u);
   int i = int(it - cdf) - 1;
   i = std::clamp(i, 0, n - 1);
-  while (i > 0 && !(cdf[i + 1] > cdf[i])) --i;       // u == 1 rounding: last non-empty bin
+  while (i > 0 && !(cdf[i + 1] > cdf[i])) --i;  // u == 1 rounding: last non-empty bin
   while (i < n - 1 && !(cdf[i + 1] > cdf[i])) ++i;
   return i;
 }
@@ -81,9 +81,7 @@ EnvironmentDistribution::Sample EnvironmentDistribution::sample(const Vec2& u) c
   const double* cdf = &conditional_[std::size_t(r) * (w_ + 1)];
   const int c = find_bin(cdf, w_, u.y());
   // Reuse the position of u within its CDF bin as the position within the cell.
-  auto frac = [](double u, double lo, double hi) {
-    return hi > lo ? std::clamp((u - lo) / (hi - lo), 0.0, 1.0) : 0.5;
-  };
+  auto frac = [](double u, double lo, double hi) { return hi > lo ? std::clamp((u - lo) / (hi - lo), 0.0, 1.0) : 0.5; };
   const double fr = frac(u.x(), marginal_[std::size_t(r)], marginal_[std::size_t(r) + 1]);
   const double fc = frac(u.y(), cdf[c], cdf[c + 1]);
 
@@ -124,8 +122,6 @@ long EnvironmentDistribution::texel_of(const Vec3& d_in) const {
   return long(r) * w_ + c;
 }
 
-double EnvironmentDistribution::pdf(const Vec3& dir) const {
-  return density_[std::size_t(texel_of(dir))];
-}
+double EnvironmentDistribution::pdf(const Vec3& dir) const { return density_[std::size_t(texel_of(dir))]; }
 
 }  // namespace rsibr

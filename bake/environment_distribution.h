@@ -48,8 +48,8 @@ class EnvironmentDistribution {
   Layout layout_;
   int w_ = 0, h_ = 0;
   std::vector<double> prob_, omega_, density_;  // density = prob / omega
-  std::vector<double> marginal_;     // h+1 entries, CDF over rows
-  std::vector<double> conditional_;  // h rows x (w+1) entries, CDF over columns per row
+  std::vector<double> marginal_;                // h+1 entries, CDF over rows
+  std::vector<double> conditional_;             // h rows x (w+1) entries, CDF over columns per row
 };
 
 // The cell geometry behind EnvironmentDistribution::cell_direction, for any lat-long layout.

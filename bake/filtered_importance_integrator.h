@@ -22,8 +22,7 @@ class FilteredImportanceIntegrator final : public Integrator {
   explicit FilteredImportanceIntegrator(const EnvMap& env);
   std::string name() const override { return "fis"; }
   cv::Mat radiance_map(const Brdf& brdf, const Vec3& view, const Mat3& world_from_view, int size,
-                       const IntegratorOptions& options,
-                       const std::function<void(int)>& progress = {}) const override;
+                       const IntegratorOptions& options, const std::function<void(int)>& progress = {}) const override;
 
  private:
   Layout latlong_;

@@ -26,8 +26,7 @@ Vec3 SchlickFresnel::eval(double cos_t) const {
 std::string SchlickFresnel::spec() const { return spec_text::cat({"{type: schlick, f0: ", spec_text::rgb(f0_), "}"}); }
 
 DielectricFresnel::DielectricFresnel(double eta) : eta_(eta) {
-  if (!(eta > 0.0 && std::isfinite(eta)))
-    throw std::invalid_argument("dielectric fresnel: ior must be finite and > 0");
+  if (!(eta > 0.0 && std::isfinite(eta))) throw std::invalid_argument("dielectric fresnel: ior must be finite and > 0");
 }
 
 Vec3 DielectricFresnel::eval(double cos_t) const { return Vec3::Constant(fresnel_dielectric(cos_t, eta_)); }

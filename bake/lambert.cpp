@@ -37,6 +37,8 @@ Vec3 LambertBrdf::albedo(const Vec3& wo) const { return wo.z() > 0 ? rho_ : Vec3
 
 double LambertBrdf::lobe_width(const Vec3&) const { return std::asin(std::sqrt(kLobeEnergyFraction)); }
 
-std::string LambertBrdf::spec() const { return spec_text::cat({"{type: lambert, albedo: ", spec_text::rgb(rho_), "}"}); }
+std::string LambertBrdf::spec() const {
+  return spec_text::cat({"{type: lambert, albedo: ", spec_text::rgb(rho_), "}"});
+}
 
 }  // namespace rsibr

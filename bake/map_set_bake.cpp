@@ -10,7 +10,8 @@ namespace rsibr {
 
 MapSet bake_map_set(const Brdf& brdf, const Integrator& integrator, const ViewSet& views,
                     const MapSetBakeOptions& options, const std::function<void(double)>& progress) {
-  if (options.res < 1) throw std::invalid_argument("bake: the map size must be at least 1, not " + std::to_string(options.res));
+  if (options.res < 1)
+    throw std::invalid_argument("bake: the map size must be at least 1, not " + std::to_string(options.res));
   const double total_rows = double(views.views().size()) * options.res;
   std::atomic<long> rows_before{0};
   std::vector<cv::Mat> radiance;

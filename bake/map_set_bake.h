@@ -16,11 +16,11 @@
 namespace rsibr {
 
 struct MapSetBakeOptions {
-  int res = 128;                  // sphere-map size (square), >= 1
-  IntegratorOptions integrator;   // samples, seed, reference width (recorded as attributes)
+  int res = 128;                 // sphere-map size (square), >= 1
+  IntegratorOptions integrator;  // samples, seed, reference width (recorded as attributes)
   // Albedo-normalised maps (core/albedo_normalisation.h): texels hold L / A(n.v), the table is stored.
   bool normalise_albedo = false;
-  std::string environment_name;   // provenance: rsibr.environment (the CLI writes the file name)
+  std::string environment_name;  // provenance: rsibr.environment (the CLI writes the file name)
 };
 
 // For every view v of `views`, in order: world_from_view = world_from_view_for(v), warp "normal"

@@ -25,8 +25,7 @@ MisIntegrator::MisIntegrator(const EnvMap& env)
 }
 
 cv::Mat MisIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Mat3& world_from_view, int size,
-                                    const IntegratorOptions& options,
-                                    const std::function<void(int)>& progress) const {
+                                    const IntegratorOptions& options, const std::function<void(int)>& progress) const {
   if (options.samples < 1) throw std::invalid_argument("mis: samples must be >= 1");
   const int n = options.samples;
   return integrator_detail::for_each_texel(

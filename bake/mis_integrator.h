@@ -29,8 +29,7 @@ class MisIntegrator final : public Integrator {
   explicit MisIntegrator(const EnvMap& env);
   std::string name() const override { return "mis"; }
   cv::Mat radiance_map(const Brdf& brdf, const Vec3& view, const Mat3& world_from_view, int size,
-                       const IntegratorOptions& options,
-                       const std::function<void(int)>& progress = {}) const override;
+                       const IntegratorOptions& options, const std::function<void(int)>& progress = {}) const override;
   const EnvironmentDistribution& distribution() const { return dist_; }
   const EnvironmentSplit& split() const { return split_; }
 
@@ -38,7 +37,7 @@ class MisIntegrator final : public Integrator {
   EnvMap env_;  // lat-long
   EnvironmentSplit split_;
   EnvironmentDistribution dist_;  // of split_.remainder
-  std::vector<Vec3> radiance_;  // per texel, RGB
+  std::vector<Vec3> radiance_;    // per texel, RGB
 };
 
 // The environment in lat-long (itself when it already is).

@@ -14,8 +14,7 @@ Vec3 mirror_of(const Vec3& wo) { return Vec3(-wo.x(), -wo.y(), wo.z()); }
 }  // namespace
 
 PhongBrdf::PhongBrdf(const Vec3& rho, double exponent) : rho_(rho), e_(exponent) {
-  if (!(rho.minCoeff() >= 0.0 && rho.maxCoeff() <= 1.0))
-    throw std::invalid_argument("phong: albedo must be in [0,1]");
+  if (!(rho.minCoeff() >= 0.0 && rho.maxCoeff() <= 1.0)) throw std::invalid_argument("phong: albedo must be in [0,1]");
   if (!(exponent > 0.0 && std::isfinite(exponent)))
     throw std::invalid_argument("phong: exponent must be finite and > 0");
 }

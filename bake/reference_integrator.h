@@ -24,8 +24,7 @@ class ReferenceIntegrator final : public Integrator {
   explicit ReferenceIntegrator(const EnvMap& env);
   std::string name() const override { return "reference"; }
   cv::Mat radiance_map(const Brdf& brdf, const Vec3& view, const Mat3& world_from_view, int size,
-                       const IntegratorOptions& options,
-                       const std::function<void(int)>& progress = {}) const override;
+                       const IntegratorOptions& options, const std::function<void(int)>& progress = {}) const override;
 
   // The environment as a list of (direction, L * Omega) over its texels with non-zero radiance and
   // solid angle (exact solid angles): the quadrature this integrator and the SH projection share.
@@ -40,7 +39,7 @@ class ReferenceIntegrator final : public Integrator {
 
   EnvMap base_;
   std::vector<Texel> full_;
-  mutable std::unique_ptr<MipPyramid> pyramid_;            // built on first use of reference_width
+  mutable std::unique_ptr<MipPyramid> pyramid_;     // built on first use of reference_width
   mutable std::vector<std::vector<Texel>> levels_;  // filled lazily (guarded by mutex_)
   mutable std::unique_ptr<std::mutex> mutex_;
 };

@@ -22,9 +22,7 @@ std::string to_string(Background b) { return b == Background::Environment ? "env
 
 namespace {
 
-Vec3 texel_rgb(const float* p, int channels) {
-  return channels >= 3 ? Vec3(p[0], p[1], p[2]) : Vec3::Constant(p[0]);
-}
+Vec3 texel_rgb(const float* p, int channels) { return channels >= 3 ? Vec3(p[0], p[1], p[2]) : Vec3::Constant(p[0]); }
 
 }  // namespace
 
@@ -58,10 +56,10 @@ namespace {
 // The local shading frame at a hit seen from direction v (unit, from the hit toward the viewer),
 // with the normal policy of the header comment applied.
 struct Surface {
-  Vec3 x;      // position (world)
-  Vec3 ng;     // geometric normal turned toward the viewer (world, unit)
+  Vec3 x;                // position (world)
+  Vec3 ng;               // geometric normal turned toward the viewer (world, unit)
   shading::Frame frame;  // around the shading normal
-  Vec3 wo;     // v in the local frame; wo.z >= kMinViewCosine except when n had to fall back to n_g
+  Vec3 wo;               // v in the local frame; wo.z >= kMinViewCosine except when n had to fall back to n_g
 };
 
 Surface surface_at(const RayScene& scene, const RayHit& hit, const Vec3& v) {
@@ -104,10 +102,10 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
   const Eigen::AlignedBox3f box = scene.mesh().bounds();
   double eps = options.ray_epsilon;
   if (!(eps > 0)) {
-    const double extent = box.isEmpty() ? 1.0
-                                        : std::max<double>(box.diagonal().norm(),
-                                                           std::max(box.min().cwiseAbs().maxCoeff(),
-                                                                    box.max().cwiseAbs().maxCoeff()));
+    const double extent =
+        box.isEmpty() ? 1.0
+                      : std::max<double>(box.diagonal().norm(),
+                                         std::max(box.min().cwiseAbs().maxCoeff(), box.max().cwiseAbs().maxCoeff()));
     eps = 1e-4 * std::max(extent, 1e-30);
   }
   const bool shadows = options.shadows;
@@ -132,7 +130,8 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
       // The light samples of sub-pixel sample s use a per-pixel random permutation of the index:
       // with the same index in both, the light sample would be a function of the sub-pixel
       // position and the pixel would converge to a seed-dependent value.
-      const auto key_b = std::uint32_t(rng.uniform() * 4294967296.0), key_e = std::uint32_t(rng.uniform() * 4294967296.0);
+      const auto key_b = std::uint32_t(rng.uniform() * 4294967296.0),
+                 key_e = std::uint32_t(rng.uniform() * 4294967296.0);
       Vec3 pixel = Vec3::Zero();
       int covered = 0;
       for (int s = 0; s < spp; ++s) {
@@ -153,8 +152,7 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
           // The sun split where a cluster level fits this lobe: clusters as point lights (one
           // shadow ray each), MIS over the remainder; otherwise MIS over the whole environment.
           const BrightClusterLevel* level =
-              lighting.split().bright.empty() ? nullptr
-                                              : cluster_level_for(lighting.split(), brdf.lobe_width(S.wo));
+              lighting.split().bright.empty() ? nullptr : cluster_level_for(lighting.split(), brdf.lobe_width(S.wo));
           const EnvironmentDistribution& dist = level ? lighting.remainder_distribution() : lighting.distribution();
           auto env_radiance = [&](long texel) -> const Vec3& {
             return level ? lighting.remainder_radiance(texel) : lighting.radiance(texel);
@@ -182,10 +180,10 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
             Vec2 ub, ue;
             if (depth == 0) {
               const auto index = std::uint32_t(s * K + k), count = std::uint32_t(n_first);
-              ub = integrator_detail::rotated_hammersley(
-                  int(integrator_detail::permute_index(index, count, key_b)), n_first, shift_b);
-              ue = integrator_detail::rotated_hammersley(
-                  int(integrator_detail::permute_index(index, count, key_e)), n_first, shift_e);
+              ub = integrator_detail::rotated_hammersley(int(integrator_detail::permute_index(index, count, key_b)),
+                                                         n_first, shift_b);
+              ue = integrator_detail::rotated_hammersley(int(integrator_detail::permute_index(index, count, key_e)),
+                                                         n_first, shift_e);
             } else {
               ub = rng.uniform2();
               ue = rng.uniform2();
@@ -215,8 +213,8 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
               }
               if (escapes) {
                 const Vec3 f = brdf.eval(S.wo, b.wi);
-                radiance += inv_k * beta.cwiseProduct(f.cwiseProduct(env_radiance(dist.texel_of(w)))) /
-                            (b.pdf + dist.pdf(w));
+                radiance +=
+                    inv_k * beta.cwiseProduct(f.cwiseProduct(env_radiance(dist.texel_of(w)))) / (b.pdf + dist.pdf(w));
               }
             }
             // Environment sample: L(w) eval / (p_b + p_e).
@@ -236,8 +234,8 @@ ReferenceImage render_reference(const RayScene& scene, const Brdf& brdf, const R
                     }
                   }
                   if (visible)
-                    radiance += inv_k * beta.cwiseProduct(f.cwiseProduct(env_radiance(e.texel))) /
-                                (brdf.pdf(S.wo, wi) + e.pdf);
+                    radiance +=
+                        inv_k * beta.cwiseProduct(f.cwiseProduct(env_radiance(e.texel))) / (brdf.pdf(S.wo, wi) + e.pdf);
                 }
               }
             }

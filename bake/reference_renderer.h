@@ -73,11 +73,11 @@ Background parse_background(const std::string& text);
 std::string to_string(Background b);
 
 struct ReferenceOptions {
-  int spp = 16;            // camera samples per pixel (stratified: rotated Hammersley set per pixel)
-  int light_samples = 1;   // per surface interaction: this many environment AND BRDF samples (MIS)
+  int spp = 16;           // camera samples per pixel (stratified: rotated Hammersley set per pixel)
+  int light_samples = 1;  // per surface interaction: this many environment AND BRDF samples (MIS)
   std::uint64_t seed = 0;
-  bool shadows = true;     // false: the baked-map contract (no occlusion, no bounces)
-  int bounces = 1;         // surface interactions per path (>= 1); only used with shadows
+  bool shadows = true;  // false: the baked-map contract (no occlusion, no bounces)
+  int bounces = 1;      // surface interactions per path (>= 1); only used with shadows
   Background background = Background::Environment;
   // Offset of secondary rays, world units; <= 0: 1e-4 x the scene's extent (the larger of the
   // bounds' diagonal and the largest coordinate magnitude), which the float positions resolve.
@@ -88,8 +88,8 @@ struct ReferenceOptions {
 inline constexpr double kMinViewCosine = 1e-3;
 
 struct ReferenceImage {
-  cv::Mat rgb;    // CV_32FC3, RGB radiance, camera.height x camera.width
-  cv::Mat alpha;  // CV_32FC1, coverage in [0,1]
+  cv::Mat rgb;           // CV_32FC3, RGB radiance, camera.height x camera.width
+  cv::Mat alpha;         // CV_32FC1, coverage in [0,1]
   long samples = 0;      // camera samples (pixels x spp)
   long hits = 0;         // camera samples that hit the mesh
   long shadow_rays = 0;  // occlusion queries (0 without shadows)

@@ -28,8 +28,8 @@ ShIntegrator::ShIntegrator(const EnvMap& env) {
 }
 
 Vec3 ShIntegrator::irradiance(const Vec3& n) const {
-  static constexpr double A[9] = {kPi,           2 * kPi / 3,  2 * kPi / 3,  2 * kPi / 3, kPi / 4,
-                                  kPi / 4,       kPi / 4,      kPi / 4,      kPi / 4};
+  static constexpr double A[9] = {kPi,     2 * kPi / 3, 2 * kPi / 3, 2 * kPi / 3, kPi / 4,
+                                  kPi / 4, kPi / 4,     kPi / 4,     kPi / 4};
   const auto y = basis(n);
   Vec3 e = Vec3::Zero();
   for (int k = 0; k < 9; ++k) e += A[k] * y[std::size_t(k)] * coeffs_[std::size_t(k)];
@@ -46,7 +46,9 @@ cv::Mat ShIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Mat
   const Vec3 rho = lambert->rho();
   return integrator_detail::for_each_texel(
       size, view, world_from_view, options.texel_mask,
-      [&](long, const integrator_detail::TexelFrame& t) { return Vec3(rho.cwiseProduct(irradiance(t.frame.normal())) / kPi); },
+      [&](long, const integrator_detail::TexelFrame& t) {
+        return Vec3(rho.cwiseProduct(irradiance(t.frame.normal())) / kPi);
+      },
       progress);
 }
 

@@ -23,8 +23,7 @@ class ShIntegrator final : public Integrator {
   explicit ShIntegrator(const EnvMap& env);
   std::string name() const override { return "sh"; }
   cv::Mat radiance_map(const Brdf& brdf, const Vec3& view, const Mat3& world_from_view, int size,
-                       const IntegratorOptions& options,
-                       const std::function<void(int)>& progress = {}) const override;
+                       const IntegratorOptions& options, const std::function<void(int)>& progress = {}) const override;
 
   // The 9 real SH basis functions at a unit direction (order: l=0; l=1: y, z, x; l=2: xy, yz,
   // 3z^2-1, xz, x^2-y^2 with R&H's constants).

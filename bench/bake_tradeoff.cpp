@@ -33,15 +33,12 @@ namespace {
 
 using namespace rsibr::bench;
 
-
-
 double disc_texel_count(int size) {
   int n = 0;
   for (int r = 0; r < size; ++r)
     for (int c = 0; c < size; ++c) n += sphere_map::disc_from_pixel(Vec2(c, r), size, size).squaredNorm() < 1.0;
   return n;
 }
-
 
 struct Config {
   std::string method;
@@ -53,11 +50,15 @@ struct Config {
 const std::vector<std::pair<std::string, std::string>>& brdfs() {
   static const std::vector<std::pair<std::string, std::string>> list = {
       {"lambert", "{type: lambert, albedo: [0.8, 0.8, 0.8]}"},
-      {"ggx 0.05", "{type: ggx, roughness: 0.05, fresnel: {type: conductor, eta: [0.2, 0.92, 1.1], k: [3.9, 2.45, 2.14]}}"},
-      {"ggx 0.2", "{type: ggx, roughness: 0.2, fresnel: {type: conductor, eta: [0.2, 0.92, 1.1], k: [3.9, 2.45, 2.14]}}"},
-      {"ggx 0.5", "{type: ggx, roughness: 0.5, fresnel: {type: conductor, eta: [0.2, 0.92, 1.1], k: [3.9, 2.45, 2.14]}}"},
-      {"clear coat", "{type: clearcoat, coat: {ior: 1.5, roughness: 0.05}, flakes: {coverage: 0.3, roughness: 0.3, "
-                     "fresnel: {type: conductor, eta: [1.66, 0.88, 0.52], k: [9.22, 6.27, 4.84]}}, base: {albedo: [0.5, 0.05, 0.03]}}"},
+      {"ggx 0.05",
+       "{type: ggx, roughness: 0.05, fresnel: {type: conductor, eta: [0.2, 0.92, 1.1], k: [3.9, 2.45, 2.14]}}"},
+      {"ggx 0.2",
+       "{type: ggx, roughness: 0.2, fresnel: {type: conductor, eta: [0.2, 0.92, 1.1], k: [3.9, 2.45, 2.14]}}"},
+      {"ggx 0.5",
+       "{type: ggx, roughness: 0.5, fresnel: {type: conductor, eta: [0.2, 0.92, 1.1], k: [3.9, 2.45, 2.14]}}"},
+      {"clear coat",
+       "{type: clearcoat, coat: {ior: 1.5, roughness: 0.05}, flakes: {coverage: 0.3, roughness: 0.3, "
+       "fresnel: {type: conductor, eta: [1.66, 0.88, 0.52], k: [9.22, 6.27, 4.84]}}, base: {albedo: [0.5, 0.05, 0.03]}}"},
   };
   return list;
 }
@@ -107,16 +108,26 @@ nlohmann::json sweep(const std::vector<std::string>& envs, int size, int probes,
         const double secs = seconds_since(t0);
         ErrorSums e;
         e.add(map, ref, mask);
-        rows.push_back({{"env", env_name}, {"brdf", brdf_name}, {"method", c.method}, {"knob", c.knob},
-                        {"value", c.value}, {"lod_bias", c.lod_bias}, {"seconds", secs},
+        rows.push_back({{"env", env_name},
+                        {"brdf", brdf_name},
+                        {"method", c.method},
+                        {"knob", c.knob},
+                        {"value", c.value},
+                        {"lod_bias", c.lod_bias},
+                        {"seconds", secs},
                         {"rel_rms", e.relative_rms()}});
         std::cerr << env_name << " | " << brdf_name << " | " << c.method << " " << c.knob << "=" << c.value << ": "
                   << e.relative_rms() << " in " << secs << " s\n";
       }
       // The full reference, extrapolated from the probes (its cost per texel is constant).
-      rows.push_back({{"env", env_name}, {"brdf", brdf_name}, {"method", "reference"}, {"knob", "reference_width"},
-                      {"value", env.layout.width()}, {"seconds", ref_probe_seconds * disc_texels / probes},
-                      {"rel_rms", 0.0}, {"extrapolated", true}});
+      rows.push_back({{"env", env_name},
+                      {"brdf", brdf_name},
+                      {"method", "reference"},
+                      {"knob", "reference_width"},
+                      {"value", env.layout.width()},
+                      {"seconds", ref_probe_seconds * disc_texels / probes},
+                      {"rel_rms", 0.0},
+                      {"extrapolated", true}});
     }
   }
   return rows;
@@ -149,8 +160,8 @@ nlohmann::json target(const std::string& env_path, int size, int probes) {
   const double ref_seconds = seconds_since(t0) * disc_texels / probes;
   out["reference_seconds_extrapolated"] = ref_seconds;
   nlohmann::json rows = nlohmann::json::array();
-  for (const auto& [method, samples] : std::vector<std::pair<std::string, int>>{
-           {"fis", 16}, {"fis", 32}, {"fis", 64}, {"mis", 64}, {"mis", 256}}) {
+  for (const auto& [method, samples] :
+       std::vector<std::pair<std::string, int>>{{"fis", 16}, {"fis", 32}, {"fis", 64}, {"mis", 64}, {"mis", 256}}) {
     t0 = Clock::now();
     const auto integrator = make_integrator(method, env);  // its precomputation is part of the cost
     ErrorSums e;
@@ -164,7 +175,10 @@ nlohmann::json target(const std::string& env_path, int size, int probes) {
     }
     const double secs = seconds_since(t0);
     for (int v = 0; v < int(views.views().size()); ++v) e.add(maps[std::size_t(v)], refs[std::size_t(v)], mask);
-    rows.push_back({{"method", method}, {"samples", samples}, {"seconds", secs}, {"rel_rms", e.relative_rms()},
+    rows.push_back({{"method", method},
+                    {"samples", samples},
+                    {"seconds", secs},
+                    {"rel_rms", e.relative_rms()},
                     {"speedup_vs_reference", ref_seconds / secs}});
     std::cerr << method << " " << samples << ": " << e.relative_rms() << " in " << secs << " s (" << ref_seconds / secs
               << "x the reference)\n";

@@ -36,8 +36,8 @@ const MapSet& mirror_set(int size) {
     mv.view = v;
     mv.world_from_view = world_from_view_for(v);
     const Mat3 T = mv.world_from_view;
-    mv.rgb = render_pattern([&](const Vec3& d) { return f(T * d); }, Layout::with_size(LayoutKind::Sphere, size), 1)
-                 .pixels;
+    mv.rgb =
+        render_pattern([&](const Vec3& d) { return f(T * d); }, Layout::with_size(LayoutKind::Sphere, size), 1).pixels;
     set.views.push_back(std::move(mv));
   }
   return cache.emplace(size, std::move(set)).first->second;
@@ -151,9 +151,7 @@ void BM_Blend(benchmark::State& state) {
 }
 // Against the tile path before the engine, same size and warp.
 void BM_BlendEngine(benchmark::State& state) { blend_frames(state, int(state.range(0)), int(state.range(1)), 0); }
-void BM_PreviousTilePath(benchmark::State& state) {
-  blend_frames(state, int(state.range(0)), int(state.range(1)), 2);
-}
+void BM_PreviousTilePath(benchmark::State& state) { blend_frames(state, int(state.range(0)), int(state.range(1)), 2); }
 
 BENCHMARK(BM_RemapThreeMaps)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_OpenCvBlend)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();

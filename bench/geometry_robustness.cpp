@@ -59,19 +59,19 @@ int main(int argc, char** argv) {
       for (const auto& b : v["balls"]) {
         const std::string name = b["name"].as<std::string>();
         const double d = b["distance_m"].as<double>(), r = 0.5 * diameter[name];
-        where[v["name"].as<std::string>()][name] = {Vec2(b["centre_px"][0].as<double>(), b["centre_px"][1].as<double>()),
-                                                    f * r / std::sqrt(d * d - r * r)};
+        where[v["name"].as<std::string>()][name] = {
+            Vec2(b["centre_px"][0].as<double>(), b["centre_px"][1].as<double>()), f * r / std::sqrt(d * d - r * r)};
       }
     nlohmann::json out, balls = nlohmann::json::object();
     for (const auto& v : extract["summary"]["views"])
       for (const auto& b : v["balls"]) {
         const std::string name = b["ball"], view = v["name"];
         auto& j = balls[name];
-        if (!j.contains("found")) j = {{"found", 0}, {"wrong", 0}, {"missing", nlohmann::json::array()}, {"cut_flagged", 0},
-                                       {"cut_true", 0}};
+        if (!j.contains("found"))
+          j = {{"found", 0}, {"wrong", 0}, {"missing", nlohmann::json::array()}, {"cut_flagged", 0}, {"cut_true", 0}};
         const auto [c, r] = where[view][name];
-        const bool truly_cut = c.x() - r < -0.5 || c.y() - r < -0.5 || c.x() + r > lens.width() - 0.5 ||
-                               c.y() + r > lens.height() - 0.5;
+        const bool truly_cut =
+            c.x() - r < -0.5 || c.y() - r < -0.5 || c.x() + r > lens.width() - 0.5 || c.y() + r > lens.height() - 0.5;
         if (!b.contains("centre_px")) {
           j["missing"].push_back(view + ": " + b["status"].get<std::string>() + " (" + b.value("note", "") + ")");
           continue;
@@ -83,13 +83,15 @@ int main(int argc, char** argv) {
         j["cut_true"] = j["cut_true"].get<int>() + int(truly_cut);
       }
     for (const auto& v : extract["summary"]["views"])
-      if (v.contains("left_out")) balls["*"]["missing"].push_back(v["name"].get<std::string>() + ": " + v["left_out"].get<std::string>());
+      if (v.contains("left_out"))
+        balls["*"]["missing"].push_back(v["name"].get<std::string>() + ": " + v["left_out"].get<std::string>());
     out["balls"] = balls;
     const PoseSet est = read_pose_file((run / "poses.yaml").string());
     const PoseSet tru = read_given_poses((syn / "truth" / "truth.yaml").string());
     out["views"] = {{"oriented", est.views.size()}, {"listed", tru.views.size()}};
     Vec3 up = Vec3::Zero();
-    for (const ViewPose& v : est.views) up += tru.find(v.name)->world_from_cam * v.world_from_cam.transpose() * Vec3(0, 1, 0);
+    for (const ViewPose& v : est.views)
+      up += tru.find(v.name)->world_from_cam * v.world_from_cam.transpose() * Vec3(0, 1, 0);
     out["tilt_deg"] = angle_between(up, Vec3(0, 1, 0)) * 180 / kPi;
     out["sigma_deg"] = orient["summary"].contains("world_up") && orient["summary"]["world_up"].is_object()
                            ? orient["summary"]["world_up"]["sigma_deg"]
@@ -118,14 +120,16 @@ int main(int argc, char** argv) {
       MapSet m = read_map_set((run / "maps" / ("captured-" + name + ".exr")).string());
       for (MapView& v : m.views) {
         const std::string img = v.attributes.at("image");
-        v.world_from_view = tru.find(img)->world_from_cam * est.find(img)->world_from_cam.transpose() * v.world_from_view;
+        v.world_from_view =
+            tru.find(img)->world_from_cam * est.find(img)->world_from_cam.transpose() * v.world_from_view;
         v.view = v.world_from_view.col(2);
       }
       CompareOptions co;
       co.view_tolerance_deg = 2;
       const Comparison c = compare_map_sets(m, read_map_set((syn / "truth" / "maps" / (name + ".exr")).string()), co);
       for (const PairComparison& p : c.pairs) {
-        grey.push_back({{"ball", name}, {"view", m.views[p.index_a].attributes.at("image")}, {"stops", p.after.log_rms_stops}});
+        grey.push_back(
+            {{"ball", name}, {"view", m.views[p.index_a].attributes.at("image")}, {"stops", p.after.log_rms_stops}});
         worst = std::max(worst, p.after.log_rms_stops);
       }
       out["grey_overall_stops"] = c.after.log_rms_stops;
@@ -138,7 +142,8 @@ int main(int argc, char** argv) {
           per.push_back({{"view", m.views[p.index_a].attributes.at("image")}, {"stops", p.after.log_rms_stops}});
           rw = std::max(rw, p.after.log_rms_stops);
         }
-        out["reference"] = {{"ball", name}, {"views", per}, {"worst_stops", rw}, {"overall_stops", r.after.log_rms_stops}};
+        out["reference"] = {
+            {"ball", name}, {"views", per}, {"worst_stops", rw}, {"overall_stops", r.after.log_rms_stops}};
       }
     }
     out["grey"] = grey;

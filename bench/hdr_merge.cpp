@@ -38,7 +38,7 @@ using bench::seconds_since;
 double luminance(const cv::Vec3d& v) { return 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]; }
 
 struct Regions {
-  cv::Mat label;  // 0 excluded, 1 shadows, 2 mid-tones, 3 highlights
+  cv::Mat label;    // 0 excluded, 1 shadows, 2 mid-tones, 3 highlights
   cv::Mat darkest;  // 1 in the darkest decade
 };
 
@@ -96,7 +96,10 @@ nlohmann::json errors(const cv::Mat& est, const cv::Mat& truth, const Regions& g
       for (int c = 0; c < 3; ++c) {
         const double t = truth.at<cv::Vec3d>(r, x)[c];
         const double e = double(est.at<cv::Vec3f>(r, x)[c]) * scales[c];
-        if (!std::isfinite(e)) { ++bad; continue; }
+        if (!std::isfinite(e)) {
+          ++bad;
+          continue;
+        }
         if (lum > 0) se[k] += (e - t) * (e - t) / (lum * lum), n[k] += 1;
         if (g.darkest.at<unsigned char>(r, x)) sig += t * t, noise += (e - t) * (e - t);
       }
@@ -105,7 +108,8 @@ nlohmann::json errors(const cv::Mat& est, const cv::Mat& truth, const Regions& g
           {"midtones", std::sqrt(se[2] / std::max(1.0, n[2]))},
           {"highlights", std::sqrt(se[3] / std::max(1.0, n[3]))},
           {"snr_darkest_decade_db", 10 * std::log10(sig / std::max(noise, 1e-300))},
-          {"non_finite", bad}, {"scale", scale}};
+          {"non_finite", bad},
+          {"scale", scale}};
 }
 
 nlohmann::json errors(const cv::Mat& est, const cv::Mat& truth, const Regions& g) {
@@ -140,7 +144,9 @@ double cpu_seconds() {
 
 // Best wall time of `repeats` runs, and the CPU time (all threads) of that run: on a shared
 // machine the wall time depends on the load, the CPU time much less.
-struct Timing { double wall = 1e300, cpu = 0; };
+struct Timing {
+  double wall = 1e300, cpu = 0;
+};
 template <class F>
 Timing best_of(int repeats, F&& f) {
   Timing best;
@@ -187,8 +193,13 @@ int run(int argc, char** argv) {
   cam.max_code = 255;
   cam.read_sigma = 5e-4;
   cam.response = testing::s_curve;
-  out["scene"] = {{"env", std::filesystem::path(env_path).filename().string()}, {"width", width}, {"height", height},
-                  {"exposures", e}, {"full_well", cam.full_well}, {"read_sigma", cam.read_sigma}, {"bits", 8}};
+  out["scene"] = {{"env", std::filesystem::path(env_path).filename().string()},
+                  {"width", width},
+                  {"height", height},
+                  {"exposures", e},
+                  {"full_well", cam.full_well},
+                  {"read_sigma", cam.read_sigma},
+                  {"bits", 8}};
   const auto t_syn = Clock::now();
   const BracketSet b = make_brackets(testing::synthesize(truth, e, cam, seed), e);
   std::cerr << "synthesized " << b.size() << " brackets in " << seconds_since(t_syn) << " s\n";
@@ -207,19 +218,34 @@ int run(int argc, char** argv) {
   const Regions g = regions(truth, clipped_everywhere);
   nlohmann::json cands = nlohmann::json::array();
   for (const auto& c : rec.candidates)
-    cands.push_back({{"model", c.model}, {"shared", c.shared}, {"complexity", c.complexity},
-                     {"held_out_error", c.held_out_error}, {"tied", c.tied}, {"parameters", c.parameters}});
-  out["response"] = {{"chosen", rec.chosen}, {"candidates", cands}, {"seconds", t_recover},
-                     {"margin_sigmas", rec.margin_sigmas}, {"warning", rec.warning}};
-  out["noise"] = {{"shot", noise.shot}, {"read", noise.read}, {"true_shot", cam.shot()}, {"true_read", cam.read()}, {"seconds", t_noise}};
+    cands.push_back({{"model", c.model},
+                     {"shared", c.shared},
+                     {"complexity", c.complexity},
+                     {"held_out_error", c.held_out_error},
+                     {"tied", c.tied},
+                     {"parameters", c.parameters}});
+  out["response"] = {{"chosen", rec.chosen},
+                     {"candidates", cands},
+                     {"seconds", t_recover},
+                     {"margin_sigmas", rec.margin_sigmas},
+                     {"warning", rec.warning}};
+  out["noise"] = {{"shot", noise.shot},
+                  {"read", noise.read},
+                  {"true_shot", cam.shot()},
+                  {"true_read", cam.read()},
+                  {"seconds", t_noise}};
   out["clipped_pixels"] = ours.clipped;
   out["ghost_pixels"] = ours.ghost;
 
   nlohmann::json methods = nlohmann::json::array();
-  methods.push_back({{"method", "rsibr: inverse-variance merge (" + rec.curve.model + " curve, estimated noise)"}, {"errors", errors(ours.radiance, truth, g)}, {"seconds", t_merge}});
+  methods.push_back({{"method", "rsibr: inverse-variance merge (" + rec.curve.model + " curve, estimated noise)"},
+                     {"errors", errors(ours.radiance, truth, g)},
+                     {"seconds", t_merge}});
   t0 = Clock::now();
   const cv::Mat hat = merge_hat_weighted(b, rec.curve);
-  methods.push_back({{"method", "Debevec hat weighting (same curve)"}, {"errors", errors(hat, truth, g)}, {"seconds", seconds_since(t0)}});
+  methods.push_back({{"method", "Debevec hat weighting (same curve)"},
+                     {"errors", errors(hat, truth, g)},
+                     {"seconds", seconds_since(t0)}});
   // The true curve: how much of the error is the curve's.
   const ResponseCurve true_curve = ResponseCurve::sampled("true", 255, 256, [&](int c, double u) {
     double lo = 0, hi = 1;
@@ -233,9 +259,14 @@ int run(int argc, char** argv) {
   out["true_middle_code_ratio"] = {true_curve.linear(0, 127.5) / true_curve.linear(1, 127.5), 1.0,
                                    true_curve.linear(2, 127.5) / true_curve.linear(1, 127.5)};
   NoiseModel true_noise;
-  for (int c = 0; c < 3; ++c) true_noise.shot[std::size_t(c)] = cam.shot(), true_noise.read[std::size_t(c)] = cam.read();
-  methods.push_back({{"method", "rsibr merge with the true curve and noise"}, {"errors", errors(merge_brackets(b, true_curve, true_noise).radiance, truth, g)}, {"seconds", nullptr}});
-  methods.push_back({{"method", "Debevec hat weighting, true curve"}, {"errors", errors(merge_hat_weighted(b, true_curve), truth, g)}, {"seconds", nullptr}});
+  for (int c = 0; c < 3; ++c)
+    true_noise.shot[std::size_t(c)] = cam.shot(), true_noise.read[std::size_t(c)] = cam.read();
+  methods.push_back({{"method", "rsibr merge with the true curve and noise"},
+                     {"errors", errors(merge_brackets(b, true_curve, true_noise).radiance, truth, g)},
+                     {"seconds", nullptr}});
+  methods.push_back({{"method", "Debevec hat weighting, true curve"},
+                     {"errors", errors(merge_hat_weighted(b, true_curve), truth, g)},
+                     {"seconds", nullptr}});
   // OpenCV: CalibrateDebevec (its defaults: 70 samples, lambda 10, random) + MergeDebevec.
   const std::vector<cv::Mat> bgr = to_bgr8(b);
   std::vector<float> times(e.begin(), e.end());
@@ -246,7 +277,10 @@ int run(int argc, char** argv) {
   t0 = Clock::now();
   const cv::Mat cv_hdr = opencv_merge(bgr, times, cv_response);
   const double t_cv_merge = seconds_since(t0);
-  methods.push_back({{"method", "OpenCV CalibrateDebevec + MergeDebevec"}, {"errors", errors(cv_hdr, truth, g)}, {"seconds", t_cv_merge}, {"calibrate_seconds", t_cv_cal}});
+  methods.push_back({{"method", "OpenCV CalibrateDebevec + MergeDebevec"},
+                     {"errors", errors(cv_hdr, truth, g)},
+                     {"seconds", t_cv_merge},
+                     {"calibrate_seconds", t_cv_cal}});
   out["accuracy"] = methods;
   std::cerr << "accuracy done\n";
 
@@ -273,12 +307,20 @@ int run(int argc, char** argv) {
   const Timing t_cv = best_of(cv_repeats, [&] { cv::createMergeDebevec()->process(big_bgr, cvb, times, cv_response); });
   double load[3] = {0, 0, 0};
   getloadavg(load, 3);
-  out["speed"] = {{"width", big_w}, {"height", big_h}, {"brackets", int(bb.size())},
-                  {"rsibr_merge_s", t_ours.wall}, {"rsibr_merge_cpu_s", t_ours.cpu},
-                  {"rsibr_noise_estimate_s", t_noise_big.wall}, {"rsibr_noise_estimate_cpu_s", t_noise_big.cpu},
-                  {"hat_merge_s", t_hat.wall}, {"hat_merge_cpu_s", t_hat.cpu},
-                  {"opencv_merge_debevec_s", t_cv.wall}, {"opencv_merge_debevec_cpu_s", t_cv.cpu},
-                  {"repeats", repeats}, {"opencv_repeats", cv_repeats}, {"load_average_1min", load[0]}};
+  out["speed"] = {{"width", big_w},
+                  {"height", big_h},
+                  {"brackets", int(bb.size())},
+                  {"rsibr_merge_s", t_ours.wall},
+                  {"rsibr_merge_cpu_s", t_ours.cpu},
+                  {"rsibr_noise_estimate_s", t_noise_big.wall},
+                  {"rsibr_noise_estimate_cpu_s", t_noise_big.cpu},
+                  {"hat_merge_s", t_hat.wall},
+                  {"hat_merge_cpu_s", t_hat.cpu},
+                  {"opencv_merge_debevec_s", t_cv.wall},
+                  {"opencv_merge_debevec_cpu_s", t_cv.cpu},
+                  {"repeats", repeats},
+                  {"opencv_repeats", cv_repeats},
+                  {"load_average_1min", load[0]}};
   std::ofstream(out_path) << out.dump(1) << "\n";
   std::cerr << "ours " << t_ours.wall << " s (cpu " << t_ours.cpu << "), hat " << t_hat.wall << " s (cpu " << t_hat.cpu
             << "), OpenCV " << t_cv.wall << " s (cpu " << t_cv.cpu << "), load " << load[0] << "\n";

@@ -168,10 +168,16 @@ int run(int argc, char** argv) {
           return 1;
         }
       }
-    nlohmann::json s = {{"env", std::filesystem::path(env).filename().string()}, {"jpeg_quality", jpeg}, {"seed", seed},
-                        {"exposures", sh.exposures}, {"views", sh.views.size()},
-                        {"view_width", sh.views.front().cols()}, {"view_height", sh.views.front().rows()},
-                        {"width", stack.front().cols}, {"height", stack.front().rows}, {"max_code", 255},
+    nlohmann::json s = {{"env", std::filesystem::path(env).filename().string()},
+                        {"jpeg_quality", jpeg},
+                        {"seed", seed},
+                        {"exposures", sh.exposures},
+                        {"views", sh.views.size()},
+                        {"view_width", sh.views.front().cols()},
+                        {"view_height", sh.views.front().rows()},
+                        {"width", stack.front().cols},
+                        {"height", stack.front().rows},
+                        {"max_code", 255},
                         {"shoot_seconds", shoot_s}};
     std::ofstream(write_dir + "/shoot.json") << s.dump(1) << "\n";
     return 0;
@@ -189,8 +195,12 @@ int run(int argc, char** argv) {
     std::vector<cv::Mat> est;
     for (const auto& b : sh.views) est.push_back(merge_brackets(b, rec.curve, noise).radiance);
     const double t = seconds_since(t0);
-    methods.push_back({{"method", "rsibr"}, {"settings", "automatic: " + rec.chosen}, {"chosen", rec.chosen},
-                       {"near_tie", rec.near_tie}, {"seconds", t}, {"errors", errors_json(est, sh)}});
+    methods.push_back({{"method", "rsibr"},
+                       {"settings", "automatic: " + rec.chosen},
+                       {"chosen", rec.chosen},
+                       {"near_tie", rec.near_tie},
+                       {"seconds", t},
+                       {"errors", errors_json(est, sh)}});
   }
   if (opencv_debevec.empty()) opencv_debevec = {"70,10"};
   for (const std::string& s : opencv_debevec) {
@@ -204,16 +214,19 @@ int run(int argc, char** argv) {
     const cv::Mat hdr = opencv_merge(stack, times, false, samples, lambda);
     const double t = seconds_since(t0);
     methods.push_back({{"method", "OpenCV Debevec"},
-                       {"settings", "CalibrateDebevec samples " + std::to_string(samples) + ", lambda " + s.substr(s.find(',') + 1) +
-                                        " + MergeDebevec"},
-                       {"seconds", t}, {"errors", errors_json(split_views(hdr, sh), sh)}});
+                       {"settings", "CalibrateDebevec samples " + std::to_string(samples) + ", lambda " +
+                                        s.substr(s.find(',') + 1) + " + MergeDebevec"},
+                       {"seconds", t},
+                       {"errors", errors_json(split_views(hdr, sh), sh)}});
   }
   {
     const auto t0 = Clock::now();
     const cv::Mat hdr = opencv_merge(stack, times, true, 0, 0);
     const double t = seconds_since(t0);
-    methods.push_back({{"method", "OpenCV Robertson"}, {"settings", "CalibrateRobertson (30 iterations, threshold 0.01) + MergeRobertson"},
-                       {"seconds", t}, {"errors", errors_json(split_views(hdr, sh), sh)}});
+    methods.push_back({{"method", "OpenCV Robertson"},
+                       {"settings", "CalibrateRobertson (30 iterations, threshold 0.01) + MergeRobertson"},
+                       {"seconds", t},
+                       {"errors", errors_json(split_views(hdr, sh), sh)}});
   }
   for (const std::string& s : score) {
     const auto eq = s.find('=');
@@ -229,8 +242,11 @@ int run(int argc, char** argv) {
     }
     methods.push_back({{"method", name}, {"errors", errors_json(split_views(img, sh), sh)}});
   }
-  nlohmann::json out = {{"env", std::filesystem::path(env).filename().string()}, {"jpeg_quality", jpeg}, {"seed", seed},
-                        {"exposures", sh.exposures}, {"methods", methods}};
+  nlohmann::json out = {{"env", std::filesystem::path(env).filename().string()},
+                        {"jpeg_quality", jpeg},
+                        {"seed", seed},
+                        {"exposures", sh.exposures},
+                        {"methods", methods}};
   write_text_atomically(out_path, out.dump(1) + "\n");
   return 0;
 }

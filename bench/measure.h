@@ -31,8 +31,9 @@ inline EnvMap load_sanitized(const std::string& path) {
   return env;
 }
 
-inline // `count` distinct random texels whose centres lie inside the disc (radius^2 < 0.98), fixed by the seed.
-cv::Mat probe_mask(int size, int count, std::uint32_t seed) {
+inline  // `count` distinct random texels whose centres lie inside the disc (radius^2 < 0.98), fixed by the seed.
+    cv::Mat
+    probe_mask(int size, int count, std::uint32_t seed) {
   cv::Mat mask(size, size, CV_8UC1, cv::Scalar(0));
   std::mt19937 rng(seed);
   std::uniform_int_distribution<int> pick(0, size - 1);

@@ -48,10 +48,7 @@ const char* kClearCoat =
     "{type: clearcoat, coat: {ior: 1.5, roughness: 0.05}, flakes: {coverage: 0.3, roughness: 0.3, fresnel: {type: "
     "conductor, eta: [1.66, 0.88, 0.52], k: [9.22, 6.27, 4.84]}}, base: {albedo: [0.5, 0.05, 0.03]}}";
 
-
-std::vector<Vec3> views_of(const std::string& name) {
-  return ViewSet::named(name).views();
-}
+std::vector<Vec3> views_of(const std::string& name) { return ViewSet::named(name).views(); }
 
 struct Baked {
   MapSet set;
@@ -59,7 +56,6 @@ struct Baked {
   ViewSet views;
   double seconds = 0;
 };
-
 
 // Texels whose centre lies inside the disc of the given radius (1: the whole disc).
 cv::Mat disc_mask(int size, double radius = 1.0) {
@@ -228,17 +224,30 @@ int run(int argc, char** argv) {
       // the total's square when the parts' errors are uncorrelated).
       const double part_rel[2] = {err.den > 0 ? std::sqrt(err_part[0] / err.den) : 0.0,
                                   err.den > 0 ? std::sqrt(err_part[1] / err.den) : 0.0};
-      std::printf("  %-12s %-8s maps %3d: rel RMS %.4f (inner %.4f, worst view %.4f; normal part %.4f, mirror part %.4f), "
-                  "bake %.1f s, blend %.2f ms/view\n",
-                  cfg_text.c_str(), sets.size() == 1 ? "single" : "split", maps, err.relative_rms(), err_inner.relative_rms(), worst, part_rel[0], part_rel[1],
-                  bake_seconds, 1e3 * blend_seconds / double(novel_views.size()));
+      std::printf(
+          "  %-12s %-8s maps %3d: rel RMS %.4f (inner %.4f, worst view %.4f; normal part %.4f, mirror part %.4f), "
+          "bake %.1f s, blend %.2f ms/view\n",
+          cfg_text.c_str(), sets.size() == 1 ? "single" : "split", maps, err.relative_rms(), err_inner.relative_rms(),
+          worst, part_rel[0], part_rel[1], bake_seconds, 1e3 * blend_seconds / double(novel_views.size()));
       std::fflush(stdout);
-      rows.push_back({{"env", env_name}, {"config", cfg_text}, {"normalised", normalised}, {"kind", sets.size() == 1 ? "single" : "split"},
-                      {"sets", sizes}, {"maps", maps}, {"rel_rms", err.relative_rms()}, {"rel_rms_inner", err_inner.relative_rms()}, {"worst_view", worst},
-                      {"normal_part_rel_rms", part_rel[0]}, {"mirror_part_rel_rms", part_rel[1]},
-                      {"bake_s", bake_seconds}, {"blend_ms", 1e3 * blend_seconds / double(novel_views.size())},
-                      {"truth_noise", noise.relative_rms()}, {"res", res}, {"samples", samples},
-                      {"truth_samples", truth_samples}, {"novel", novel}});
+      rows.push_back({{"env", env_name},
+                      {"config", cfg_text},
+                      {"normalised", normalised},
+                      {"kind", sets.size() == 1 ? "single" : "split"},
+                      {"sets", sizes},
+                      {"maps", maps},
+                      {"rel_rms", err.relative_rms()},
+                      {"rel_rms_inner", err_inner.relative_rms()},
+                      {"worst_view", worst},
+                      {"normal_part_rel_rms", part_rel[0]},
+                      {"mirror_part_rel_rms", part_rel[1]},
+                      {"bake_s", bake_seconds},
+                      {"blend_ms", 1e3 * blend_seconds / double(novel_views.size())},
+                      {"truth_noise", noise.relative_rms()},
+                      {"res", res},
+                      {"samples", samples},
+                      {"truth_samples", truth_samples},
+                      {"novel", novel}});
     }
   }
   nlohmann::json doc;

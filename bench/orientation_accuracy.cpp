@@ -17,7 +17,8 @@
 int main(int argc, char** argv) {
   using namespace rsibr;
   CLI::App app("Orientation accuracy on rendered views");
-  double radius_px = 120, noise = 0.01, ball_prior_px = 0.25, radius_prior_px = 2, max_radius_fraction = 0.95, contrast = 0.01;
+  double radius_px = 120, noise = 0.01, ball_prior_px = 0.25, radius_prior_px = 2, max_radius_fraction = 0.95,
+         contrast = 0.01;
   int views = 4, max_features = 800;
   double spacing = 20;
   std::string domain = "cube";
@@ -38,7 +39,8 @@ int main(int argc, char** argv) {
   app.add_option("--ball-prior-px", ball_prior_px, "Ball centre prior floor, pixels");
   app.add_option("--radius-prior-px", radius_prior_px, "Ball radius prior, pixels (0: held at the outline's)");
   app.add_option("--max-features", max_features, "SIFT features per view");
-  app.add_option("--max-radius-fraction", max_radius_fraction, "Features within this fraction of the ball's angular radius");
+  app.add_option("--max-radius-fraction", max_radius_fraction,
+                 "Features within this fraction of the ball's angular radius");
   app.add_option("--contrast-threshold", contrast, "SIFT contrast threshold");
   CLI11_PARSE(app, argc, argv);
   const double distance = 0.5, f = radius_px * distance / 0.05;
@@ -83,22 +85,37 @@ int main(int argc, char** argv) {
   try {
     p = orient_views(names, images, scene.camera.lens, o, &rep);
   } catch (const std::exception& e) {  // e.g. a view sharing too few features: reported, not fatal
-    std::cout << nlohmann::json({{"radius_px", radius_px}, {"noise", noise}, {"views", views}, {"spacing", spacing},
-                                 {"domain", domain}, {"seed", seed}, {"refine", refine}, {"failed", e.what()}})
+    std::cout << nlohmann::json({{"radius_px", radius_px},
+                                 {"noise", noise},
+                                 {"views", views},
+                                 {"spacing", spacing},
+                                 {"domain", domain},
+                                 {"seed", seed},
+                                 {"refine", refine},
+                                 {"failed", e.what()}})
                      .dump()
               << "\n";
     return 0;
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const Mat3 g = p.views[0].world_from_cam * truth[0].transpose();
-  nlohmann::json j = {{"radius_px", radius_px}, {"noise", noise}, {"views", views}, {"spacing", spacing},
-                      {"domain", domain}, {"seed", seed}, {"refine", refine},
-                      {"refine_tracks", refine_tracks}, {"tracks", rep.tracks}, {"rms_sigmas", rep.rms_sigmas},
+  nlohmann::json j = {{"radius_px", radius_px},
+                      {"noise", noise},
+                      {"views", views},
+                      {"spacing", spacing},
+                      {"domain", domain},
+                      {"seed", seed},
+                      {"refine", refine},
+                      {"refine_tracks", refine_tracks},
+                      {"tracks", rep.tracks},
+                      {"rms_sigmas", rep.rms_sigmas},
                       {"relocated", rep.track_refinement.observations_refined},
                       {"dropped", rep.track_refinement.observations_dropped},
-                      {"sigma_ratio", rep.track_refinement.median_sigma_ratio}, {"seconds", seconds}};
+                      {"sigma_ratio", rep.track_refinement.median_sigma_ratio},
+                      {"seconds", seconds}};
   for (int v = 1; v < views; ++v) {
-    j["error_deg"].push_back(Eigen::AngleAxisd(p.views[v].world_from_cam.transpose() * g * truth[v]).angle() * 180 / kPi);
+    j["error_deg"].push_back(Eigen::AngleAxisd(p.views[v].world_from_cam.transpose() * g * truth[v]).angle() * 180 /
+                             kPi);
     j["sigma_deg"].push_back(p.views[v].sigma_deg);
   }
   for (int v = 0; v < views; ++v) {

@@ -21,9 +21,9 @@ namespace rsibr::previous {
 
 namespace {
 
-RSIBR_AVX2_CLONES void central_directions_row(
-    CentralDirection kind, int width, int height, int row, int c_begin, int c_end, double* __restrict out_x,
-    double* __restrict out_y, double* __restrict out_z) {
+RSIBR_AVX2_CLONES void central_directions_row(CentralDirection kind, int width, int height, int row, int c_begin,
+                                              int c_end, double* __restrict out_x, double* __restrict out_y,
+                                              double* __restrict out_z) {
   const double y = 1.0 - (2.0 * row + 1.0) / height;
   const int n = c_end - c_begin;
   for (int i = 0; i < n; ++i) {
@@ -82,9 +82,6 @@ RSIBR_AVX2_CLONES void warp_directions(CentralDirection kind, const double m[9],
   }
 }
 
-
-
-
 // One located source, ready to sample.
 struct Source : DiscMap {
   CentralDirection kind = CentralDirection::Mirror;
@@ -108,8 +105,8 @@ struct FastSource {
   double m[9] = {};
   double weight = 0;
   double scale_x = 0, offset_x = 0, scale_y = 0, offset_y = 0;  // pixel = (x scale_x + offset_x, offset_y - y scale_y)
-  double interior2 = -1;                                         // squared disc radius of the interior
-  std::vector<int> lo, hi;                                     // per row: valid tap columns [lo, hi)
+  double interior2 = -1;                                        // squared disc radius of the interior
+  std::vector<int> lo, hi;                                      // per row: valid tap columns [lo, hi)
 };
 
 void prepare(const Source& s, FastSource& f) {
@@ -134,8 +131,8 @@ void prepare(const Source& s, FastSource& f) {
   // have all of these inside the disc and in the image. Offsets must fit an int (else no interior).
   const double reach = std::sqrt(16.0 / (double(s.width) * s.width) + 4.0 / (double(s.height) * s.height));
   const double radius = 1.0 - reach - 1e-4;
-  const bool fits = double(s.rgb->step1()) * s.height < 2e9 &&
-                    (!s.confidence || double(s.confidence->step1()) * s.height < 2e9);
+  const bool fits =
+      double(s.rgb->step1()) * s.height < 2e9 && (!s.confidence || double(s.confidence->step1()) * s.height < 2e9);
   f.interior2 = radius > 0 && fits ? radius * radius : -1.0;
   f.lo.assign(std::size_t(s.height), s.width);
   f.hi.assign(std::size_t(s.height), 0);
@@ -177,7 +174,8 @@ struct Scratch {
   float *a[3], *fx[3], *fy[3], *acc[4];
   int *offset[3], *conf_offset[3], *interior[3];
   explicit Scratch(int width)
-      : doubles(std::size_t(15) * std::size_t(width)), floats(std::size_t(13) * std::size_t(width)),
+      : doubles(std::size_t(15) * std::size_t(width)),
+        floats(std::size_t(13) * std::size_t(width)),
         ints(std::size_t(9) * std::size_t(width)) {
     double* p = doubles.data();
     float* q = floats.data();
@@ -218,9 +216,9 @@ RSIBR_AVX2_CLONES void fade_row(int n, double weight, double rim_fade, const dou
 // The bilinear footprint of each disc point (vectorised): the offset of its top-left tap in floats
 // (rgb; the confidence offset follows from it), the fractions, and whether it lies in the interior
 // (all four taps valid: the gather loop needs no further test).
-RSIBR_AVX2_CLONES void footprints_row(
-    const FastSource& f, int n, const double* __restrict disc_x, const double* __restrict disc_y, float* __restrict fx,
-    float* __restrict fy, int* __restrict offset, int* __restrict conf_offset, int* __restrict interior) {
+RSIBR_AVX2_CLONES void footprints_row(const FastSource& f, int n, const double* __restrict disc_x,
+                                      const double* __restrict disc_y, float* __restrict fx, float* __restrict fy,
+                                      int* __restrict offset, int* __restrict conf_offset, int* __restrict interior) {
   // Locals: the int stores below could otherwise alias f's members, which would then be reloaded.
   const double interior2 = f.interior2, scale_x = f.scale_x, offset_x = f.offset_x, scale_y = f.scale_y,
                offset_y = f.offset_y;
@@ -310,8 +308,9 @@ void fallback(const Source* sources, int n, int W, int H, int r, int c, float* o
 }  // namespace
 
 BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_dir, const Vec3& up,
-                                const BlendOptions& options) {
-  if (!view_dir.allFinite() || !(view_dir.norm() > 0)) throw std::invalid_argument("blend: view direction must be finite and non-zero");
+                  const BlendOptions& options) {
+  if (!view_dir.allFinite() || !(view_dir.norm() > 0))
+    throw std::invalid_argument("blend: view direction must be finite and non-zero");
   if ((options.width > 0) != (options.height > 0) || options.width < 0 || options.height < 0)
     throw std::invalid_argument("blend: give both width and height (> 0), or neither");
   const int W = options.width > 0 ? options.width : maps.width();
@@ -320,8 +319,8 @@ BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_
   static const ExactWarp exact;
   const Warp& warp = options.warp ? *options.warp : exact;
   if (!warp.supports(W, H))
-    throw std::invalid_argument(std::string("blend: the ") + warp.name() + " warp does not support " + std::to_string(W) +
-                                "x" + std::to_string(H));
+    throw std::invalid_argument(std::string("blend: the ") + warp.name() + " warp does not support " +
+                                std::to_string(W) + "x" + std::to_string(H));
 
   BlendResult result;
   result.world_from_view = world_from_view_for(view_dir, up);
@@ -350,7 +349,6 @@ BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_
   if (options.source_weights)
     for (int k = 0; k < 3; ++k) result.source_weight[std::size_t(k)] = cv::Mat::zeros(H, W, CV_32FC1);
 
-
   // The fast path: structure of arrays, one fused pass per tile
   // row (warp and fade in double, footprints, float taps and sums, normalisation), bands of rows in
   // parallel. Per texel the arithmetic does not depend on the tiling or the threads.
@@ -371,7 +369,8 @@ BlendResult blend(const MapSet& maps, const ViewSet& view_set, const Vec3& view_
     if (fused)
       for (int kind = 0; kind < 2; ++kind)
         if (kinds[kind])
-          central_directions_row(CentralDirection(kind), W, H, r, c0, c1, s.dir[kind][0], s.dir[kind][1], s.dir[kind][2]);
+          central_directions_row(CentralDirection(kind), W, H, r, c0, c1, s.dir[kind][0], s.dir[kind][1],
+                                 s.dir[kind][2]);
     int active[3], m = 0;
     for (int k = 0; k < n; ++k) {
       const Source& src = sources[k];

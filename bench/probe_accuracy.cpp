@@ -177,7 +177,8 @@ int main(int argc, char** argv) {
     std::printf(
         "{\"covered_fraction\": %.6f, \"all\": %.6f, \"no_sun\": %.6f, \"cameras\": %.6f, \"no_rig\": %.6f, \"sun_energy\": %.6f, \"log_rms_stops\": %.6f, \"log_rms_no_rig_stops\": %.6f, \"gain\": [%.6g, %.6g, %.6g], "
         "\"sun\": [%.5f, %.5f, %.5f]}\n",
-        covered / total, all, no_sun, at_cameras, no_rig, sun_energy, log_rms, log_rms_no_rig, gain[0], gain[1], gain[2], sun.x(), sun.y(), sun.z());
+        covered / total, all, no_sun, at_cameras, no_rig, sun_energy, log_rms, log_rms_no_rig, gain[0], gain[1],
+        gain[2], sun.x(), sun.y(), sun.z());
   } catch (const std::exception& e) {
     std::cerr << "rsibr_probe_accuracy: " << e.what() << "\n";
     return 1;

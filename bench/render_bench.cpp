@@ -36,7 +36,8 @@ const MapSet& map_set() {
       mv.view = v;
       mv.world_from_view = world_from_view_for(v);
       const Mat3 T = mv.world_from_view;
-      mv.rgb = render_pattern([&](const Vec3& d) { return f(T * d); }, Layout::with_size(LayoutKind::Sphere, 256), 1).pixels;
+      mv.rgb =
+          render_pattern([&](const Vec3& d) { return f(T * d); }, Layout::with_size(LayoutKind::Sphere, 256), 1).pixels;
       s.views.push_back(std::move(mv));
     }
     return s;
@@ -93,8 +94,8 @@ void BM_Render(benchmark::State& state) {
   }
   const char* names[] = {"primary rays only (packets of 16)", "paper mode, precomputed warp, 256^2",
                          "paper mode, tessellated warp, 256^2", "per-pixel mode"};
-  state.SetLabel(std::string(names[kind]) + ", 1280x720, " + std::to_string(hits / std::max<long long>(1, state.iterations())) +
-                " hits/frame");
+  state.SetLabel(std::string(names[kind]) + ", 1280x720, " +
+                 std::to_string(hits / std::max<long long>(1, state.iterations())) + " hits/frame");
   state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }
 

@@ -12,10 +12,10 @@ namespace {
 
 const EnvMap& source() {
   // A 1024x512 lat-long sky with a 0.5-degree sun 1e5 times brighter than the sky.
-  static const EnvMap env = render_pattern(
-      patterns::sun_and_sky(Vec3(0.3, 0.6, -0.5), 0.5 * kPi / 180, Vec3(1e5, 1e5, 1e5), Vec3(0.25, 0.45, 1.0),
-                            Vec3(0.9, 0.9, 0.85)),
-      Layout::with_size(LayoutKind::LatLong, 1024), 6);
+  static const EnvMap env =
+      render_pattern(patterns::sun_and_sky(Vec3(0.3, 0.6, -0.5), 0.5 * kPi / 180, Vec3(1e5, 1e5, 1e5),
+                                           Vec3(0.25, 0.45, 1.0), Vec3(0.9, 0.9, 0.85)),
+                     Layout::with_size(LayoutKind::LatLong, 1024), 6);
   return env;
 }
 

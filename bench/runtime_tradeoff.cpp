@@ -86,7 +86,6 @@ std::vector<std::string> split(const std::string& text) {
   return out;
 }
 
-
 // The BRDFs by short name (the conductor is gold's, as in bench/bake_tradeoff.cpp).
 std::string brdf_spec(const std::string& name) {
   const std::string gold = "fresnel: {type: conductor, eta: [0.2, 0.92, 1.1], k: [3.9, 2.45, 2.14]}";
@@ -123,7 +122,7 @@ EnvMap working_environment(const std::string& path, int max_width) {
 
 struct BakeMethod {
   std::string method = "reference";  // or "mis"
-  int samples = 0;                    // mis only
+  int samples = 0;                   // mis only
   std::string key() const { return method == "mis" ? "mis" + std::to_string(samples) : method; }
 };
 
@@ -134,12 +133,15 @@ struct Baker {
   BakeMethod method;
   std::unique_ptr<Integrator> integrator;
   Baker(const std::string& cache_dir, const std::string& env_path, const EnvMap& e, const BakeMethod& m)
-      : cache(cache_dir), env_name(std::filesystem::path(env_path).stem().string()), env(&e), method(m),
+      : cache(cache_dir),
+        env_name(std::filesystem::path(env_path).stem().string()),
+        env(&e),
+        method(m),
         integrator(make_integrator(m.method, e)) {}
 
   std::string prefix(const std::string& brdf_name) const {
-    return cache + "/" + file_key(env_name + "_" + std::to_string(env->layout.width()) + "_" + brdf_name + "_" +
-                                  method.key());
+    return cache + "/" +
+           file_key(env_name + "_" + std::to_string(env->layout.width()) + "_" + brdf_name + "_" + method.key());
   }
 
   MapView bake_view(const Brdf& brdf, const Vec3& v, int size, std::uint64_t seed) const {
@@ -190,7 +192,6 @@ struct Baker {
   }
 };
 
-
 cv::Mat disc_mask(int size) {
   cv::Mat m(size, size, CV_8UC1, cv::Scalar(0));
   for (int r = 0; r < size; ++r) {
@@ -234,7 +235,6 @@ std::vector<WarpChoice> warps_for(int size) {
   return w;
 }
 
-
 struct SetSpec {
   int size, views;
 };
@@ -259,8 +259,7 @@ nlohmann::json run_novel(const std::string& env_path, int env_width, const std::
   const EnvMap env = working_environment(env_path, env_width);
   const Baker baker(cache, env_path, env, BakeMethod{});
   const auto brdf = parse_brdf(brdf_spec(brdf_name));
-  nlohmann::json out, rows = nlohmann::json::array(), bakes = nlohmann::json::array(),
-                     checks = nlohmann::json::array();
+  nlohmann::json out, rows = nlohmann::json::array(), bakes = nlohmann::json::array(), checks = nlohmann::json::array();
   out["novel_views"] = nlohmann::json::array();
   for (const Vec3& d : novel_dirs) out["novel_views"].push_back({d.x(), d.y(), d.z()});
 
@@ -282,8 +281,11 @@ nlohmann::json run_novel(const std::string& env_path, int env_width, const std::
     const double working_s = seconds_since(t0);
     ErrorSums e;
     e.add(working, truth, mask);
-    checks.push_back({{"what", "quadrature"}, {"env_width", env.layout.width()}, {"env_height", env.layout.height()},
-                      {"rel_rms", e.relative_rms()}, {"seconds_per_texel", working_s / probes},
+    checks.push_back({{"what", "quadrature"},
+                      {"env_width", env.layout.width()},
+                      {"env_height", env.layout.height()},
+                      {"rel_rms", e.relative_rms()},
+                      {"seconds_per_texel", working_s / probes},
                       {"full_seconds_per_texel", full_s / probes}});
     const auto mis = make_integrator("mis", full);
     for (int n : mis_samples) {
@@ -294,8 +296,8 @@ nlohmann::json run_novel(const std::string& env_path, int env_width, const std::
       const double mis_s = seconds_since(t0);
       ErrorSums em;
       em.add(m, truth, mask);
-      checks.push_back({{"what", "mis"}, {"samples", n}, {"rel_rms", em.relative_rms()},
-                        {"seconds_per_texel", mis_s / probes}});
+      checks.push_back(
+          {{"what", "mis"}, {"samples", n}, {"rel_rms", em.relative_rms()}, {"seconds_per_texel", mis_s / probes}});
     }
   }
 
@@ -343,9 +345,17 @@ nlohmann::json run_novel(const std::string& env_path, int env_width, const std::
           inner.add(b.rgb, directs[std::size_t(i)], mask & interior);
         }
       const double t = median(times);
-      rows.push_back({{"env", baker.env_name}, {"brdf", brdf_name}, {"size", size}, {"views", spec.views},
-                      {"warp", w.name}, {"rings", w.rings}, {"rel_rms", e.relative_rms()}, {"worst", e.worst()},
-                      {"rel_rms_inner", inner.relative_rms()}, {"worst_inner", inner.worst()}, {"seconds", t}});
+      rows.push_back({{"env", baker.env_name},
+                      {"brdf", brdf_name},
+                      {"size", size},
+                      {"views", spec.views},
+                      {"warp", w.name},
+                      {"rings", w.rings},
+                      {"rel_rms", e.relative_rms()},
+                      {"worst", e.worst()},
+                      {"rel_rms_inner", inner.relative_rms()},
+                      {"worst_inner", inner.worst()},
+                      {"seconds", t}});
       std::cerr << brdf_name << " | " << size << " | " << spec.views << " | " << w.name
                 << (w.rings ? std::to_string(w.rings) : "") << ": rel " << e.relative_rms() << " worst " << e.worst()
                 << " " << t * 1e3 << " ms\n";
@@ -371,8 +381,7 @@ void write_f32(const std::string& path, const cv::Mat& m) {
 
 nlohmann::json run_render(const std::string& mesh_path, const std::string& env_path, int env_width,
                           const std::string& brdf_name, const std::vector<SetSpec>& specs,
-                          const std::vector<double>& fovs, int width, int height, int ref_spp, int ref_seeds,
-                          int reps,
+                          const std::vector<double>& fovs, int width, int height, int ref_spp, int ref_seeds, int reps,
                           const std::string& cache, const std::string& heat_prefix, const SetSpec& heat_set,
                           double heat_fov) {
   const Mesh mesh = load_mesh(mesh_path);
@@ -420,10 +429,13 @@ nlohmann::json run_render(const std::string& mesh_path, const std::string& env_p
         mask.at<unsigned char>(r, c) = a.alpha.at<float>(r, c) >= 1.f && b.alpha.at<float>(r, c) >= 1.f;
     ErrorSums noise;
     noise.add(a.rgb, ref, mask);  // A - (A+B)/2 = (A-B)/2: sigma_half/sqrt 2 = the average's noise
-    refs.push_back({{"fov", fov}, {"spp", ro.spp * ref_seeds}, {"seeds", ref_seeds}, {"seconds", ref_s}, {"noise_rel_rms", noise.relative_rms()},
+    refs.push_back({{"fov", fov},
+                    {"spp", ro.spp * ref_seeds},
+                    {"seeds", ref_seeds},
+                    {"seconds", ref_s},
+                    {"noise_rel_rms", noise.relative_rms()},
                     {"pixels", cv::countNonZero(mask)}});
-    std::cerr << brdf_name << " fov " << fov << ": reference " << ref_s << " s, noise " << noise.relative_rms()
-              << "\n";
+    std::cerr << brdf_name << " fov " << fov << ": reference " << ref_s << " s, noise " << noise.relative_rms() << "\n";
     for (std::size_t k = 0; k < specs.size(); ++k)
       for (RenderMode mode : {RenderMode::Paper, RenderMode::PerPixel}) {
         const SetSpec& spec = specs[k];
@@ -457,9 +469,15 @@ nlohmann::json run_render(const std::string& mesh_path, const std::string& env_p
         if (!heat_prefix.empty() && spec.views == heat_set.views && spec.size == heat_set.size &&
             std::abs(fov - heat_fov) < 1e-9)
           write_f32(heat_prefix + "_" + mode_name + ".f32", abs_error / std::sqrt(e.den / double(e.count)));
-        rows.push_back({{"fov", fov}, {"views", spec.views}, {"size", spec.size}, {"mode", mode_name},
-                        {"rel_rms", e.relative_rms()}, {"worst", e.worst()}, {"rel_rms_spp1", e1.relative_rms()},
-                        {"seconds", median(times)}, {"pixels", e.count}});
+        rows.push_back({{"fov", fov},
+                        {"views", spec.views},
+                        {"size", spec.size},
+                        {"mode", mode_name},
+                        {"rel_rms", e.relative_rms()},
+                        {"worst", e.worst()},
+                        {"rel_rms_spp1", e1.relative_rms()},
+                        {"seconds", median(times)},
+                        {"pixels", e.count}});
         std::cerr << "fov " << fov << " | " << spec.views << "@" << spec.size << " | " << mode_name << ": rel "
                   << e.relative_rms() << " (spp1 " << e1.relative_rms() << ") worst " << e.worst() << " "
                   << median(times) * 1e3 << " ms\n";
@@ -476,8 +494,8 @@ nlohmann::json run_render(const std::string& mesh_path, const std::string& env_p
   out["env"] = baker.env_name;
   out["env_size"] = {env.layout.width(), env.layout.height()};
   out["mesh"] = std::filesystem::path(mesh_path).filename().string();
-  out["heat"] = {{"views", heat_set.views}, {"size", heat_set.size}, {"fov", heat_fov}, {"width", width},
-                 {"height", height}};
+  out["heat"] = {
+      {"views", heat_set.views}, {"size", heat_set.size}, {"fov", heat_fov}, {"width", width}, {"height", height}};
   return out;
 }
 
@@ -540,9 +558,9 @@ int main(int argc, char** argv) {
     } else {
       std::vector<double> fov_list;
       for (const std::string& f : rsibr::split(fovs)) fov_list.push_back(std::stod(f));
-      result["render"] = rsibr::run_render(mesh, env, env_width, brdf, rsibr::parse_sets(sets), fov_list, width,
-                                           height, ref_spp, ref_seeds, reps, cache, heat, rsibr::parse_sets(heat_set).at(0),
-                                           heat_fov);
+      result["render"] =
+          rsibr::run_render(mesh, env, env_width, brdf, rsibr::parse_sets(sets), fov_list, width, height, ref_spp,
+                            ref_seeds, reps, cache, heat, rsibr::parse_sets(heat_set).at(0), heat_fov);
     }
     std::ofstream(out) << result.dump(1) << "\n";
   } catch (const std::exception& e) {

@@ -49,7 +49,8 @@ Vec3 integral3(const EnvMap& e) {
 }
 
 cv::Vec3f pixel(const cv::Mat& m, const Vec2& p) {
-  const int x = std::clamp(int(std::lround(p.x())), 0, m.cols - 1), y = std::clamp(int(std::lround(p.y())), 0, m.rows - 1);
+  const int x = std::clamp(int(std::lround(p.x())), 0, m.cols - 1),
+            y = std::clamp(int(std::lround(p.y())), 0, m.rows - 1);
   return m.at<cv::Vec3f>(y, x);
 }
 
@@ -120,18 +121,20 @@ int main(int argc, char** argv) {
                 const cv::Vec3f p = mv.rgb.at<cv::Vec3f>(rr, cc);
                 sum += Vec3(p[0], p[1], p[2]), ++count;
               }
-            if (count) small.at<cv::Vec3f>(r, q) = cv::Vec3f(float(sum[0] / count), float(sum[1] / count), float(sum[2] / count));
+            if (count)
+              small.at<cv::Vec3f>(r, q) =
+                  cv::Vec3f(float(sum[0] / count), float(sum[1] / count), float(sum[2] / count));
           }
         mv.rgb = small;
       }
       for (MapSet* set : {&c, &cap})
-      for (MapView& mv : set->views) {
-        const std::string image = mv.attributes.count("image") ? mv.attributes.at("image") : "";
-        const Vec3 u = unit.count(image) && unit[image].count(ball) ? unit[image][ball] : Vec3::Constant(gain);
-        mv.rgb.forEach<cv::Vec3f>([&](cv::Vec3f& p, const int*) {
-          for (int k = 0; k < 3; ++k) p[k] = float(p[k] / u[k]);
-        });
-      }
+        for (MapView& mv : set->views) {
+          const std::string image = mv.attributes.count("image") ? mv.attributes.at("image") : "";
+          const Vec3 u = unit.count(image) && unit[image].count(ball) ? unit[image][ball] : Vec3::Constant(gain);
+          mv.rgb.forEach<cv::Vec3f>([&](cv::Vec3f& p, const int*) {
+            for (int k = 0; k < 3; ++k) p[k] = float(p[k] / u[k]);
+          });
+        }
       // Views whose ball was not found where the truth has it (the extracted view more than 2
       // degrees off: a wrong detection) are left out and counted.
       int dropped = 0;
@@ -140,8 +143,10 @@ int main(int argc, char** argv) {
         for (MapView& mv : set->views) {
           bool near = false;
           for (const MapView& tv : t.views) near = near || angle_between(mv.view, tv.view) < 2 * kPi / 180;
-          if (near) kept.views.push_back(std::move(mv));
-          else if (set == &c) ++dropped;
+          if (near)
+            kept.views.push_back(std::move(mv));
+          else if (set == &c)
+            ++dropped;
         }
         *set = std::move(kept);
       }
@@ -152,7 +157,8 @@ int main(int argc, char** argv) {
       const Comparison fit = compare_map_sets(c, t, co);
       co.fit = false;
       const Comparison raw = compare_map_sets(c, t, co);
-      out["computed_vs_truth"][ball] = {{"after_fit", fit.after.relative_rms}, {"calibrated", raw.before.relative_rms},
+      out["computed_vs_truth"][ball] = {{"after_fit", fit.after.relative_rms},
+                                        {"calibrated", raw.before.relative_rms},
                                         {"gains", fit.fit ? nlohmann::json(fit.fit->gains) : nlohmann::json()}};
       co.fit = true;
       const Comparison capt = compare_map_sets(cap, t, co);
@@ -183,8 +189,9 @@ int main(int argc, char** argv) {
         centroid += om * (0.2126 * L[0] + 0.7152 * L[1] + 0.0722 * L[2]) * w;
       }
     power = power.cwiseProduct(chrome_unit);
-    nlohmann::json sun = {{"direction", {centroid.normalized().x(), centroid.normalized().y(), centroid.normalized().z()}},
-                          {"power", {power[0], power[1], power[2]}}};
+    nlohmann::json sun = {
+        {"direction", {centroid.normalized().x(), centroid.normalized().y(), centroid.normalized().z()}},
+        {"power", {power[0], power[1], power[2]}}};
     // The recovered sources, summed, against what they had to supply; the direction of the most
     // powerful source against the sun's.
     const fs::path record = process / "steps" / "sources.json";
@@ -196,8 +203,9 @@ int main(int argc, char** argv) {
       // measured probe's own holes (the stand's directions) are no source's to fill.
       std::vector<std::pair<Vec3, double>> caps;
       for (const auto& rg : rec["summary"]["regions"])
-        caps.push_back({Vec3(rg["direction"][0].get<double>(), rg["direction"][1].get<double>(), rg["direction"][2].get<double>()),
-                        (rg["radius_deg"].get<double>() + 2) * kPi / 180});
+        caps.push_back(
+            {Vec3(rg["direction"][0].get<double>(), rg["direction"][1].get<double>(), rg["direction"][2].get<double>()),
+             (rg["radius_deg"].get<double>() + 2) * kPi / 180});
       auto in_caps = [&](const EnvMap& e, const Vec3& scale) {
         Vec3 p = Vec3::Zero();
         for (int r = 0; r < e.layout.height(); ++r)
@@ -211,16 +219,19 @@ int main(int argc, char** argv) {
           }
         return p;
       };
-      const Vec3 need = in_caps(env, chrome_unit) - in_caps(read_environment((process / "probe-measured.exr").string()), Vec3::Ones());
+      const Vec3 need = in_caps(env, chrome_unit) -
+                        in_caps(read_environment((process / "probe-measured.exr").string()), Vec3::Ones());
       Vec3 total = Vec3::Zero(), variance = Vec3::Zero();
       double strongest = -1;
       for (const auto& src : sources) {
         Vec3 p, sg;
-        for (int k = 0; k < 3; ++k) p[k] = src["power"][std::size_t(k)].get<double>(), sg[k] = src["power_sigma"][std::size_t(k)].get<double>();
+        for (int k = 0; k < 3; ++k)
+          p[k] = src["power"][std::size_t(k)].get<double>(), sg[k] = src["power_sigma"][std::size_t(k)].get<double>();
         total += p, variance += sg.cwiseAbs2();
         if (p.sum() <= strongest) continue;
         strongest = p.sum();
-        const Vec3 d(src["direction"][0].get<double>(), src["direction"][1].get<double>(), src["direction"][2].get<double>());
+        const Vec3 d(src["direction"][0].get<double>(), src["direction"][1].get<double>(),
+                     src["direction"][2].get<double>());
         sun["angle_deg"] = angle_between(d, centroid.normalized()) * 180 / kPi;
         sun["direction_sigma_deg"] = src["direction_sigma_deg"];
       }

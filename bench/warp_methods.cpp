@@ -127,9 +127,10 @@ int run(const std::vector<int>& sizes, int reps) {
             for (int f = 0; f < frames; ++f) warp_map(*m.warp, kind, sources_of(ring, frame++, &dest), n, buf);
             best = std::min(best, since(t0) / frames);
           }
-          std::printf("{\"what\": \"warp\", \"size\": %d, \"case\": \"%s\", \"kind\": \"%s\", \"warp\": \"%s\", "
-                      "\"knob\": %d, \"seconds_per_map\": %.6g, \"max_texels\": %.5g, \"rms_texels\": %.5g}\n",
-                      n, ring ? "ring" : "general", to_string(kind), m.name.c_str(), m.knob, best, max_t, rms_t);
+          std::printf(
+              "{\"what\": \"warp\", \"size\": %d, \"case\": \"%s\", \"kind\": \"%s\", \"warp\": \"%s\", "
+              "\"knob\": %d, \"seconds_per_map\": %.6g, \"max_texels\": %.5g, \"rms_texels\": %.5g}\n",
+              n, ring ? "ring" : "general", to_string(kind), m.name.c_str(), m.knob, best, max_t, rms_t);
           std::fflush(stdout);
         }
     // The blend (all threads) to destinations on the upper ring of a two-ring set, with each warp,
@@ -151,8 +152,8 @@ int run(const std::vector<int>& sizes, int reps) {
         for (int f = 0; f < frames; ++f) engine.map(ring_frame(20, 5.0 + 1.3 * frame++).col(2), Vec3(0, 1, 0), o);
         best = std::min(best, since(t0) / frames);
       }
-      std::printf("{\"what\": \"blend\", \"size\": %d, \"warp\": \"%s\", \"knob\": %d, \"seconds_per_frame\": %.6g}\n", n,
-                  m.name.c_str(), m.knob, best);
+      std::printf("{\"what\": \"blend\", \"size\": %d, \"warp\": \"%s\", \"knob\": %d, \"seconds_per_frame\": %.6g}\n",
+                  n, m.name.c_str(), m.knob, best);
       std::fflush(stdout);
     }
   }
@@ -174,8 +175,10 @@ int main(int argc, char** argv) {
   std::vector<int> sizes = {128, 256, 512};
   int reps = 5;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--sizes") && i + 1 < argc) sizes = rsibr::parse_ints(argv[++i]);
-    else if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::stoi(argv[++i]);
+    if (!std::strcmp(argv[i], "--sizes") && i + 1 < argc)
+      sizes = rsibr::parse_ints(argv[++i]);
+    else if (!std::strcmp(argv[i], "--reps") && i + 1 < argc)
+      reps = std::stoi(argv[++i]);
     else {
       std::fprintf(stderr, "usage: rsibr_warp_methods [--sizes 128,256,512] [--reps 5]\n");
       return 2;

@@ -37,7 +37,7 @@ std::optional<BallCone> fit_cone_algebraic(const std::vector<Vec3>& rays, const 
 double pixels_per_radian(const LensModel& lens, const Vec3& axis, const Vec3& d) {
   Vec3 e = d - d.dot(axis) * axis;  // d = cos(theta) axis + sin(theta) e
   const double en = e.norm();
-  if (!(en > 1e-12)) {               // d on the axis: any perpendicular direction
+  if (!(en > 1e-12)) {  // d on the axis: any perpendicular direction
     e = axis.unitOrthogonal();
   } else {
     e /= en;

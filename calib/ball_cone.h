@@ -37,16 +37,16 @@ std::optional<BallCone> fit_cone_algebraic(const std::vector<Vec3>& rays, const 
 
 struct ConeFitOptions {
   int ransac_iterations = 1000;  // minimal (3-ray) samples; 0 skips RANSAC
-  double inlier_px = 1.0;       // RANSAC inlier threshold, pixels
-  double huber_px = 0.5;        // robust loss scale of the refinement, pixels
-  int refine_iterations = 20;   // Gauss-Newton iterations
-  std::uint64_t seed = 1;       // RANSAC sampling
+  double inlier_px = 1.0;        // RANSAC inlier threshold, pixels
+  double huber_px = 0.5;         // robust loss scale of the refinement, pixels
+  int refine_iterations = 20;    // Gauss-Newton iterations
+  std::uint64_t seed = 1;        // RANSAC sampling
 };
 
 struct ConeFit {
   BallCone cone;
-  int inliers = 0;               // rays within inlier_px of the fitted outline
-  double rms_px = 0;             // RMS pixel residual over the inliers
+  int inliers = 0;                  // rays within inlier_px of the fitted outline
+  double rms_px = 0;                // RMS pixel residual over the inliers
   std::vector<double> residual_px;  // signed, per ray (outward positive)
 };
 

@@ -18,8 +18,8 @@ namespace {
 
 struct BallGeometry {
   Vec3 axis, centre;
-  double limit;          // max angle of a used pixel's ray from the axis, radians
-  double cos_cam;        // cos(camera_mask_deg)
+  double limit;    // max angle of a used pixel's ray from the axis, radians
+  double cos_cam;  // cos(camera_mask_deg)
 };
 
 // The pixel that shows the reflected direction r (camera frame, unit), or nullopt when r is not
@@ -218,8 +218,10 @@ CubeFeatureSet ball_cube_feature_set(const cv::Mat& image, const cv::Mat& flags,
     }
   }
   // The strongest max_features (stable order for equal responses).
-  std::stable_sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) { return a.response > b.response; });
-  if (options.max_features > 0 && static_cast<int>(cands.size()) > options.max_features) cands.resize(options.max_features);
+  std::stable_sort(cands.begin(), cands.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.response > b.response; });
+  if (options.max_features > 0 && static_cast<int>(cands.size()) > options.max_features)
+    cands.resize(options.max_features);
   for (const Candidate& c : cands) {
     const Vec3 r = faces[c.face].direction(c.kp.pt.x, c.kp.pt.y);
     const auto b = ball_pixel_of(lens, cone, options, r);

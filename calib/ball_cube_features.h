@@ -37,8 +37,8 @@
 namespace rsibr {
 
 struct CubeFeatureOptions {
-  double face_fov_deg = 100;   // per face (> 90: overlap)
-  double texel_scale = 1.0;    // face texel = texel_scale * 2 / radius_px radians at the face centre
+  double face_fov_deg = 100;  // per face (> 90: overlap)
+  double texel_scale = 1.0;   // face texel = texel_scale * 2 / radius_px radians at the face centre
   double min_face_size = 32, max_face_size = 1024;
 };
 
@@ -47,9 +47,9 @@ struct CubeFeatureOptions {
 struct CubeFace {
   Vec3 axis, right, down;
   int size = 0;
-  double step = 0;  // s above: tan units per texel
-  cv::Mat radiance;  // CV_32FC3, linear
-  cv::Mat valid;     // CV_8UC1
+  double step = 0;        // s above: tan units per texel
+  cv::Mat radiance;       // CV_32FC3, linear
+  cv::Mat valid;          // CV_8UC1
   cv::Mat log_luminance;  // CV_32FC1: what SIFT saw (log(luminance + eps)); filled by ball_cube_feature_set only
   // The camera-frame direction of texel position (u, v) (sub-texel, gnomonic inverse).
   Vec3 direction(double u, double v) const;
@@ -65,8 +65,8 @@ std::vector<CubeFace> ball_cube_faces(const cv::Mat& image, const cv::Mat& flags
 struct CubeFeatureSet {
   BallFeatures features;
   std::vector<CubeFace> faces;
-  std::vector<int> face;       // per feature
-  std::vector<Vec2> face_uv;   // per feature, texels
+  std::vector<int> face;      // per feature
+  std::vector<Vec2> face_uv;  // per feature, texels
 };
 
 // `image` CV_32FC3 linear RGB of the lens's size; `flags` empty or CV_8UC1 of that size (hdr/merge.h

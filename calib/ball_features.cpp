@@ -41,7 +41,8 @@ BallFeatures ball_features(const cv::Mat& image, const LensModel& lens, const Ba
   // The ball's bounding box in pixels, from its outline.
   const std::vector<Vec2> outline = cone_outline(cone, lens, 64);
   double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
-  for (const Vec2& p : outline) x0 = std::min(x0, p.x()), x1 = std::max(x1, p.x()), y0 = std::min(y0, p.y()), y1 = std::max(y1, p.y());
+  for (const Vec2& p : outline)
+    x0 = std::min(x0, p.x()), x1 = std::max(x1, p.x()), y0 = std::min(y0, p.y()), y1 = std::max(y1, p.y());
   const int cx0 = std::max(0, int(std::floor(x0))), cx1 = std::min(image.cols - 1, int(std::ceil(x1)));
   const int cy0 = std::max(0, int(std::floor(y0))), cy1 = std::min(image.rows - 1, int(std::ceil(y1)));
   const double eps = std::max(1e-3 * cv::mean(lum)[0], 1e-30);
@@ -80,10 +81,12 @@ BallFeatures ball_features(const cv::Mat& image, const LensModel& lens, const Ba
   return out;
 }
 
-std::vector<DirectionObservation> match_ball_features(const std::vector<BallFeatures>& views, int* features, double ratio) {
+std::vector<DirectionObservation> match_ball_features(const std::vector<BallFeatures>& views, int* features,
+                                                      double ratio) {
   // Union-find over (view, index).
   std::vector<int> offset(views.size() + 1, 0);
-  for (std::size_t v = 0; v < views.size(); ++v) offset[v + 1] = offset[v] + static_cast<int>(views[v].directions.size());
+  for (std::size_t v = 0; v < views.size(); ++v)
+    offset[v + 1] = offset[v] + static_cast<int>(views[v].directions.size());
   std::vector<int> parent(offset.back());
   std::iota(parent.begin(), parent.end(), 0);
   auto find = [&](int a) {
@@ -107,7 +110,8 @@ std::vector<DirectionObservation> match_ball_features(const std::vector<BallFeat
   // Tracks: roots seen by >= 2 views, numbered in order of first appearance.
   std::map<int, std::vector<std::pair<int, int>>> tracks;
   for (std::size_t v = 0; v < views.size(); ++v)
-    for (int i = 0; i < static_cast<int>(views[v].directions.size()); ++i) tracks[find(offset[v] + i)].push_back({int(v), i});
+    for (int i = 0; i < static_cast<int>(views[v].directions.size()); ++i)
+      tracks[find(offset[v] + i)].push_back({int(v), i});
   std::vector<DirectionObservation> obs;
   int id = 0;
   for (const auto& [root, members] : tracks) {

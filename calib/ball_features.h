@@ -22,8 +22,8 @@ namespace rsibr {
 
 struct BallFeatureOptions {
   int max_features = 800;
-  double sigma_px = 0.3;             // keypoint localisation std dev, pixels
-  double max_radius_fraction = 0.85; // of the angular radius alpha
+  double sigma_px = 0.3;              // keypoint localisation std dev, pixels
+  double max_radius_fraction = 0.85;  // of the angular radius alpha
   double camera_mask_deg = 25;
   double contrast_threshold = 0.04;  // SIFT's (OpenCV's default); lower finds more, weaker features
 };
@@ -32,8 +32,8 @@ struct BallFeatures {
   std::vector<Vec3> directions;  // camera frame, unit
   std::vector<double> sigma;     // radians
   std::vector<Vec2> pixels;
-  std::vector<Vec3> rays;        // camera frame, unit: lens.unproject(pixel)
-  cv::Mat descriptors;           // CV_32F, one row per feature
+  std::vector<Vec3> rays;  // camera frame, unit: lens.unproject(pixel)
+  cv::Mat descriptors;     // CV_32F, one row per feature
 };
 
 // `image` CV_32FC3 linear RGB of the lens's size.

@@ -119,7 +119,8 @@ struct LambertFit {
   double unexplained_texture = std::numeric_limits<double>::infinity();
 };
 
-LambertFit lambert_fit(const cv::Mat& image, const LensModel& lens, const BallLocation& loc, const std::vector<Disc>& ex) {
+LambertFit lambert_fit(const cv::Mat& image, const LensModel& lens, const BallLocation& loc,
+                       const std::vector<Disc>& ex) {
   const Vec3 centre = loc.fit.cone.axis.normalized() / std::sin(loc.fit.cone.half_angle);
   struct Px {
     int x, y;
@@ -214,11 +215,13 @@ LambertFit lambert_fit(const cv::Mat& image, const LensModel& lens, const BallLo
   // reflected edges survive the average), then its change between neighbours.
   const double rr = 0.8 * loc.radius_px;
   const int x0 = std::max(0, int(loc.centre_px.x() - rr) - 1), y0 = std::max(0, int(loc.centre_px.y() - rr) - 1);
-  const int x1 = std::min(image.cols, int(loc.centre_px.x() + rr) + 2), y1 = std::min(image.rows, int(loc.centre_px.y() + rr) + 2);
+  const int x1 = std::min(image.cols, int(loc.centre_px.x() + rr) + 2),
+            y1 = std::min(image.rows, int(loc.centre_px.y() + rr) + 2);
   if (x1 - x0 < 3 || y1 - y0 < 3) return out;
   cv::Mat q(y1 - y0, x1 - x0, CV_64F, cv::Scalar(0)), w(y1 - y0, x1 - x0, CV_64F, cv::Scalar(0));
   for (std::size_t i = 0; i < px.size(); ++i)
-    if ((Vec2(px[i].x, px[i].y) - loc.centre_px).norm() <= rr && px[i].x >= x0 && px[i].x < x1 && px[i].y >= y0 && px[i].y < y1) {
+    if ((Vec2(px[i].x, px[i].y) - loc.centre_px).norm() <= rr && px[i].x >= x0 && px[i].x < x1 && px[i].y >= y0 &&
+        px[i].y < y1) {
       q.at<double>(px[i].y - y0, px[i].x - x0) = std::log(std::max(1e-6, px[i].v) / std::max(1e-3 * mean, fit[int(i)]));
       w.at<double>(px[i].y - y0, px[i].x - x0) = 1;
     }
@@ -266,7 +269,8 @@ Vec3 centre_in_radii(const BallCone& c) { return c.axis.normalized() / std::sin(
 
 namespace {
 
-BallCandidate measure(const cv::Mat& image, const LensModel& lens, const BallLocation& loc, const std::vector<Disc>& ex) {
+BallCandidate measure(const cv::Mat& image, const LensModel& lens, const BallLocation& loc,
+                      const std::vector<Disc>& ex) {
   BallCandidate c;
   c.loc = loc;
   c.inlier_fraction = loc.outline_px.empty() ? 0 : double(loc.fit.inliers) / double(loc.outline_px.size());
@@ -295,7 +299,8 @@ bool acceptable_outline(const BallCandidate& c, const BallSearchOptions& o) {
          c.frame_fraction >= o.min_frame_fraction;
 }
 
-std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const LensModel& lens, const BallSearchOptions& o) {
+std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const LensModel& lens,
+                                                const BallSearchOptions& o) {
   const double m = std::min(lens.width(), lens.height());
   const double rmin = o.min_radius_px > 0 ? o.min_radius_px : std::max(4.0, m / 40);
   const double rmax = o.max_radius_px > 0 ? o.max_radius_px : m / 2;
@@ -304,8 +309,9 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
   for (const BallGuess& g : guesses) {
     // A guess on a ball already located is not located again.
     bool known = false;
-    for (const BallCandidate& b : balls) known |= (b.loc.centre_px - g.centre_px).norm() < 0.3 * b.loc.radius_px &&
-                                                  std::abs(b.loc.radius_px - g.radius_px) < 0.3 * b.loc.radius_px;
+    for (const BallCandidate& b : balls)
+      known |= (b.loc.centre_px - g.centre_px).norm() < 0.3 * b.loc.radius_px &&
+               std::abs(b.loc.radius_px - g.radius_px) < 0.3 * b.loc.radius_px;
     if (known) continue;
     // Hough radii in a textured scene are rough: the guess, then 0.8 and 1.25 times it.
     for (double scale : {1.0, 0.8, 1.25}) {
@@ -320,9 +326,12 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
       if (!(loc.radius_px >= rmin / 1.25 && loc.radius_px <= 1.25 * rmax) || !lens.in_image(loc.centre_px)) continue;
       BallCandidate c = measure_ball(image, lens, loc);
       if (!acceptable_outline(c, o)) continue;
-      auto same = std::find_if(balls.begin(), balls.end(), [&](const BallCandidate& b) { return same_circle(b.loc, loc); });
-      if (same == balls.end()) balls.push_back(c);
-      else if (loc.fit.inliers > same->loc.fit.inliers) *same = c;
+      auto same =
+          std::find_if(balls.begin(), balls.end(), [&](const BallCandidate& b) { return same_circle(b.loc, loc); });
+      if (same == balls.end())
+        balls.push_back(c);
+      else if (loc.fit.inliers > same->loc.fit.inliers)
+        *same = c;
       break;
     }
   }
@@ -357,7 +366,8 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
     for (std::size_t i = 0; i < balls.size(); ++i) {
       if (i == k || !inside_disc(balls[i], balls[k]) || !looks_like(balls[i], BallKind::chrome)) continue;
       if (!(balls[i].inlier_fraction >= 0.8 && balls[i].loc.fit.rms_px <= 0.5)) continue;  // a clean outline of its own
-      const BallCandidate without = measure(image, lens, balls[k].loc, {{balls[i].loc.centre_px, balls[i].loc.radius_px}});
+      const BallCandidate without =
+          measure(image, lens, balls[k].loc, {{balls[i].loc.centre_px, balls[i].loc.radius_px}});
       if (!looks_like(without, BallKind::chrome)) {
         balls[k].texture = without.texture, balls[k].rim_texture = without.rim_texture;
         balls[k].mirror_score = without.mirror_score, balls[k].diffuse_residual = without.diffuse_residual;
@@ -379,7 +389,8 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
   for (std::size_t i = 0; i < out.size(); ++i) {
     std::vector<Disc> ex;
     for (std::size_t k = 0; k < kept.size(); ++k)
-      if (k != i && overlapping_ball(kept[k].loc, kept[i].loc)) ex.push_back({kept[k].loc.centre_px, kept[k].loc.radius_px});
+      if (k != i && overlapping_ball(kept[k].loc, kept[i].loc))
+        ex.push_back({kept[k].loc.centre_px, kept[k].loc.radius_px});
     if (ex.empty()) continue;
     const BallCandidate m = measure(image, lens, kept[i].loc, ex);
     out[i].texture = m.texture, out[i].rim_texture = m.rim_texture, out[i].mirror_score = m.mirror_score;
@@ -439,7 +450,9 @@ std::vector<int> assign_balls_in_view(const std::vector<BallCandidate>& cands, c
   // Distance from the camera in units of the ball's listed diameter (1 when unknown): similar for
   // the balls of one rig (within a factor 2.5; penalised beyond 1.5: a rig 15 cm deep seen from
   // 45 cm is 1.33).
-  auto distance = [&](int b, int c) { return diameter_or_one(balls[std::size_t(b)]) / std::sin(cands[std::size_t(c)].loc.fit.cone.half_angle); };
+  auto distance = [&](int b, int c) {
+    return diameter_or_one(balls[std::size_t(b)]) / std::sin(cands[std::size_t(c)].loc.fit.cone.half_angle);
+  };
   std::function<void(int, double)> search = [&](int b, double score) {
     if (b == k) {
       if (score > best_score) best_score = score, best = cur;
@@ -456,8 +469,10 @@ std::vector<int> assign_balls_in_view(const std::vector<BallCandidate>& cands, c
       for (int a = 0; a < b && ok; ++a) {
         if (cur[std::size_t(a)] < 0) continue;
         const double q = std::abs(std::log(distance(b, c) / distance(a, cur[std::size_t(a)])));
-        if (q > std::log(2.5)) ok = false;
-        else s -= std::max(0.0, q - std::log(1.5)) * 4;
+        if (q > std::log(2.5))
+          ok = false;
+        else
+          s -= std::max(0.0, q - std::log(1.5)) * 4;
       }
       if (!ok) continue;
       cur[std::size_t(b)] = c;
@@ -485,7 +500,8 @@ Vec3 implied_offset(const ViewBalls& v, const BallCandidate& c, double scale) {
 }
 
 double tolerance(const RigOptions& o, const ViewBalls& v, const BallCone& ball, double scale) {
-  return o.tolerance + o.relative_tolerance * 0.5 * (centre_in_radii(*v.chrome).norm() + scale * centre_in_radii(ball).norm());
+  return o.tolerance +
+         o.relative_tolerance * 0.5 * (centre_in_radii(*v.chrome).norm() + scale * centre_in_radii(ball).norm());
 }
 
 // A candidate on the ball of `cone`: centres within half its radius, radii within 30%.
@@ -553,7 +569,8 @@ std::vector<RigMember> fit_ball_rig(const std::vector<ViewBalls>& views, const s
     std::vector<Obs> obs;
     for (int i : anchored)
       for (std::size_t c = 0; c < views[std::size_t(i)].candidates.size(); ++c)
-        if (!claimed[std::size_t(i)][c] && looks_like(views[std::size_t(i)].candidates[c], lb.kind)) obs.push_back({i, int(c)});
+        if (!claimed[std::size_t(i)][c] && looks_like(views[std::size_t(i)].candidates[c], lb.kind))
+          obs.push_back({i, int(c)});
     // Support of a hypothesis: per view, the agreeing candidate nearest it.
     auto support = [&](double s, const Vec3& off, std::vector<Obs>* who, double* sum2) {
       int n = 0;
@@ -587,7 +604,9 @@ std::vector<RigMember> fit_ball_rig(const std::vector<ViewBalls>& views, const s
     };
     if (scale_given) {
       for (const Obs& ob : obs)
-        consider(given_scale, implied_offset(views[std::size_t(ob.view)], views[std::size_t(ob.view)].candidates[std::size_t(ob.cand)], given_scale));
+        consider(given_scale,
+                 implied_offset(views[std::size_t(ob.view)],
+                                views[std::size_t(ob.view)].candidates[std::size_t(ob.cand)], given_scale));
     } else {
       for (std::size_t p = 0; p < obs.size(); ++p)
         for (std::size_t q = p + 1; q < obs.size(); ++q) {
@@ -603,7 +622,10 @@ std::vector<RigMember> fit_ball_rig(const std::vector<ViewBalls>& views, const s
           const auto [s, off] = solve_scale_offset(r, g, c);
           consider(s, off);
         }
-      if (anchored.size() == 1 && !obs.empty()) consider(given_scale, implied_offset(views[std::size_t(obs[0].view)], views[std::size_t(obs[0].view)].candidates[std::size_t(obs[0].cand)], given_scale));
+      if (anchored.size() == 1 && !obs.empty())
+        consider(given_scale,
+                 implied_offset(views[std::size_t(obs[0].view)],
+                                views[std::size_t(obs[0].view)].candidates[std::size_t(obs[0].cand)], given_scale));
     }
     if (best_n < need) continue;
     // Refit on the supporters (twice: the support may grow).
@@ -638,12 +660,14 @@ std::vector<RigMember> fit_ball_rig(const std::vector<ViewBalls>& views, const s
   return rig;
 }
 
-BallLocation refit_outline_excluding(const BallLocation& ball, const LensModel& lens, const std::vector<BallLocation>& others) {
+BallLocation refit_outline_excluding(const BallLocation& ball, const LensModel& lens,
+                                     const std::vector<BallLocation>& others) {
   std::vector<Vec3> rays;
   std::vector<Vec2> kept;
   for (const Vec2& p : ball.outline_px) {
     bool on_other = false;
-    for (const BallLocation& o : others) on_other |= (p - o.centre_px).norm() <= o.radius_px + std::max(2.0, 0.05 * o.radius_px);
+    for (const BallLocation& o : others)
+      on_other |= (p - o.centre_px).norm() <= o.radius_px + std::max(2.0, 0.05 * o.radius_px);
     if (!on_other) rays.push_back(lens.unproject(p)), kept.push_back(p);
   }
   if (kept.size() == ball.outline_px.size() || kept.size() < 16) return ball;
@@ -796,7 +820,8 @@ std::vector<BallFinding> identify_view_balls(const ViewBalls& view, const std::v
     // Hidden behind a nearer ball of the view (the chrome's or another found one)?
     auto hidden_by = [&](const BallCone& other) {
       const double gap = angle_between(other.axis, pred.axis);
-      return gap + 0.5 * pred.half_angle < other.half_angle && centre_in_radii(other).norm() < centre_in_radii(pred).norm() * m.scale;
+      return gap + 0.5 * pred.half_angle < other.half_angle &&
+             centre_in_radii(other).norm() < centre_in_radii(pred).norm() * m.scale;
     };
     if (hidden_by(*view.chrome)) {
       f.note = "hidden behind the chrome ball (predicted at " + px_text(pc, pr) + ")";
@@ -823,8 +848,8 @@ std::vector<BallFinding> identify_view_balls(const ViewBalls& view, const std::v
       s.precision(2);
       s << "the outline at the predicted place " << px_text(pc, pr) << " does not qualify (inliers "
         << c.inlier_fraction << ", RMS " << c.loc.fit.rms_px << " px, "
-        << (looks_like(c, balls[b].kind) ? "" : "does not look " + std::string(to_string(balls[b].kind)) + ", ")
-        << d << " chrome radii from the rig's place)";
+        << (looks_like(c, balls[b].kind) ? "" : "does not look " + std::string(to_string(balls[b].kind)) + ", ") << d
+        << " chrome radii from the rig's place)";
       f.note = s.str();
     } catch (const std::invalid_argument& e) {
       f.note = "no outline at the predicted place " + px_text(pc, pr);
@@ -856,7 +881,8 @@ std::vector<ChromeRescue> rescue_chrome_balls(const std::vector<std::optional<Vi
     for (const auto& vc : views)
       if (vc && vc->pick[std::size_t(chrome)] >= 0 && vc->pick[b] >= 0)
         d.push_back((centre_in_radii(vc->cands[std::size_t(vc->pick[std::size_t(chrome)])].loc.fit.cone) -
-                     scale * centre_in_radii(vc->cands[std::size_t(vc->pick[b])].loc.fit.cone)).norm());
+                     scale * centre_in_radii(vc->cands[std::size_t(vc->pick[b])].loc.fit.cone))
+                        .norm());
     if (d.size() < 2) continue;
     std::sort(d.begin(), d.end());
     const double rig = d[d.size() / 2];
@@ -873,10 +899,12 @@ std::vector<ChromeRescue> rescue_chrome_balls(const std::vector<std::optional<Vi
       for (std::size_t k = 0; k < vc->cands.size(); ++k) {
         const BallCandidate& c = vc->cands[k];
         if (std::find(vc->pick.begin(), vc->pick.end(), int(k)) != vc->pick.end()) continue;
-        if (!acceptable_outline(c, search) || looks_like(c, BallKind::grey) || !looks_like(c, BallKind::glossy)) continue;
+        if (!acceptable_outline(c, search) || looks_like(c, BallKind::grey) || !looks_like(c, BallKind::glossy))
+          continue;
         const Vec3 cc = centre_in_radii(c.loc.fit.cone);
         const double dist = (cc - g).norm();
-        if (std::abs(dist - rig) <= tolerance + relative * 0.5 * (cc.norm() + g.norm())) ++hits, hit = int(k), hit_d = dist;
+        if (std::abs(dist - rig) <= tolerance + relative * 0.5 * (cc.norm() + g.norm()))
+          ++hits, hit = int(k), hit_d = dist;
       }
       if (hits != 1) continue;
       char note[256];

@@ -41,9 +41,10 @@ namespace rsibr {
 
 struct BallCandidate {
   BallLocation loc;
-  double inlier_fraction = 0;   // outline points within the cone fit's inlier threshold
-  double texture = 0;           // mean |ln L| change between neighbouring pixels within 0.8 radii
-  double rim_texture = 0;       // fraction of the pixels between 0.5 and 0.9 radii whose ln L changes by > 0.06 to a neighbour
+  double inlier_fraction = 0;  // outline points within the cone fit's inlier threshold
+  double texture = 0;          // mean |ln L| change between neighbouring pixels within 0.8 radii
+  double rim_texture =
+      0;  // fraction of the pixels between 0.5 and 0.9 radii whose ln L changes by > 0.06 to a neighbour
   double mirror_score = 0;      // 98th percentile of |grad log2 L| within 0.9 radii, stops per radius
   double diffuse_residual = 0;  // RMS of a Lambert fit (order-2 spherical harmonics and one sun) over 0.9 radii / mean
   double shading_texture = 0;   // mean |ln(L / that fit)| change between neighbouring pixels within 0.8 radii
@@ -52,11 +53,11 @@ struct BallCandidate {
 };
 
 struct BallSearchOptions {
-  double min_radius_px = 0;     // 0: max(4, min(width, height) / 40)
-  double max_radius_px = 0;     // 0: min(width, height) / 2
-  int per_band = 6;             // Hough circles kept per radius band
+  double min_radius_px = 0;  // 0: max(4, min(width, height) / 40)
+  double max_radius_px = 0;  // 0: min(width, height) / 2
+  int per_band = 6;          // Hough circles kept per radius band
   double min_inlier_fraction = 0.6;
-  double max_rms_px = 0.8;       // a chrome ball's limb reflects what lies behind it: 0.5 px on low contrast
+  double max_rms_px = 0.8;  // a chrome ball's limb reflects what lies behind it: 0.5 px on low contrast
   double min_frame_fraction = 0.5;
 };
 
@@ -86,7 +87,8 @@ bool looks_like(const BallCandidate& c, BallKind kind);
 
 // One view: candidate index per listed ball (-1: none fits), maximising appearance and size
 // agreement. Throws nothing; an empty candidate list gives all -1.
-std::vector<int> assign_balls_in_view(const std::vector<BallCandidate>& candidates, const std::vector<ListedBall>& balls);
+std::vector<int> assign_balls_in_view(const std::vector<BallCandidate>& candidates,
+                                      const std::vector<ListedBall>& balls);
 
 // One view's candidates and the listed balls assign_balls_in_view matched them to.
 struct ViewCandidates {
@@ -110,7 +112,8 @@ struct ChromeRescue {
   std::string note;
 };
 std::vector<ChromeRescue> rescue_chrome_balls(const std::vector<std::optional<ViewCandidates>>& views,
-                                              const std::vector<ListedBall>& balls, const BallSearchOptions& search = {});
+                                              const std::vector<ListedBall>& balls,
+                                              const BallSearchOptions& search = {});
 
 // One view's balls as the cross-view stage sees them.
 struct ViewBalls {
@@ -126,16 +129,16 @@ struct ViewBalls {
 struct RigMember {
   bool known = false;
   Vec3 offset = Vec3::Zero();
-  double scale = 1;        // radius / chrome radius
+  double scale = 1;          // radius / chrome radius
   bool scale_given = false;  // from the listed diameters (else estimated)
-  int support = 0;         // views agreeing
-  double rms = 0;          // RMS disagreement of the supporting views, chrome radii
+  int support = 0;           // views agreeing
+  double rms = 0;            // RMS disagreement of the supporting views, chrome radii
 };
 
 struct RigOptions {
-  double tolerance = 1.0;           // agreement: within tolerance + relative * (|c| + |s g|) / 2 chrome radii
+  double tolerance = 1.0;  // agreement: within tolerance + relative * (|c| + |s g|) / 2 chrome radii
   double relative_tolerance = 0.04;
-  int min_support = 2;              // views that must agree (fewer views: all of them)
+  int min_support = 2;  // views that must agree (fewer views: all of them)
 };
 
 // Chrome balls (kind chrome) are the anchors (offset 0, scale 1 for the first; others fitted like
@@ -158,11 +161,11 @@ std::optional<AnchorFromRig> anchor_from_rig(const ViewBalls& view, const std::v
 
 // One ball in one view, as identification decided.
 struct BallFinding {
-  std::string status = "missing";  // "found", "found at the predicted place", "given", "missing"
+  std::string status = "missing";     // "found", "found at the predicted place", "given", "missing"
   std::optional<BallCandidate> ball;  // when found
-  std::string note;                // what was checked (for the report), or why it is missing
-  double disagreement = -1;        // distance from the rig's prediction, chrome radii (-1: not checked)
-  std::optional<Vec2> predicted_px;  // where the rig put it
+  std::string note;                   // what was checked (for the report), or why it is missing
+  double disagreement = -1;           // distance from the rig's prediction, chrome radii (-1: not checked)
+  std::optional<Vec2> predicted_px;   // where the rig put it
   double predicted_radius_px = 0;
   bool found() const { return ball.has_value(); }
 };
@@ -180,7 +183,8 @@ BallCone predicted_cone(const BallCone& chrome, const Mat3& world_from_cam, cons
 
 // The ball's cone fitted again without its outline points on or inside `others` (balls in front of
 // it, whose edges are not its own): the located ball unchanged when no point goes or too few stay.
-BallLocation refit_outline_excluding(const BallLocation& ball, const LensModel& lens, const std::vector<BallLocation>& others);
+BallLocation refit_outline_excluding(const BallLocation& ball, const LensModel& lens,
+                                     const std::vector<BallLocation>& others);
 
 // A ball given by hand: located at the guess (calib/ball_locator.h) and measured.
 BallCandidate given_ball(const cv::Mat& image, const LensModel& lens, const BallGuess& guess);

@@ -113,8 +113,7 @@ BallLocation locate_ball(const cv::Mat& image, const LensModel& lens, const Ball
   const cv::Mat lum = brightness_image(image);
   // eps of the log: 1e-3 of the mean level, so noise in black areas makes no edges.
   const double eps = std::max(1e-3 * cv::mean(lum)[0], 1e-30);
-  const int lines = options.lines > 0 ? options.lines
-                                      : std::max(48, static_cast<int>(2 * kPi * guess.radius_px / 1.5));
+  const int lines = options.lines > 0 ? options.lines : std::max(48, static_cast<int>(2 * kPi * guess.radius_px / 1.5));
 
   // Pass 1: radial lines from the guessed centre, up to 3 edge candidates each (RANSAC finds the
   // ones on one cone among reflections, the stand and the background).
@@ -198,7 +197,8 @@ std::vector<BallGuess> detect_balls(const cv::Mat& image, double min_radius_px, 
   cv::GaussianBlur(u8, u8, cv::Size(5, 5), 1.2);
   std::vector<std::pair<double, double>> bands;
   if (per_band > 0) {
-    for (double r0 = min_radius_px; r0 < max_radius_px; r0 *= 2) bands.push_back({r0, std::min(2.1 * r0, max_radius_px)});
+    for (double r0 = min_radius_px; r0 < max_radius_px; r0 *= 2)
+      bands.push_back({r0, std::min(2.1 * r0, max_radius_px)});
   } else {
     bands.push_back({min_radius_px, max_radius_px});
   }

@@ -27,17 +27,17 @@ struct BallGuess {
 };
 
 struct BallLocateOptions {
-  int lines = 0;                  // search lines around the outline; 0: about one per 1.5 px of outline (>= 48)
-  double search_fraction = 0.25;  // first pass: search radius_px * (1 +- this)
-  double refine_px = 3;           // second pass: +- this across the fitted outline
-  double min_log_contrast = 0.05; // edges weaker than this (natural log) are skipped
+  int lines = 0;                   // search lines around the outline; 0: about one per 1.5 px of outline (>= 48)
+  double search_fraction = 0.25;   // first pass: search radius_px * (1 +- this)
+  double refine_px = 3;            // second pass: +- this across the fitted outline
+  double min_log_contrast = 0.05;  // edges weaker than this (natural log) are skipped
   ConeFitOptions fit;
 };
 
 struct BallLocation {
-  ConeFit fit;                 // the cone (camera frame), inliers, RMS in pixels
-  Vec2 centre_px;              // lens.project(axis): the ball centre's pixel
-  double radius_px = 0;        // mean distance of the fitted outline from centre_px
+  ConeFit fit;                   // the cone (camera frame), inliers, RMS in pixels
+  Vec2 centre_px;                // lens.project(axis): the ball centre's pixel
+  double radius_px = 0;          // mean distance of the fitted outline from centre_px
   std::vector<Vec2> outline_px;  // the second pass's outline points (inliers and outliers)
 };
 

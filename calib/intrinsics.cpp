@@ -92,8 +92,8 @@ mrcal_stats_t optimize(const IntrinsicsProblem& p, const std::vector<int>& subse
   std::vector<mrcal_observation_board_t> obs = board_observations(n);
   const int sizes[2] = {p.width, p.height};
   const mrcal_problem_constants_t constants = problem_constants();
-  return mrcal_optimize(nullptr, 0, nullptr, 0, intrinsics.data(), nullptr, frames.data(), nullptr, nullptr, 1, 0, n,
-                        0, 0, obs.data(), nullptr, n, 0, pool.data(), &model, sizes, sel, &constants, p.spacing_m,
+  return mrcal_optimize(nullptr, 0, nullptr, 0, intrinsics.data(), nullptr, frames.data(), nullptr, nullptr, 1, 0, n, 0,
+                        0, obs.data(), nullptr, n, 0, pool.data(), &model, sizes, sel, &constants, p.spacing_m,
                         p.corners_x, p.corners_y, false, false);
 }
 
@@ -126,11 +126,11 @@ Eigen::MatrixXd covariance(const IntrinsicsProblem& p, int n, const mrcal_lensmo
   cholmod_start(&common);
   cholmod_sparse* jt = cholmod_allocate_sparse(nstate, nmeas, nnz, 1, 1, 0, CHOLMOD_REAL, &common);
   std::vector<double> b(nstate), x(nmeas);
-  const bool ok = jt && mrcal_optimizer_callback(b.data(), nstate * int(sizeof(double)), x.data(),
-                                                 nmeas * int(sizeof(double)), jt, intrinsics.data(), nullptr,
-                                                 frames.data(), nullptr, nullptr, 1, 0, n, 0, 0, obs.data(), nullptr, n,
-                                                 0, pool.data(), &model, sizes, sel, &constants, p.spacing_m,
-                                                 p.corners_x, p.corners_y, false);
+  const bool ok =
+      jt && mrcal_optimizer_callback(b.data(), nstate * int(sizeof(double)), x.data(), nmeas * int(sizeof(double)), jt,
+                                     intrinsics.data(), nullptr, frames.data(), nullptr, nullptr, 1, 0, n, 0, 0,
+                                     obs.data(), nullptr, n, 0, pool.data(), &model, sizes, sel, &constants,
+                                     p.spacing_m, p.corners_x, p.corners_y, false);
   Eigen::MatrixXd j = Eigen::MatrixXd::Zero(nmeas, nstate);
   if (ok) {
     // Jt is compressed by column: column r holds row r of J.
@@ -190,7 +190,7 @@ void board_residuals(const IntrinsicsProblem& p, int board, const LensModel& len
 // OpenCV's planar calibration of `subset` with the distortion held at zero: a pinhole core and each
 // board's pose, the seed of every mrcal solve.
 struct PinholeSeed {
-  cv::Mat k;                      // 3x3 CV_64F
+  cv::Mat k;                          // 3x3 CV_64F
   std::vector<cv::Mat> rvecs, tvecs;  // board -> camera, one per subset entry
 };
 PinholeSeed pinhole_seed(const IntrinsicsProblem& p, const std::vector<int>& subset) {
@@ -209,7 +209,8 @@ PinholeSeed pinhole_seed(const IntrinsicsProblem& p, const std::vector<int>& sub
 
 }  // namespace
 
-IntrinsicsFit fit_intrinsics(const IntrinsicsProblem& p, const std::string& model_name, const std::vector<int>& subset_in) {
+IntrinsicsFit fit_intrinsics(const IntrinsicsProblem& p, const std::string& model_name,
+                             const std::vector<int>& subset_in) {
   const std::vector<int> subset = subset_in.empty() ? all_boards(p) : subset_in;
   check(p, subset);
   const mrcal_lensmodel_t model = lensmodel(model_name);
@@ -353,8 +354,8 @@ std::vector<ModelScore> cross_validate_models(const IntrinsicsProblem& p, const 
   for (const std::string& m : models) {
     ModelScore s;
     s.model = m;
-    s.held_out_rms_px = 0.5 * (held_out_rms(p, fit_intrinsics(p, m, a).lens, b) +
-                               held_out_rms(p, fit_intrinsics(p, m, b).lens, a));
+    s.held_out_rms_px =
+        0.5 * (held_out_rms(p, fit_intrinsics(p, m, a).lens, b) + held_out_rms(p, fit_intrinsics(p, m, b).lens, a));
     s.fit_rms_px = fit_intrinsics(p, m).rms_px;
     scores.push_back(s);
   }

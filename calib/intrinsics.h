@@ -41,18 +41,18 @@ struct ChessboardObservation {
 };
 
 struct IntrinsicsProblem {
-  int width = 0, height = 0;           // image size
-  int corners_x = 0, corners_y = 0;    // inner corners
+  int width = 0, height = 0;         // image size
+  int corners_x = 0, corners_y = 0;  // inner corners
   double spacing_m = 0;
   std::vector<ChessboardObservation> boards;
 };
 
 struct IntrinsicsFit {
   LensModel lens = LensModel::pinhole(1, 1, 1);
-  double rms_px = 0;        // over the corners not rejected as outliers
-  int outliers = 0;         // corners rejected by mrcal
+  double rms_px = 0;                                // over the corners not rejected as outliers
+  int outliers = 0;                                 // corners rejected by mrcal
   std::vector<std::array<double, 6>> rt_cam_board;  // per board: Rodrigues rotation, translation (m)
-  std::vector<Vec2> residuals;  // observed - projected, every corner of every board, in board order
+  std::vector<Vec2> residuals;                      // observed - projected, every corner of every board, in board order
   // Covariance of lens.intrinsics() (mrcal's order), board poses marginalised; px^2 per unit^2.
   Eigen::MatrixXd intrinsics_covariance;
   double noise_sigma_px = 0;  // per-axis corner noise estimated from the residuals

@@ -37,7 +37,7 @@ bool sample_at_normal(const MapView& mv, const Vec3& n, double min_conf, double*
 }  // namespace
 
 std::vector<LambertConsensusView> mask_lambert_inconsistencies(std::vector<MapView>& views,
-                                                                const LambertConsensusOptions& o) {
+                                                               const LambertConsensusOptions& o) {
   std::vector<LambertConsensusView> out(views.size());
   std::vector<cv::Mat> masks(views.size());
   std::vector<char> in(views.size(), 1);  // still a judge
@@ -92,8 +92,10 @@ std::vector<LambertConsensusView> mask_lambert_inconsistencies(std::vector<MapVi
     out[std::size_t(worst)].left_out = true;
   }
   for (std::size_t v = 0; v < views.size(); ++v) {
-    if (out[v].left_out) views[v].confidence.setTo(0);
-    else views[v].confidence.setTo(0, masks[v]);
+    if (out[v].left_out)
+      views[v].confidence.setTo(0);
+    else
+      views[v].confidence.setTo(0, masks[v]);
   }
   return out;
 }

@@ -34,6 +34,6 @@ struct LambertConsensusView {
 
 // Changes the confidence channels in place; one entry per view.
 std::vector<LambertConsensusView> mask_lambert_inconsistencies(std::vector<MapView>& views,
-                                                                const LambertConsensusOptions& options = {});
+                                                               const LambertConsensusOptions& options = {});
 
 }  // namespace rsibr

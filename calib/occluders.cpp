@@ -64,7 +64,8 @@ std::vector<Occluder> chrome_occluders(const BallCone& chrome, const std::vector
     out.push_back(p);
   };
   stand(c, 1.0, "the chrome ball");
-  for (const OtherBall& b : others) stand(b.scale * b.cone.axis.normalized() / std::sin(b.cone.half_angle), b.scale, b.name);
+  for (const OtherBall& b : others)
+    stand(b.scale * b.cone.axis.normalized() / std::sin(b.cone.half_angle), b.scale, b.name);
   if (o.photographer) {
     // Behind the camera: its forward axis made horizontal, reversed.
     Vec3 back = -(Vec3(0, 0, 1) - down.z() * down);

@@ -25,20 +25,22 @@ struct Occluder {
   Vec3 axis = Vec3(0, 1, 0);   // capsule: unit direction of the segment
   double length = 0;           // capsule
   double radius = 1;
-  std::string what;            // "ball grey", "stand under chrome", "photographer"
+  std::string what;  // "ball grey", "stand under chrome", "photographer"
 };
 
 // Whether the ray o + t d (t in (0, t_max), d unit) meets the occluder.
 bool ray_hits(const Occluder& occ, const Vec3& o, const Vec3& d, double t_max = 1e6);
 
 struct OccluderOptions {
-  double ball_margin = 1.15;       // other balls' radii times this
-  double stand_radius = 0.5;       // a stand's radius, in radii of the ball it holds (a light stand ~ 1/4 of a 10 cm ball's diameter)
-  double stand_length_m = 2.0;     // how far down a stand is masked
+  double ball_margin = 1.15;  // other balls' radii times this
+  double stand_radius =
+      0.5;  // a stand's radius, in radii of the ball it holds (a light stand ~ 1/4 of a 10 cm ball's diameter)
+  double stand_length_m = 2.0;  // how far down a stand is masked
   bool photographer = true;
   // The photographer, as a capsule about the vertical through a point `behind_m` behind the camera,
   // from `above_m` above the camera down `below_m`, radius `radius_m` (shoulders and a margin).
-  double photographer_radius_m = 0.35, photographer_above_m = 0.3, photographer_below_m = 1.8, photographer_behind_m = 0.15;
+  double photographer_radius_m = 0.35, photographer_above_m = 0.3, photographer_below_m = 1.8,
+         photographer_behind_m = 0.15;
 };
 
 // A ball of the view besides the chrome ball: its cone and its radius over the chrome's.

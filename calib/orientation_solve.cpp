@@ -39,7 +39,8 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
                                   std::to_string(o.feature) + ")");
   std::vector<std::map<int, Vec3>> seen(views);  // per view: feature -> direction
   if (!options.balls.empty()) {
-    if (static_cast<int>(options.balls.size()) != views) throw std::invalid_argument("orientation: ball priors must be given for every view or none");
+    if (static_cast<int>(options.balls.size()) != views)
+      throw std::invalid_argument("orientation: ball priors must be given for every view or none");
     for (const BallPrior& b : options.balls)
       if (!b.axis.allFinite() || std::abs(b.axis.norm() - 1) > 1e-6 || !(b.half_angle > 0 && b.half_angle < kPi / 2) ||
           !(b.sigma_axis > 0) || !std::isfinite(b.sigma_axis) || !(b.sigma_half_angle >= 0) ||
@@ -111,7 +112,8 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
     }
     if (best_in.size() < 3) {
       const std::string why = "no rotation agrees with 3 or more shared features";
-      if (!options.leave_out_unplaced) throw std::invalid_argument("orientation: view " + std::to_string(v) + ": " + why);
+      if (!options.leave_out_unplaced)
+        throw std::invalid_argument("orientation: view " + std::to_string(v) + ": " + why);
       dropped[v] = 1;
       left_out[v] = why;
       continue;
@@ -143,18 +145,22 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
                                axes[o.view].data(), &sines[o.view], d[o.feature].data());
       continue;
     }
-    auto* cost = new ceres::AutoDiffCostFunction<DirectionResidual, 3, 4, 3>(new DirectionResidual(o.direction, o.sigma));
-    problem.AddResidualBlock(cost, new ceres::CauchyLoss(options.loss_sigmas), q[o.view].coeffs().data(), d[o.feature].data());
+    auto* cost =
+        new ceres::AutoDiffCostFunction<DirectionResidual, 3, 4, 3>(new DirectionResidual(o.direction, o.sigma));
+    problem.AddResidualBlock(cost, new ceres::CauchyLoss(options.loss_sigmas), q[o.view].coeffs().data(),
+                             d[o.feature].data());
   }
   for (int v = 0; v < views && refine_balls; ++v) {
     if (!problem.HasParameterBlock(axes[v].data())) continue;
     const BallPrior& b = options.balls[v];
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BallAxisPrior, 3, 3>(new BallAxisPrior(b.axis, b.sigma_axis)),
-                             nullptr, axes[v].data());
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<BallAxisPrior, 3, 3>(new BallAxisPrior(b.axis, b.sigma_axis)), nullptr,
+        axes[v].data());
     problem.SetManifold(axes[v].data(), new ceres::SphereManifold<3>);
     if (b.sigma_half_angle > 0) {
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<HalfAnglePrior, 1, 1>(new HalfAnglePrior(b.half_angle, b.sigma_half_angle)),
-                               nullptr, &sines[v]);
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<HalfAnglePrior, 1, 1>(new HalfAnglePrior(b.half_angle, b.sigma_half_angle)),
+          nullptr, &sines[v]);
       problem.SetParameterLowerBound(&sines[v], 0, 1e-6);
       problem.SetParameterUpperBound(&sines[v], 0, 1 - 1e-6);
     } else {

@@ -27,13 +27,13 @@ namespace rsibr {
 
 struct DirectionObservation {
   int view = 0, feature = 0;
-  Vec3 direction;     // unit, camera frame of `view`
-  double sigma = 0;   // angular std dev, radians (> 0)
+  Vec3 direction;    // unit, camera frame of `view`
+  double sigma = 0;  // angular std dev, radians (> 0)
   // The unit camera ray of the feature's pixel (lens.unproject), or zero. With a ball prior for the
   // view (OrientationOptions::balls) the direction is recomputed from it and the view's ball axis in
   // the solve (BallReflectionResidual), so the ball centre is refined by the features.
   Vec3 ray = Vec3::Zero();
-  int index = -1;     // the feature's index among its view's detections (calib/ball_features.h), or -1
+  int index = -1;  // the feature's index among its view's detections (calib/ball_features.h), or -1
 };
 
 // A view's ball as located in its image (calib/ball_cone.h), with the std dev of its axis
@@ -46,8 +46,8 @@ struct BallPrior {
 };
 
 struct OrientationOptions {
-  double loss_sigmas = 3.0;      // Cauchy loss scale, in sigmas
-  double inlier_deg = 2.0;       // RANSAC inlier threshold
+  double loss_sigmas = 3.0;  // Cauchy loss scale, in sigmas
+  double inlier_deg = 2.0;   // RANSAC inlier threshold
   int ransac_iterations = 200;
   std::uint64_t seed = 1;
   Mat3 first_world_from_cam = Mat3::Identity();  // the gauge
@@ -66,14 +66,14 @@ struct OrientationOptions {
 };
 
 struct OrientationSolution {
-  std::vector<char> oriented;           // per view: 1, or 0 when left out (leave_out_unplaced)
-  std::vector<std::string> left_out;    // per view: why it was left out ("" when oriented)
-  std::vector<Mat3> world_from_cam;     // per view (identity for a view left out)
-  std::vector<double> sigma_deg;        // per view: rotation std dev, all axes together (0 for the gauge view)
-  std::vector<Vec3> feature_directions; // per feature, world, unit (zero for unobserved features)
-  std::vector<Vec3> ball_axes;          // per view, the refined ball axes (camera frame; with balls only)
-  std::vector<double> ball_half_angles; // per view, the refined half angles (radians; with balls only)
-  double rms_sigmas = 0;                // RMS whitened residual over inliers
+  std::vector<char> oriented;            // per view: 1, or 0 when left out (leave_out_unplaced)
+  std::vector<std::string> left_out;     // per view: why it was left out ("" when oriented)
+  std::vector<Mat3> world_from_cam;      // per view (identity for a view left out)
+  std::vector<double> sigma_deg;         // per view: rotation std dev, all axes together (0 for the gauge view)
+  std::vector<Vec3> feature_directions;  // per feature, world, unit (zero for unobserved features)
+  std::vector<Vec3> ball_axes;           // per view, the refined ball axes (camera frame; with balls only)
+  std::vector<double> ball_half_angles;  // per view, the refined half angles (radians; with balls only)
+  double rms_sigmas = 0;                 // RMS whitened residual over inliers
   int inliers = 0, observations = 0;
 };
 
@@ -114,7 +114,8 @@ struct BallReflectionResidual {
   template <class T>
   bool operator()(const T* q, const T* a, const T* s, const T* d, T* r) const {  // q: x, y, z, w; a: 3; s: 1; d: 3
     const Eigen::Map<const Eigen::Quaternion<T>> rot(q);
-    const Eigen::Matrix<T, 3, 1> o = reflect_off_ball<T>(ray_.cast<T>(), Eigen::Matrix<T, 3, 1>(a[0], a[1], a[2]), s[0]);
+    const Eigen::Matrix<T, 3, 1> o =
+        reflect_off_ball<T>(ray_.cast<T>(), Eigen::Matrix<T, 3, 1>(a[0], a[1], a[2]), s[0]);
     const Eigen::Matrix<T, 3, 1> ro = rot * o;
     for (int k = 0; k < 3; ++k) r[k] = (ro[k] - d[k]) * T(inv_sigma_);
     return true;

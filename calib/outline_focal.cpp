@@ -122,7 +122,8 @@ OutlineFocal focal_from_outlines(const std::vector<std::vector<Vec2>>& outlines,
   tbb::parallel_for(0, ng * nb, [&](int job) {
     const int k = job / nb, b = job % nb;
     if (pts[std::size_t(b)].empty()) return;
-    cost[std::size_t(b)][std::size_t(k)] = ball_cost(pts[std::size_t(b)], with_focal(lens, f0 * std::exp(u[std::size_t(k)])));
+    cost[std::size_t(b)][std::size_t(k)] =
+        ball_cost(pts[std::size_t(b)], with_focal(lens, f0 * std::exp(u[std::size_t(k)])));
   });
 
   // Each ball alone: its focal and sigma from its own profile (sigma in u, then pixels).
@@ -162,8 +163,9 @@ OutlineFocal focal_from_outlines(const std::vector<std::vector<Vec2>>& outlines,
       out.focal_px = f0;
       out.sigma_px = kInf;
       out.rms_px = std::sqrt(*std::min_element(joint.begin(), joint.end()) / std::max(1, points));
-      out.note = "the outlines do not constrain the focal length between " + std::to_string(int(f0 * options.min_scale)) +
-                 " and " + std::to_string(int(f0 * options.max_scale)) + " px (balls near the image centre say little)";
+      out.note = "the outlines do not constrain the focal length between " +
+                 std::to_string(int(f0 * options.min_scale)) + " and " + std::to_string(int(f0 * options.max_scale)) +
+                 " px (balls near the image centre say little)";
       break;
     }
     // A finer look near the minimum: 9 samples a fifth of the coarse step apart.
@@ -174,7 +176,8 @@ OutlineFocal focal_from_outlines(const std::vector<std::vector<Vec2>>& outlines,
     tbb::parallel_for(0, 9 * nb, [&](int job) {
       const int k = job / nb, b = job % nb;
       if (!out.balls[std::size_t(b)].used) return;
-      fine[std::size_t(b)][std::size_t(k)] = ball_cost(pts[std::size_t(b)], with_focal(lens, f0 * std::exp(uf[std::size_t(k)])));
+      fine[std::size_t(b)][std::size_t(k)] =
+          ball_cost(pts[std::size_t(b)], with_focal(lens, f0 * std::exp(uf[std::size_t(k)])));
     });
     for (int b = 0; b < nb; ++b)
       for (int k = 0; k < 9; ++k) cf[std::size_t(k)] += fine[std::size_t(b)][std::size_t(k)];
@@ -185,7 +188,8 @@ OutlineFocal focal_from_outlines(const std::vector<std::vector<Vec2>>& outlines,
       if (!ob.used) continue;
       if (const auto pb = parabola_min(uf, fine[std::size_t(b)])) {
         ob.focal_px = f0 * std::exp(pb->u);
-        ob.sigma_px = ob.focal_px * sigma_u(pb->curvature, std::max(pb->cost, 1e-12) / std::max(1.0, double(ob.points) - 4));
+        ob.sigma_px =
+            ob.focal_px * sigma_u(pb->curvature, std::max(pb->cost, 1e-12) / std::max(1.0, double(ob.points) - 4));
       }
     }
     const auto mf = parabola_min(uf, cf);
@@ -245,7 +249,8 @@ OutlineFocal focal_from_outlines(const std::vector<std::vector<Vec2>>& outlines,
     left_out += (left_out.empty() ? "" : ", ") + std::to_string(worst);
   }
   if (!left_out.empty())
-    out.note += (out.note.empty() ? "" : "; ") + std::string("outlines left out (their own focal length disagrees): ") + left_out;
+    out.note += (out.note.empty() ? "" : "; ") + std::string("outlines left out (their own focal length disagrees): ") +
+                left_out;
   return out;
 }
 

@@ -47,14 +47,14 @@ struct OutlineFocalBall {
 };
 
 struct OutlineFocal {
-  double focal_px = 0;   // fx of the best lens (fy scaled with it)
-  double sigma_px = 0;   // 1 sigma; infinite when the outlines do not constrain f in the range
-  double rms_px = 0;     // outline residual RMS at focal_px
-  double birge_ratio = 1;  // the balls' scatter about focal_px over their sigmas; sigma_px is scaled by it when > 1
+  double focal_px = 0;       // fx of the best lens (fy scaled with it)
+  double sigma_px = 0;       // 1 sigma; infinite when the outlines do not constrain f in the range
+  double rms_px = 0;         // outline residual RMS at focal_px
+  double birge_ratio = 1;    // the balls' scatter about focal_px over their sigmas; sigma_px is scaled by it when > 1
   double systematic_px = 0;  // the shape systematic's share of sigma_px (in quadrature)
   int balls_used = 0, points = 0;
   std::vector<OutlineFocalBall> balls;  // per input outline
-  std::string note;      // why balls were left out or f is unconstrained (empty: nothing to say)
+  std::string note;                     // why balls were left out or f is unconstrained (empty: nothing to say)
 };
 
 // `outlines`: per ball and view, its outline points in pixels (at least 8 each to be used). Throws

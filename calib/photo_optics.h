@@ -24,12 +24,12 @@
 namespace rsibr {
 
 struct PhotoOptics {
-  std::string make, model, lens;           // EXIF Make, Model, LensModel (may be empty)
-  std::optional<double> focal_mm;          // FocalLength
-  std::optional<double> focal_35mm;        // FocalLengthIn35mmFilm
-  std::optional<double> aperture;          // FNumber
-  std::optional<double> crop_factor;       // lensfun's, for make + model
-  std::string crop_camera;                 // the lensfun entry it came from
+  std::string make, model, lens;      // EXIF Make, Model, LensModel (may be empty)
+  std::optional<double> focal_mm;     // FocalLength
+  std::optional<double> focal_35mm;   // FocalLengthIn35mmFilm
+  std::optional<double> aperture;     // FNumber
+  std::optional<double> crop_factor;  // lensfun's, for make + model
+  std::string crop_camera;            // the lensfun entry it came from
 };
 
 // Never throws for missing metadata (the fields stay empty); throws std::runtime_error("<file>:

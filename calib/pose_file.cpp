@@ -36,7 +36,8 @@ void check(const PoseSet& p) {
     const ViewPose& v = p.views[i];
     names.add(v.name, key + ".name", "view");
     checked_rotation(v.world_from_cam, key + ".world_from_cam");
-    if (!(v.sigma_deg >= 0) || !std::isfinite(v.sigma_deg)) spec_fail(key + ".sigma_deg", "must be a finite number >= 0");
+    if (!(v.sigma_deg >= 0) || !std::isfinite(v.sigma_deg))
+      spec_fail(key + ".sigma_deg", "must be a finite number >= 0");
     if (v.ball) {
       if (!v.ball->axis.allFinite() || std::abs(v.ball->axis.norm() - 1) > 1e-6)
         spec_fail(key + ".ball.axis", "expected a unit vector");
@@ -64,11 +65,13 @@ PoseSet read_pose_file(const std::string& path) {
     const YAML::Node views = top.get("views");
     if (!views.IsSequence() || views.size() == 0) spec_fail(top.at("views"), "expected a non-empty sequence");
     for (std::size_t i = 0; i < views.size(); ++i) {
-      YamlMap v(views[i], top.at("views") + "[" + std::to_string(i) + "]", {"name", "world_from_cam", "sigma_deg", "ball"});
+      YamlMap v(views[i], top.at("views") + "[" + std::to_string(i) + "]",
+                {"name", "world_from_cam", "sigma_deg", "ball"});
       ViewPose pose;
       pose.name = v.string("name");
       const std::vector<double> m = v.numbers("world_from_cam");
-      if (m.size() != 9) spec_fail(v.at("world_from_cam"), "expected 9 numbers (row-major), got " + std::to_string(m.size()));
+      if (m.size() != 9)
+        spec_fail(v.at("world_from_cam"), "expected 9 numbers (row-major), got " + std::to_string(m.size()));
       Mat3 r;
       for (int k = 0; k < 9; ++k) r(k / 3, k % 3) = m[k];
       pose.world_from_cam = checked_rotation(r, v.at("world_from_cam"));

@@ -21,7 +21,6 @@ struct Lookup {
   double clipped = 0, clipped_weight = 0;
 };
 
-
 Lookup look_up(const MapView& mv, const Vec3& r) {
   Lookup out;
   const Vec2 px = sphere_map::pixel_from_disc(sphere_map::g_mirror_inv(r), mv.rgb.cols, mv.rgb.rows);
@@ -65,9 +64,11 @@ Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
   for (std::size_t v = 0; v < set.views.size(); ++v) {
     const MapView& mv = set.views[v];
     if (mv.confidence.empty() || mv.rgb.type() != CV_32FC3)
-      throw std::invalid_argument("probe: view." + std::to_string(v) + " has no confidence channel (not a captured map)");
+      throw std::invalid_argument("probe: view." + std::to_string(v) +
+                                  " has no confidence channel (not a captured map)");
     if (!mv.clipped.empty() && (mv.clipped.type() != CV_32FC1 || mv.clipped.size() != mv.rgb.size()))
-      throw std::invalid_argument("probe: view." + std::to_string(v) + " has a clipped channel of the wrong type or size");
+      throw std::invalid_argument("probe: view." + std::to_string(v) +
+                                  " has a clipped channel of the wrong type or size");
   }
   if (options.width < 4 || options.width % 2) throw std::invalid_argument("probe: width must be even and >= 4");
   const Layout layout(LayoutKind::LatLong, options.width, options.width / 2);
@@ -82,7 +83,8 @@ Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
   for (const MapView& mv : set.views) map_size = std::max(map_size, std::min(mv.rgb.cols, mv.rgb.rows));
   const double map_texel = 4.0 / std::max(map_size, 1), probe_texel = kPi / (layout.height() - 1);
   const int k = std::clamp(int(std::ceil(probe_texel / map_texel - 1e-9)), 1, 4);
-  std::vector<double> row_area(layout.height(), 0.0), row_covered(layout.height(), 0.0), row_clipped(layout.height(), 0.0);
+  std::vector<double> row_area(layout.height(), 0.0), row_covered(layout.height(), 0.0),
+      row_clipped(layout.height(), 0.0);
   parallel_for_rows(layout.height(), [&](int row) {
     for (int col = 0; col < layout.width(); ++col) {
       const auto centre = layout.texel_direction(col, row);

@@ -37,16 +37,16 @@ namespace rsibr {
 inline constexpr const char* kDefaultChromeFresnel = "{type: conductor, eta: [2.9, 2.9, 2.6], k: [3.4, 3.4, 3.2]}";
 
 struct ProbeOptions {
-  int width = 256;                  // lat-long width (height = width / 2)
-  const Fresnel* fresnel = nullptr; // the ball's Fresnel, divided out; none: the probe is F L
+  int width = 256;                   // lat-long width (height = width / 2)
+  const Fresnel* fresnel = nullptr;  // the ball's Fresnel, divided out; none: the probe is F L
   double min_weight = 1e-3;
 };
 
 struct Probe {
-  EnvMap env;               // lat-long, RGB
-  cv::Mat weight;           // CV_32FC1, summed confidence per texel
-  cv::Mat clipped;          // CV_32FC1, summed weight of the clipped lookups at clipped texels (0 elsewhere)
-  cv::Mat lower_bound;      // CV_32FC3, the largest lower bound of L seen there (0 elsewhere)
+  EnvMap env;                   // lat-long, RGB
+  cv::Mat weight;               // CV_32FC1, summed confidence per texel
+  cv::Mat clipped;              // CV_32FC1, summed weight of the clipped lookups at clipped texels (0 elsewhere)
+  cv::Mat lower_bound;          // CV_32FC3, the largest lower bound of L seen there (0 elsewhere)
   double covered_fraction = 0;  // solid-angle fraction with weight >= min_weight
   double clipped_fraction = 0;  // solid-angle fraction of texels clipped in every view that saw them
 };

@@ -68,22 +68,22 @@ namespace rsibr {
 enum class SphereIndexing { orthographic, reflection };
 
 struct ExtractOptions {
-  int size = 128;                    // square map
+  int size = 128;  // square map
   SphereIndexing indexing = SphereIndexing::reflection;
-  bool mirror = true;                // the map's warp: "mirror" (chrome) or "normal" (grey)
+  bool mirror = true;  // the map's warp: "mirror" (chrome) or "normal" (grey)
   double rim_zero_deg = 82, rim_full_deg = 70;
   double limb_margin_px = 1.5;
   double camera_mask_deg = 0, camera_ramp_deg = 4;
-  std::optional<Vec3> down;          // camera frame; none: no stand mask
+  std::optional<Vec3> down;  // camera frame; none: no stand mask
   double stand_mask_deg = 8, stand_ramp_deg = 4;
-  unsigned char clipped_mask = 1;    // hdr/merge.h kClipped
-  std::vector<Occluder> occluders;   // camera frame, this ball's radii (mirror maps only)
-  std::vector<Occluder> in_front;    // camera frame, this ball's radii (any map)
+  unsigned char clipped_mask = 1;   // hdr/merge.h kClipped
+  std::vector<Occluder> occluders;  // camera frame, this ball's radii (mirror maps only)
+  std::vector<Occluder> in_front;   // camera frame, this ball's radii (any map)
   // Mirror maps only (a grey or glossy ball's shading has no feature smaller than a texel);
   // <= 0: the centre alone.
   double supersample_spacing_px = 0.5;
   int max_supersample = 16;
-  std::string material;              // the map's rsibr.material
+  std::string material;  // the map's rsibr.material
 };
 
 // `image` CV_32FC3 RGB linear of the lens's size; `flags` empty or CV_8UC1 of that size.

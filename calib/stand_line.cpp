@@ -18,7 +18,8 @@ struct LogImage {
   cv::Mat l;  // CV_32FC1, ln(luminance + eps)
   bool inside(const Vec2& p) const { return p.x() >= 0 && p.y() >= 0 && p.x() <= l.cols - 1 && p.y() <= l.rows - 1; }
   double at(const Vec2& p) const {
-    const int x0 = std::clamp(int(std::floor(p.x())), 0, l.cols - 2), y0 = std::clamp(int(std::floor(p.y())), 0, l.rows - 2);
+    const int x0 = std::clamp(int(std::floor(p.x())), 0, l.cols - 2),
+              y0 = std::clamp(int(std::floor(p.y())), 0, l.rows - 2);
     const double fx = p.x() - x0, fy = p.y() - y0;
     const float* r0 = l.ptr<float>(y0);
     const float* r1 = l.ptr<float>(y0 + 1);

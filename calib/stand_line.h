@@ -26,7 +26,7 @@ namespace rsibr {
 
 struct StandLineOptions {
   double max_angle_deg = 35;
-  double min_contrast = 0.08;   // natural log units
+  double min_contrast = 0.08;  // natural log units
   double min_coverage = 0.6;
   double min_distinction = 2.0;  // best score over the best score away from it
   // How vertical a stand is (levelled by eye): a tilt every view of it shares, so n lines of one
@@ -35,8 +35,8 @@ struct StandLineOptions {
 };
 
 struct StandLine {
-  Vec3 plane_normal;       // unit, camera frame
-  double angle_deg = 0;    // the line's direction in the image, from image down toward +x
+  Vec3 plane_normal;     // unit, camera frame
+  double angle_deg = 0;  // the line's direction in the image, from image down toward +x
   double half_width_px = 0;
   double score = 0, coverage = 0, distinction = 0;
   double sigma_deg = 0.1;

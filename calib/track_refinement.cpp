@@ -166,7 +166,8 @@ std::vector<int> faces_facing(const std::vector<CubeFace>& faces, const Vec3& d)
 
 // The re-located observation's std dev (radians) from the alignment's covariance at uv on `face`.
 std::optional<double> sigma_of(const Eigen::Matrix2d& cov, const CubeFace& face, const Vec2& uv, const LensModel& lens,
-                               const BallCone& cone, const BallFeatureOptions& features, const TrackRefinementOptions& o) {
+                               const BallCone& cone, const BallFeatureOptions& features,
+                               const TrackRefinementOptions& o) {
   const auto q0 = ball_pixel_of(lens, cone, features, face.direction(uv.x(), uv.y()));
   const auto qu = ball_pixel_of(lens, cone, features, face.direction(uv.x() + 1, uv.y()), false);
   const auto qv = ball_pixel_of(lens, cone, features, face.direction(uv.x(), uv.y() + 1), false);
@@ -195,7 +196,8 @@ std::vector<DirectionObservation> refine_tracks(const std::vector<CubeFeatureSet
   if (cones.size() != views.size() || refined_cones.size() != views.size() || world_from_cam.size() != views.size())
     throw std::invalid_argument("refine_tracks: views, cones and rotations differ in number");
   std::vector<ViewGeometry> geo;
-  for (std::size_t v = 0; v < views.size(); ++v) geo.push_back({&views[v], cones[v], refined_cones[v], world_from_cam[v]});
+  for (std::size_t v = 0; v < views.size(); ++v)
+    geo.push_back({&views[v], cones[v], refined_cones[v], world_from_cam[v]});
   const std::vector<BallCone>& detected = cones;
   if (options.half_size < 1 || options.max_iterations < 1)
     throw std::invalid_argument("refine_tracks: half_size and max_iterations must be >= 1");
@@ -204,7 +206,8 @@ std::vector<DirectionObservation> refine_tracks(const std::vector<CubeFeatureSet
         ob.index >= static_cast<int>(views[ob.view].face.size()))
       throw std::invalid_argument("refine_tracks: an observation without its view's feature index");
   std::map<int, std::vector<int>> by_track;
-  for (std::size_t i = 0; i < observations.size(); ++i) by_track[observations[i].feature].push_back(static_cast<int>(i));
+  for (std::size_t i = 0; i < observations.size(); ++i)
+    by_track[observations[i].feature].push_back(static_cast<int>(i));
   std::vector<std::vector<int>> tracks;
   for (auto& [id, members] : by_track) tracks.push_back(std::move(members));
 
@@ -242,8 +245,8 @@ std::vector<DirectionObservation> refine_tracks(const std::vector<CubeFeatureSet
       const DirectionObservation& ob = observations[i];
       const CubeFeatureSet& b = views[ob.view];
       const Vec3 keypoint_dir = b.faces[b.face[ob.index]].direction(b.face_uv[ob.index].x(), b.face_uv[ob.index].y());
-      const Vec3 seen = world_from_cam[ob.view].transpose() * world_from_cam[va] *
-                        a.faces[fa].direction(anchor.x(), anchor.y());
+      const Vec3 seen =
+          world_from_cam[ob.view].transpose() * world_from_cam[va] * a.faces[fa].direction(anchor.x(), anchor.y());
       bool done = false;
       for (int f : faces_facing(b.faces, seen)) {
         const CubeFace& face = b.faces[f];
@@ -254,7 +257,8 @@ std::vector<DirectionObservation> refine_tracks(const std::vector<CubeFeatureSet
         bool ok = true;
         for (int j = 0; j < 3 && ok; ++j)
           for (int i = 0; i < 3 && ok; ++i) {
-            const auto t = transfer(geo[va], fa, anchor + Vec2((i - 1) * h, (j - 1) * h), geo[ob.view], f, lens, features);
+            const auto t =
+                transfer(geo[va], fa, anchor + Vec2((i - 1) * h, (j - 1) * h), geo[ob.view], f, lens, features);
             if (t) grid[j][i] = *t;
             ok = t.has_value();
           }

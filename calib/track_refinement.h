@@ -43,16 +43,16 @@
 namespace rsibr {
 
 struct TrackRefinementOptions {
-  int half_size = 7;              // h: the patch is (2h + 1)^2 texels
+  int half_size = 7;  // h: the patch is (2h + 1)^2 texels
   int max_iterations = 30;
   double max_shift_texels = 2;
   double min_ncc = 0.8;
-  double floor_px = 0.03;         // in the image's pixels: what the noise model leaves out (interpolation, pixel-locking)
+  double floor_px = 0.03;  // in the image's pixels: what the noise model leaves out (interpolation, pixel-locking)
 };
 
 struct TrackRefinementReport {
-  int tracks_refined = 0;         // tracks with >= 1 re-located partner
-  int observations_refined = 0;   // re-located observations, references included
+  int tracks_refined = 0;        // tracks with >= 1 re-located partner
+  int observations_refined = 0;  // re-located observations, references included
   int observations_dropped = 0;
   double median_sigma_ratio = 0;  // re-located sigma / SIFT sigma, median
 };
@@ -61,13 +61,10 @@ struct TrackRefinementReport {
 // detected with in `cones[v]`; `refined_cones` and `world_from_cam` per view from a first solve
 // (the cones as detected where the balls were not refined); `observations` from
 // match_ball_features (index set). Returns the observations to solve again.
-std::vector<DirectionObservation> refine_tracks(const std::vector<CubeFeatureSet>& views,
-                                                const std::vector<BallCone>& cones,
-                                                const std::vector<BallCone>& refined_cones, const LensModel& lens,
-                                                const BallFeatureOptions& features,
-                                                const std::vector<Mat3>& world_from_cam,
-                                                const std::vector<DirectionObservation>& observations,
-                                                const TrackRefinementOptions& options = {},
-                                                TrackRefinementReport* report = nullptr);
+std::vector<DirectionObservation> refine_tracks(
+    const std::vector<CubeFeatureSet>& views, const std::vector<BallCone>& cones,
+    const std::vector<BallCone>& refined_cones, const LensModel& lens, const BallFeatureOptions& features,
+    const std::vector<Mat3>& world_from_cam, const std::vector<DirectionObservation>& observations,
+    const TrackRefinementOptions& options = {}, TrackRefinementReport* report = nullptr);
 
 }  // namespace rsibr

@@ -113,8 +113,8 @@ cv::Mat masked_flags(const cv::Mat& flags, const cv::Size& size, const std::vect
 
 }  // namespace
 
-PoseSet orient_views(const std::vector<std::string>& all_names, const std::vector<ViewImage>& all_views, const LensModel& lens,
-                     const ViewOrientationOptions& options, ViewOrientationReport* report) {
+PoseSet orient_views(const std::vector<std::string>& all_names, const std::vector<ViewImage>& all_views,
+                     const LensModel& lens, const ViewOrientationOptions& options, ViewOrientationReport* report) {
   if (all_names.size() != all_views.size()) throw std::invalid_argument("orient: names and views differ in number");
   // One view is a shoot (the paper's own capture): its camera is the world frame, levelled below.
   if (all_views.empty()) throw std::invalid_argument("orient: no views");
@@ -151,9 +151,10 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
     const cv::Mat& img = all_views[v].radiance;
     std::optional<BallCandidate> found;
     std::vector<BallLocation> overlapping;
-    const std::optional<BallGuess> guess = !options.given_chrome.empty() && options.given_chrome[v]
-                                               ? options.given_chrome[v]
-                                               : (!options.balls.empty() ? std::optional<BallGuess>(options.balls[v]) : std::nullopt);
+    const std::optional<BallGuess> guess =
+        !options.given_chrome.empty() && options.given_chrome[v]
+            ? options.given_chrome[v]
+            : (!options.balls.empty() ? std::optional<BallGuess>(options.balls[v]) : std::nullopt);
     if (guess) {
       try {
         found = given_ball(img, lens, *guess);
@@ -166,7 +167,8 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
       if (k < 0 && found) rep.notes.push_back(all_names[v] + ": " + rescued[v].note);
     }
     if (!found) {
-      rep.left_out.push_back(all_names[v] + ": no chrome ball found (no candidate with a clean outline that looks like a mirror)");
+      rep.left_out.push_back(all_names[v] +
+                             ": no chrome ball found (no candidate with a clean outline that looks like a mirror)");
       continue;
     }
     // Another ball overlapping the chrome one may be in front: its edge is no part of the chrome
@@ -174,7 +176,8 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
     if (!overlapping.empty()) found->loc = refit_outline_excluding(found->loc, lens, overlapping);
     const BallLocation& loc = found->loc;
     if (options.domain == FeatureDomain::cube) {
-      const cv::Mat flags = overlapping.empty() ? all_views[v].flags : masked_flags(all_views[v].flags, img.size(), overlapping);
+      const cv::Mat flags =
+          overlapping.empty() ? all_views[v].flags : masked_flags(all_views[v].flags, img.size(), overlapping);
       sets.push_back(ball_cube_feature_set(img, flags, lens, loc.fit.cone, options.features, options.cube));
       feats.push_back(sets.back().features);
       if (!options.refine_tracks) sets.back().faces.clear();
@@ -194,8 +197,8 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
     return PoseSet{};
   }
   if (names.size() < 2 && known.empty() && !(single && names.size() == 1)) {
-    std::string why = "orient: a chrome ball was found in " + std::to_string(names.size()) + " of " + std::to_string(all_views.size()) +
-                      " views, need at least " + (single ? "1" : "2");
+    std::string why = "orient: a chrome ball was found in " + std::to_string(names.size()) + " of " +
+                      std::to_string(all_views.size()) + " views, need at least " + (single ? "1" : "2");
     if (!rep.left_out.empty()) why += " (" + rep.left_out.front() + ")";
     throw std::invalid_argument(why);
   }
@@ -261,7 +264,8 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
       // without a known rotation is the gauge itself.
       s.world_from_cam = known.empty() ? std::vector<Mat3>{so.first_world_from_cam} : known;
       s.sigma_deg.assign(n, 0.0);
-      for (const BallLocation& b : rep.balls) s.ball_axes.push_back(b.fit.cone.axis), s.ball_half_angles.push_back(b.fit.cone.half_angle);
+      for (const BallLocation& b : rep.balls)
+        s.ball_axes.push_back(b.fit.cone.axis), s.ball_half_angles.push_back(b.fit.cone.half_angle);
     } else {
       s = solved ? *solved : solve_orientations(nv, tracks, obs, so);
       if (options.domain == FeatureDomain::cube && options.refine_tracks) {

@@ -42,15 +42,16 @@ namespace rsibr {
 enum class FeatureDomain { cube, image };
 
 struct ViewOrientationOptions {
-  std::optional<Vec3> up;              // camera frame of the first view; none: the first-view gauge
-  bool estimate_up = false;            // without `up`: estimated from the views (gauge "estimated-up")
+  std::optional<Vec3> up;    // camera frame of the first view; none: the first-view gauge
+  bool estimate_up = false;  // without `up`: estimated from the views (gauge "estimated-up")
   WorldUpOptions up_options;
-  bool stand_lines = true;             // with estimate_up: the stand under each chrome ball as a vertical line (calib/stand_line.h)
+  bool stand_lines =
+      true;  // with estimate_up: the stand under each chrome ball as a vertical line (calib/stand_line.h)
   StandLineOptions stand;
-  std::vector<BallGuess> balls;        // per view, or empty: detected
+  std::vector<BallGuess> balls;                        // per view, or empty: detected
   std::vector<std::optional<BallGuess>> given_chrome;  // per view or empty: a given chrome ball (--ball)
-  std::vector<ListedBall> listed;      // the photo set's balls (empty: one chrome ball)
-  BallSearchOptions search;            // min/max radius 0: min(width, height) / 40 and / 2
+  std::vector<ListedBall> listed;                      // the photo set's balls (empty: one chrome ball)
+  BallSearchOptions search;                            // min/max radius 0: min(width, height) / 40 and / 2
   // Known rotations (a pose file without balls), per view: the features refine only the balls.
   std::vector<Mat3> known_world_from_cam;
   // Denser than BallFeatureOptions' defaults: weaker SIFT features (contrast 0.01) and out to 0.95 of
@@ -72,7 +73,7 @@ struct ViewOrientationOptions {
   // in docs/tradeoffs.md, "Orientation" and "Measured choices in the code".
   bool refine_tracks = true;
   TrackRefinementOptions tracks;
-  OrientationOptions solve;            // its first_world_from_cam is set from the gauge
+  OrientationOptions solve;  // its first_world_from_cam is set from the gauge
 };
 
 // What orient_views saw, for reports (--json).

@@ -65,7 +65,8 @@ WorldUp estimate_world_up(const std::vector<Mat3>& world_from_cam, const std::ve
   double sigma_roll = o.roll_sigma_deg * kDeg;
   Mat3 s = Mat3::Zero();
   for (const Vec3& xi : x) s += xi * xi.transpose() / (sigma_roll * sigma_roll);
-  for (const VerticalLine& l : lines) s += l.plane_normal * l.plane_normal.transpose() / std::pow(l.sigma_deg * kDeg, 2);
+  for (const VerticalLine& l : lines)
+    s += l.plane_normal * l.plane_normal.transpose() / std::pow(l.sigma_deg * kDeg, 2);
   s += (Mat3::Identity() - u0 * u0.transpose()) / std::pow(o.prior_sigma_deg * kDeg, 2);
   Eigen::SelfAdjointEigenSolver<Mat3> eig(s);
   Vec3 start = eig.eigenvectors().col(0);

@@ -35,15 +35,15 @@ struct WorldUpOptions {
 };
 
 struct VerticalLine {
-  Vec3 plane_normal;      // unit, world (the solve's frame): normal of the plane through the camera centre and the line
-  double sigma_deg = 0.3; // how well the line fixes it
-  std::string what;       // e.g. "view03: stand under chrome"
+  Vec3 plane_normal;  // unit, world (the solve's frame): normal of the plane through the camera centre and the line
+  double sigma_deg = 0.3;  // how well the line fixes it
+  std::string what;        // e.g. "view03: stand under chrome"
 };
 
 struct WorldUp {
-  Vec3 up = Vec3(0, 1, 0);       // unit
-  double sigma_deg = 0;          // std dev, both axes together
-  double roll_sigma_deg = 0;     // the cameras' roll scatter used
+  Vec3 up = Vec3(0, 1, 0);    // unit
+  double sigma_deg = 0;       // std dev, both axes together
+  double roll_sigma_deg = 0;  // the cameras' roll scatter used
   bool roll_sigma_estimated = false;
   std::vector<double> roll_deg;  // per camera: asin(x_i . u), its roll from level
   int lines = 0;

@@ -101,8 +101,9 @@ RigMesh build_rig_mesh(const SynthScene& scene, const CameraPose* pose) {
     for (const SynthBall& b : scene.balls) {
       const double bottom = b.centre.y() - 0.5 * b.diameter_m;
       // The pole ends a little inside the ball so no gap shows where it holds it.
-      if (bottom > 0) add_pole(out, b.centre.x(), b.centre.z(), 0.0, bottom + 0.2 * b.diameter_m, kStandRadius,
-                               Vec3::Constant(kStandAlbedo));
+      if (bottom > 0)
+        add_pole(out, b.centre.x(), b.centre.z(), 0.0, bottom + 0.2 * b.diameter_m, kStandRadius,
+                 Vec3::Constant(kStandAlbedo));
     }
   for (const SynthClutter& c : scene.clutter) {
     if (c.shape == "sphere") {

@@ -55,8 +55,8 @@ std::vector<CameraPose> plan_camera_poses(const SynthScene& scene) {
         axis = axis.norm() > 0 ? axis.normalized() : Vec3::UnitY();
         const double angle = plan.jitter_deg * kDeg * sample_normal(rng);
         pose.eye += plan.jitter_m * dp;
-        pose.world_from_cam =
-            Eigen::AngleAxisd(angle, axis).toRotationMatrix() * aim(pose.eye, at, plan.roll_deg, plan.yaw_deg, plan.pan_deg);
+        pose.world_from_cam = Eigen::AngleAxisd(angle, axis).toRotationMatrix() *
+                              aim(pose.eye, at, plan.roll_deg, plan.yaw_deg, plan.pan_deg);
       }
       char name[32];
       std::snprintf(name, sizeof name, "view%02zu", out.size());

@@ -32,10 +32,10 @@
 namespace rsibr {
 
 struct CameraProcessing {
-  Vec3 sensitivity = Vec3::Ones();        // s: raw channel sensitivities (the sensor's colour)
-  std::optional<Vec3> white_balance;      // g; nullopt: automatic, max(s) / s_c
-  double saturation = 1.0;                // s of M when no matrix is given
-  std::optional<Mat3> colour_matrix;      // M (rows summing to 1 keep greys grey)
+  Vec3 sensitivity = Vec3::Ones();    // s: raw channel sensitivities (the sensor's colour)
+  std::optional<Vec3> white_balance;  // g; nullopt: automatic, max(s) / s_c
+  double saturation = 1.0;            // s of M when no matrix is given
+  std::optional<Mat3> colour_matrix;  // M (rows summing to 1 keep greys grey)
 
   Vec3 gains() const;   // g
   Mat3 matrix() const;  // M

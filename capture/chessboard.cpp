@@ -21,8 +21,8 @@ double board_reflectance(double u, double v, int corners, double spacing) {
 
 }  // namespace
 
-ChessboardShot render_chessboard(const LensModel& lens, const RayTable& rays, const SynthChessboards& boards,
-                                 int index, std::uint64_t seed, int supersampling) {
+ChessboardShot render_chessboard(const LensModel& lens, const RayTable& rays, const SynthChessboards& boards, int index,
+                                 std::uint64_t seed, int supersampling) {
   const int n = boards.corners;
   const double s = boards.spacing_m;
   const double f = lens.intrinsics().empty() ? 500 : lens.intrinsics()[0];

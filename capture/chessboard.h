@@ -25,12 +25,12 @@ namespace rsibr {
 
 struct ChessboardShot {
   Mat3 cam_from_board = Mat3::Identity();
-  Vec3 board_centre_cam = Vec3::Zero();   // board origin in the camera frame, metres
-  std::vector<Vec2> corners;              // true pixel positions, row-major (j outer, i inner)
-  cv::Mat reflectance;                    // CV_32FC1, supersampled (n x n jittered) board reflectance
+  Vec3 board_centre_cam = Vec3::Zero();  // board origin in the camera frame, metres
+  std::vector<Vec2> corners;             // true pixel positions, row-major (j outer, i inner)
+  cv::Mat reflectance;                   // CV_32FC1, supersampled (n x n jittered) board reflectance
 };
 
-ChessboardShot render_chessboard(const LensModel& lens, const RayTable& rays, const SynthChessboards& boards,
-                                 int index, std::uint64_t seed, int supersampling);
+ChessboardShot render_chessboard(const LensModel& lens, const RayTable& rays, const SynthChessboards& boards, int index,
+                                 std::uint64_t seed, int supersampling);
 
 }  // namespace rsibr

@@ -16,8 +16,8 @@ namespace rsibr {
 
 struct DngInfo {
   std::string make = "rsibr", model = "synthetic camera";
-  std::string cfa = "RGGB";        // the 2x2 pattern from the top-left pixel, row by row
-  int black = 0, white = 65535;    // code of no light, code of the sensor's saturation
+  std::string cfa = "RGGB";                 // the 2x2 pattern from the top-left pixel, row by row
+  int black = 0, white = 65535;             // code of no light, code of the sensor's saturation
   Mat3 camera_from_xyz = Mat3::Identity();  // ColorMatrix1 (D65); any scale (readers normalise it)
   Vec3 as_shot_neutral = Vec3::Ones();      // camera RGB of a neutral, the largest 1
   double exposure_s = 0, iso = 100, aperture = 1;

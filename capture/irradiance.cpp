@@ -8,10 +8,7 @@
 #include <numeric>
 
 namespace rsibr {
-namespace {
-
-
-}  // namespace
+namespace {}  // namespace
 
 IrradianceQuadrature::IrradianceQuadrature(const EnvMap& env, int rest_width, double bright_ratio, int max_bright) {
   const Layout& lay = env.layout;
@@ -36,7 +33,8 @@ IrradianceQuadrature::IrradianceQuadrature(const EnvMap& env, int rest_width, do
       if (mean > 0 && y >= bright_ratio * mean && lay.texel_direction(c, r))
         bright.push_back({c, r, y * lay.texel_solid_angle(c, r)});
     }
-  std::stable_sort(bright.begin(), bright.end(), [](const Candidate& a, const Candidate& b) { return a.power > b.power; });
+  std::stable_sort(bright.begin(), bright.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.power > b.power; });
   if (int(bright.size()) > max_bright) bright.resize(std::size_t(max_bright));
   EnvMap rest = env;
   rest.pixels = env.pixels.clone();

@@ -14,8 +14,7 @@ namespace rsibr {
 
 EnvMap irradiance_map(const EnvMap& env, int width) { return IrradianceQuadrature(env).latlong_map(width); }
 
-RigRenderer::RigRenderer(const SynthScene& scene, EnvMap env)
-    : scene_(scene), env_(std::move(env)), quadrature_(env_) {
+RigRenderer::RigRenderer(const SynthScene& scene, EnvMap env) : scene_(scene), env_(std::move(env)), quadrature_(env_) {
   irradiance_ = quadrature_.latlong_map(256);
   for (const SynthBall& b : scene.balls) {
     Ball ball{b.centre, 0.5 * b.diameter_m, b.kind == "chrome", b.kind == "glossy", b.albedo, nullptr};

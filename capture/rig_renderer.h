@@ -74,7 +74,7 @@ class RigRenderer {
     const RayScene* scene = nullptr;
     const RigMesh* mesh = nullptr;
     std::vector<EnvMap> ball_irradiance;
-    std::vector<EnvMap> ball_map;           // glossy: the view's sphere map (sphere layout, view frame)
+    std::vector<EnvMap> ball_map;            // glossy: the view's sphere map (sphere layout, view frame)
     std::vector<Mat3> ball_world_from_view;  // glossy: its frame
   };
   ViewScene view_scene(const RayScene* scene, const RigMesh* mesh, const Vec3& eye) const;

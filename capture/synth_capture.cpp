@@ -63,8 +63,8 @@ void write_codes(const fs::path& file, const cv::Mat& codes, const std::string& 
 // length (fx over the sensor's width) and its 35 mm equivalent on the diagonal, in whole mm.
 void write_photo_exif(const fs::path& file, const SynthCamera& cam, double t, const SynthExposure& ex) {
   const double fx = cam.lens.intrinsics().at(0);
-  const double focal_mm = cam.exif_focal_scale *
-                          (cam.exif_focal_mm > 0 ? cam.exif_focal_mm : fx * cam.sensor_width_mm / cam.lens.width());
+  const double focal_mm =
+      cam.exif_focal_scale * (cam.exif_focal_mm > 0 ? cam.exif_focal_mm : fx * cam.sensor_width_mm / cam.lens.width());
   const double f35 = std::round(cam.exif_focal_scale * fx * 43.266615305567875 /
                                 std::hypot(double(cam.lens.width()), double(cam.lens.height())));
   try {
@@ -143,9 +143,8 @@ cv::Mat dng_linear_output(const cv::Mat& L, const SynthCamera& cam) {
   const Vec3 g = cam.processing ? cam.processing->gains() : Vec3::Ones();
   const Vec3 f = (g / g.minCoeff()).cwiseProduct(s);
   cv::Mat out = L.clone();
-  out.forEach<cv::Vec3f>([&](cv::Vec3f& p, const int*) {
-    p = cv::Vec3f(float(p[0] * f[0]), float(p[1] * f[1]), float(p[2] * f[2]));
-  });
+  out.forEach<cv::Vec3f>(
+      [&](cv::Vec3f& p, const int*) { p = cv::Vec3f(float(p[0] * f[0]), float(p[1] * f[1]), float(p[2] * f[2])); });
   return out;
 }
 
@@ -226,9 +225,9 @@ EnvMap synth_environment(const SynthScene& scene) {
       throw std::invalid_argument(e.file->string() + ": " + std::to_string(bad) +
                                   " NaN, Inf or negative values (set environment.sanitize: true to zero them)");
   } else {
-    env = render_pattern(patterns::sun_and_sky(e.sun_direction, e.sun_radius_deg * kPi / 180, e.sun_rgb, e.zenith_rgb,
-                                               e.horizon_rgb),
-                         Layout::with_size(LayoutKind::LatLong, e.size), 4);
+    env = render_pattern(
+        patterns::sun_and_sky(e.sun_direction, e.sun_radius_deg * kPi / 180, e.sun_rgb, e.zenith_rgb, e.horizon_rgb),
+        Layout::with_size(LayoutKind::LatLong, e.size), 4);
   }
   if (e.scale != 1.0) env.pixels *= e.scale;
   return env;
@@ -292,8 +291,11 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
   set.folder = photos;
   set.camera_name = cam.name;
   for (const SynthBall& b : scene.balls)
-    set.balls.push_back(
-        {b.name, b.kind == "chrome" ? BallKind::chrome : b.kind == "grey" ? BallKind::grey : BallKind::glossy, b.diameter_m});
+    set.balls.push_back({b.name,
+                         b.kind == "chrome" ? BallKind::chrome
+                         : b.kind == "grey" ? BallKind::grey
+                                            : BallKind::glossy,
+                         b.diameter_m});
 
   YAML::Node ty;
   ty["rsibr_synth_truth"] = 1;
@@ -325,15 +327,17 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
     tc["processing"] = tp;
   }
   tc["supersampling"] = cam.supersampling;
-  tc["convention"] = "X = L e k electrons (L after vignetting and white balance, e = t*iso/100/N^2); "
-                     "X = clamp(Poisson(X) + Normal(0, read_noise^2), 0, full_well); code = round(f(X/full_well)*max_code)";
+  tc["convention"] =
+      "X = L e k electrons (L after vignetting and white balance, e = t*iso/100/N^2); "
+      "X = clamp(Poisson(X) + Normal(0, read_noise^2), 0, full_well); code = round(f(X/full_well)*max_code)";
 
   for (std::size_t vi = 0; vi < poses.size(); ++vi) {
     const CameraPose& pose = poses[vi];
     const auto r0 = Clock::now();
     const double before = done;
-    const cv::Mat scene_radiance =
-        renderer.render(pose, cam.lens, rays, ropt, [&](double f) { if (progress) progress(std::min(1.0, (before + f) / work)); });
+    const cv::Mat scene_radiance = renderer.render(pose, cam.lens, rays, ropt, [&](double f) {
+      if (progress) progress(std::min(1.0, (before + f) / work));
+    });
     report.pixels_rendered += (long long)(scene_radiance.total()) * cam.supersampling * cam.supersampling;
     advance(1);
     // L at the pixel: vignetting and white balance applied to the scene radiance (with in-camera
@@ -343,8 +347,9 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
       for (int x = 0; x < L.cols; ++x) {
         const float v = vignette.at<float>(y, x);
         const cv::Vec3f s = scene_radiance.at<cv::Vec3f>(y, x);
-        L.at<cv::Vec3f>(y, x) = cv::Vec3f(float(s[0] * v * cam.white_balance[0]), float(s[1] * v * cam.white_balance[1]),
-                                          float(s[2] * v * cam.white_balance[2]));
+        L.at<cv::Vec3f>(y, x) =
+            cv::Vec3f(float(s[0] * v * cam.white_balance[0]), float(s[1] * v * cam.white_balance[1]),
+                      float(s[2] * v * cam.white_balance[2]));
       }
     if (cam.format == "dng") L = optical_low_pass(L);
     const auto r1 = Clock::now();
@@ -365,7 +370,9 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
       tc["gain"] = noise.gain;
       // hdr/'s normalised units (X / X_sat, X_sat = full_well): docs/conventions.md.
       tc["gain_normalised"] = noise.gain / cam.full_well;
-      tc["gain_source"] = cam.gain ? "scene" : "auto: the first view's median radiance records 18% of the full well at the middle exposure";
+      tc["gain_source"] =
+          cam.gain ? "scene"
+                   : "auto: the first view's median radiance records 18% of the full well at the middle exposure";
       report.gain = noise.gain;
     }
     PhotoView pv;
@@ -412,11 +419,15 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
                                                 {"view", pose.name},
                                                 {"cameraModel", cam.lens.name()},
                                                 {"seed", std::to_string(scene.seed)}};
-    attrs["content"] = cam.format == "dng" ? "what a RAW developer recovers: (gains / min gain) * sensitivity * L for L at the pixel: X = L e k"
-                       : cam.processing ? "the camera's linear output M (gains * sensitivity * L) for L at the pixel: X = L e k"
-                                        : "L at the pixel (after vignetting and white balance): X = L e k";
+    attrs["content"] =
+        cam.format == "dng"
+            ? "what a RAW developer recovers: (gains / min gain) * sensitivity * L for L at the pixel: X = L e k"
+        : cam.processing ? "the camera's linear output M (gains * sensitivity * L) for L at the pixel: X = L e k"
+                         : "L at the pixel (after vignetting and white balance): X = L e k";
     write_truth_image(file_in_folder(truth / "views", pose.name + "_radiance.exr"),
-                      cam.format == "dng" ? dng_linear_output(L, cam) : cam.processing ? linear_output(L, *cam.processing) : L,
+                      cam.format == "dng" ? dng_linear_output(L, cam)
+                      : cam.processing    ? linear_output(L, *cam.processing)
+                                          : L,
                       &pose, attrs);
     attrs["content"] = "scene radiance along each pixel's rays (before vignetting and white balance)";
     write_truth_image(file_in_folder(truth / "views", pose.name + "_scene.exr"), scene_radiance, &pose, attrs);
@@ -468,10 +479,13 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
     const SensorNoise board_noise{0.7 * cam.full_well / 0.9, cam.full_well, cam.read_noise};
     const std::string board_ext = "." + ext_of(cam.format);
     for (int i = 0; i < scene.chessboards.count; ++i) {
-      const ChessboardShot shot = render_chessboard(cam.lens, rays, scene.chessboards, i, scene.seed, cam.supersampling);
+      const ChessboardShot shot =
+          render_chessboard(cam.lens, rays, scene.chessboards, i, scene.seed, cam.supersampling);
       const cv::Mat lit1 = shot.reflectance.mul(vignette);
       cv::Mat lit;
-      cv::merge(std::vector<cv::Mat>{lit1 * cam.white_balance[0], lit1 * cam.white_balance[1], lit1 * cam.white_balance[2]}, lit);
+      cv::merge(
+          std::vector<cv::Mat>{lit1 * cam.white_balance[0], lit1 * cam.white_balance[1], lit1 * cam.white_balance[2]},
+          lit);
       char name[32];
       std::snprintf(name, sizeof name, "board%02d", i);
       const std::uint64_t board_stream = 0xB0000 + std::uint64_t(i);
@@ -509,7 +523,8 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
     csv.precision(17);
     csv << "code,R,G,B\n";
     const CameraResponse written(cam.format == "dng" ? "linear" : cam.response);
-    for (const auto& row : written.table(max_code)) csv << row[0] << "," << row[1] << "," << row[2] << "," << row[3] << "\n";
+    for (const auto& row : written.table(max_code))
+      csv << row[0] << "," << row[1] << "," << row[2] << "," << row[3] << "\n";
     if (!csv) throw std::runtime_error((truth / "response.csv").string() + ": cannot write");
   }
   {

@@ -16,15 +16,16 @@ namespace {
 
 Vec3 vec3_in(const YamlMap& m, const std::string& key, double lo, bool lo_open) {
   const Vec3 v = m.vec3(key);
-  for (int i = 0; i < 3; ++i) spec_in_range(v[i], m.at(key) + "[" + std::to_string(i) + "]", lo, lo_open, INFINITY, true);
+  for (int i = 0; i < 3; ++i)
+    spec_in_range(v[i], m.at(key) + "[" + std::to_string(i) + "]", lo, lo_open, INFINITY, true);
   return v;
 }
 
 SynthEnvironment parse_environment(const YAML::Node& node, const std::string& path,
                                    const std::filesystem::path& folder) {
   const YamlMap m(node, path,
-                  {"file", "sanitize", "pattern", "size", "sun_direction", "sun_radius_deg", "sun_rgb",
-                   "zenith_rgb", "horizon_rgb", "scale"});
+                  {"file", "sanitize", "pattern", "size", "sun_direction", "sun_radius_deg", "sun_rgb", "zenith_rgb",
+                   "horizon_rgb", "scale"});
   SynthEnvironment e;
   if (m.has("file") == m.has("pattern")) spec_fail(path, "give either file or pattern");
   if (m.has("file")) {
@@ -60,15 +61,18 @@ SynthBall parse_ball(const YAML::Node& node, const std::string& path) {
   if (m.has("diameter_m")) b.diameter_m = m.positive("diameter_m");
   if (m.has("centre")) b.centre = m.vec3("centre");
   if (b.kind == "glossy") {
-    if (m.has("albedo") || m.has("fresnel")) spec_fail(m.at(m.has("albedo") ? "albedo" : "fresnel"), "glossy balls take a brdf");
-    const YAML::Node f = m.has("brdf") ? m.get("brdf")
-                                       : YAML::Load("{type: ggx, roughness: 0.15, fresnel: {type: dielectric, ior: 1.5}}");
+    if (m.has("albedo") || m.has("fresnel"))
+      spec_fail(m.at(m.has("albedo") ? "albedo" : "fresnel"), "glossy balls take a brdf");
+    const YAML::Node f = m.has("brdf")
+                             ? m.get("brdf")
+                             : YAML::Load("{type: ggx, roughness: 0.15, fresnel: {type: dielectric, ior: 1.5}}");
     b.brdf = make_brdf(f, m.at("brdf"))->spec();
   } else if (b.kind == "chrome") {
     if (m.has("albedo")) spec_fail(m.at("albedo"), "only for kind: grey");
     // Chromium-like conductor: about 57% reflectance at normal incidence (real chrome balls reflect
     // roughly 60%).
-    YAML::Node f = m.has("fresnel") ? m.get("fresnel") : YAML::Load("{type: conductor, eta: [2.9, 2.9, 2.6], k: [3.4, 3.4, 3.2]}");
+    YAML::Node f =
+        m.has("fresnel") ? m.get("fresnel") : YAML::Load("{type: conductor, eta: [2.9, 2.9, 2.6], k: [3.4, 3.4, 3.2]}");
     b.fresnel = make_fresnel(f, m.at("fresnel"))->spec();
   } else {
     if (m.has("fresnel")) spec_fail(m.at("fresnel"), "only for kind: chrome");
@@ -148,9 +152,9 @@ CameraProcessing parse_processing(const YAML::Node& node, const std::string& pat
 
 SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const std::filesystem::path& folder) {
   const YamlMap m(node, path,
-                  {"name", "width", "height", "lens", "response", "format", "jpeg_quality", "processing", "supersampling",
-                   "vignetting", "white_balance", "full_well", "read_noise", "gain", "sensor_width_mm", "make", "lens_name",
-                   "exif_focal_scale"});
+                  {"name", "width", "height", "lens", "response", "format", "jpeg_quality", "processing",
+                   "supersampling", "vignetting", "white_balance", "full_well", "read_noise", "gain", "sensor_width_mm",
+                   "make", "lens_name", "exif_focal_scale"});
   SynthCamera c;
   const int w = int(spec_in_range(double(m.integer("width")), m.at("width"), 16, false, 16384, false));
   const int h = int(spec_in_range(double(m.integer("height")), m.at("height"), 16, false, 16384, false));
@@ -162,21 +166,24 @@ SynthCamera parse_camera(const YAML::Node& node, const std::string& path, const 
     spec_fail(m.at("lens"), "models that see behind the camera (stereographic, splined) are not supported yet");
   if (m.has("response")) c.response = m.choice("response", CameraResponse::kinds());
   if (m.has("format")) c.format = m.choice("format", {"png", "jpeg", "tiff", "dng"});
-  if (c.format == "dng" && (w % 2 || h % 2)) spec_fail(m.at("format"), "dng needs an even width and height (a 2x2 Bayer pattern)");
+  if (c.format == "dng" && (w % 2 || h % 2))
+    spec_fail(m.at("format"), "dng needs an even width and height (a 2x2 Bayer pattern)");
   if (m.has("jpeg_quality")) {
     if (c.format != "jpeg") spec_fail(m.at("jpeg_quality"), "only for format: jpeg");
     c.jpeg_quality = int(spec_in_range(double(m.integer("jpeg_quality")), m.at("jpeg_quality"), 1, false, 100, false));
   }
   if (m.has("processing")) c.processing = parse_processing(m.get("processing"), m.at("processing"));
   if (m.has("supersampling"))
-    c.supersampling = int(spec_in_range(double(m.integer("supersampling")), m.at("supersampling"), 1, false, 16, false));
+    c.supersampling =
+        int(spec_in_range(double(m.integer("supersampling")), m.at("supersampling"), 1, false, 16, false));
   if (m.has("vignetting")) {
     if (m.get("vignetting").IsSequence()) {
       const Vec3 k = m.vec3("vignetting");
       // v must stay in (0.02, 1.5] from the centre to the corner.
       for (int i = 0; i <= 100; ++i) {
         const double r2 = i / 100.0, v = 1 + k[0] * r2 + k[1] * r2 * r2 + k[2] * r2 * r2 * r2;
-        if (!(v > 0.02 && v <= 1.5)) spec_fail(m.at("vignetting"), "the polynomial leaves (0.02, 1.5] inside the image");
+        if (!(v > 0.02 && v <= 1.5))
+          spec_fail(m.at("vignetting"), "the polynomial leaves (0.02, 1.5] inside the image");
       }
       c.vignetting_poly = k;
     } else {
@@ -223,8 +230,8 @@ SynthClutter parse_clutter(const YAML::Node& node, const std::string& path) {
 
 SynthViewPlan parse_plan(const YAML::Node& node, const std::string& path) {
   const YamlMap m(node, path,
-                  {"plan", "count", "azimuths_deg", "azimuth0_deg", "elevation_deg", "min_elevation_deg",
-                   "distance_m", "look_at", "roll_deg", "yaw_deg", "pan_deg", "jitter_m", "jitter_deg"});
+                  {"plan", "count", "azimuths_deg", "azimuth0_deg", "elevation_deg", "min_elevation_deg", "distance_m",
+                   "look_at", "roll_deg", "yaw_deg", "pan_deg", "jitter_m", "jitter_deg"});
   SynthViewPlan p;
   p.plan = m.choice("plan", {"ring", "icosa", "handheld"});
   auto only = [&](const char* key, std::initializer_list<const char*> plans) {
@@ -241,8 +248,10 @@ SynthViewPlan parse_plan(const YAML::Node& node, const std::string& path) {
     if (p.azimuths_deg.empty()) spec_fail(m.at("azimuths_deg"), "must not be empty");
   }
   if (only("azimuth0_deg", {"ring", "handheld"})) p.azimuth0_deg = m.number("azimuth0_deg");
-  if (only("elevation_deg", {"ring", "handheld"})) p.elevation_deg = m.number_in("elevation_deg", -89, false, 89, false);
-  if (only("min_elevation_deg", {"icosa"})) p.min_elevation_deg = m.number_in("min_elevation_deg", -90, false, 90, false);
+  if (only("elevation_deg", {"ring", "handheld"}))
+    p.elevation_deg = m.number_in("elevation_deg", -89, false, 89, false);
+  if (only("min_elevation_deg", {"icosa"}))
+    p.min_elevation_deg = m.number_in("min_elevation_deg", -90, false, 90, false);
   if (m.has("distance_m")) p.distance_m = m.positive("distance_m");
   if (m.has("look_at")) p.look_at = m.vec3("look_at");
   if (m.has("roll_deg")) p.roll_deg = m.number_in("roll_deg", -180, false, 180, false);
@@ -259,7 +268,8 @@ SynthScene parse_root(const YAML::Node& root, const std::filesystem::path& folde
                    "views", "chessboards", "truth_map_size", "clutter"});
   if (m.integer("rsibr_synth") != 1) spec_fail(m.at("rsibr_synth"), "unsupported version (expected 1)");
   SynthScene s;
-  if (m.has("seed")) s.seed = std::uint64_t(spec_in_range(double(m.integer("seed")), m.at("seed"), 0, false, 9e15, false));
+  if (m.has("seed"))
+    s.seed = std::uint64_t(spec_in_range(double(m.integer("seed")), m.at("seed"), 0, false, 9e15, false));
   s.environment = parse_environment(m.get("environment"), m.at("environment"), folder);
   const YAML::Node balls = m.get("balls");
   if (!balls.IsSequence() || balls.size() == 0) spec_fail(m.at("balls"), "expected a non-empty list");
@@ -285,7 +295,8 @@ SynthScene parse_root(const YAML::Node& root, const std::filesystem::path& folde
   if (m.has("exposure")) {
     const YamlMap e(m.get("exposure"), m.at("exposure"), {"middle_s", "count", "step_ev", "iso", "aperture"});
     if (e.has("middle_s")) s.exposure.middle_s = e.positive("middle_s");
-    if (e.has("count")) s.exposure.count = int(spec_in_range(double(e.integer("count")), e.at("count"), 1, false, 32, false));
+    if (e.has("count"))
+      s.exposure.count = int(spec_in_range(double(e.integer("count")), e.at("count"), 1, false, 32, false));
     if (e.has("step_ev")) s.exposure.step_ev = e.number_in("step_ev", 0, true, 8, false);
     if (e.has("iso")) s.exposure.iso = e.positive("iso");
     if (e.has("aperture")) s.exposure.aperture = e.positive("aperture");
@@ -305,7 +316,8 @@ SynthScene parse_root(const YAML::Node& root, const std::filesystem::path& folde
   if (m.has("chessboards")) {
     const YamlMap c(m.get("chessboards"), m.at("chessboards"), {"count", "corners", "spacing_m"});
     s.chessboards.count = int(spec_in_range(double(c.integer("count")), c.at("count"), 0, false, 1000, false));
-    if (c.has("corners")) s.chessboards.corners = int(spec_in_range(double(c.integer("corners")), c.at("corners"), 2, false, 64, false));
+    if (c.has("corners"))
+      s.chessboards.corners = int(spec_in_range(double(c.integer("corners")), c.at("corners"), 2, false, 64, false));
     if (c.has("spacing_m")) s.chessboards.spacing_m = c.positive("spacing_m");
   }
   if (m.has("truth_map_size"))

@@ -38,9 +38,9 @@ struct SynthBall {
   std::string kind;  // "chrome", "grey" or "glossy"
   double diameter_m = 0.1;
   Vec3 centre = Vec3(0, 1.3, 0);
-  std::string fresnel;  // chrome: a Fresnel spec (bake/brdf_spec.h), flow YAML
+  std::string fresnel;                 // chrome: a Fresnel spec (bake/brdf_spec.h), flow YAML
   Vec3 albedo = Vec3::Constant(0.18);  // grey: Lambert albedo
-  std::string brdf;  // glossy: a BRDF spec (bake/brdf_spec.h), flow YAML, e.g. GGX with Fresnel
+  std::string brdf;                    // glossy: a BRDF spec (bake/brdf_spec.h), flow YAML, e.g. GGX with Fresnel
 };
 
 // Background objects that are not balls (the clocks, lamps, plates and spheres of real rooms that
@@ -53,24 +53,24 @@ struct SynthClutter {
   double radius_m = 0.2;
   std::optional<Vec3> normal;  // disc
   Vec3 albedo = Vec3::Constant(0.7);
-  int rings = 1;                            // disc
-  Vec3 ring_albedo = Vec3::Constant(0.1);   // disc, odd annuli
+  int rings = 1;                           // disc
+  Vec3 ring_albedo = Vec3::Constant(0.1);  // disc, odd annuli
 };
 
 struct SynthViewPlan {
-  std::string plan;                 // "ring", "icosa" or "handheld"
-  int count = 3;                    // ring, handheld: views evenly spaced in azimuth
-  std::vector<double> azimuths_deg; // ring: explicit azimuths instead of count
-  double azimuth0_deg = 0;          // first azimuth (0 = +Z, 90 = +X)
-  double elevation_deg = 10;        // above the horizontal through look_at
-  double min_elevation_deg = -90;   // icosa: directions below this are dropped
-  double distance_m = 1.5;          // camera centre to look_at
-  std::optional<Vec3> look_at;      // default: the centre of the balls
+  std::string plan;                  // "ring", "icosa" or "handheld"
+  int count = 3;                     // ring, handheld: views evenly spaced in azimuth
+  std::vector<double> azimuths_deg;  // ring: explicit azimuths instead of count
+  double azimuth0_deg = 0;           // first azimuth (0 = +Z, 90 = +X)
+  double elevation_deg = 10;         // above the horizontal through look_at
+  double min_elevation_deg = -90;    // icosa: directions below this are dropped
+  double distance_m = 1.5;           // camera centre to look_at
+  std::optional<Vec3> look_at;       // default: the centre of the balls
   double roll_deg = 0;
-  double yaw_deg = 0;               // after aiming: turn the camera right by this (the target moves left)
-                                    // about its own y axis (aimed up or down, that tilts the horizon)
-  double pan_deg = 0;               // after aiming: turn right about the world's vertical (a person turning:
-                                    // the horizon stays level)
+  double yaw_deg = 0;                        // after aiming: turn the camera right by this (the target moves left)
+                                             // about its own y axis (aimed up or down, that tilts the horizon)
+  double pan_deg = 0;                        // after aiming: turn right about the world's vertical (a person turning:
+                                             // the horizon stays level)
   double jitter_m = 0.03, jitter_deg = 1.5;  // handheld: position and orientation jitter (std dev)
 };
 
@@ -94,8 +94,8 @@ struct SynthCamera {
   // In-camera processing (capture/camera_processing.h): raw sensitivities, white balance, colour
   // matrix, then `response` as the tone curve. Absent: codes are response(raw) per channel.
   std::optional<CameraProcessing> processing;
-  int supersampling = 2;       // n: n x n stratified, jittered samples per pixel
-  double vignetting = 0.0;     // v = 1 - vignetting * (r / r_corner)^2
+  int supersampling = 2;    // n: n x n stratified, jittered samples per pixel
+  double vignetting = 0.0;  // v = 1 - vignetting * (r / r_corner)^2
   // Instead of that, when set: v = 1 + k1 r^2 + k2 r^4 + k3 r^6, r = |p - c| / r_corner (the
   // polynomial of lens databases; real lenses fall off faster than r^2 toward the corner).
   std::optional<Vec3> vignetting_poly;
@@ -105,13 +105,13 @@ struct SynthCamera {
   // The sensor's width: with the lens's fx it gives the EXIF FocalLength the photos carry
   // (FocalLengthIn35mmFilm: the diagonal equivalent, in whole mm, as cameras write it).
   double sensor_width_mm = 23.5;
-  std::string make = "rsibr";  // EXIF Make (with `name` as Model: a real pair lets lensfun find the camera)
-  std::string lens_name;       // EXIF LensModel (empty: not written)
-  double exif_focal_mm = 0;    // EXIF FocalLength; 0: fx * sensor_width_mm / width (a lensfun lens gives its own)
-  double exif_focal_scale = 1; // the EXIF's focal lengths over the lens's (a zoom's nominal focal length, focus
-                               // breathing); 0: none written (stripped by a messaging app)
-  std::string lensfun_lens;    // the lensfun profile the lens came from (empty: none); its vignetting
-                               // at the exposure's aperture is the camera's unless `vignetting` is given
+  std::string make = "rsibr";   // EXIF Make (with `name` as Model: a real pair lets lensfun find the camera)
+  std::string lens_name;        // EXIF LensModel (empty: not written)
+  double exif_focal_mm = 0;     // EXIF FocalLength; 0: fx * sensor_width_mm / width (a lensfun lens gives its own)
+  double exif_focal_scale = 1;  // the EXIF's focal lengths over the lens's (a zoom's nominal focal length, focus
+                                // breathing); 0: none written (stripped by a messaging app)
+  std::string lensfun_lens;     // the lensfun profile the lens came from (empty: none); its vignetting
+                                // at the exposure's aperture is the camera's unless `vignetting` is given
 };
 
 struct SynthChessboards {

@@ -55,7 +55,8 @@ MapView true_sphere_map(const SynthBall& ball, const Vec3& camera_centre, const 
     mv.warp = CentralDirection::Normal;
     std::ostringstream spec;
     spec.precision(17);
-    spec << "{type: lambert, albedo: [" << ball.albedo.x() << ", " << ball.albedo.y() << ", " << ball.albedo.z() << "]}";
+    spec << "{type: lambert, albedo: [" << ball.albedo.x() << ", " << ball.albedo.y() << ", " << ball.albedo.z()
+         << "]}";
     mv.material = parse_brdf(spec.str())->spec();
     // Lambert: L_o = albedo E(n) / pi (the integral of bake/'s LambertBrdf against the environment).
     std::optional<IrradianceQuadrature> own;

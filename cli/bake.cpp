@@ -100,8 +100,8 @@ int run_bake(const BakeArgs& a) {
   const bool stochastic = a.method == "mis" || a.method == "fis";
   Progress bar("bake", session.is_root() && !a.quiet && Progress::stderr_is_terminal());
   cluster::DistributedBakeTimes times;
-  const MapSet set = cluster::bake_map_set_distributed(*brdf, *in.integrator, in.views, bake_options, session,
-                                                       [&](double f) { bar.update(f); }, &times);
+  const MapSet set = cluster::bake_map_set_distributed(
+      *brdf, *in.integrator, in.views, bake_options, session, [&](double f) { bar.update(f); }, &times);
   bar.done();
   if (!session.is_root()) return 0;
   const auto t2 = std::chrono::steady_clock::now();
@@ -131,9 +131,9 @@ int run_bake(const BakeArgs& a) {
   j["ranks"] = session.size();
   // integrate: the whole bake as the root saw it (its own rows, then the gather); gather: the part
   // of it spent waiting for and receiving the other ranks' rows; root_integrate: the root's own rows.
-  j["seconds"] = {{"setup", secs(t1 - t0)}, {"integrate", secs(t2 - t1)}, {"write", secs(t3 - t2)},
-                  {"per_map", secs(t2 - t1) / double(set.views.size())}, {"gather", times.gather},
-                  {"root_integrate", times.integrate}};
+  j["seconds"] = {{"setup", secs(t1 - t0)}, {"integrate", secs(t2 - t1)},
+                  {"write", secs(t3 - t2)}, {"per_map", secs(t2 - t1) / double(set.views.size())},
+                  {"gather", times.gather}, {"root_integrate", times.integrate}};
   j["root_rows"] = times.rows;
   write_summary(json, j);
   outputs.commit();
@@ -145,17 +145,18 @@ int run_bake(const BakeArgs& a) {
 Runner add_bake(CLI::App& app) {
   auto a = std::make_shared<BakeArgs>();
   CLI::App* c = app.add_subcommand("bake", "Compute a map set: a BRDF lit by an environment, one sphere map per view");
-  c->footer("Methods: reference (quadrature over every environment texel; exact, slow), mis (Monte Carlo, BRDF and "
-            "environment sampling combined), fis (filtered importance sampling over a MIP pyramid), sh (spherical "
-            "harmonics order 2, lambert only). The same inputs and --seed give the same bytes.\n"
-            "Multi-lobe maps: --lobe normal and --lobe mirror bake the two parts of a BRDF (clear coat: the binder; "
-            "the coat and flakes) as two sets, each warped with its own warp; the runtime sums them "
-            "(rsibr render --maps normal.exr --maps mirror.exr).\n"
-            "Under mpirun (a build with MPI) the ranks split the maps' texels and the root writes the set: the same "
-            "bytes as one process (mpirun -n 8 rsibr bake ...).\n"
-            "--normalise albedo stores each texel divided by the BRDF's directional albedo at its n.v (a table in the "
-            "file); the runtime multiplies it back at the destination view, so a view dependence through Fresnel "
-            "factors is not warped (the clear coat's normal part becomes exactly view independent).");
+  c->footer(
+      "Methods: reference (quadrature over every environment texel; exact, slow), mis (Monte Carlo, BRDF and "
+      "environment sampling combined), fis (filtered importance sampling over a MIP pyramid), sh (spherical "
+      "harmonics order 2, lambert only). The same inputs and --seed give the same bytes.\n"
+      "Multi-lobe maps: --lobe normal and --lobe mirror bake the two parts of a BRDF (clear coat: the binder; "
+      "the coat and flakes) as two sets, each warped with its own warp; the runtime sums them "
+      "(rsibr render --maps normal.exr --maps mirror.exr).\n"
+      "Under mpirun (a build with MPI) the ranks split the maps' texels and the root writes the set: the same "
+      "bytes as one process (mpirun -n 8 rsibr bake ...).\n"
+      "--normalise albedo stores each texel divided by the BRDF's directional albedo at its n.v (a table in the "
+      "file); the runtime multiplies it back at the destination view, so a view dependence through Fresnel "
+      "factors is not warped (the clear coat's normal part becomes exactly view independent).");
   c->add_option("output", a->output, "Output map set (.exr)")->required();
   c->add_option("--env", a->env, "Environment map (EXR or .hdr)")->required();
   c->add_option("--brdf", a->brdf, "BRDF spec (YAML)")->required();

@@ -63,8 +63,12 @@ int run_batch(const BatchArgs& a) {
       result = run_command_line(job.args);
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - j0).count();
-    nlohmann::json r = {{"index", i + 1}, {"name", job.name}, {"args", job.args}, {"rank", session.rank()},
-                        {"exit_code", result.exit_code}, {"status", result.exit_code == 0 ? "ok" : "failed"},
+    nlohmann::json r = {{"index", i + 1},
+                        {"name", job.name},
+                        {"args", job.args},
+                        {"rank", session.rank()},
+                        {"exit_code", result.exit_code},
+                        {"status", result.exit_code == 0 ? "ok" : "failed"},
                         {"seconds", seconds}};
     if (result.exit_code != 0) r["error"] = result.error;
     if (!a.quiet)
@@ -82,8 +86,8 @@ int run_batch(const BatchArgs& a) {
   int failed = 0;
   std::string first_failure;
   for (const auto& r : results)
-    if (r["status"] != "ok" && failed++ == 0) first_failure = "job " + std::to_string(r["index"].get<int>()) + " '" +
-                                                              r["name"].get<std::string>() + "'";
+    if (r["status"] != "ok" && failed++ == 0)
+      first_failure = "job " + std::to_string(r["index"].get<int>()) + " '" + r["name"].get<std::string>() + "'";
   nlohmann::json j;
   j["spec"] = a.spec;
   j["ranks"] = session.size();
@@ -105,15 +109,16 @@ int run_batch(const BatchArgs& a) {
 Runner add_batch(CLI::App& app) {
   auto a = std::make_shared<BatchArgs>();
   CLI::App* c = app.add_subcommand("batch", "Run many rsibr commands from a YAML list, over MPI ranks or one by one");
-  c->footer("SPEC lists the jobs, each the words after 'rsibr':\n"
-            "  jobs:\n"
-            "    - name: grey-esplanade\n"
-            "      args: [bake, grey.exr, --env, esplanade.exr, --brdf, grey.yaml]\n"
-            "    - [process, shoot-a, --out, run-a]\n"
-            "Paths in the jobs are relative to SPEC's folder. Under mpirun (a build with MPI) job i runs on rank i mod "
-            "N, each job as a one-process run using its rank's share of the machine's cores; without it the jobs run "
-            "one after another. A failed job is reported and the others run on; the exit status is 1 when any "
-            "failed. --json lists every job: rank, exit code, error line, seconds.");
+  c->footer(
+      "SPEC lists the jobs, each the words after 'rsibr':\n"
+      "  jobs:\n"
+      "    - name: grey-esplanade\n"
+      "      args: [bake, grey.exr, --env, esplanade.exr, --brdf, grey.yaml]\n"
+      "    - [process, shoot-a, --out, run-a]\n"
+      "Paths in the jobs are relative to SPEC's folder. Under mpirun (a build with MPI) job i runs on rank i mod "
+      "N, each job as a one-process run using its rank's share of the machine's cores; without it the jobs run "
+      "one after another. A failed job is reported and the others run on; the exit status is 1 when any "
+      "failed. --json lists every job: rank, exit code, error line, seconds.");
   c->add_option("spec", a->spec, "Batch spec (YAML)")->required();
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   c->add_flag("-q,--quiet", a->quiet, "No line per job (failures are still printed by the jobs)");

@@ -75,7 +75,8 @@ int run_blend(const BlendArgs& a) {
   mv.confidence = r.weight;
   out.views.push_back(mv);
   write_map_set(exr, out);
-  if (!preview.empty() && !cv::imwrite(preview, display_encode(r.rgb, a.preview_exposure ? *a.preview_exposure : preview_exposure(r.rgb))))
+  if (!preview.empty() &&
+      !cv::imwrite(preview, display_encode(r.rgb, a.preview_exposure ? *a.preview_exposure : preview_exposure(r.rgb))))
     throw std::runtime_error(a.preview + ": cannot write the preview image");
   nlohmann::json j;
   j["maps"] = a.maps;
@@ -99,10 +100,11 @@ int run_blend(const BlendArgs& a) {
 Runner add_blend(CLI::App& app) {
   auto a = std::make_shared<BlendArgs>();
   CLI::App* c = app.add_subcommand("blend", "Warp and blend a map set to the radiance map of any view");
-  c->footer("Finds the view's triangle in the map set's view set, warps its three maps in reflection space "
-            "(each with its own mirror or normal warp), fades each near its singularity and normalises per "
-            "texel. The output is a one-view map set; its confidence channel is the blend's total weight.\n"
-            "Example: rsibr blend maps.exr novel.exr --view 0.3 0.5 0.8 --preview novel.png");
+  c->footer(
+      "Finds the view's triangle in the map set's view set, warps its three maps in reflection space "
+      "(each with its own mirror or normal warp), fades each near its singularity and normalises per "
+      "texel. The output is a one-view map set; its confidence channel is the blend's total weight.\n"
+      "Example: rsibr blend maps.exr novel.exr --view 0.3 0.5 0.8 --preview novel.png");
   c->add_option("maps", a->maps, "Map set (.exr)")->required();
   c->add_option("output", a->output, "Output one-view map set (.exr)")->required();
   c->add_option("--view", a->view, "View direction (world, toward the viewer)")->expected(3);
@@ -113,14 +115,19 @@ Runner add_blend(CLI::App& app) {
                 "vertices warped exactly, texture coordinates interpolated) or double-indirection (a screen table "
                 "and a parametric table; a rotation about --up, as between views of one ring or turntable, is an "
                 "offset into them)");
-  c->add_option("--rings", a->rings, "tessellated: rings of the disc mesh (4x as many segments)")->check(CLI::Range(1, 1024));
-  c->add_option("--table", a->table, "double-indirection: columns of the parametric table (half as many rows; "
-                                     "default: the map width)")->check(CLI::Range(3, 4096));
+  c->add_option("--rings", a->rings, "tessellated: rings of the disc mesh (4x as many segments)")
+      ->check(CLI::Range(1, 1024));
+  c->add_option("--table", a->table,
+                "double-indirection: columns of the parametric table (half as many rows; "
+                "default: the map width)")
+      ->check(CLI::Range(3, 4096));
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--preview", a->preview, "Also write a display-encoded PNG");
-  c->add_option("--preview-exposure", a->preview_exposure, "Exposure of the preview in stops (default: the median luminance at mid-grey)");
-  c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
-                                         "confidences to [0, 1]) instead of failing; the JSON counts them");
+  c->add_option("--preview-exposure", a->preview_exposure,
+                "Exposure of the preview in stops (default: the median luminance at mid-grey)");
+  c->add_flag("--sanitize", a->sanitize,
+              "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
+              "confidences to [0, 1]) instead of failing; the JSON counts them");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   return [a] { return run_blend(*a); };
 }

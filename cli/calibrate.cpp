@@ -60,17 +60,25 @@ int calibrate_from_metadata(const CalibrateArgs& a, const PhotoSet& set, OutputP
   const std::filesystem::path photo = set.views[0].brackets[0].file;
   const std::optional<MetadataLens> m = metadata_lens(photo, b.cols(), b.rows());
   if (!m)
-    throw std::invalid_argument(photo.string() + ": no chessboards listed and no usable focal length in the photo's "
+    throw std::invalid_argument(photo.string() +
+                                ": no chessboards listed and no usable focal length in the photo's "
                                 "metadata (FocalLengthIn35mmFilm, or FocalLength of a camera lensfun knows)");
   std::ostringstream comment;
   comment << std::setprecision(4) << "# rsibr calibrate: no chessboards; " << m->source << " (" << m->lens.source
           << ")\n# focal length " << m->lens.focal_px << " px, 1 sigma " << 100 * m->lens.sigma_relative << "%\n";
   write_with_comment(m->lens.lens, model, comment.str());
-  nlohmann::json j = {{"photoset", a.photoset}, {"out", a.out}, {"image_size", {b.cols(), b.rows()}},
-                      {"source", m->source}, {"model", m->lens.lens.name()}, {"intrinsics", m->lens.lens.intrinsics()},
-                      {"focal_px", m->lens.focal_px}, {"focal_sigma_relative", m->lens.sigma_relative},
-                      {"focal_from", m->lens.source}, {"photo", photo.string()},
-                      {"camera", m->optics.make + " " + m->optics.model}, {"lens", m->optics.lens}};
+  nlohmann::json j = {{"photoset", a.photoset},
+                      {"out", a.out},
+                      {"image_size", {b.cols(), b.rows()}},
+                      {"source", m->source},
+                      {"model", m->lens.lens.name()},
+                      {"intrinsics", m->lens.lens.intrinsics()},
+                      {"focal_px", m->lens.focal_px},
+                      {"focal_sigma_relative", m->lens.sigma_relative},
+                      {"focal_from", m->lens.source},
+                      {"photo", photo.string()},
+                      {"camera", m->optics.make + " " + m->optics.model},
+                      {"lens", m->optics.lens}};
   if (!m->lensfun_why.empty()) j["lensfun"] = m->lensfun_why;
   write_summary(json, j);
   outputs.commit();
@@ -131,9 +139,7 @@ int run_calibrate(const CalibrateArgs& a) {
       const Eigen::Matrix2d c = projection_covariance(fit.lens, fit.intrinsics_covariance, fit.lens.unproject(q));
       const double s = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(c).eigenvalues()(1)));
       worst_sigma = std::max(worst_sigma, s);
-      points.push_back({{"pixel", {q.x(), q.y()}},
-                        {"sigma_px", s},
-                        {"covariance_px2", {c(0, 0), c(0, 1), c(1, 1)}}});
+      points.push_back({{"pixel", {q.x(), q.y()}}, {"sigma_px", s}, {"covariance_px2", {c(0, 0), c(0, 1), c(1, 1)}}});
     }
   nlohmann::json intrinsics_sigma = nlohmann::json::array();
   for (Eigen::Index k = 0; k < fit.intrinsics_covariance.rows(); ++k)
@@ -142,7 +148,8 @@ int run_calibrate(const CalibrateArgs& a) {
   std::ostringstream comment;
   comment << std::setprecision(4) << "# rsibr calibrate: " << models[chosen] << " chosen by cross-validation over "
           << p.boards.size() << " boards\n# RMS " << fit.rms_px << " px, corner noise " << fit.noise_sigma_px
-          << " px per axis, " << fit.outliers << " outliers\n# projection uncertainty (1 sigma, 3x3 grid over the image): "
+          << " px per axis, " << fit.outliers
+          << " outliers\n# projection uncertainty (1 sigma, 3x3 grid over the image): "
           << "worst " << worst_sigma << " px, centre " << points[4]["sigma_px"].get<double>() << " px\n";
   write_with_comment(fit.lens, model, comment.str());
 
@@ -214,7 +221,8 @@ int run_calibrate(const CalibrateArgs& a) {
 
 Runner add_calibrate(CLI::App& app) {
   auto a = std::make_shared<CalibrateArgs>();
-  CLI::App* c = app.add_subcommand("calibrate", "Calibrate the lens from a photo set's chessboards (mrgingham + mrcal)");
+  CLI::App* c =
+      app.add_subcommand("calibrate", "Calibrate the lens from a photo set's chessboards (mrgingham + mrcal)");
   c->footer(
       "Finds the chessboard corners of every image listed under chessboards: in photoset.yaml (mrgingham), seeds a "
       "pinhole core and the board poses (OpenCV), and solves with mrcal in two stages (core and poses, then "
@@ -232,7 +240,8 @@ Runner add_calibrate(CLI::App& app) {
       "Example: rsibr calibrate shoot/photoset.yaml --out shoot/camera.cameramodel --json -");
   c->add_option("photoset", a->photoset, "photoset.yaml or the folder holding it")->required();
   c->add_option("--out", a->out, "Output .cameramodel")->required();
-  c->add_option("--model", a->models, "Candidate mrcal models, simplest first (repeatable; 'splined' for the automatic spline)");
+  c->add_option("--model", a->models,
+                "Candidate mrcal models, simplest first (repeatable; 'splined' for the automatic spline)");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or report line");
   return [a] { return run_calibrate(*a); };

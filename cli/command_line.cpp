@@ -73,8 +73,9 @@ CommandResult run_command_line(const std::vector<std::string>& args) {
     if (speaks) std::cerr << line << "\n";
     return CommandResult{code, line};
   };
-  CLI::App app{"rsibr: radiance environment maps from photographed spheres and computed lighting\n"
-               "integrals, warped and blended in reflection space. 'rsibr <verb> --help' for each verb."};
+  CLI::App app{
+      "rsibr: radiance environment maps from photographed spheres and computed lighting\n"
+      "integrals, warped and blended in reflection space. 'rsibr <verb> --help' for each verb."};
   app.set_version_flag("--version", std::string("rsibr ") + RSIBR_VERSION);
   app.require_subcommand(1);
   int threads = 0;

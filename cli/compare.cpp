@@ -35,8 +35,12 @@ struct CompareArgs {
 };
 
 nlohmann::json metrics_json(const ErrorMetrics& m) {
-  return {{"relative_rms", m.relative_rms}, {"log_rms_stops", m.log_rms_stops}, {"psnr_db", m.psnr_db},
-          {"psnr_capped", m.psnr_capped},   {"mse", m.mse},                     {"mean_a", m.mean_a},
+  return {{"relative_rms", m.relative_rms},
+          {"log_rms_stops", m.log_rms_stops},
+          {"psnr_db", m.psnr_db},
+          {"psnr_capped", m.psnr_capped},
+          {"mse", m.mse},
+          {"mean_a", m.mean_a},
           {"mean_b", m.mean_b}};
 }
 
@@ -103,7 +107,8 @@ int run_compare(const CompareArgs& a) {
     EnvMap ea = read_environment(a.a, hint), eb = read_environment(a.b, hint);
     for (auto [path, env] : {std::pair<const std::string*, EnvMap*>{&a.a, &ea}, {&a.b, &eb}}) {
       const TexelAudit audit = audit_texels(env->pixels);
-      if (audit.bad() && !a.sanitize) throw std::runtime_error(*path + ": " + audit.describe() + "; pass --sanitize to zero them");
+      if (audit.bad() && !a.sanitize)
+        throw std::runtime_error(*path + ": " + audit.describe() + "; pass --sanitize to zero them");
       if (a.sanitize) sanitized += sanitize_texels(env->pixels);
     }
     c = compare_environments(ea, eb, o);
@@ -135,8 +140,10 @@ int run_compare(const CompareArgs& a) {
                    {"view_tolerance_deg", a.view_tolerance},
                    {"weights", kind == "map set" ? "texel centre inside the disc x confidence of A and B"
                                                  : "sphere layout: disc; other layouts: texel solid angle"}};
-  j["overall"] = {{"before", metrics_json(c.before)}, {"after", metrics_json(c.after)},
-                  {"texels", c.before.texels}, {"weight", c.before.weight}};
+  j["overall"] = {{"before", metrics_json(c.before)},
+                  {"after", metrics_json(c.after)},
+                  {"texels", c.before.texels},
+                  {"weight", c.before.weight}};
   if (c.fit) {
     j["fit"] = {{"gains", c.fit->gains},
                 {"exposure_stops", c.fit->exposure_stops},
@@ -220,8 +227,8 @@ int run_compare(const CompareArgs& a) {
     text << "  overall  before: " << metrics_text(c.before) << "\n  overall  after:  " << metrics_text(c.after) << "\n";
     if (c.fit)
       text << "  fitted gains (A -> B) " << c.fit->gains[0] << " " << c.fit->gains[1] << " " << c.fit->gains[2]
-           << ": exposure " << c.fit->exposure_stops << " stops, chroma " << c.fit->chroma[0] << " "
-           << c.fit->chroma[1] << " " << c.fit->chroma[2] << (c.fit->converged ? "" : " (not converged)") << "\n";
+           << ": exposure " << c.fit->exposure_stops << " stops, chroma " << c.fit->chroma[0] << " " << c.fit->chroma[1]
+           << " " << c.fit->chroma[2] << (c.fit->converged ? "" : " (not converged)") << "\n";
     if (!a.out.empty()) text << "  pictures in " << a.out << " (heat scale 0.." << heat_max << " stops)\n";
   }
   // The summary is written first, to its temporary: the pictures and the summary appear together.
@@ -274,10 +281,12 @@ Runner add_compare(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   c->add_option("--exposure", a->exposure, "Display exposure of A and B in stops (default: B's mean at 0.18)");
   c->add_option("--layout", a->layout, "Layout of environments whose header and shape do not tell");
-  c->add_option("--fail-above", a->fail_above, "Exit with status 3 when the overall log RMS after the fit exceeds this (stops)")
+  c->add_option("--fail-above", a->fail_above,
+                "Exit with status 3 when the overall log RMS after the fit exceeds this (stops)")
       ->check(CLI::PositiveNumber);
-  c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
-                                         "confidences to [0, 1]) instead of failing; the JSON counts them");
+  c->add_flag("--sanitize", a->sanitize,
+              "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
+              "confidences to [0, 1]) instead of failing; the JSON counts them");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or report");
   return [a] { return run_compare(*a); };
 }

@@ -85,13 +85,17 @@ int run_convert(const ConvertArgs& a) {
   ExrWriteOptions wo;
   wo.half = a.half;
   write_environment(exr, out, wo);
-  if (!preview.empty() && !cv::imwrite(preview, display_encode(out.pixels, a.preview_exposure ? *a.preview_exposure : preview_exposure(out.pixels))))
+  if (!preview.empty() &&
+      !cv::imwrite(preview,
+                   display_encode(out.pixels, a.preview_exposure ? *a.preview_exposure : preview_exposure(out.pixels))))
     throw std::runtime_error(a.preview + ": cannot write the preview image");
   const auto t3 = std::chrono::steady_clock::now();
 
   const std::vector<double> in_int = integral(src), out_int = integral(out);
   double rel = 0;
-  for (int k = 0; k < 3; ++k) rel = std::max(rel, std::abs(out_int[std::size_t(k)] - in_int[std::size_t(k)]) / std::max(1e-30, std::abs(in_int[std::size_t(k)])));
+  for (int k = 0; k < 3; ++k)
+    rel = std::max(rel, std::abs(out_int[std::size_t(k)] - in_int[std::size_t(k)]) /
+                            std::max(1e-30, std::abs(in_int[std::size_t(k)])));
   auto secs = [](auto d) { return std::chrono::duration<double>(d).count(); };
   if (!a.quiet)
     std::cerr << "rsibr convert: " << to_string(src.layout.kind()) << " " << src.layout.width() << "x"
@@ -100,8 +104,11 @@ int run_convert(const ConvertArgs& a) {
   nlohmann::json j;
   j["input"] = a.input;
   j["output"] = a.output;
-  j["from"] = {{"layout", to_string(src.layout.kind())}, {"width", src.layout.width()}, {"height", src.layout.height()},
-               {"layout_source", report.layout_source}, {"compression", report.compression}};
+  j["from"] = {{"layout", to_string(src.layout.kind())},
+               {"width", src.layout.width()},
+               {"height", src.layout.height()},
+               {"layout_source", report.layout_source},
+               {"compression", report.compression}};
   j["to"] = {{"layout", to_string(dst.kind())}, {"width", dst.width()}, {"height", dst.height()}};
   j["integral_in"] = in_int;
   j["integral_out"] = out_int;
@@ -128,7 +135,8 @@ Runner add_convert(CLI::App& app) {
   c->add_option("--to", a->to, "Target layout: latlong, cube, octahedral or sphere")->required();
   c->add_option("--size", a->size,
                 "Target size: lat-long width, cube face, octahedral/sphere side (default: same texel count as "
-                "the input)")->check(CLI::Range(2, 32768));
+                "the input)")
+      ->check(CLI::Range(2, 32768));
   c->add_option("--layout", a->from_layout, "Layout of the input when its header and shape do not tell");
   c->add_option("--input-colorspace", a->input_colour_space,
                 "OpenColorIO colour space of the input pixels (default: the file's chromaticities; $OCIO honoured)");
@@ -136,13 +144,17 @@ Runner add_convert(CLI::App& app) {
   c->add_flag("--sanitize", a->sanitize, "Replace NaN, Inf and negative input values (lossy-compression ringing) by 0");
   c->add_option("--supersampling", a->supersampling,
                 "Taps per source texel across an output texel's footprint (1: area sampling; default 4 keeps a "
-                "one-texel sun's energy to ~1e-3)")->check(CLI::Range(1.0, 16.0));
+                "one-texel sun's energy to ~1e-3)")
+      ->check(CLI::Range(1.0, 16.0));
   c->add_option("--energy-tolerance", a->energy_tolerance,
                 "Energy budget per texel relative to the map's (extra taps where the input is far brighter than "
-                "its mean, e.g. a sun; 0 disables)")->check(CLI::Range(0.0, 1.0));
-  c->add_option("--max-subsamples", a->max_subsamples, "Cap on n for the n x n taps per output texel")->check(CLI::Range(1, 64));
+                "its mean, e.g. a sun; 0 disables)")
+      ->check(CLI::Range(0.0, 1.0));
+  c->add_option("--max-subsamples", a->max_subsamples, "Cap on n for the n x n taps per output texel")
+      ->check(CLI::Range(1, 64));
   c->add_option("--preview", a->preview, "Also write a display-encoded PNG of the output");
-  c->add_option("--preview-exposure", a->preview_exposure, "Exposure of the preview in stops (default: the median luminance at mid-grey)");
+  c->add_option("--preview-exposure", a->preview_exposure,
+                "Exposure of the preview in stops (default: the median luminance at mid-grey)");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or report line");
   return [a] { return run_convert(*a); };

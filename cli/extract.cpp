@@ -129,9 +129,10 @@ int run_extract(const ExtractArgs& a) {
   mv.attributes["ballCentrePx"] = centre.str();
   mv.attributes["ballHalfAngleRad"] = std::to_string(loc.fit.cone.half_angle);
   mv.attributes["ballKind"] = a.kind;
-  mv.attributes["frame"] = poses                 ? "world (pose file " + std::filesystem::path(a.poses).filename().string() + ", view " + pose_name + ")"
-                          : view.world_from_cam ? "world (image header pose)"
-                                                : "camera (no pose)";
+  mv.attributes["frame"] =
+      poses ? "world (pose file " + std::filesystem::path(a.poses).filename().string() + ", view " + pose_name + ")"
+      : view.world_from_cam ? "world (image header pose)"
+                            : "camera (no pose)";
   MapSet set;
   set.views.push_back(std::move(mv));
   write_map_set(exr, set);
@@ -170,7 +171,8 @@ int run_extract(const ExtractArgs& a) {
 
 Runner add_extract(CLI::App& app) {
   auto a = std::make_shared<ExtractArgs>();
-  CLI::App* c = app.add_subcommand("extract", "Locate a ball in a view's HDR image and extract its sphere map (captured map set)");
+  CLI::App* c = app.add_subcommand("extract",
+                                   "Locate a ball in a view's HDR image and extract its sphere map (captured map set)");
   c->footer(
       "The ball is found by a Hough transform (or --ball X,Y,R), located to sub-pixel accuracy by a cone fit to its "
       "outline through the lens model, and its sphere map is extracted in the view frame (z from the ball toward the "
@@ -188,9 +190,11 @@ Runner add_extract(CLI::App& app) {
   c->add_option("--kind", a->kind, "chrome (mirror map) or grey (normal map)");
   c->add_option("--indexing", a->indexing, "reflection (exact for mirrors) or orthographic");
   c->add_option("--size", a->size, "Map size in texels (square)")->check(CLI::Range(8, 4096));
-  c->add_option("--camera-mask-deg", a->camera_mask_deg, "Mask reflections within this of the camera (default 12 chrome, 0 grey)")
+  c->add_option("--camera-mask-deg", a->camera_mask_deg,
+                "Mask reflections within this of the camera (default 12 chrome, 0 grey)")
       ->check(CLI::Range(0.0, 90.0));
-  c->add_option("--stand-mask-deg", a->stand_mask_deg, "Mask directions within this of straight down")->check(CLI::Range(0.0, 90.0));
+  c->add_option("--stand-mask-deg", a->stand_mask_deg, "Mask directions within this of straight down")
+      ->check(CLI::Range(0.0, 90.0));
   c->add_flag("--no-stand", a->no_stand, "No stand mask");
   c->add_option("--poses", a->poses,
                 "Pose file (rsibr orient): the world frame of the entry named like the image, and for a chrome ball "

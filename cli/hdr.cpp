@@ -41,7 +41,7 @@ namespace fs = std::filesystem;
 
 struct HdrArgs {
   std::string photoset, out, response, model = "auto", channels = "auto", noise, input_colour_space, json, saturation,
-      white_balance;
+                                       white_balance;
   std::vector<std::string> views;
   int samples = 20000;
   double smoothness = 1000.0, ghost_sigmas = -1;
@@ -63,7 +63,8 @@ NoiseModel parse_noise(const std::string& text) {
   std::istringstream in(text);
   if (!(in >> shot >> comma >> read) || comma != ',' || !(in >> std::ws).eof() || !(shot >= 0) || !(read > 0) ||
       !std::isfinite(shot) || !std::isfinite(read))
-    throw std::invalid_argument("--noise '" + text + "': expected SHOT,READ with SHOT >= 0 and READ > 0 (variance = SHOT * X + READ)");
+    throw std::invalid_argument("--noise '" + text +
+                                "': expected SHOT,READ with SHOT >= 0 and READ > 0 (variance = SHOT * X + READ)");
   n.shot = {shot, shot, shot};
   n.read = {read, read, read};
   n.source = "given";
@@ -133,8 +134,10 @@ int run_hdr(const HdrArgs& a) {
   if (a.views.empty())
     for (const PhotoView& v : set.views) views.push_back(&v);
   for (const std::string& name : a.views) {
-    const auto it = std::find_if(set.views.begin(), set.views.end(), [&](const PhotoView& v) { return v.name == name; });
-    if (it == set.views.end()) throw std::invalid_argument(a.photoset + ": no view named '" + quoted_for_message(name) + "'");
+    const auto it =
+        std::find_if(set.views.begin(), set.views.end(), [&](const PhotoView& v) { return v.name == name; });
+    if (it == set.views.end())
+      throw std::invalid_argument(a.photoset + ": no view named '" + quoted_for_message(name) + "'");
     views.push_back(&*it);
   }
   std::optional<NoiseModel> given_noise;
@@ -147,7 +150,8 @@ int run_hdr(const HdrArgs& a) {
   if (!a.response.empty()) given_curve = load_response(a.response);
   if (a.model != "auto" && a.model != "identity" && a.model != "gamma" && a.model != "polynomial" &&
       a.model != "robertson" && a.model != "debevec")
-    throw std::invalid_argument("--model '" + a.model + "': expected auto, identity, gamma, polynomial, robertson or debevec");
+    throw std::invalid_argument("--model '" + a.model +
+                                "': expected auto, identity, gamma, polynomial, robertson or debevec");
   const std::string working = working_space();
   // The camera's colour space: --input-colorspace, else the photo set's camera.colour_space.
   const std::string input_space = !a.input_colour_space.empty() ? a.input_colour_space : set.camera_colour_space;
@@ -155,8 +159,8 @@ int run_hdr(const HdrArgs& a) {
     try {
       colour_conversion_matrix(input_space, working);  // errors before any work
     } catch (const std::runtime_error& e) {
-      throw std::invalid_argument((a.input_colour_space.empty() ? a.photoset + ": camera.colour_space: " : "--input-colorspace: ") +
-                                  e.what());
+      throw std::invalid_argument(
+          (a.input_colour_space.empty() ? a.photoset + ": camera.colour_space: " : "--input-colorspace: ") + e.what());
     }
   }
 
@@ -228,9 +232,11 @@ int run_hdr(const HdrArgs& a) {
                                     " is above the photos' top code " + std::to_string(curve.max_code));
     curve.validate();
     response_json["saturation_code"] = {curve.saturation_code(0), curve.saturation_code(1), curve.saturation_code(2)};
-    response_json["noise"] = {{"source", pooled_noise.source}, {"views", pooled_noise.views}, {"shot", pooled_noise.shot},
-                              {"read", pooled_noise.read}, {"code", pooled_noise.code}, {"texture", pooled_noise.texture}};
-    response_json["white_balance"] = gains ? nlohmann::json({(*gains)[0], (*gains)[1], (*gains)[2]}) : nlohmann::json("camera");
+    response_json["noise"] = {{"source", pooled_noise.source}, {"views", pooled_noise.views},
+                              {"shot", pooled_noise.shot},     {"read", pooled_noise.read},
+                              {"code", pooled_noise.code},     {"texture", pooled_noise.texture}};
+    response_json["white_balance"] =
+        gains ? nlohmann::json({(*gains)[0], (*gains)[1], (*gains)[2]}) : nlohmann::json("camera");
     // A plot-friendly curve: 65 points per channel.
     nlohmann::json plot = nlohmann::json::array();
     for (int k = 0; k <= 64; ++k) {
@@ -280,9 +286,11 @@ int run_hdr(const HdrArgs& a) {
       for (const std::string& f : b.files) files += (files.empty() ? "" : ";") + relative_name(f, set.folder);
       std::vector<double> times;
       std::string sources;
-      for (const auto& md : b.metadata) times.push_back(md.exposure_s), sources += (sources.empty() ? "" : " ") + md.source;
+      for (const auto& md : b.metadata)
+        times.push_back(md.exposure_s), sources += (sources.empty() ? "" : " ") + md.source;
       std::string shift_text;
-      for (const auto& s : shifts) shift_text += (shift_text.empty() ? "" : " ") + std::to_string(s.x) + "," + std::to_string(s.y);
+      for (const auto& s : shifts)
+        shift_text += (shift_text.empty() ? "" : " ") + std::to_string(s.x) + "," + std::to_string(s.y);
       const std::map<std::string, std::string> attrs = {
           {"version", RSIBR_VERSION},
           {"view", v.name},
@@ -296,9 +304,12 @@ int run_hdr(const HdrArgs& a) {
           {"radianceUnit", "X/e: signal over saturation per relative exposure t*iso/100/N^2"},
           {"colourSpace", working},
           {"inputColourSpace", from.empty() ? working : from},
-          {"alignment", alignment == Alignment::off ? "none" : std::string("MTB (") + to_string(alignment) + "), shifts " + shift_text},
+          {"alignment", alignment == Alignment::off
+                            ? "none"
+                            : std::string("MTB (") + to_string(alignment) + "), shifts " + shift_text},
           {"ghosts", a.deghost ? "flagged; longest usable bracket alone" : "flagged; merged as usual"},
-          {"flags", "clipped: lower bound (saturated in every bracket); black: nothing recorded; ghost: brackets disagree"}};
+          {"flags",
+           "clipped: lower bound (saturated in every bracket); black: nothing recorded; ghost: brackets disagree"}};
       write_merged_exr(file_in_folder(stage, v.name + ".exr").string(), m, attrs);
       staged.push_back({stage / (v.name + ".exr"), file_in_folder(out_dir, v.name + ".exr")});
       const float stops = a.preview_exposure ? *a.preview_exposure : unclipped_exposure(m);
@@ -313,24 +324,38 @@ int run_hdr(const HdrArgs& a) {
       const double pixels = double(m.radiance.total());
       double lo = 0, hi = 0;
       cv::minMaxLoc(m.radiance.reshape(1), &lo, &hi);
-      nlohmann::json vj = {
-          {"name", v.name}, {"width", b.cols()}, {"height", b.rows()}, {"bit_depth", b.max_code == 255 ? 8 : 16},
-          {"files", b.files}, {"exposures", b.exposures}, {"exposure_s", times}, {"exposure_source", sources},
-          {"noise", {{"source", noise.source}, {"shot", noise.shot}, {"read", noise.read}}},
-          {"clipped_pixels", m.clipped}, {"clipped_fraction", m.clipped / pixels},
-          {"black_pixels", m.black}, {"ghost_pixels", m.ghost}, {"ghost_fraction", m.ghost / pixels},
-          {"radiance_min", lo}, {"radiance_max", hi}, {"preview_exposure_stops", stops},
-          {"exr", (out_dir / (v.name + ".exr")).string()},
-          {"seconds", {{"load", secs(t1 - t0)}, {"merge", secs(t2 - t1)}, {"write", secs(t3 - t2)}}}};
+      nlohmann::json vj = {{"name", v.name},
+                           {"width", b.cols()},
+                           {"height", b.rows()},
+                           {"bit_depth", b.max_code == 255 ? 8 : 16},
+                           {"files", b.files},
+                           {"exposures", b.exposures},
+                           {"exposure_s", times},
+                           {"exposure_source", sources},
+                           {"noise", {{"source", noise.source}, {"shot", noise.shot}, {"read", noise.read}}},
+                           {"clipped_pixels", m.clipped},
+                           {"clipped_fraction", m.clipped / pixels},
+                           {"black_pixels", m.black},
+                           {"ghost_pixels", m.ghost},
+                           {"ghost_fraction", m.ghost / pixels},
+                           {"radiance_min", lo},
+                           {"radiance_max", hi},
+                           {"preview_exposure_stops", stops},
+                           {"exr", (out_dir / (v.name + ".exr")).string()},
+                           {"seconds", {{"load", secs(t1 - t0)}, {"merge", secs(t2 - t1)}, {"write", secs(t3 - t2)}}}};
       if (b.raw) {
         // How LibRaw developed the RAW files (hdr/raw_image.h), per bracket.
         nlohmann::json rj = nlohmann::json::array();
         for (const RawInfo& ri : b.raw_info) {
           nlohmann::json M = nlohmann::json::array();
-          for (int r = 0; r < 3; ++r) M.push_back({ri.rgb_from_camera(r, 0), ri.rgb_from_camera(r, 1), ri.rgb_from_camera(r, 2)});
-          rj.push_back({{"camera", ri.make + " " + ri.model}, {"black", ri.black}, {"white", ri.white},
+          for (int r = 0; r < 3; ++r)
+            M.push_back({ri.rgb_from_camera(r, 0), ri.rgb_from_camera(r, 1), ri.rgb_from_camera(r, 2)});
+          rj.push_back({{"camera", ri.make + " " + ri.model},
+                        {"black", ri.black},
+                        {"white", ri.white},
                         {"white_balance", {ri.white_balance[0], ri.white_balance[1], ri.white_balance[2]}},
-                        {"rec709_from_camera", M}, {"saturated_fraction", ri.saturated_fraction}});
+                        {"rec709_from_camera", M},
+                        {"saturated_fraction", ri.saturated_fraction}});
         }
         vj["raw"] = rj;
       }
@@ -339,9 +364,13 @@ int run_hdr(const HdrArgs& a) {
         for (const auto& s : shifts) sj.push_back({s.x, s.y});
         for (const auto& s : vm.alignment.found) fj.push_back({s.x, s.y});
         for (const auto& s : b.file_sizes) sizes.push_back({s.width, s.height});
-        vj["alignment"] = {{"mode", to_string(alignment)}, {"shifts", sj}, {"found", fj},
-                           {"mismatch_before", vm.alignment.mismatch_before}, {"mismatch_after", vm.alignment.mismatch_after},
-                           {"file_sizes", sizes}, {"sizes_fitted", b.fitted_sizes}};
+        vj["alignment"] = {{"mode", to_string(alignment)},
+                           {"shifts", sj},
+                           {"found", fj},
+                           {"mismatch_before", vm.alignment.mismatch_before},
+                           {"mismatch_after", vm.alignment.mismatch_after},
+                           {"file_sizes", sizes},
+                           {"sizes_fitted", b.fitted_sizes}};
         vj["alignment_shifts"] = sj;
       }
       view_list.push_back(vj);
@@ -375,7 +404,8 @@ int run_hdr(const HdrArgs& a) {
 
 Runner add_hdr(CLI::App& app) {
   auto a = std::make_shared<HdrArgs>();
-  CLI::App* c = app.add_subcommand("hdr", "Merge each view's exposure brackets into radiance (EXR with variance and flags)");
+  CLI::App* c =
+      app.add_subcommand("hdr", "Merge each view's exposure brackets into radiance (EXR with variance and flags)");
   c->footer(
       "For every view of the photo set: exposures from photoset.yaml (EXIF fills what it leaves out), the camera "
       "response (recovered once per photo set and written to OUT/response.json, or reused with --response), a "
@@ -390,11 +420,14 @@ Runner add_hdr(CLI::App& app) {
   c->add_option("--out", a->out, "Output folder (created if missing; its parent must exist)")->required();
   c->add_option("--view", a->views, "Merge only this view (repeatable; default: all)");
   c->add_option("--response", a->response, "Reuse this response curve file (from an earlier run, same camera)");
-  c->add_option("--model", a->model, "Response model: auto (held-out error), identity, gamma, polynomial, robertson, debevec");
+  c->add_option("--model", a->model,
+                "Response model: auto (held-out error), identity, gamma, polynomial, robertson, debevec");
   c->add_option("--channels", a->channels,
                 "Response curves: auto (held-out error), shared (one curve for R, G, B: in-camera JPEG), separate");
-  c->add_option("--samples", a->samples, "Pixels sampled for response recovery, over all views")->check(CLI::Range(100, 200000));
-  c->add_option("--smoothness", a->smoothness, "Smoothness weight lambda of the debevec and robertson curves")->check(CLI::Range(0.0, 1e8));
+  c->add_option("--samples", a->samples, "Pixels sampled for response recovery, over all views")
+      ->check(CLI::Range(100, 200000));
+  c->add_option("--smoothness", a->smoothness, "Smoothness weight lambda of the debevec and robertson curves")
+      ->check(CLI::Range(0.0, 1e8));
   c->add_option("--saturation-code", a->saturation,
                 "Codes at or above this saturate: N or R,G,B (default: measured from the brackets)");
   c->add_option("--white-balance", a->white_balance,
@@ -406,7 +439,8 @@ Runner add_hdr(CLI::App& app) {
   c->add_flag("--no-align", a->no_align, "Never shift brackets; files of different sizes are an error")->excludes(on);
   c->add_flag("--deghost", a->deghost, "Ghost pixels take the longest usable bracket alone instead of a blend");
   c->add_option("--ghost-sigmas", a->ghost_sigmas,
-                "Ghost threshold in standard deviations of chi-square (default: 6, 8 for JPEG)")->check(CLI::Range(0.0, 1e6));
+                "Ghost threshold in standard deviations of chi-square (default: 6, 8 for JPEG)")
+      ->check(CLI::Range(0.0, 1e6));
   c->add_option("--input-colorspace", a->input_colour_space,
                 "OpenColorIO colour space of the linearised camera RGB (default: the working space; $OCIO honoured)");
   c->add_option("--preview-exposure", a->preview_exposure, "Preview exposure in stops (default: median grey at 0.18)");

@@ -21,7 +21,6 @@ struct InfoArgs {
   std::string input, layout, json;
 };
 
-
 nlohmann::json channel_stats(const cv::Mat& img) {
   std::vector<double> lo(3, INFINITY), hi(3, -INFINITY), sum(3, 0.0);
   long finite = 0;
@@ -40,7 +39,8 @@ nlohmann::json channel_stats(const cv::Mat& img) {
   nlohmann::json j;
   for (int k = 0; k < 3; ++k) {
     const char* name = k == 0 ? "R" : k == 1 ? "G" : "B";
-    j[name] = {{"min", finite ? lo[std::size_t(k)] : 0.0}, {"max", finite ? hi[std::size_t(k)] : 0.0},
+    j[name] = {{"min", finite ? lo[std::size_t(k)] : 0.0},
+               {"max", finite ? hi[std::size_t(k)] : 0.0},
                {"mean", finite ? sum[std::size_t(k)] / double(finite) : 0.0}};
   }
   return j;
@@ -98,7 +98,9 @@ int info_environment(const InfoArgs& a) {
   j["negative"] = rep.texels.negative;
   j["integral_rgb"] = integ;
   j["mean_radiance_rgb"] = {integ[0] / (4 * kPi), integ[1] / (4 * kPi), integ[2] / (4 * kPi)};
-  j["peak"] = {{"luminance", peak}, {"pixel", {pc, pr}}, {"direction", {peak_dir.x(), peak_dir.y(), peak_dir.z()}},
+  j["peak"] = {{"luminance", peak},
+               {"pixel", {pc, pr}},
+               {"direction", {peak_dir.x(), peak_dir.y(), peak_dir.z()}},
                {"share_of_luminance_integral", total > 0 ? std::max(0.0, peak) * sa.at<double>(pr, pc) / total : 0.0}};
   j["median_luminance"] = median;
   j["dynamic_range"] = median > 0 ? peak / median : INFINITY;
@@ -106,22 +108,21 @@ int info_environment(const InfoArgs& a) {
 
   // With --json - stdout carries the JSON alone.
   std::ostream& text = a.json == "-" ? std::cerr : std::cout;
-  text << a.input << ": " << to_string(env.layout.kind()) << " " << env.layout.width() << "x"
-            << env.layout.height() << " (" << rep.layout_source << "), " << rep.format << " " << rep.channels
-            << ", compression " << rep.compression << "\n"
-            << "  colour:   " << j["colour"].get<std::string>() << "\n";
+  text << a.input << ": " << to_string(env.layout.kind()) << " " << env.layout.width() << "x" << env.layout.height()
+       << " (" << rep.layout_source << "), " << rep.format << " " << rep.channels << ", compression " << rep.compression
+       << "\n"
+       << "  colour:   " << j["colour"].get<std::string>() << "\n";
   for (const char* ch : {"R", "G", "B"})
     text << "  " << ch << ":        min " << j["values"][ch]["min"].get<double>() << "  max "
-              << j["values"][ch]["max"].get<double>() << "  mean " << j["values"][ch]["mean"].get<double>() << "\n";
+         << j["values"][ch]["max"].get<double>() << "  mean " << j["values"][ch]["mean"].get<double>() << "\n";
   text << "  mean radiance (solid-angle weighted) " << integ[0] / (4 * kPi) << " " << integ[1] / (4 * kPi) << " "
-            << integ[2] / (4 * kPi) << "\n"
-            << "  peak luminance " << peak << " at pixel (" << pc << ", " << pr << "), direction (" << peak_dir.x()
-            << ", " << peak_dir.y() << ", " << peak_dir.z() << "); median " << median << "; dynamic range "
-            << j["dynamic_range"].get<double>() << "\n"
-            << "  suspicious values: " << rep.texels.nan << " NaN, " << rep.texels.inf << " Inf, " << rep.texels.huge
-            << " beyond " << kMaxRadiance << ", " << rep.texels.negative << " negative"
-            << (rep.texels.negative ? " (lossy-compression ringing? see --sanitize in convert)" : "")
-            << "\n";
+       << integ[2] / (4 * kPi) << "\n"
+       << "  peak luminance " << peak << " at pixel (" << pc << ", " << pr << "), direction (" << peak_dir.x() << ", "
+       << peak_dir.y() << ", " << peak_dir.z() << "); median " << median << "; dynamic range "
+       << j["dynamic_range"].get<double>() << "\n"
+       << "  suspicious values: " << rep.texels.nan << " NaN, " << rep.texels.inf << " Inf, " << rep.texels.huge
+       << " beyond " << kMaxRadiance << ", " << rep.texels.negative << " negative"
+       << (rep.texels.negative ? " (lossy-compression ringing? see --sanitize in convert)" : "") << "\n";
   for (const auto& [k, v] : env.attributes) text << "  rsibr." << k << ": " << v << "\n";
   write_summary(a.json, j);
   return 0;
@@ -144,8 +145,8 @@ int info_map_set(const InfoArgs& a) {
   j["colour"] = "linear Rec.709 D65";
   std::ostream& text = a.json == "-" ? std::cerr : std::cout;
   text << a.input << ": map set, " << set.views.size() << " views of " << set.width() << "x" << set.height()
-            << ", linear Rec.709 D65, " << vs.triangles().size() << " triangles, "
-            << (vs.surrounds() ? "surrounds the sphere" : "does not surround the sphere") << "\n";
+       << ", linear Rec.709 D65, " << vs.triangles().size() << " triangles, "
+       << (vs.surrounds() ? "surrounds the sphere" : "does not surround the sphere") << "\n";
   if (unusable)
     text << "  " << unusable << " values that are NaN, Inf, beyond " << kMaxRadiance
          << ", negative, or confidences outside [0, 1]: --sanitize zeroes them (the other verbs refuse the "
@@ -156,7 +157,8 @@ int info_map_set(const InfoArgs& a) {
     nlohmann::json jv;
     jv["view"] = {v.view.x(), v.view.y(), v.view.z()};
     nlohmann::json T = nlohmann::json::array();
-    for (int r = 0; r < 3; ++r) T.push_back({v.world_from_view(r, 0), v.world_from_view(r, 1), v.world_from_view(r, 2)});
+    for (int r = 0; r < 3; ++r)
+      T.push_back({v.world_from_view(r, 0), v.world_from_view(r, 1), v.world_from_view(r, 2)});
     jv["world_from_view"] = T;
     jv["channels"] = v.confidence.empty() ? "R G B" : "R G B confidence";
     jv["warp"] = to_string(v.warp);
@@ -170,8 +172,8 @@ int info_map_set(const InfoArgs& a) {
     std::ostringstream line;
     line << std::fixed << std::setprecision(4) << "  view." << std::setw(3) << std::setfill('0') << i
          << std::setfill(' ') << "  v=(" << v.view.x() << ", " << v.view.y() << ", " << v.view.z() << ")  up=("
-         << v.world_from_view(0, 1) << ", " << v.world_from_view(1, 1) << ", " << v.world_from_view(2, 1) << ")  " << to_string(v.warp)
-         << "  " << to_string(v.source) << (v.confidence.empty() ? "" : "  +confidence")
+         << v.world_from_view(0, 1) << ", " << v.world_from_view(1, 1) << ", " << v.world_from_view(2, 1) << ")  "
+         << to_string(v.warp) << "  " << to_string(v.source) << (v.confidence.empty() ? "" : "  +confidence")
          << (v.albedo.empty() ? "" : "  albedo-normalised");
     const std::string first_line = v.material.substr(0, v.material.find('\n'));
     if (!first_line.empty()) line << "  material: " << first_line;
@@ -188,8 +190,9 @@ int info_map_set(const InfoArgs& a) {
 Runner add_info(CLI::App& app) {
   auto a = std::make_shared<InfoArgs>();
   CLI::App* c = app.add_subcommand("info", "Show the header and a value summary of an environment map or a map set");
-  c->footer("For an environment: layout, channels, compression, colour, per-channel range, NaN/Inf/negative counts, "
-            "mean radiance, peak and dynamic range. For a map set: views, frames, warp, source, material.");
+  c->footer(
+      "For an environment: layout, channels, compression, colour, per-channel range, NaN/Inf/negative counts, "
+      "mean radiance, peak and dynamic range. For a map set: views, frames, warp, source, material.");
   c->add_option("input", a->input, "Environment (.exr, .hdr) or map set (.exr)")->required();
   c->add_option("--layout", a->layout, "Layout of an environment whose header and shape do not tell");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");

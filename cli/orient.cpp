@@ -33,7 +33,8 @@ Vec3 parse_up(const std::string& text) {
   char c1 = 0, c2 = 0;
   if (!(in >> x >> c1 >> y >> c2 >> z) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof() || !std::isfinite(x) ||
       !std::isfinite(y) || !std::isfinite(z) || Vec3(x, y, z).norm() < 1e-12)
-    throw std::invalid_argument("--up '" + text + "': expected X,Y,Z, a non-zero direction in the first camera's frame");
+    throw std::invalid_argument("--up '" + text +
+                                "': expected X,Y,Z, a non-zero direction in the first camera's frame");
   return Vec3(x, y, z);
 }
 
@@ -43,8 +44,10 @@ int run_orient(const OrientArgs& a) {
   OutputPlan outputs(inputs);
   const std::string pose_file = outputs.file(a.out), json = outputs.file(a.json);
   ViewOrientationOptions o;
-  if (a.up == "auto") o.estimate_up = true;
-  else if (!a.up.empty()) o.up = parse_up(a.up);
+  if (a.up == "auto")
+    o.estimate_up = true;
+  else if (!a.up.empty())
+    o.up = parse_up(a.up);
   if (a.images.size() < 2)
     throw std::invalid_argument("orient: " + std::to_string(a.images.size()) + " image(s), need at least 2 views");
   const LensModel lens = LensModel::read(a.lens);
@@ -96,27 +99,30 @@ int run_orient(const OrientArgs& a) {
     std::vector<double> m;
     for (int k = 0; k < 9; ++k) m.push_back(poses.views[v].world_from_cam(k / 3, k % 3));
     const std::size_t image = std::size_t(std::find(names.begin(), names.end(), poses.views[v].name) - names.begin());
-    jv.push_back({{"name", poses.views[v].name},
-                  {"image", a.images[image]},
-                  {"world_from_cam", m},
-                  {"sigma_deg", poses.views[v].sigma_deg},
-                  {"features", rep.features[v]},
-                  {"ball", {{"centre_px", {b.centre_px.x(), b.centre_px.y()}}, {"radius_px", b.radius_px}, {"rms_px", b.fit.rms_px}}}});
+    jv.push_back(
+        {{"name", poses.views[v].name},
+         {"image", a.images[image]},
+         {"world_from_cam", m},
+         {"sigma_deg", poses.views[v].sigma_deg},
+         {"features", rep.features[v]},
+         {"ball",
+          {{"centre_px", {b.centre_px.x(), b.centre_px.y()}}, {"radius_px", b.radius_px}, {"rms_px", b.fit.rms_px}}}});
   }
   j["views"] = jv;
   j["left_out"] = rep.left_out;
   j["notes"] = rep.notes;
   if (rep.world_up)
     j["world_up"] = {{"up_in_first_camera", {rep.world_up->up.x(), rep.world_up->up.y(), rep.world_up->up.z()}},
-                     {"sigma_deg", rep.world_up->sigma_deg}, {"roll_sigma_deg", rep.world_up->roll_sigma_deg},
+                     {"sigma_deg", rep.world_up->sigma_deg},
+                     {"roll_sigma_deg", rep.world_up->roll_sigma_deg},
                      {"roll_deg", rep.world_up->roll_deg}};
   write_summary(json, j);
   outputs.commit();
   if (!a.quiet && a.json != "-") {
     double worst = 0;
     for (const ViewPose& p : poses.views) worst = std::max(worst, p.sigma_deg);
-    std::cerr << poses.views.size() << " views, " << rep.tracks << " feature tracks, largest orientation sigma " << worst
-              << " deg -> " << a.out << "\n";
+    std::cerr << poses.views.size() << " views, " << rep.tracks << " feature tracks, largest orientation sigma "
+              << worst << " deg -> " << a.out << "\n";
     for (const std::string& l : rep.left_out) std::cerr << "rsibr orient: left out " << l << "\n";
     for (const std::string& l : rep.notes) std::cerr << "rsibr orient: " << l << "\n";
   }
@@ -127,7 +133,8 @@ int run_orient(const OrientArgs& a) {
 
 Runner add_orient(CLI::App& app) {
   auto a = std::make_shared<OrientArgs>();
-  CLI::App* c = app.add_subcommand("orient", "Solve every view's camera orientation from the features in its chrome ball");
+  CLI::App* c =
+      app.add_subcommand("orient", "Solve every view's camera orientation from the features in its chrome ball");
   c->footer(
       "Each image is a merged view (rsibr hdr) of the same ball rig from a different position. The chrome ball is "
       "found in every view (calib/ball_identification.h: the candidate that looks like a mirror), features in it are turned into the world "
@@ -142,8 +149,9 @@ Runner add_orient(CLI::App& app) {
   c->add_option("images", a->images, "Merged view EXRs (rsibr hdr), at least 2")->required();
   c->add_option("--lens", a->lens, "mrcal .cameramodel of the camera")->required();
   c->add_option("--out", a->out, "Output pose file (poses.yaml)")->required();
-  c->add_option("--up", a->up, "World up X,Y,Z in the first camera's frame, or 'auto' (estimated from the views; "
-                              "default: world = first camera)");
+  c->add_option("--up", a->up,
+                "World up X,Y,Z in the first camera's frame, or 'auto' (estimated from the views; "
+                "default: world = first camera)");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or report line");
   return [a] { return run_orient(*a); };

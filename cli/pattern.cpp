@@ -99,15 +99,17 @@ int run_pattern(const PatternArgs& a) {
 Runner add_pattern(CLI::App& app) {
   auto a = std::make_shared<PatternArgs>();
   CLI::App* c = app.add_subcommand("pattern", "Write an analytic test environment in any layout");
-  c->footer("Patterns: direction (RGB = (d+1)/2, integral 2*pi per channel), white (L = 1, integral 4*pi), "
-            "checker (lat-long squares), sun-sky (a disc sun over a sky gradient). Texels are area averages.");
+  c->footer(
+      "Patterns: direction (RGB = (d+1)/2, integral 2*pi per channel), white (L = 1, integral 4*pi), "
+      "checker (lat-long squares), sun-sky (a disc sun over a sky gradient). Texels are area averages.");
   c->add_option("pattern", a->kind, "direction, white, checker or sun-sky")->required();
   c->add_option("output", a->output, "Output .exr")->required();
   c->add_option("--to", a->to, "Layout: latlong, cube, octahedral or sphere");
   c->add_option("--size", a->size, "Layout size (lat-long width, cube face, square side)")->check(CLI::Range(2, 16384));
   c->add_option("--subsamples", a->subsamples, "n x n points per texel")->check(CLI::Range(1, 64));
   c->add_option("--sun-intensity", a->sun_intensity, "sun-sky: sun radiance");
-  c->add_option("--sun-radius", a->sun_radius_deg, "sun-sky: sun angular radius in degrees")->check(CLI::Range(1e-4, 90.0));
+  c->add_option("--sun-radius", a->sun_radius_deg, "sun-sky: sun angular radius in degrees")
+      ->check(CLI::Range(1e-4, 90.0));
   c->add_option("--sun-dir", a->sun_dir, "sun-sky: direction toward the sun (world, +Y up)")->expected(3);
   c->add_option("--checker", a->checker_deg, "checker: square size in degrees")->check(CLI::Range(0.01, 180.0));
   c->add_option("--map-set", a->views,

@@ -31,8 +31,10 @@ struct ProbeArgs {
 MapSet read_ball_maps(const std::string& path, const std::string& option) {
   MapSet s = read_map_set(path);
   for (std::size_t v = 0; v < s.views.size(); ++v)
-    if (s.views[v].confidence.empty() || s.views[v].source != MapSource::Captured || s.views[v].warp != CentralDirection::Normal)
-      throw std::invalid_argument(path + ": view." + std::to_string(v) + " is not a captured grey or glossy map (" + option + ")");
+    if (s.views[v].confidence.empty() || s.views[v].source != MapSource::Captured ||
+        s.views[v].warp != CentralDirection::Normal)
+      throw std::invalid_argument(path + ": view." + std::to_string(v) + " is not a captured grey or glossy map (" +
+                                  option + ")");
   return s;
 }
 
@@ -43,7 +45,8 @@ int run_probe(const ProbeArgs& a) {
   OutputPlan outputs(inputs);
   const std::string exr = outputs.file(a.out), json = outputs.file(a.json);
   const std::shared_ptr<const Fresnel> fresnel = chrome_fresnel_from_spec(a.fresnel, "--fresnel");
-  if (!a.glossy.empty() && a.glossy_brdf.empty()) throw std::invalid_argument("--glossy: needs --glossy-brdf (the glossy ball's BRDF)");
+  if (!a.glossy.empty() && a.glossy_brdf.empty())
+    throw std::invalid_argument("--glossy: needs --glossy-brdf (the glossy ball's BRDF)");
   std::unique_ptr<Brdf> glossy_brdf;
   if (!a.glossy_brdf.empty()) {
     try {
@@ -61,10 +64,12 @@ int run_probe(const ProbeArgs& a) {
     for (std::size_t v = 0; v < s.views.size(); ++v) {
       const MapView& mv = s.views[v];
       if (mv.confidence.empty() || mv.source != MapSource::Captured)
-        throw std::invalid_argument(path + ": view." + std::to_string(v) + " is not a captured map (no confidence channel)");
+        throw std::invalid_argument(path + ": view." + std::to_string(v) +
+                                    " is not a captured map (no confidence channel)");
       if (!all.views.empty() && (mv.rgb.size() != all.views.front().rgb.size()))
-        throw std::invalid_argument(path + ": maps are " + std::to_string(mv.rgb.cols) + "x" + std::to_string(mv.rgb.rows) +
-                                    " but the first input's are " + std::to_string(all.views.front().rgb.cols) + "x" +
+        throw std::invalid_argument(path + ": maps are " + std::to_string(mv.rgb.cols) + "x" +
+                                    std::to_string(mv.rgb.rows) + " but the first input's are " +
+                                    std::to_string(all.views.front().rgb.cols) + "x" +
                                     std::to_string(all.views.front().rgb.rows));
       all.views.push_back(mv);
     }
@@ -93,7 +98,8 @@ int run_probe(const ProbeArgs& a) {
   o.width = a.width;
   o.fresnel = fresnel.get();
   // Light clipped in every view is recovered when a grey or glossy ball's maps are given.
-  RecoveredProbe rp = recover_probe_sources(all, o, grey, glossy, SourceRecoveryOptions{}, !grey.empty() || !glossy.empty());
+  RecoveredProbe rp =
+      recover_probe_sources(all, o, grey, glossy, SourceRecoveryOptions{}, !grey.empty() || !glossy.empty());
   const Probe& p = rp.measured;
   rp.env.attributes["views"] = std::to_string(all.views.size());
   if (fresnel) rp.env.attributes["fresnel"] = fresnel->spec();
@@ -128,7 +134,9 @@ Runner add_probe(CLI::App& app) {
       "Every view of the inputs (rsibr extract outputs in one world frame) is looked up at each direction through "
       "its mirror mapping and weighted by its confidence channel, so the camera, photographer and stretched rim of "
       "one view are replaced by the others. --fresnel divides out the ball's reflectance (a Fresnel spec as in "
-      "rsibr bake; default: chrome, '" + std::string(kDefaultChromeFresnel) + "', about 57% at normal incidence; "
+      "rsibr bake; default: chrome, '" +
+      std::string(kDefaultChromeFresnel) +
+      "', about 57% at normal incidence; "
       "'none' keeps F L). Directions no view saw are 0. Directions clipped in every bracket of every view that saw "
       "them (a sun) are light the probe lacks: with --grey (a grey ball's captured maps in the same world frame) "
       "each such region is recovered as a compact source from the grey ball's shading (and a glossy ball's with "
@@ -140,12 +148,16 @@ Runner add_probe(CLI::App& app) {
   c->add_option("--fresnel", a->fresnel, "The ball's Fresnel spec (divided out; 'none': the probe holds F L)")
       ->capture_default_str();
   c->add_option("--grey", a->grey, "Captured grey-ball map sets: recover the clipped light from them");
-  c->add_option("--grey-albedo", a->grey_albedo, "The grey ball's albedo")->check(CLI::Range(0.001, 1.0))->capture_default_str();
-  c->add_option("--glossy", a->glossy, "Captured glossy-ball map sets (with --glossy-brdf): they constrain the sources too");
+  c->add_option("--grey-albedo", a->grey_albedo, "The grey ball's albedo")
+      ->check(CLI::Range(0.001, 1.0))
+      ->capture_default_str();
+  c->add_option("--glossy", a->glossy,
+                "Captured glossy-ball map sets (with --glossy-brdf): they constrain the sources too");
   c->add_option("--glossy-brdf", a->glossy_brdf, "The glossy ball's BRDF spec (YAML text)");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
-  c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
-                                         "confidences to [0, 1]) instead of failing; the JSON counts them");
+  c->add_flag("--sanitize", a->sanitize,
+              "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
+              "confidences to [0, 1]) instead of failing; the JSON counts them");
   c->add_flag("-q,--quiet", a->quiet, "No report line");
   return [a] { return run_probe(*a); };
 }

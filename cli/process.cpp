@@ -51,7 +51,10 @@ int run_process_verb(ProcessArgs a) {
   const ProcessResult r = run_process(a.o);
   nlohmann::json steps = nlohmann::json::array();
   for (const StepOutcome& s : r.steps)
-    steps.push_back({{"step", s.step}, {"ran", s.ran}, {"reason", s.reason}, {"seconds", s.seconds},
+    steps.push_back({{"step", s.step},
+                     {"ran", s.ran},
+                     {"reason", s.reason},
+                     {"seconds", s.seconds},
                      {"recorded_seconds", s.recorded_seconds}});
   nlohmann::json j;
   j["photoset"] = a.o.photoset;
@@ -69,7 +72,8 @@ int run_process_verb(ProcessArgs a) {
 
 Runner add_process(CLI::App& app) {
   auto a = std::make_shared<ProcessArgs>();
-  CLI::App* c = app.add_subcommand("process", "The whole job: photo set -> probe, captured vs computed maps, render, report");
+  CLI::App* c =
+      app.add_subcommand("process", "The whole job: photo set -> probe, captured vs computed maps, render, report");
   c->footer(
       "Steps (each skipped when its inputs and outputs hold what its record says and its settings are unchanged; records in "
       "DIR/steps/<step>.json): calibrate (chessboards, --lens, or the photos' EXIF and the lensfun database) -> hdr "
@@ -87,17 +91,23 @@ Runner add_process(CLI::App& app) {
   c->add_option("--out", a->o.out, "Output folder DIR (created; its parent must exist)")->required();
   c->add_option("--lens", a->o.lens, "The camera's .cameramodel (instead of calibrating from chessboards)");
   c->add_option("--poses", a->o.poses, "Camera orientations: poses.yaml (rsibr orient) or a synth truth.yaml");
-  c->add_option("--up", a->up, "World up: 'auto' (estimated from the views: cameras are held level in roll), "
-                              "X,Y,Z in the first camera's frame (0,-1,0 for a levelled camera), or 'none' (world = "
-                              "first camera)")->capture_default_str();
-  c->add_option("--ball", a->o.ball_overrides, "VIEW:BALL=X,Y,R: that ball of that view is at pixel (X, Y) with radius R "
-                                               "(roughly), instead of the detection (repeatable)");
+  c->add_option("--up", a->up,
+                "World up: 'auto' (estimated from the views: cameras are held level in roll), "
+                "X,Y,Z in the first camera's frame (0,-1,0 for a levelled camera), or 'none' (world = "
+                "first camera)")
+      ->capture_default_str();
+  c->add_option("--ball", a->o.ball_overrides,
+                "VIEW:BALL=X,Y,R: that ball of that view is at pixel (X, Y) with radius R "
+                "(roughly), instead of the detection (repeatable)");
   c->add_option("--input-colorspace", a->o.input_colour_space,
                 "OpenColorIO colour space of the linearised camera RGB (default: the photo set's camera.colour_space, "
                 "else the working space; $OCIO honoured)");
-  c->add_option("--vignetting", a->o.vignetting, "'auto' (estimated from the chessboards), 'none', or a JSON model "
-                                                 "(DIR/hdr/vignetting.json of another run)")->capture_default_str();
-  c->add_option("--radiance", a->o.radiance_dir, "Use these linear EXRs (<view>_radiance.exr or <view>.exr) instead of the merge");
+  c->add_option("--vignetting", a->o.vignetting,
+                "'auto' (estimated from the chessboards), 'none', or a JSON model "
+                "(DIR/hdr/vignetting.json of another run)")
+      ->capture_default_str();
+  c->add_option("--radiance", a->o.radiance_dir,
+                "Use these linear EXRs (<view>_radiance.exr or <view>.exr) instead of the merge");
   c->add_option("--probe", a->o.probe_file, "Use this environment as the probe instead of the chrome maps' blend");
   c->add_option("--mesh", a->o.mesh, "Mesh for the turntable (.glb, .gltf, .obj; default: a torus)");
   c->add_option("--force", a->o.force, "Re-run this step even if up to date (repeatable; 'all')");
@@ -106,11 +116,14 @@ Runner add_process(CLI::App& app) {
   c->add_option("--chrome-fresnel", a->o.chrome_fresnel,
                 "The chrome ball's Fresnel spec, divided out of the probe ('none': the probe holds F L)")
       ->capture_default_str();
-  c->add_flag("--no-self-calibration", a->no_self_calibration,
-              "Keep the focal length of a lens from the photos' EXIF as it is (no refinement from the balls' outlines)");
-  c->add_flag("--no-sources", a->no_sources,
-              "Do not recover light clipped in every chrome view from the grey and glossy balls (probe.exr is the measured probe)");
-  c->add_option("--glossy-brdf", a->o.glossy_brdf, "The glossy balls' BRDF spec (YAML text): they then constrain the recovered sources");
+  c->add_flag(
+      "--no-self-calibration", a->no_self_calibration,
+      "Keep the focal length of a lens from the photos' EXIF as it is (no refinement from the balls' outlines)");
+  c->add_flag(
+      "--no-sources", a->no_sources,
+      "Do not recover light clipped in every chrome view from the grey and glossy balls (probe.exr is the measured probe)");
+  c->add_option("--glossy-brdf", a->o.glossy_brdf,
+                "The glossy balls' BRDF spec (YAML text): they then constrain the recovered sources");
   c->add_option("--grey-albedo", a->o.grey_albedo, "The grey ball's albedo")->check(CLI::Range(0.001, 1.0));
   c->add_option("--bake-method", a->o.bake_method, "Integrator of the computed maps: mis, fis, sh, reference");
   c->add_option("--bake-samples", a->o.bake_samples, "Samples per texel (mis, fis)")->check(CLI::Range(1, 1 << 20));

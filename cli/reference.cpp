@@ -51,7 +51,9 @@ void write_render(const std::string& path, const ReferenceImage& im, const Camer
   all["seed"] = std::to_string(o.seed);
   all["background"] = to_string(o.background);
   write_render_exr(path, rgba, cam, all,
-                   {{"spp", o.spp}, {"lightSamples", o.light_samples}, {"shadows", o.shadows ? 1 : 0},
+                   {{"spp", o.spp},
+                    {"lightSamples", o.light_samples},
+                    {"shadows", o.shadows ? 1 : 0},
                     {"bounces", o.shadows ? o.bounces : 1}});
 }
 
@@ -86,9 +88,11 @@ int run_reference(const ReferenceArgs& a) {
   const RayScene scene(mesh);
   const auto t2 = std::chrono::steady_clock::now();
 
-  const std::map<std::string, std::string> strings = {
-      {"version", RSIBR_VERSION}, {"mesh", a.mesh}, {"environment", a.env}, {"material", brdf->spec()},
-      {"brdfSpec", a.brdf}};
+  const std::map<std::string, std::string> strings = {{"version", RSIBR_VERSION},
+                                                      {"mesh", a.mesh},
+                                                      {"environment", a.env},
+                                                      {"material", brdf->spec()},
+                                                      {"brdfSpec", a.brdf}};
   Progress bar("reference", !a.quiet && Progress::stderr_is_terminal());
   double render_s = 0, write_s = 0;
   long samples = 0, hits = 0, shadow_rays = 0, bounce_rays = 0;
@@ -98,13 +102,13 @@ int run_reference(const ReferenceArgs& a) {
     const Camera cam = k == 0 ? first : make_camera(a.camera, mesh.bounds(), k);
     const auto r0 = std::chrono::steady_clock::now();
     const double rows_total = double(frames) * cam.height;
-    const ReferenceImage im = render_reference(scene, *brdf, lighting, cam, o, [&](int done) {
-      bar.update((double(k) * cam.height + done) / rows_total);
-    });
+    const ReferenceImage im = render_reference(
+        scene, *brdf, lighting, cam, o, [&](int done) { bar.update((double(k) * cam.height + done) / rows_total); });
     const auto r1 = std::chrono::steady_clock::now();
     const std::string out = frame_path(a.output, a.camera.turntable, k);
     write_render(exr_tmp[std::size_t(k)], im, cam, strings, o);
-    if (!a.preview.empty() && !cv::imwrite(png_tmp[std::size_t(k)], display_encode(im.rgb, *(stops = stops ? stops : preview_exposure(im.rgb)))))
+    if (!a.preview.empty() && !cv::imwrite(png_tmp[std::size_t(k)],
+                                           display_encode(im.rgb, *(stops = stops ? stops : preview_exposure(im.rgb)))))
       throw std::runtime_error(frame_path(a.preview, a.camera.turntable, k) + ": cannot write the preview image");
     const auto r2 = std::chrono::steady_clock::now();
     render_s += std::chrono::duration<double>(r1 - r0).count();
@@ -174,10 +178,10 @@ Runner add_reference(CLI::App& app) {
   c->add_option("--env", a->env, "Environment map (EXR or .hdr), any layout")->required();
   c->add_option("--brdf", a->brdf, "BRDF spec (YAML)")->required();
   add_camera_options(c, a->camera);
-  c->add_option("--spp", a->spp, "Camera samples per pixel (stratified)")->capture_default_str()->check(
-      CLI::Range(1, 1 << 16));
-  c->add_option("--light-samples", a->light_samples,
-                "Environment and BRDF samples per surface interaction (each)")
+  c->add_option("--spp", a->spp, "Camera samples per pixel (stratified)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1 << 16));
+  c->add_option("--light-samples", a->light_samples, "Environment and BRDF samples per surface interaction (each)")
       ->capture_default_str()
       ->check(CLI::Range(1, 1 << 12));
   c->add_option("--seed", a->seed, "Random seed")->capture_default_str()->check(seed_check());
@@ -192,7 +196,8 @@ Runner add_reference(CLI::App& app) {
   c->add_option("--layout", a->layout, "Layout of the environment when its header and shape do not tell");
   c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and negative environment values instead of failing");
   c->add_option("--preview", a->preview, "Also write a display-encoded PNG (OCIO; numbered with --turntable)");
-  c->add_option("--preview-exposure", a->preview_exposure, "Exposure of the preview in stops (default: the first frame's median luminance at mid-grey)");
+  c->add_option("--preview-exposure", a->preview_exposure,
+                "Exposure of the preview in stops (default: the first frame's median luminance at mid-grey)");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or summary line");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   return [a] { return run_reference(*a); };

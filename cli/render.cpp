@@ -47,14 +47,14 @@ std::string extension_of(const std::string& path) {
   return e;
 }
 
-
 int run_render(const RenderArgs& a) {
   const std::string ext = extension_of(a.output);
   if (ext != ".png" && ext != ".exr") throw std::invalid_argument(a.output + ": the output must be .png or .exr");
   if (a.mode != "paper" && a.mode != "per-pixel")
     throw std::invalid_argument("--mode must be 'paper' or 'per-pixel', not '" + a.mode + "'");
   const int side = int(std::lround(std::sqrt(double(a.spp))));
-  if (side * side != a.spp) throw std::invalid_argument("--spp must be a perfect square (1, 4, 9, ...), not " + std::to_string(a.spp));
+  if (side * side != a.spp)
+    throw std::invalid_argument("--spp must be a perfect square (1, 4, 9, ...), not " + std::to_string(a.spp));
   RenderOptions options;
   options.mode = render_mode_from_string(a.mode);
   options.map_size = a.map_size;
@@ -131,7 +131,8 @@ int run_render(const RenderArgs& a) {
     const std::string path = frame_path(a.output, a.camera.turntable, k);
     auto p = provenance;
     if (a.camera.turntable > 0) p["frame"] = std::to_string(k) + "/" + std::to_string(a.camera.turntable);
-    if (ext == ".exr") write_render_exr(frame_tmp[std::size_t(k)], image, cam, p);
+    if (ext == ".exr")
+      write_render_exr(frame_tmp[std::size_t(k)], image, cam, p);
     else {
       if (!stops) stops = preview_exposure(image);  // every frame of a turntable at one exposure
       write_rgba_png(frame_tmp[std::size_t(k)], image, *stops);
@@ -190,16 +191,22 @@ Runner add_render(CLI::App& app) {
   c->add_option("--mode", a->mode, "per-pixel (exact) or paper (one destination map per frame)")->capture_default_str();
   c->add_option("--size-map", a->map_size, "paper: destination map size (default: the first map set's)")
       ->check(CLI::Range(2, 8192));
-  c->add_option("--warp", a->warp, "paper: exact, precomputed, tessellated or double-indirection (about world up) warp for the destination map")
+  c->add_option(
+       "--warp", a->warp,
+       "paper: exact, precomputed, tessellated or double-indirection (about world up) warp for the destination map")
       ->capture_default_str();
-  c->add_option("--rings", a->rings, "tessellated: rings of the disc mesh (4x as many segments)")->check(CLI::Range(1, 1024));
+  c->add_option("--rings", a->rings, "tessellated: rings of the disc mesh (4x as many segments)")
+      ->check(CLI::Range(1, 1024));
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--spp", a->spp, "Samples per pixel: a perfect square (1, 4, 9, ...)")->check(CLI::Range(1, 1024));
   c->add_option("--env", a->env, "Environment map shown where rays miss (alpha 1)");
-  c->add_option("--exposure", a->exposure, "PNG: exposure in stops before the display transform (default: the first frame's median luminance at mid-grey)");
+  c->add_option(
+      "--exposure", a->exposure,
+      "PNG: exposure in stops before the display transform (default: the first frame's median luminance at mid-grey)");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
-  c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
-                                         "confidences to [0, 1]) instead of failing; the JSON counts them");
+  c->add_flag("--sanitize", a->sanitize,
+              "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
+              "confidences to [0, 1]) instead of failing; the JSON counts them");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar");
   return [a] { return run_render(*a); };
 }

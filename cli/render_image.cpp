@@ -5,13 +5,11 @@
 #include "core/map_set.h"
 #include "core/text.h"
 
-
 #include <cmath>
 #include <optional>
 #include <stdexcept>
 
 namespace rsibr::cli {
-
 
 EnvMap read_environment_input(const std::string& path, const std::string& layout, bool sanitize) {
   const std::optional<LayoutKind> hint =

@@ -50,7 +50,9 @@ int run_synth(const SynthArgs& a) {
   j["supersampling"] = scene.camera.supersampling;
   j["gain"] = r.gain;
   j["samples_traced"] = r.pixels_rendered;
-  j["seconds"] = {{"render", r.seconds_render}, {"brackets", r.seconds_brackets}, {"truth", r.seconds_truth},
+  j["seconds"] = {{"render", r.seconds_render},
+                  {"brackets", r.seconds_brackets},
+                  {"truth", r.seconds_truth},
                   {"total", r.seconds_total}};
   write_summary(json, j);
   outputs.commit();
@@ -62,10 +64,11 @@ int run_synth(const SynthArgs& a) {
 Runner add_synth(CLI::App& app) {
   auto a = std::make_shared<SynthArgs>();
   CLI::App* c = app.add_subcommand("synth", "Synthesize a photo set of a ball rig with its ground truth");
-  c->footer("Writes OUT/photos (photoset.yaml, bracketed images, chessboards) and OUT/truth (truth.yaml, "
-            "camera.cameramodel, response.csv, linear radiance EXRs per view, true sphere maps per ball, chessboard "
-            "corners). The scene spec format: datasets-synthetic/README.md. The same spec and --seed give the same "
-            "bytes.");
+  c->footer(
+      "Writes OUT/photos (photoset.yaml, bracketed images, chessboards) and OUT/truth (truth.yaml, "
+      "camera.cameramodel, response.csv, linear radiance EXRs per view, true sphere maps per ball, chessboard "
+      "corners). The scene spec format: datasets-synthetic/README.md. The same spec and --seed give the same "
+      "bytes.");
   c->add_option("scene", a->scene, "Scene spec (YAML)")->required();
   c->add_option("--out", a->out, "Output folder (must not exist, or be empty)")->required();
   c->add_option("--seed", a->seed, "Random seed (overrides the spec's seed)")->check(seed_check());

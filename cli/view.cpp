@@ -190,7 +190,9 @@ Runner add_view(CLI::App& app) {
       "blends one destination map per frame, read by normal. Two sets (--maps2) are compared by a wipe or side by "
       "side. Colours: exposure and the OpenColorIO display transform ($OCIO honoured).\n"
 #if RSIBR_HAVE_VIEWER
-      "Keys: " + std::string(viewer::kViewerKeys) + "\n"
+      "Keys: " +
+      std::string(viewer::kViewerKeys) +
+      "\n"
 #else
       "(This rsibr was built without the viewer.)\n"
 #endif
@@ -205,8 +207,10 @@ Runner add_view(CLI::App& app) {
   add_camera_options(c, a->camera);
   c->remove_option(c->get_option("--turntable"));  // --orbit here
   c->add_option("--mode", a->mode, "per-pixel (fragment shader) or paper (CPU destination map)")->capture_default_str();
-  c->add_option("--warp", a->warp, "paper: exact, precomputed, tessellated or double-indirection (about world up) warp")->capture_default_str();
-  c->add_option("--size-map", a->map_size, "paper: destination map size (default: the set's)")->check(CLI::Range(2, 8192));
+  c->add_option("--warp", a->warp, "paper: exact, precomputed, tessellated or double-indirection (about world up) warp")
+      ->capture_default_str();
+  c->add_option("--size-map", a->map_size, "paper: destination map size (default: the set's)")
+      ->check(CLI::Range(2, 8192));
   c->add_option("--rings", a->rings, "tessellated: rings of the disc mesh")->check(CLI::Range(1, 1024));
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--exposure", a->exposure, "Exposure in stops before the display transform");
@@ -221,8 +225,9 @@ Runner add_view(CLI::App& app) {
   c->add_option("--exr", a->exr, "Scripted: write each frame as RGBA float EXR (numbered when N > 1)");
   c->add_flag("--benchmark", a->benchmark, "Scripted: print each frame's time and the median frame rate");
   c->add_option("--json", a->json, "Scripted: write a JSON summary to FILE ('-' for stdout)");
-  c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
-                                         "confidences to [0, 1]) instead of failing; the JSON counts them");
+  c->add_flag("--sanitize", a->sanitize,
+              "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
+              "confidences to [0, 1]) instead of failing; the JSON counts them");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar");
   return [a] { return run_view(*a); };
 }

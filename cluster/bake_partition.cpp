@@ -30,8 +30,8 @@ long row_weight(int r, int res) {
 
 std::vector<RowSpan> rows_of_rank(int views, int res, int rank, int ranks) {
   if (views < 0 || res < 1 || ranks < 1 || rank < 0 || rank >= ranks)
-    throw std::invalid_argument("bake partition: rank " + std::to_string(rank) + " of " + std::to_string(ranks) +
-                                ", " + std::to_string(views) + " views of " + std::to_string(res) + " rows");
+    throw std::invalid_argument("bake partition: rank " + std::to_string(rank) + " of " + std::to_string(ranks) + ", " +
+                                std::to_string(views) + " views of " + std::to_string(res) + " rows");
   std::vector<long> weight(static_cast<std::size_t>(res));
   long per_map = 0;
   for (int r = 0; r < res; ++r) per_map += weight[std::size_t(r)] = row_weight(r, res);

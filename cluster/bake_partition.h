@@ -10,8 +10,8 @@
 namespace rsibr::cluster {
 
 struct RowSpan {
-  int view = 0;                      // index into the view set
-  int row_begin = 0, row_end = 0;    // rows [row_begin, row_end) of that view's map, non-empty
+  int view = 0;                    // index into the view set
+  int row_begin = 0, row_end = 0;  // rows [row_begin, row_end) of that view's map, non-empty
 };
 
 // The rows of `rank` (0 <= rank < ranks), in view-major order; empty when the rank has none (more

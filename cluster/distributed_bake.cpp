@@ -43,15 +43,19 @@ std::vector<std::uint8_t> integrate_spans(const Brdf& brdf, const Integrator& in
     // The masked-out rows are visited too (and cost nothing): count only this span's.
     const long before = rows_before;
     if (progress && total_rows > 0)
-      rows = [&, before](int done) { progress(std::min(1.0, double(before + done * (s.row_end - s.row_begin) / res) / total_rows)); };
+      rows = [&, before](int done) {
+        progress(std::min(1.0, double(before + done * (s.row_end - s.row_begin) / res) / total_rows));
+      };
     const cv::Mat map = integrator.radiance_map(brdf, v, world_from_view_for(v), res, io, rows);
-    for (int r = s.row_begin; r < s.row_end; ++r, at += row_bytes) std::memcpy(bytes.data() + at, map.ptr(r), row_bytes);
+    for (int r = s.row_begin; r < s.row_end; ++r, at += row_bytes)
+      std::memcpy(bytes.data() + at, map.ptr(r), row_bytes);
     rows_before += s.row_end - s.row_begin;
   }
   return bytes;
 }
 
-void place_spans(const std::uint8_t* bytes, std::size_t n, const std::vector<RowSpan>& spans, std::vector<cv::Mat>& maps) {
+void place_spans(const std::uint8_t* bytes, std::size_t n, const std::vector<RowSpan>& spans,
+                 std::vector<cv::Mat>& maps) {
   std::size_t at = 0;
   for (const RowSpan& s : spans) {
     cv::Mat& map = maps.at(std::size_t(s.view));
@@ -73,7 +77,8 @@ MapSet bake_map_set_distributed(const Brdf& brdf, const Integrator& integrator, 
     if (times) *times = {seconds_since(t0), 0.0, long(views.views().size()) * options.res};
     return set;
   }
-  if (options.res < 1) throw std::invalid_argument("bake: the map size must be at least 1, not " + std::to_string(options.res));
+  if (options.res < 1)
+    throw std::invalid_argument("bake: the map size must be at least 1, not " + std::to_string(options.res));
   const int n_views = int(views.views().size());
   const auto mine = rows_of_rank(n_views, options.res, session.rank(), session.size());
   const auto t0 = std::chrono::steady_clock::now();

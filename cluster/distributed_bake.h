@@ -35,6 +35,7 @@ std::vector<std::uint8_t> integrate_spans(const Brdf& brdf, const Integrator& in
                                           const MapSetBakeOptions& options, const std::vector<RowSpan>& spans,
                                           const std::function<void(double)>& progress = {});
 // Throws std::runtime_error when the bytes are not exactly the spans' rows.
-void place_spans(const std::uint8_t* bytes, std::size_t n, const std::vector<RowSpan>& spans, std::vector<cv::Mat>& maps);
+void place_spans(const std::uint8_t* bytes, std::size_t n, const std::vector<RowSpan>& spans,
+                 std::vector<cv::Mat>& maps);
 
 }  // namespace rsibr::cluster

@@ -131,8 +131,8 @@ cv::Mat side_by_side(const SideBySideInput& in, int min_panel, int max_panel) {
   const double ticks[3] = {0.0, 0.5 * in.heat_max, in.heat_max};
   for (int i = 0; i < 3; ++i) {
     const std::string t = number_text(ticks[i]);
-    const int tx = std::clamp(hx + int(std::lround(i * 0.5 * (pw - 1))) - text_width(t) / 2, hx,
-                              hx + pw - text_width(t));
+    const int tx =
+        std::clamp(hx + int(std::lround(i * 0.5 * (pw - 1))) - text_width(t) / 2, hx, hx + pw - text_width(t));
     put_text(out, t, tx, by + bar_h + ticks_h - 5);
   }
   return out;

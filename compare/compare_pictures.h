@@ -28,11 +28,11 @@ double heat_scale_max(const std::vector<cv::Mat>& errors, const std::vector<cv::
                       double min_max = 0.01);
 
 struct SideBySideInput {
-  cv::Mat a_rgb, b_rgb;       // CV_32FC3 scene-linear working space
-  cv::Mat error, weight;      // CV_32FC1
-  float exposure_stops = 0;   // display exposure of A and B
-  double heat_max = 1;        // the heat map's scale
-  std::string title;          // e.g. "view.003  (0.00, 1.00, 0.00)"
+  cv::Mat a_rgb, b_rgb;      // CV_32FC3 scene-linear working space
+  cv::Mat error, weight;     // CV_32FC1
+  float exposure_stops = 0;  // display exposure of A and B
+  double heat_max = 1;       // the heat map's scale
+  std::string title;         // e.g. "view.003  (0.00, 1.00, 0.00)"
   std::string a_label = "A", b_label = "B", heat_label = "error";
   std::string unit = "stops";
 };

@@ -74,7 +74,8 @@ ErrorMetrics error_metrics(const ErrorSums& s, const ErrorSettings& settings) {
   if (s.squared_reference > 0) {
     m.relative_rms = std::sqrt(s.squared_error / s.squared_reference);
   } else if (s.squared_error > 0) {
-    throw std::invalid_argument("the reference B is zero over every weighted texel, A is not: no scale for a relative error");
+    throw std::invalid_argument(
+        "the reference B is zero over every weighted texel, A is not: no scale for a relative error");
   }
   m.log_rms_stops = std::sqrt(s.squared_log / (3 * s.weight));
   m.mse = s.squared_error / (3 * s.weight);

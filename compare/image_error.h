@@ -30,11 +30,11 @@ struct ErrorSettings {
 
 // Accumulated weighted sums; add() one image pair or merge() two accumulations, then metrics().
 struct ErrorSums {
-  double weight = 0;          // sum_p w_p
-  long texels = 0;            // texels with w_p > 0
-  double squared_error = 0;   // sum_p w_p sum_c (a-b)^2
-  double squared_reference = 0;  // sum_p w_p sum_c b^2
-  double squared_log = 0;     // sum_p w_p sum_c log2(...)^2
+  double weight = 0;                                     // sum_p w_p
+  long texels = 0;                                       // texels with w_p > 0
+  double squared_error = 0;                              // sum_p w_p sum_c (a-b)^2
+  double squared_reference = 0;                          // sum_p w_p sum_c b^2
+  double squared_log = 0;                                // sum_p w_p sum_c log2(...)^2
   std::array<double, 3> sum_a{0, 0, 0}, sum_b{0, 0, 0};  // sum_p w_p a_pc, sum_p w_p b_pc
 
   void merge(const ErrorSums& other);

@@ -47,7 +47,8 @@ void check_confidence(const cv::Mat& conf, const std::string& where) {
     const float* p = conf.ptr<float>(r);
     for (int x = 0; x < conf.cols; ++x)
       if (!std::isfinite(p[x]) || p[x] < 0)
-        throw std::invalid_argument(where + ": confidence at texel " + texel_text(x, r) + " is " + std::to_string(p[x]) + " (must be finite and >= 0)");
+        throw std::invalid_argument(where + ": confidence at texel " + texel_text(x, r) + " is " +
+                                    std::to_string(p[x]) + " (must be finite and >= 0)");
   }
 }
 
@@ -128,7 +129,8 @@ Comparison compare_pairs(std::vector<PairComparison> pairs, const CompareOptions
                                   size_text(im.b) + "; resample one of them first");
     if (im.a.type() != CV_32FC3 || im.b.type() != CV_32FC3 || im.weight.type() != CV_32FC1 ||
         im.weight.size() != im.a.size())
-      throw std::invalid_argument(o.name_a + ": " + p.name + ": images must be RGB float with a float weight of their size");
+      throw std::invalid_argument(o.name_a + ": " + p.name +
+                                  ": images must be RGB float with a float weight of their size");
     check_confidence(im.weight, o.name_a + ": " + p.name + " weight");
     if (const std::string at = first_non_finite(im.a, im.weight); !at.empty())
       throw std::invalid_argument(o.name_a + ": " + p.name + " has a non-finite value at texel " + at);
@@ -240,9 +242,9 @@ Reframed reframe(const MapView& view, const Mat3& world_from_view) {
 Comparison compare_map_sets(const MapSet& a, const MapSet& b, const CompareOptions& o) {
   if (a.views.empty() || b.views.empty()) throw std::invalid_argument(o.name_a + ": a map set without views");
   if (a.width() != b.width() || a.height() != b.height())
-    throw std::invalid_argument(o.name_a + ": maps are " + std::to_string(a.width()) + "x" + std::to_string(a.height()) +
-                                " but " + o.name_b + "'s are " + std::to_string(b.width()) + "x" +
-                                std::to_string(b.height()) + "; the sizes must match");
+    throw std::invalid_argument(
+        o.name_a + ": maps are " + std::to_string(a.width()) + "x" + std::to_string(a.height()) + " but " + o.name_b +
+        "'s are " + std::to_string(b.width()) + "x" + std::to_string(b.height()) + "; the sizes must match");
   if (a.views.front().albedo.empty() != b.views.front().albedo.empty() ||
       a.views.front().albedo != b.views.front().albedo)
     throw std::invalid_argument(o.name_a + ": albedo normalisation differs from " + o.name_b +
@@ -290,7 +292,7 @@ Comparison compare_environments(const EnvMap& a, const EnvMap& b, const CompareO
   p.name = "environment";
   p.images = {a.pixels, b.pixels,
               a.layout.kind() == LayoutKind::Sphere ? sphere_map_weight(a.pixels.cols, a.pixels.rows)
-                                                     : solid_angle_weight(a.layout)};
+                                                    : solid_angle_weight(a.layout)};
   std::vector<PairComparison> pairs;
   pairs.push_back(std::move(p));
   return compare_pairs(std::move(pairs), o);

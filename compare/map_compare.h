@@ -27,20 +27,20 @@ struct CompareOptions {
   // eps of the log error = this fraction of B's level: the weighted median over all pairs' texels
   // of B's channel mean (robust to a sun); B's weighted mean where that median is 0, else A's, else 1.
   double log_epsilon_fraction = 1e-2;
-  double psnr_peak = 0;            // > 0: this peak; 0: B's largest weighted value (the HDR peak)
+  double psnr_peak = 0;  // > 0: this peak; 0: B's largest weighted value (the HDR peak)
   double view_tolerance_deg = 0.5;
-  bool fit = true;                 // the global gain fit (metrics "after" equal "before" without it)
-  GainFitOptions fit_options;      // its log_epsilon is replaced by the eps above
+  bool fit = true;             // the global gain fit (metrics "after" equal "before" without it)
+  GainFitOptions fit_options;  // its log_epsilon is replaced by the eps above
 };
 
 struct PairComparison {
-  std::string name;       // "view.003" (A's part), or the environment's name
+  std::string name;  // "view.003" (A's part), or the environment's name
   int index_a = 0, index_b = 0;
-  Vec3 view = Vec3::Zero();  // A's view direction (zero for an environment)
-  double angle_deg = 0;      // between A's and B's view directions
+  Vec3 view = Vec3::Zero();    // A's view direction (zero for an environment)
+  double angle_deg = 0;        // between A's and B's view directions
   double frame_angle_deg = 0;  // rotation between A's and B's frames (roll and tilt)
   bool b_resampled = false;    // B was resampled into A's frame
-  WeightedImages images;     // A as read, B (in A's frame), the weights
+  WeightedImages images;       // A as read, B (in A's frame), the weights
   ErrorMetrics before, after;
 };
 

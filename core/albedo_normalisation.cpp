@@ -52,7 +52,8 @@ void for_disc_texels(cv::Mat& rgb, const std::vector<float>& table, Op op) {
 void normalise_by_albedo(cv::Mat& rgb, const std::vector<float>& table) {
   // Clamped to the float range: a radiance far above what the albedo allows must not become Inf.
   static constexpr float kMax = std::numeric_limits<float>::max();
-  for_disc_texels(rgb, table, [](float L, float a) { return a > kAlbedoFloor ? std::clamp(L / a, -kMax, kMax) : 0.0f; });
+  for_disc_texels(rgb, table,
+                  [](float L, float a) { return a > kAlbedoFloor ? std::clamp(L / a, -kMax, kMax) : 0.0f; });
 }
 
 void denormalise_by_albedo(cv::Mat& rgb, const std::vector<float>& table) {

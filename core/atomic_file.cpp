@@ -10,8 +10,7 @@
 
 namespace rsibr {
 
-void write_atomically(const std::filesystem::path& target,
-                      const std::function<void(const std::string&)>& writer) {
+void write_atomically(const std::filesystem::path& target, const std::function<void(const std::string&)>& writer) {
   static std::atomic<int> counter{0};
   // Keep the extension last so format-sniffing writers (OpenCV) still see it.
   std::filesystem::path tmp = target;

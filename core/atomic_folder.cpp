@@ -24,7 +24,7 @@ void check_output_folder(const std::filesystem::path& folder, const std::vector<
   std::error_code ec;
   if (folder.empty()) throw std::invalid_argument("the output folder name is empty");
   const fs::path parent = normal_folder(folder).parent_path();
-  if ( !fs::is_directory(parent, ec))
+  if (!fs::is_directory(parent, ec))
     throw std::invalid_argument(folder.string() + ": the folder " + parent.string() + " does not exist");
   if (fs::exists(folder, ec) && !fs::is_directory(folder, ec))
     throw std::invalid_argument(folder.string() + ": exists and is not a folder");
@@ -44,15 +44,15 @@ std::filesystem::path file_in_folder(const std::filesystem::path& folder, const 
   const fs::path parent = fs::weakly_canonical(normal_folder(path).parent_path(), ec1);
   const fs::path expected = fs::weakly_canonical(normal_folder(folder), ec2);
   if (ec1 || ec2 || parent != expected)
-    throw std::invalid_argument(folder.string() + ": '" + quoted_for_message(file_name) + "' lies outside the output folder");
+    throw std::invalid_argument(folder.string() + ": '" + quoted_for_message(file_name) +
+                                "' lies outside the output folder");
   return path;
 }
 
 void write_folder_atomically(const std::filesystem::path& folder, const FolderContents& files) {
   namespace fs = std::filesystem;
   check_output_folder(folder);
-  for (const auto& [name, bytes] : files)
-    file_in_folder(folder, name);
+  for (const auto& [name, bytes] : files) file_in_folder(folder, name);
   const fs::path target = normal_folder(folder);
   std::string staging_name = ".";
   staging_name += target.filename().string();

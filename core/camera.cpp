@@ -17,7 +17,8 @@ Camera look_at(const Vec3& eye, const Vec3& at, const Vec3& up, double vfov_deg,
   if (!eye.allFinite() || !at.allFinite() || !up.allFinite())
     throw std::invalid_argument("camera: eye, at and up must be finite");
   if ((at - eye).norm() <= 0) throw std::invalid_argument("camera: eye and at coincide");
-  if (!(vfov_deg > 0 && vfov_deg < 180)) throw std::invalid_argument("camera: field of view must be in (0, 180) degrees");
+  if (!(vfov_deg > 0 && vfov_deg < 180))
+    throw std::invalid_argument("camera: field of view must be in (0, 180) degrees");
   if (width <= 0 || height <= 0) throw std::invalid_argument("camera: image size must be positive");
   // The view frame of world_from_view_for(-forward, up) has x right, y up, z toward the viewer;
   // the camera frame is x right, y down, z forward: flip y and z.

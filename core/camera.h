@@ -25,9 +25,9 @@ struct CameraPose {
 struct Camera {
   int width = 640;
   int height = 360;
-  double fx = 500, fy = 500;  // focal lengths, pixels
-  double cx = 319.5, cy = 179.5;  // principal point, pixels (mrcal convention)
-  Vec3 eye = Vec3(0, 0, 3);       // camera centre, world
+  double fx = 500, fy = 500;               // focal lengths, pixels
+  double cx = 319.5, cy = 179.5;           // principal point, pixels (mrcal convention)
+  Vec3 eye = Vec3(0, 0, 3);                // camera centre, world
   Mat3 world_from_cam = Mat3::Identity();  // columns: camera x (right), y (down), z (forward) in world
 
   // Unit world direction of the ray through image point (px, py) (pixel units, mrcal convention).

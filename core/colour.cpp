@@ -33,8 +33,8 @@ OCIO::ConstConfigRcPtr load_config() {
       config->validate();
       return config;
     } catch (const std::exception& e) {
-      throw std::runtime_error("rsibr: cannot load the OpenColorIO config named by $OCIO ('" +
-                               std::string(env) + "'): " + one_line(e.what()));
+      throw std::runtime_error("rsibr: cannot load the OpenColorIO config named by $OCIO ('" + std::string(env) +
+                               "'): " + one_line(e.what()));
     }
   }
   try {
@@ -43,8 +43,7 @@ OCIO::ConstConfigRcPtr load_config() {
     config->validate();
     return config;
   } catch (const std::exception& e) {
-    throw std::runtime_error("rsibr: the embedded OpenColorIO config is invalid: " +
-                             one_line(e.what()));
+    throw std::runtime_error("rsibr: the embedded OpenColorIO config is invalid: " + one_line(e.what()));
   }
 }
 
@@ -110,13 +109,11 @@ void convert_colour_space(cv::Mat& rgb, const std::string& from, const std::stri
   if (rgb.empty()) return;
   // Lossless optimisation: exact pow/log (the default level approximates them).
   const OCIO::ConstCPUProcessorRcPtr cpu =
-      config->getProcessor(from.c_str(), to.c_str())
-          ->getOptimizedCPUProcessor(OCIO::OPTIMIZATION_LOSSLESS);
+      config->getProcessor(from.c_str(), to.c_str())->getOptimizedCPUProcessor(OCIO::OPTIMIZATION_LOSSLESS);
   if (cpu->isNoOp()) return;
   const long channels = rgb.channels();
-  OCIO::PackedImageDesc desc(rgb.data, rgb.cols, rgb.rows, channels, OCIO::BIT_DEPTH_F32,
-                             sizeof(float), static_cast<ptrdiff_t>(sizeof(float) * channels),
-                             static_cast<ptrdiff_t>(rgb.step[0]));
+  OCIO::PackedImageDesc desc(rgb.data, rgb.cols, rgb.rows, channels, OCIO::BIT_DEPTH_F32, sizeof(float),
+                             static_cast<ptrdiff_t>(sizeof(float) * channels), static_cast<ptrdiff_t>(rgb.step[0]));
   cpu->apply(desc);
 }
 
@@ -140,8 +137,7 @@ cv::Mat display_encode(const cv::Mat& linear_rgb, float exposure_stops, const st
     if (v == config->getView(disp.c_str(), i)) view_known = true;
   }
   if (!view_known) {
-    throw std::runtime_error("rsibr: unknown view '" + v + "' for display '" + disp +
-                             "' in the OpenColorIO config");
+    throw std::runtime_error("rsibr: unknown view '" + v + "' for display '" + disp + "' in the OpenColorIO config");
   }
 
   // Scale and sanitise: NaN -> 0 and +-Inf -> +-max finite, so the transform sees finite input.
@@ -162,12 +158,10 @@ cv::Mat display_encode(const cv::Mat& linear_rgb, float exposure_stops, const st
 
   if (!work.empty()) {
     const OCIO::ConstCPUProcessorRcPtr cpu =
-        config->getProcessor(working_space().c_str(), disp.c_str(), v.c_str(),
-                             OCIO::TRANSFORM_DIR_FORWARD)
+        config->getProcessor(working_space().c_str(), disp.c_str(), v.c_str(), OCIO::TRANSFORM_DIR_FORWARD)
             ->getDefaultCPUProcessor();
-    OCIO::PackedImageDesc desc(work.data, work.cols, work.rows, 3, OCIO::BIT_DEPTH_F32,
-                               sizeof(float), 3 * sizeof(float),
-                               static_cast<ptrdiff_t>(work.step[0]));
+    OCIO::PackedImageDesc desc(work.data, work.cols, work.rows, 3, OCIO::BIT_DEPTH_F32, sizeof(float),
+                               3 * sizeof(float), static_cast<ptrdiff_t>(work.step[0]));
     cpu->apply(desc);
   }
 
@@ -196,8 +190,7 @@ Eigen::Matrix3d working_from_chromaticities(const Imf::Chromaticities& c) {
   const Imf::Chromaticities working;  // default: Rec.709 primaries, D65 white
   const Eigen::Matrix3d xyz_from_rgb = to_column_major_3x3(Imf::RGBtoXYZ(c, 1.0f));
   // Invert in double rather than using Imf::XYZtoRGB so the Rec.709 case is identity to ~1e-7.
-  const Eigen::Matrix3d working_from_xyz =
-      to_column_major_3x3(Imf::RGBtoXYZ(working, 1.0f)).inverse();
+  const Eigen::Matrix3d working_from_xyz = to_column_major_3x3(Imf::RGBtoXYZ(working, 1.0f)).inverse();
   if (c.white == working.white) return working_from_xyz * xyz_from_rgb;
   return working_from_xyz * bradford(c.white, working.white) * xyz_from_rgb;
 }

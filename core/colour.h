@@ -34,8 +34,8 @@ void convert_colour_space(cv::Mat& rgb, const std::string& from, const std::stri
 // transform (empty names: the config's default display and its default view), and quantises to
 // CV_8UC3 in **BGR** order, ready for cv::imwrite. Out-of-range results clamp to [0, 255]; NaN
 // maps to 0, +Inf to 255, -Inf to 0. Throws std::runtime_error for an unknown display or view.
-cv::Mat display_encode(const cv::Mat& linear_rgb, float exposure_stops,
-                       const std::string& display = "", const std::string& view = "");
+cv::Mat display_encode(const cv::Mat& linear_rgb, float exposure_stops, const std::string& display = "",
+                       const std::string& view = "");
 
 // 3x3 matrix taking linear RGB with the given primaries and white (e.g. an EXR `chromaticities`
 // attribute) to the working space's linear Rec.709 primaries with D65 white, adapting the white

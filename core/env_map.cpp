@@ -55,9 +55,7 @@ void sample_bilinear(const EnvMap& map, const Vec3& dir, float* out) {
   const int W = L.width(), H = L.height();
   Tap taps[4];
   switch (L.kind()) {
-    case LayoutKind::LatLong:
-      clamped_taps(L.pixel(dir), 0, W - 1, 0, H - 1, taps);
-      break;
+    case LayoutKind::LatLong: clamped_taps(L.pixel(dir), 0, W - 1, 0, H - 1, taps); break;
     case LayoutKind::Cube: {
       // Stay inside the face the direction belongs to (its edge texels lie on the cube's edges).
       const Vec2 p = L.pixel(dir);
@@ -73,10 +71,20 @@ void sample_bilinear(const EnvMap& map, const Vec3& dir, float* out) {
       // Neighbours across the square's border: the octahedral fold makes (u, 1) and (-u, 1) (and
       // likewise on every edge) the same direction, so texel (c, -1) is texel (N-1-c, 0).
       auto wrap = [N](int c, int r) {
-        if (c < 0) { c = 0; r = N - 1 - r; }
-        else if (c >= N) { c = N - 1; r = N - 1 - r; }
-        if (r < 0) { r = 0; c = N - 1 - c; }
-        else if (r >= N) { r = N - 1; c = N - 1 - c; }
+        if (c < 0) {
+          c = 0;
+          r = N - 1 - r;
+        } else if (c >= N) {
+          c = N - 1;
+          r = N - 1 - r;
+        }
+        if (r < 0) {
+          r = 0;
+          c = N - 1 - c;
+        } else if (r >= N) {
+          r = N - 1;
+          c = N - 1 - c;
+        }
         return std::pair<int, int>(std::clamp(c, 0, N - 1), std::clamp(r, 0, N - 1));
       };
       const int cs[4] = {c0, c0 + 1, c0, c0 + 1}, rs[4] = {r0, r0, r0 + 1, r0 + 1};

@@ -115,7 +115,8 @@ void check_before_opening(const std::string& path) {
   in.seekg(0);
   unsigned char head[8] = {};
   in.read(reinterpret_cast<char*>(head), 8);
-  if (!in || head[0] != 0x76 || head[1] != 0x2f || head[2] != 0x31 || head[3] != 0x01) fail(path, "not an OpenEXR file");
+  if (!in || head[0] != 0x76 || head[1] != 0x2f || head[2] != 0x31 || head[3] != 0x01)
+    fail(path, "not an OpenEXR file");
   const bool multipart = (head[5] & 0x10) != 0;
   auto read_string = [&](const char* what) {
     std::string s;
@@ -148,7 +149,6 @@ void check_before_opening(const std::string& path) {
   }
 }
 
-
 ExrPartIn part_from_header(const Imf::Header& h, const std::string& path) {
   ExrPartIn p;
   if (h.hasName()) p.name = h.name();
@@ -165,12 +165,16 @@ ExrPartIn part_from_header(const Imf::Header& h, const std::string& path) {
     p.working_from_file = working_from_chromaticities(Imf::chromaticities(h));
   for (auto it = h.begin(); it != h.end(); ++it) {
     const Imf::Attribute& a = it.attribute();
-    if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&a)) p.attributes[it.name()] = s->value();
-    else if (const auto* i = dynamic_cast<const Imf::IntAttribute*>(&a)) p.attributes[it.name()] = i->value();
+    if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&a))
+      p.attributes[it.name()] = s->value();
+    else if (const auto* i = dynamic_cast<const Imf::IntAttribute*>(&a))
+      p.attributes[it.name()] = i->value();
     else if (const auto* v = dynamic_cast<const Imf::V3fAttribute*>(&a))
       p.attributes[it.name()] = Vec3(v->value().x, v->value().y, v->value().z);
-    else if (const auto* m = dynamic_cast<const Imf::M33fAttribute*>(&a)) p.attributes[it.name()] = from_m33(m->value());
-    else if (const auto* f = dynamic_cast<const Imf::FloatVectorAttribute*>(&a)) p.attributes[it.name()] = f->value();
+    else if (const auto* m = dynamic_cast<const Imf::M33fAttribute*>(&a))
+      p.attributes[it.name()] = from_m33(m->value());
+    else if (const auto* f = dynamic_cast<const Imf::FloatVectorAttribute*>(&a))
+      p.attributes[it.name()] = f->value();
   }
   return p;
 }
@@ -184,13 +188,18 @@ Imf::Header header_for(const ExrPartOut& part, int W, int H, bool multipart, con
   if (part.envmap == ExrEnvmap::LatLong) Imf::addEnvmap(h, Imf::ENVMAP_LATLONG);
   if (part.envmap == ExrEnvmap::Cube) Imf::addEnvmap(h, Imf::ENVMAP_CUBE);
   for (const auto& [name, value] : part.attributes) {
-    if (name.size() > kMaxAttributeName) fail_output(path, "attribute name '" + name + "' is longer than 31 characters");
-    if (const auto* s = std::get_if<std::string>(&value)) h.insert(name, Imf::StringAttribute(valid_utf8(*s)));
-    else if (const auto* i = std::get_if<int>(&value)) h.insert(name, Imf::IntAttribute(*i));
+    if (name.size() > kMaxAttributeName)
+      fail_output(path, "attribute name '" + name + "' is longer than 31 characters");
+    if (const auto* s = std::get_if<std::string>(&value))
+      h.insert(name, Imf::StringAttribute(valid_utf8(*s)));
+    else if (const auto* i = std::get_if<int>(&value))
+      h.insert(name, Imf::IntAttribute(*i));
     else if (const auto* v = std::get_if<Vec3>(&value))
       h.insert(name, Imf::V3fAttribute(Imath::V3f(float(v->x()), float(v->y()), float(v->z()))));
-    else if (const auto* m = std::get_if<Mat3>(&value)) h.insert(name, Imf::M33fAttribute(to_m33(*m)));
-    else h.insert(name, Imf::FloatVectorAttribute(std::get<std::vector<float>>(value)));
+    else if (const auto* m = std::get_if<Mat3>(&value))
+      h.insert(name, Imf::M33fAttribute(to_m33(*m)));
+    else
+      h.insert(name, Imf::FloatVectorAttribute(std::get<std::vector<float>>(value)));
   }
   const Imf::PixelType type = part.half ? Imf::HALF : Imf::FLOAT;
   for (const ExrChannelOut& c : part.channels) h.channels().insert(c.name, Imf::Channel(type));
@@ -270,7 +279,8 @@ void write_exr(const std::string& path, const std::vector<ExrPartOut>& parts) {
     for (const ExrChannelOut& c : part.channels)
       if (c.image.depth() != CV_32F || c.image.size() != size || c.index < 0 || c.index >= c.image.channels())
         fail_output(path, "internal: channel '" + c.name + "' is not a float channel of the part's size");
-    if (multipart && part.name.empty()) fail_output(path, "internal: part " + std::to_string(i) + " of several has no name");
+    if (multipart && part.name.empty())
+      fail_output(path, "internal: part " + std::to_string(i) + " of several has no name");
     headers.push_back(header_for(part, size.width, size.height, multipart, path));
     fill_pixels(part, size.width, size.height, path, pixels[i]);
   }
@@ -298,7 +308,8 @@ void write_exr(const std::string& path, const std::vector<ExrPartOut>& parts) {
     // OpenEXR names the temporary, which never outlives the failure: the user is told `path`.
     std::string what = e.what();
     for (const std::string& name : {" \"" + temporary + "\"", " " + temporary})
-      for (std::size_t at; !temporary.empty() && (at = what.find(name)) != std::string::npos;) what.erase(at, name.size());
+      for (std::size_t at; !temporary.empty() && (at = what.find(name)) != std::string::npos;)
+        what.erase(at, name.size());
     for (char& c : what)
       if (c == '\n') c = ' ';
     fail_output(path, what);

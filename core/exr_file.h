@@ -39,7 +39,7 @@ struct ExrChannelOut {
 };
 
 struct ExrPartOut {
-  std::string name;  // the part's name (required for multi-part files, optional for one part)
+  std::string name;                     // the part's name (required for multi-part files, optional for one part)
   std::vector<ExrChannelOut> channels;  // all of one size, at least one
   std::vector<std::pair<std::string, ExrValue>> attributes;  // names as stored
   ExrEnvmap envmap = ExrEnvmap::None;
@@ -57,11 +57,11 @@ void write_exr(const std::string& path, const std::vector<ExrPartOut>& parts);
 
 // The header of one part as read.
 struct ExrPartIn {
-  std::string name;                  // "" when the part has none
-  int width = 0, height = 0;         // of the data window (checked)
-  std::vector<std::string> channels; // names as stored, in the file's (alphabetical) order
-  std::string channel_types;         // names and types, e.g. "B:half G:half R:half"
-  std::string compression;           // e.g. "zip", "dwaa (lossy)"
+  std::string name;                   // "" when the part has none
+  int width = 0, height = 0;          // of the data window (checked)
+  std::vector<std::string> channels;  // names as stored, in the file's (alphabetical) order
+  std::string channel_types;          // names and types, e.g. "B:half G:half R:half"
+  std::string compression;            // e.g. "zip", "dwaa (lossy)"
   ExrEnvmap envmap = ExrEnvmap::None;
   // The matrix from the file's primaries to the working space (core/colour.h); nullopt when the
   // file's `chromaticities` are Rec.709/D65 or absent.

@@ -5,7 +5,6 @@
 #include "core/input_file.h"
 #include "core/text.h"
 
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 

@@ -17,12 +17,12 @@
 namespace rsibr {
 
 struct EnvReadReport {
-  std::string format;            // "exr" or "hdr"
-  std::string channels;          // channel names and types as stored, e.g. "B:half G:half R:half"
-  std::string compression;       // EXR compression name
-  std::string layout_source;     // "envmap attribute", "rsibr.layout attribute", "--layout", "shape"
+  std::string format;         // "exr" or "hdr"
+  std::string channels;       // channel names and types as stored, e.g. "B:half G:half R:half"
+  std::string compression;    // EXR compression name
+  std::string layout_source;  // "envmap attribute", "rsibr.layout attribute", "--layout", "shape"
   bool chromaticities_converted = false;
-  TexelAudit texels;             // NaN, Inf, huge and negative values, over all channels
+  TexelAudit texels;  // NaN, Inf, huge and negative values, over all channels
 };
 
 // Throws FileError (core/file_error.h: "<path>: <problem>") on any failure.

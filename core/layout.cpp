@@ -24,12 +24,30 @@ void cube_face_and_position(const Vec2& p, int sof, Imf::CubeMapFace& face, Imat
   const double lx = p.x(), ly = p.y() - double(f) * sof, m = sof - 1;
   double px = 0, py = 0;
   switch (face) {
-    case Imf::CUBEFACE_POS_X: px = m - ly; py = lx; break;
-    case Imf::CUBEFACE_NEG_X: px = m - ly; py = m - lx; break;
-    case Imf::CUBEFACE_POS_Y: px = lx; py = m - ly; break;
-    case Imf::CUBEFACE_NEG_Y: px = lx; py = ly; break;
-    case Imf::CUBEFACE_POS_Z: px = m - lx; py = m - ly; break;
-    case Imf::CUBEFACE_NEG_Z: px = lx; py = m - ly; break;
+    case Imf::CUBEFACE_POS_X:
+      px = m - ly;
+      py = lx;
+      break;
+    case Imf::CUBEFACE_NEG_X:
+      px = m - ly;
+      py = m - lx;
+      break;
+    case Imf::CUBEFACE_POS_Y:
+      px = lx;
+      py = m - ly;
+      break;
+    case Imf::CUBEFACE_NEG_Y:
+      px = lx;
+      py = ly;
+      break;
+    case Imf::CUBEFACE_POS_Z:
+      px = m - lx;
+      py = m - ly;
+      break;
+    case Imf::CUBEFACE_NEG_Z:
+      px = lx;
+      py = m - ly;
+      break;
   }
   pif = Imath::V2f(float(px), float(py));
 }
@@ -112,8 +130,8 @@ Vec2 octahedral_uv(const Vec3& d) {
 std::optional<Vec3> Layout::direction(const Vec2& p) const {
   switch (kind_) {
     case LayoutKind::LatLong: {
-      const Imath::V3f d = Imf::LatLongMap::direction(data_window(width_, height_),
-                                                      Imath::V2f(float(p.x()), float(p.y())));
+      const Imath::V3f d =
+          Imf::LatLongMap::direction(data_window(width_, height_), Imath::V2f(float(p.x()), float(p.y())));
       return from_imath(d).normalized();
     }
     case LayoutKind::Cube: {
@@ -162,8 +180,7 @@ Vec2 Layout::pixel(const Vec3& d) const {
       const Vec2 uv = octahedral_uv(d);
       return Vec2(0.5 * ((uv.x() + 1.0) * width_ - 1.0), 0.5 * ((1.0 - uv.y()) * height_ - 1.0));
     }
-    case LayoutKind::Sphere:
-      return sphere_map::pixel_from_disc(sphere_map::g_mirror_inv(d), width_, height_);
+    case LayoutKind::Sphere: return sphere_map::pixel_from_disc(sphere_map::g_mirror_inv(d), width_, height_);
   }
   return Vec2(0, 0);
 }
@@ -187,8 +204,7 @@ double Layout::texel_solid_angle(int c, int r) const {
       cube_face_and_position(Vec2(c, r), sof, face, pif);
       const double m = sof - 1, s = 2.0 / m;
       auto coord = [&](double q) { return std::clamp(q, 0.0, m) * s - 1.0; };
-      return plane_rect_solid_angle(coord(pif.x - 0.5), coord(pif.x + 0.5), coord(pif.y - 0.5),
-                                    coord(pif.y + 0.5));
+      return plane_rect_solid_angle(coord(pif.x - 0.5), coord(pif.x + 0.5), coord(pif.y - 0.5), coord(pif.y + 0.5));
     }
     case LayoutKind::Octahedral: {
       // A texel is a square in (u,v). Lines on one octahedron face project to great circles, so

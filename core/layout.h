@@ -64,9 +64,7 @@ class Layout {
   // Solid angle per unit pixel area at a position (0 outside the sphere layout's disc).
   double solid_angle_density(const Vec2& pixel) const;
 
-  bool operator==(const Layout& o) const {
-    return kind_ == o.kind_ && width_ == o.width_ && height_ == o.height_;
-  }
+  bool operator==(const Layout& o) const { return kind_ == o.kind_ && width_ == o.width_ && height_ == o.height_; }
 
  private:
   LayoutKind kind_ = LayoutKind::LatLong;

@@ -218,8 +218,8 @@ LensModel LensModel::read(const std::filesystem::path& file) {
 void LensModel::write(const std::filesystem::path& file) const {
   const mrcal_lensmodel_t lm = lensmodel_of(name_);
   const std::size_t bytes = sizeof(mrcal_cameramodel_t) + intrinsics_.size() * sizeof(double);
-  std::unique_ptr<mrcal_cameramodel_t, decltype(&std::free)> m(
-      static_cast<mrcal_cameramodel_t*>(std::calloc(1, bytes)), &std::free);
+  std::unique_ptr<mrcal_cameramodel_t, decltype(&std::free)> m(static_cast<mrcal_cameramodel_t*>(std::calloc(1, bytes)),
+                                                               &std::free);
   if (!m) throw std::runtime_error(file.string() + ": out of memory");
   for (int i = 0; i < 6; ++i) m->rt_cam_ref[i] = rt_cam_ref_[std::size_t(i)];
   m->imagersize[0] = unsigned(width_);
@@ -286,8 +286,8 @@ RayTable::RayTable(const LensModel& lens, int step) : step_(step) {
   rows_ = int(std::ceil((lens.height() + 1.0 + 4.0 * step) / step)) + 1;
   std::vector<Vec2> pix(std::size_t(cols_) * std::size_t(rows_));
   for (int r = 0; r < rows_; ++r)
-    for (int c = 0; c < cols_; ++c) pix[std::size_t(r) * std::size_t(cols_) + std::size_t(c)] =
-        Vec2(x0_ + c * step, y0_ + r * step);
+    for (int c = 0; c < cols_; ++c)
+      pix[std::size_t(r) * std::size_t(cols_) + std::size_t(c)] = Vec2(x0_ + c * step, y0_ + r * step);
   std::vector<Vec3> d(pix.size());
   lens.unproject(pix.data(), int(pix.size()), d.data());
   xy_.resize(pix.size());

@@ -47,7 +47,6 @@ void rational(const double* k, double rho, double& num, double& den) {
   den = 1 + rho * (k[3] + rho * (k[4] + rho * k[5]));
 }
 
-
 // OPENCV8's radial factor fitted to the samples with `den_terms` (1..3) denominator terms, k[3 +
 // den_terms..5] held at 0: the linearised form t den = x num by least squares, then
 // Levenberg-Marquardt on the true residual x num / den - t. False when it does not converge to
@@ -134,7 +133,8 @@ const lfDatabase* lensfun_database() {
 std::optional<LensfunLens> lensfun_lens(const std::string& make, const std::string& model, const std::string& lens_name,
                                         double focal_mm, int width, int height, std::string* why) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("lensfun_lens: the image size must be positive");
-  if (!(focal_mm > 0) || !std::isfinite(focal_mm)) throw std::invalid_argument("lensfun_lens: the focal length must be positive");
+  if (!(focal_mm > 0) || !std::isfinite(focal_mm))
+    throw std::invalid_argument("lensfun_lens: the focal length must be positive");
   auto fail = [&](const std::string& w) -> std::optional<LensfunLens> {
     if (why) *why = w;
     return std::nullopt;
@@ -162,7 +162,8 @@ std::optional<LensfunLens> lensfun_lens(const std::string& make, const std::stri
       LensfunLens L;
       L.focal_mm = focal_mm;
       L.crop_factor = cam->CropFactor;
-      const std::string lmaker = lens->Maker ? lf_mlstr_get(lens->Maker) : "", lmodel = lens->Model ? lf_mlstr_get(lens->Model) : "";
+      const std::string lmaker = lens->Maker ? lf_mlstr_get(lens->Maker) : "",
+                        lmodel = lens->Model ? lf_mlstr_get(lens->Model) : "";
       L.lens_name = lmodel.rfind(lmaker, 0) == 0 ? lmodel : lmaker + " " + lmodel;
       L.camera = std::string(lf_mlstr_get(cam->Maker)) + " " + lf_mlstr_get(cam->Model);
       L.profile = model_text(dc);
@@ -208,8 +209,8 @@ std::optional<LensfunLens> lensfun_lens(const std::string& make, const std::stri
         const double spread = 1.6;
         for (int j = 0; j < ny; ++j)
           for (int i = 0; i < nx; ++i) {
-            const Eigen::Vector2d u = c + spread * Eigen::Vector2d((i / double(nx - 1) - 0.5) * width,
-                                                                   (j / double(ny - 1) - 0.5) * height);
+            const Eigen::Vector2d u =
+                c + spread * Eigen::Vector2d((i / double(nx - 1) - 0.5) * width, (j / double(ny - 1) - 0.5) * height);
             const Eigen::Vector2d d = distorted(mod, u);
             if (!d.allFinite() || d.x() < -2 || d.y() < -2 || d.x() > width + 1 || d.y() > height + 1) continue;
             const Eigen::Vector2d v = u - c;
@@ -308,8 +309,7 @@ std::optional<LensfunVignetting> lensfun_vignetting(const std::string& make, con
     const lfLens* lens = lenses[0];
     lfLensCalibVignetting calib;
     const float crop = cam ? cam->CropFactor : lens->CropFactor;
-    if (lf_lens_interpolate_vignetting(lens, float(focal_mm), float(aperture), float(distance_m), &calib) &&
-        crop > 0) {
+    if (lf_lens_interpolate_vignetting(lens, float(focal_mm), float(aperture), float(distance_m), &calib) && crop > 0) {
       // lensfun's correction of a flat field of ones is 1 / v: sampled on a grid of rows, fitted.
       lfModifier* mod = lf_modifier_new(lens, crop, width, height);
       const int flags = lf_modifier_initialize(mod, lens, LF_PF_F32, float(focal_mm), float(aperture),
@@ -324,8 +324,8 @@ std::optional<LensfunVignetting> lensfun_vignetting(const std::string& make, con
         std::vector<float> row(std::size_t(width) * 3);
         for (int y = 0; y < height; y += step) {
           std::fill(row.begin(), row.end(), 1.0f);
-          lf_modifier_apply_color_modification(mod, row.data(), 0.0f, float(y), width, 1,
-                                               LF_CR_3(RED, GREEN, BLUE), int(row.size() * sizeof(float)));
+          lf_modifier_apply_color_modification(mod, row.data(), 0.0f, float(y), width, 1, LF_CR_3(RED, GREEN, BLUE),
+                                               int(row.size() * sizeof(float)));
           for (int x = 0; x < width; x += step) {
             const double g = row[std::size_t(x) * 3 + 1];
             if (!(g > 0) || !std::isfinite(g)) continue;
@@ -340,7 +340,8 @@ std::optional<LensfunVignetting> lensfun_vignetting(const std::string& make, con
         if (k.allFinite() && !samples.empty()) {
           LensfunVignetting lv;
           lv.k = {k[0], k[1], k[2]};
-          const std::string maker = lens->Maker ? lf_mlstr_get(lens->Maker) : "", model = lens->Model ? lf_mlstr_get(lens->Model) : "";
+          const std::string maker = lens->Maker ? lf_mlstr_get(lens->Maker) : "",
+                            model = lens->Model ? lf_mlstr_get(lens->Model) : "";
           lv.lens = model.rfind(maker, 0) == 0 ? model : maker + " " + model;  // models usually start with the maker
           double s2 = 0;
           for (const auto& [r2, v] : samples) {

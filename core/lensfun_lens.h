@@ -33,13 +33,13 @@ const lfDatabase* lensfun_database();
 
 struct LensfunLens {
   LensModel lens = LensModel::pinhole(1, 2, 2);  // the image's size; centre: lensfun's distortion centre
-  double focal_px = 0;      // paraxial, pixels (fx = fy)
-  double focal_mm = 0;      // the focal length it was evaluated at (nominal)
-  double crop_factor = 0;   // the camera's (lensfun), else the lens's calibration crop
-  std::string lens_name;    // lensfun's name for the lens
-  std::string camera;       // lensfun's name for the camera (empty: not in the database)
-  std::string profile;      // e.g. "ptlens a=0.00644 b=-0.01245 c=-0.0348 at 18 mm"
-  double fit_rms_px = 0, fit_max_px = 0;  // the model against lensfun's mapping over the photo
+  double focal_px = 0;                           // paraxial, pixels (fx = fy)
+  double focal_mm = 0;                           // the focal length it was evaluated at (nominal)
+  double crop_factor = 0;                        // the camera's (lensfun), else the lens's calibration crop
+  std::string lens_name;                         // lensfun's name for the lens
+  std::string camera;                            // lensfun's name for the camera (empty: not in the database)
+  std::string profile;                           // e.g. "ptlens a=0.00644 b=-0.01245 c=-0.0348 at 18 mm"
+  double fit_rms_px = 0, fit_max_px = 0;         // the model against lensfun's mapping over the photo
 };
 
 // Nullopt (with *why set when given) when the database lacks the lens or its distortion at that
@@ -56,7 +56,7 @@ std::optional<LensfunLens> lensfun_lens(const std::string& make, const std::stri
 // lensfun lacks the lens or its vignetting, or the focal length or aperture is not positive.
 struct LensfunVignetting {
   std::array<double, 3> k{0, 0, 0};
-  std::string lens;      // lensfun's name for it
+  std::string lens;  // lensfun's name for it
   double fit_rms = 0;
 };
 std::optional<LensfunVignetting> lensfun_vignetting(const std::string& make, const std::string& model,

@@ -9,7 +9,6 @@
 #include "core/texel_audit.h"
 #include "core/text.h"
 
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -129,7 +128,8 @@ MapSet read_map_set(const std::string& path, BadTexels bad, long* zeroed) {
     const ExrPartIn& h = file.parts()[std::size_t(i)];
     const std::string who = "part " + std::to_string(i);
     auto fail = [&](const std::string& problem) { throw FileError(path, problem, who); };
-    if (h.name != part_name(std::size_t(i))) fail("expected a part named " + part_name(std::size_t(i)) + " (not a map set?)");
+    if (h.name != part_name(std::size_t(i)))
+      fail("expected a part named " + part_name(std::size_t(i)) + " (not a map set?)");
     const auto view = h.get<Vec3>("rsibr.view");
     const auto T = h.get<Mat3>("rsibr.worldFromView");
     const auto warp = h.get<std::string>("rsibr.warp");

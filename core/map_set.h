@@ -33,7 +33,7 @@ const char* to_string(MapSource source);                    // "computed" / "cap
 MapSource map_source_from_string(const std::string& name);  // std::invalid_argument for others
 
 struct MapView {
-  Vec3 view = Vec3(0, 0, 1);          // world, unit; stored as float on disk
+  Vec3 view = Vec3(0, 0, 1);  // world, unit; stored as float on disk
   Mat3 world_from_view = Mat3::Identity();
   CentralDirection warp = CentralDirection::Mirror;  // which central direction the runtime warps
   MapSource source = MapSource::Computed;
@@ -42,8 +42,8 @@ struct MapView {
   // L / A(n.v) and the runtime (runtime/blend_engine.h) multiplies A back at the destination.
   std::vector<float> albedo;
   std::map<std::string, std::string> attributes;  // provenance, written as rsibr.<key>
-  cv::Mat rgb;                        // CV_32FC3, RGB order, sphere-map layout (square or not)
-  cv::Mat confidence;                 // empty, or CV_32FC1 of the same size
+  cv::Mat rgb;                                    // CV_32FC3, RGB order, sphere-map layout (square or not)
+  cv::Mat confidence;                             // empty, or CV_32FC1 of the same size
   // Empty, or CV_32FC1 of the same size: where some of the texel's image samples were clipped in
   // every bracket (their radiance is a lower bound), the confidence the texel would have had without
   // them (its confidence is then 0); 0 elsewhere. "Seen" = confidence > 0 or clipped > 0.

@@ -96,10 +96,9 @@ void finalize_mesh(Mesh& mesh, std::vector<bool>& has_normal, MeshLoadReport& re
   }
   mesh.triangles.resize(kept);
   if (mesh.triangles.empty()) {
-    throw std::runtime_error(report.dropped_degenerate ? "no triangles (all " +
-                                                             std::to_string(report.dropped_degenerate) +
-                                                             " are degenerate)"
-                                                       : "no triangles");
+    throw std::runtime_error(report.dropped_degenerate
+                                 ? "no triangles (all " + std::to_string(report.dropped_degenerate) + " are degenerate)"
+                                 : "no triangles");
   }
 
   // File normals: normalised; zero or non-finite ones are recomputed like missing ones.
@@ -124,7 +123,6 @@ void finalize_mesh(Mesh& mesh, std::vector<bool>& has_normal, MeshLoadReport& re
   report.triangles = mesh.triangles.size();
 }
 
-
 Mesh load_obj(const std::string& path, MeshLoadReport& report) {
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
@@ -136,8 +134,7 @@ Mesh load_obj(const std::string& path, MeshLoadReport& report) {
     throw std::runtime_error(err.empty() ? "cannot parse OBJ" : "OBJ: " + err);
   }
   const auto& attrib = reader.GetAttrib();
-  const std::size_t nv = attrib.vertices.size() / 3, nn = attrib.normals.size() / 3,
-                    nt = attrib.texcoords.size() / 2;
+  const std::size_t nv = attrib.vertices.size() / 3, nn = attrib.normals.size() / 3, nt = attrib.texcoords.size() / 2;
 
   Mesh mesh;
   std::vector<bool> has_normal;
@@ -249,8 +246,7 @@ std::string patch_draco_json(const std::string& text) {
   return changed ? doc.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) : text;
 }
 
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
-                void*) {
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
   return true;  // textures are not part of a Mesh; leave them undecoded
 }
 
@@ -319,8 +315,7 @@ float component(const unsigned char* p, int type, bool normalized) {
       const auto v = static_cast<int8_t>(*p);
       return normalized ? std::max(float(v) / 127.0f, -1.0f) : float(v);
     }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-      return normalized ? float(*p) / 255.0f : float(*p);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? float(*p) / 255.0f : float(*p);
     case TINYGLTF_COMPONENT_TYPE_SHORT: {
       int16_t v;
       std::memcpy(&v, p, 2);
@@ -336,8 +331,7 @@ float component(const unsigned char* p, int type, bool normalized) {
       std::memcpy(&v, p, 4);
       return normalized ? float(double(v) / 4294967295.0) : float(v);
     }
-    default:
-      throw std::runtime_error("unsupported accessor component type " + std::to_string(type));
+    default: throw std::runtime_error("unsupported accessor component type " + std::to_string(type));
   }
 }
 
@@ -354,7 +348,8 @@ AccessorView view_accessor(const tinygltf::Model& model, int index, const std::s
   if (index < 0 || std::size_t(index) >= model.accessors.size())
     throw std::runtime_error(what + " accessor " + std::to_string(index) + " out of range");
   const auto& acc = model.accessors[std::size_t(index)];
-  if (acc.sparse.isSparse) throw std::runtime_error(what + " accessor " + std::to_string(index) + " is sparse (not supported)");
+  if (acc.sparse.isSparse)
+    throw std::runtime_error(what + " accessor " + std::to_string(index) + " is sparse (not supported)");
   AccessorView v;
   v.count = acc.count;
   v.component_type = acc.componentType;
@@ -402,18 +397,14 @@ std::vector<uint32_t> read_indices(const tinygltf::Model& model, int index) {
   for (std::size_t i = 0; i < v.count; ++i) {
     const unsigned char* p = v.data + i * v.stride;
     switch (v.component_type) {
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-        out[i] = *p;
-        break;
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: out[i] = *p; break;
       case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
         uint16_t x;
         std::memcpy(&x, p, 2);
         out[i] = x;
         break;
       }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-        std::memcpy(&out[i], p, 4);
-        break;
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: std::memcpy(&out[i], p, 4); break;
       default:
         throw std::runtime_error("index accessor " + std::to_string(index) + " has component type " +
                                  std::to_string(v.component_type) + " (expected an unsigned integer)");
@@ -456,7 +447,9 @@ PrimitiveData decode_draco(const tinygltf::Model& model, const tinygltf::Value& 
     }
     const int id = attrs.Get(name).GetNumberAsInt();
     const draco::PointAttribute* a = id >= 0 ? dm->GetAttributeByUniqueId(uint32_t(id)) : nullptr;
-    if (!a) throw std::runtime_error(std::string("Draco stream lacks attribute id ") + std::to_string(id) + " (" + name + ")");
+    if (!a)
+      throw std::runtime_error(std::string("Draco stream lacks attribute id ") + std::to_string(id) + " (" + name +
+                               ")");
     if (a->num_components() < components)
       throw std::runtime_error(std::string("Draco attribute ") + name + " has too few components");
     dst.assign(n * std::size_t(components), 0.0f);
@@ -505,7 +498,8 @@ Eigen::Matrix4d node_local(const tinygltf::Node& node) {
     return m;
   }
   Eigen::Affine3d t = Eigen::Affine3d::Identity();
-  if (node.translation.size() == 3) t.translate(Eigen::Vector3d(node.translation[0], node.translation[1], node.translation[2]));
+  if (node.translation.size() == 3)
+    t.translate(Eigen::Vector3d(node.translation[0], node.translation[1], node.translation[2]));
   if (node.rotation.size() == 4)  // glTF stores (x, y, z, w)
     t.rotate(Eigen::Quaterniond(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]).normalized());
   if (node.scale.size() == 3) t.scale(Eigen::Vector3d(node.scale[0], node.scale[1], node.scale[2]));
@@ -607,7 +601,8 @@ Mesh load_gltf(const std::string& path, bool binary, MeshLoadReport& report) {
   const Eigen::Matrix4d identity = Eigen::Matrix4d::Identity();
   if (!model.scenes.empty()) {
     const int s = model.defaultScene >= 0 ? model.defaultScene : 0;
-    if (std::size_t(s) >= model.scenes.size()) throw std::runtime_error("default scene " + std::to_string(s) + " out of range");
+    if (std::size_t(s) >= model.scenes.size())
+      throw std::runtime_error("default scene " + std::to_string(s) + " out of range");
     for (int node : model.scenes[std::size_t(s)].nodes) assembler.add_node(node, identity, 0);
   } else if (!model.nodes.empty()) {
     // No scene: every root node (one that is nobody's child).

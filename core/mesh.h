@@ -36,12 +36,12 @@ struct Mesh {
 };
 
 struct MeshLoadReport {
-  std::string format;              // "obj", "gltf" or "glb"
-  std::size_t vertices = 0;        // as in the returned mesh
-  std::size_t triangles = 0;       // as in the returned mesh (after dropping degenerate ones)
+  std::string format;                  // "obj", "gltf" or "glb"
+  std::size_t vertices = 0;            // as in the returned mesh
+  std::size_t triangles = 0;           // as in the returned mesh (after dropping degenerate ones)
   std::size_t dropped_degenerate = 0;  // zero-area triangles removed
-  bool computed_normals = false;   // some or all normals were computed (file had none there)
-  bool draco = false;              // some primitive was KHR_draco_mesh_compression
+  bool computed_normals = false;       // some or all normals were computed (file had none there)
+  bool draco = false;                  // some primitive was KHR_draco_mesh_compression
 };
 
 // Loads .obj, .gltf or .glb (by file extension, case-insensitive). Polygons are triangulated;

@@ -57,7 +57,7 @@ EnvMap reduce_nested(const EnvMap& fine) {
   out.attributes = fine.attributes;
   const int ch = fine.channels();
   const bool point = F.kind() == LayoutKind::LatLong || F.kind() == LayoutKind::Cube;
-  const int face_rows = F.kind() == LayoutKind::Cube ? F.width() : F.height();      // fine rows per face
+  const int face_rows = F.kind() == LayoutKind::Cube ? F.width() : F.height();  // fine rows per face
   const int coarse_face_rows = C.kind() == LayoutKind::Cube ? C.width() : C.height();
   parallel_for_rows(C.height(), [&](int r) {
     const int face = r / coarse_face_rows, lr = r % coarse_face_rows;

@@ -83,7 +83,8 @@ std::string OutputPlan::file(const std::string& path) {
   if (::stat(p.c_str(), &st) == 0) {
     if (S_ISDIR(st.st_mode)) throw std::invalid_argument(path + ": is a folder, expected a file");
     if (!S_ISREG(st.st_mode))
-      throw std::invalid_argument(path + ": is not a regular file (a FIFO, a socket or a device); refused as an output");
+      throw std::invalid_argument(path +
+                                  ": is not a regular file (a FIFO, a socket or a device); refused as an output");
   }
   check_distinct(p, "a file");
   static std::atomic<int> counter{0};

@@ -76,7 +76,8 @@ PhotoSet parse(const YAML::Node& root, const fs::path& folder) {
     const YAML::Node brackets = v.get("brackets");
     if (!brackets.IsSequence() || brackets.size() == 0) spec_fail(v.at("brackets"), "expected a non-empty sequence");
     for (std::size_t j = 0; j < brackets.size(); ++j) {
-      YamlMap b(brackets[j], v.at("brackets") + "[" + std::to_string(j) + "]", {"file", "exposure_s", "iso", "aperture"});
+      YamlMap b(brackets[j], v.at("brackets") + "[" + std::to_string(j) + "]",
+                {"file", "exposure_s", "iso", "aperture"});
       BracketPhoto photo;
       photo.file = resolve(folder, b.string("file"), b.at("file"));
       if (b.has("exposure_s")) photo.exposure_s = b.positive("exposure_s");
@@ -213,7 +214,8 @@ fs::path save_photo_set(const PhotoSet& set) {
   }
   out << YAML::EndMap;
   const fs::path target = folder / "photoset.yaml";
-  write_text_atomically(target, std::string("# rsibr photo set (core/photo_set.h describes the format)\n") + out.c_str() + "\n");
+  write_text_atomically(
+      target, std::string("# rsibr photo set (core/photo_set.h describes the format)\n") + out.c_str() + "\n");
   return target;
 }
 

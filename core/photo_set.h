@@ -35,10 +35,10 @@ namespace rsibr {
 
 // One exposure of a view. Values the YAML leaves out are nullopt (hdr/ fills them from EXIF).
 struct BracketPhoto {
-  std::filesystem::path file;       // absolute after loading
-  std::optional<double> exposure_s; // shutter time, seconds
+  std::filesystem::path file;        // absolute after loading
+  std::optional<double> exposure_s;  // shutter time, seconds
   std::optional<double> iso;
-  std::optional<double> aperture;   // f-number
+  std::optional<double> aperture;  // f-number
 
   // Exposure relative to ISO 100 at f/1: t * (iso/100) / N^2, with the unknown factors taken as 1.
   // Nullopt when the shutter time is unknown.

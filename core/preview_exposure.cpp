@@ -47,7 +47,8 @@ float preview_exposure(const std::vector<cv::Mat>& rgb, const std::vector<cv::Ma
 }
 
 float preview_exposure(const cv::Mat& rgb, const cv::Mat& mask) {
-  return preview_exposure(std::vector<cv::Mat>{rgb}, mask.empty() ? std::vector<cv::Mat>{} : std::vector<cv::Mat>{mask});
+  return preview_exposure(std::vector<cv::Mat>{rgb},
+                          mask.empty() ? std::vector<cv::Mat>{} : std::vector<cv::Mat>{mask});
 }
 
 }  // namespace rsibr

@@ -24,8 +24,8 @@ void Progress::update(double fraction) {
   fraction = std::clamp(fraction, 0.0, 1.0);
   const int width = 30, filled = int(fraction * width + 0.5);
   const double secs = std::chrono::duration<double>(now - start_).count();
-  std::fprintf(stderr, "\r%s [%.*s%*s] %3d%% %.1fs", label_.c_str(), filled,
-               "##############################", width - filled, "", int(fraction * 100 + 0.5), secs);
+  std::fprintf(stderr, "\r%s [%.*s%*s] %3d%% %.1fs", label_.c_str(), filled, "##############################",
+               width - filled, "", int(fraction * 100 + 0.5), secs);
   std::fflush(stderr);
 }
 

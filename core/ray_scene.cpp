@@ -16,7 +16,8 @@ struct RayScene::Impl {
 namespace {
 void check_device(RTCDevice device, const char* what) {
   const RTCError e = rtcGetDeviceError(device);
-  if (e != RTC_ERROR_NONE) throw std::runtime_error(std::string("Embree: ") + what + " failed (error " + std::to_string(int(e)) + ")");
+  if (e != RTC_ERROR_NONE)
+    throw std::runtime_error(std::string("Embree: ") + what + " failed (error " + std::to_string(int(e)) + ")");
 }
 }  // namespace
 
@@ -29,9 +30,9 @@ RayScene::RayScene(const Mesh& mesh) : mesh_(mesh), impl_(std::make_unique<Impl>
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
   RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                              3 * sizeof(float), mesh.positions.size()));
+                                                               3 * sizeof(float), mesh.positions.size()));
   auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                3 * sizeof(unsigned), mesh.triangles.size()));
+                                                                 3 * sizeof(unsigned), mesh.triangles.size()));
   check_device(impl_->device, "allocating geometry buffers");
   for (std::size_t i = 0; i < mesh.positions.size(); ++i)
     for (int k = 0; k < 3; ++k) vertices[3 * i + k] = mesh.positions[i][k];

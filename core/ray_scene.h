@@ -17,9 +17,9 @@ namespace rsibr {
 
 struct RayHit {
   bool hit = false;
-  double t = 0;               // distance along the (unit) direction
+  double t = 0;                // distance along the (unit) direction
   std::uint32_t triangle = 0;  // index into Mesh::triangles
-  double u = 0, v = 0;        // barycentrics of vertices 1 and 2 (vertex 0 has 1 - u - v)
+  double u = 0, v = 0;         // barycentrics of vertices 1 and 2 (vertex 0 has 1 - u - v)
 };
 
 class RayScene {

@@ -30,8 +30,7 @@ PixelFootprint pixel_footprint(const Layout& layout, const Vec2& p) {
       const double coarse = 2.0 / std::min(layout.width(), layout.height());
       return {2 * z * fine, 2 / z * coarse};
     }
-    default:
-      break;
+    default: break;
   }
   const double h = 0.25;
   const std::optional<Vec3> d0 = layout.direction(p);

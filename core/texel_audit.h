@@ -13,8 +13,8 @@ namespace rsibr {
 inline constexpr float kMaxRadiance = 1e30f;
 
 struct TexelAudit {
-  long nan = 0, inf = 0, huge = 0;  // values (not texels), over every channel
-  long negative = 0;                // finite values below zero (lossy-compression ringing)
+  long nan = 0, inf = 0, huge = 0;     // values (not texels), over every channel
+  long negative = 0;                   // finite values below zero (lossy-compression ringing)
   int first_row = -1, first_col = -1;  // the first NaN, Inf or huge value's texel
   bool bad() const { return nan > 0 || inf > 0 || huge > 0; }
   // "2 NaN, 1 Inf and 3 values beyond 1e+30 (the first at texel (column 4, row 7))".

@@ -16,9 +16,7 @@ inline constexpr double kPi = 3.14159265358979323846;
 
 // Angle between two (not necessarily unit) vectors, accurate for tiny and near-pi angles
 // (acos of a dot product loses half the digits near 0 and pi).
-inline double angle_between(const Vec3& a, const Vec3& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b));
-}
+inline double angle_between(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
 // world_from_view for a view direction v (world, toward the viewer) and an up hint (world).
 // Columns are the view frame's x (right), y (up), z (= v) axes in world coordinates: the

@@ -18,7 +18,7 @@ extern "C" {
 namespace rsibr {
 namespace {
 
-constexpr double kTieEps = 1e-12;   // radians: how far outside an edge still counts as on it
+constexpr double kTieEps = 1e-12;    // radians: how far outside an edge still counts as on it
 constexpr double kPlanarEps = 1e-9;  // relative size below which a set is treated as planar
 
 double det3(const Vec3& a, const Vec3& b, const Vec3& c) { return a.dot(b.cross(c)); }
@@ -93,8 +93,7 @@ std::array<double, 2> arc_weights(const Vec3& p, const Vec3& a, const Vec3& b) {
 
 }  // namespace
 
-std::array<double, 3> triangle_weights(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
-                                       Barycentric kind) {
+std::array<double, 3> triangle_weights(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Barycentric kind) {
   if (p == a) return {1, 0, 0};
   if (p == b) return {0, 1, 0};
   if (p == c) return {0, 0, 1};
@@ -129,8 +128,7 @@ ViewSet::ViewSet(std::vector<Vec3> views) : views_(std::move(views)) {
   for (std::size_t i = 0; i < views_.size(); ++i)
     for (std::size_t j = i + 1; j < views_.size(); ++j)
       if (angle_between(views_[i], views_[j]) < 1e-9)
-        throw std::invalid_argument("view set: views " + std::to_string(i) + " and " + std::to_string(j) +
-                                    " coincide");
+        throw std::invalid_argument("view set: views " + std::to_string(i) + " and " + std::to_string(j) + " coincide");
   triangulate();
 }
 
@@ -147,7 +145,7 @@ void ViewSet::triangulate() {
   for (const Vec3& v : views_) cov += (v - centroid) * (v - centroid).transpose();
   Eigen::SelfAdjointEigenSolver<Mat3> eig(cov / n);
   bool planar = n <= 3 || std::sqrt(std::max(0.0, eig.eigenvalues()(0))) <
-                             kPlanarEps * std::sqrt(std::max(0.0, eig.eigenvalues()(2)));
+                              kPlanarEps * std::sqrt(std::max(0.0, eig.eigenvalues()(2)));
   std::vector<QhullFace> faces;
   if (!planar) {
     try {
@@ -277,15 +275,17 @@ ViewSet ViewSet::fibonacci(int n) {
 ViewSet ViewSet::named(const std::string& name) {
   if (name == "tetra" || name == "tetrahedron") return tetrahedron();
   if (name == "octa" || name == "octahedron") return octahedron();
-  if (name.size() > 3 && name.rfind("fib", 0) == 0 &&
-      name.find_first_not_of("0123456789", 3) == std::string::npos && name.size() < 9)
+  if (name.size() > 3 && name.rfind("fib", 0) == 0 && name.find_first_not_of("0123456789", 3) == std::string::npos &&
+      name.size() < 9)
     return fibonacci(std::stoi(name.substr(3)));
   if (name == "icosa" || name == "icosahedron" || name == "12") return icosahedron();
   if (name == "42") return geodesic(1);
   if (name == "162") return geodesic(2);
   if (name == "642") return geodesic(3);
   std::ifstream in(name);
-  if (!in) throw std::invalid_argument(name + ": not a view set name (tetra, octa, icosa, 42, 162, 642, fibN) nor a readable file");
+  if (!in)
+    throw std::invalid_argument(name +
+                                ": not a view set name (tetra, octa, icosa, 42, 162, 642, fibN) nor a readable file");
   std::vector<Vec3> views;
   std::string line;
   int lineno = 0;
@@ -339,8 +339,8 @@ ViewWeights ViewSet::on_arc(const Vec3& p, const Arc& arc, Barycentric kind, dou
   if (arc.triangle >= 0) {
     // The weights the triangle gives on its own edge, so they join those inside continuously.
     const auto& T = triangles_[std::size_t(arc.triangle)];
-    const auto w = triangle_weights(q, views_[std::size_t(T[0])], views_[std::size_t(T[1])],
-                                    views_[std::size_t(T[2])], kind);
+    const auto w =
+        triangle_weights(q, views_[std::size_t(T[0])], views_[std::size_t(T[1])], views_[std::size_t(T[2])], kind);
     out.count = 3;
     out.views = T;
     out.weights = w;
@@ -386,7 +386,8 @@ ViewWeights ViewSet::locate(const Vec3& dir, Barycentric kind) const {
     const auto& T = triangles_[std::size_t(best)];
     out.count = 3;
     out.views = T;
-    out.weights = triangle_weights(p, views_[std::size_t(T[0])], views_[std::size_t(T[1])], views_[std::size_t(T[2])], kind);
+    out.weights =
+        triangle_weights(p, views_[std::size_t(T[0])], views_[std::size_t(T[1])], views_[std::size_t(T[2])], kind);
     out.triangle = best;
     out.inside = true;
     out.distance = 0;

@@ -43,12 +43,12 @@ std::array<double, 3> triangle_weights(const Vec3& p, const Vec3& a, const Vec3&
                                        Barycentric kind = Barycentric::Gnomonic);
 
 struct ViewWeights {
-  int count = 0;                       // number of views used (1..3)
+  int count = 0;                         // number of views used (1..3)
   std::array<int, 3> views{-1, -1, -1};  // indices into ViewSet::views()
   std::array<double, 3> weights{0, 0, 0};
-  int triangle = -1;                   // triangle index, or -1 (degenerate sets, boundary arcs)
-  bool inside = false;                 // p lies in a triangle of the set
-  double distance = 0;                 // radians from p to the covered region (0 inside)
+  int triangle = -1;    // triangle index, or -1 (degenerate sets, boundary arcs)
+  bool inside = false;  // p lies in a triangle of the set
+  double distance = 0;  // radians from p to the covered region (0 inside)
 };
 
 class ViewSet {
@@ -83,17 +83,17 @@ class ViewSet {
 
  private:
   struct Arc {
-    int a, b;         // view indices
-    int triangle;     // triangle the arc belongs to, or -1 (arcs of a degenerate set)
+    int a, b;      // view indices
+    int triangle;  // triangle the arc belongs to, or -1 (arcs of a degenerate set)
   };
   void triangulate();
   ViewWeights on_arc(const Vec3& p, const Arc& arc, Barycentric kind, double distance) const;
 
   std::vector<Vec3> views_;
   std::vector<std::array<int, 3>> triangles_;
-  std::vector<Vec3> cap_centre_;    // per triangle: circumcircle centre (unit) ...
-  std::vector<double> cap_cos_;     // ... and cos of its angular radius, for quick rejection
-  std::vector<Arc> boundary_;       // arcs bounding the covered region (or joining a degenerate set)
+  std::vector<Vec3> cap_centre_;  // per triangle: circumcircle centre (unit) ...
+  std::vector<double> cap_cos_;   // ... and cos of its angular radius, for quick rejection
+  std::vector<Arc> boundary_;     // arcs bounding the covered region (or joining a degenerate set)
   bool surrounds_ = false;
 };
 

@@ -31,8 +31,8 @@ void spec_fail(const std::string& path, const std::string& what) { throw std::in
 double spec_in_range(double x, const std::string& path, double lo, bool lo_open, double hi, bool hi_open) {
   const bool ok = (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi);
   if (!ok) {
-    const std::string range = std::string(lo_open ? "(" : "[") + fmt(lo) + "," +
-                              (std::isinf(hi) ? "inf" : fmt(hi)) + (hi_open ? ")" : "]");
+    const std::string range =
+        std::string(lo_open ? "(" : "[") + fmt(lo) + "," + (std::isinf(hi) ? "inf" : fmt(hi)) + (hi_open ? ")" : "]");
     spec_fail(path, "must be in " + range + ", got " + fmt(x));
   }
   return x;
@@ -160,7 +160,8 @@ void check_yaml_graph(const YAML::Node& node, std::vector<YAML::Node>& ancestors
   for (const YAML::Node& a : ancestors)
     if (a.is(node)) throw std::invalid_argument(where + ": " + path + ": an alias that contains itself (a cycle)");
   if (int(ancestors.size()) >= kMaxYamlDepth)
-    throw std::invalid_argument(where + ": " + path + ": nested deeper than " + std::to_string(kMaxYamlDepth) + " levels");
+    throw std::invalid_argument(where + ": " + path + ": nested deeper than " + std::to_string(kMaxYamlDepth) +
+                                " levels");
   if (!node.IsMap() && !node.IsSequence()) return;
   ancestors.push_back(node);
   std::size_t i = 0;
@@ -183,8 +184,8 @@ YAML::Node parse_yaml(const std::string& text, const std::string& where) {
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw std::invalid_argument(where + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                                ": invalid YAML: " + e.msg);
+    throw std::invalid_argument(where + ":" + std::to_string(e.mark.line + 1) + ":" +
+                                std::to_string(e.mark.column + 1) + ": invalid YAML: " + e.msg);
   }
   std::vector<YAML::Node> ancestors;
   long visits = 0;

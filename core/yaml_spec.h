@@ -38,7 +38,7 @@ class YamlMap {
   double number(const std::string& key) const;
   long integer(const std::string& key) const;  // a whole number
   bool boolean(const std::string& key) const;
-  Vec3 vec3(const std::string& key) const;  // a sequence of 3 numbers
+  Vec3 vec3(const std::string& key) const;                    // a sequence of 3 numbers
   std::vector<double> numbers(const std::string& key) const;  // a sequence of numbers
 
   // The same, or nullopt when the key is absent (or null).

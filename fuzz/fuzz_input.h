@@ -20,7 +20,8 @@ inline std::string input_file(const std::uint8_t* data, std::size_t size, const 
     return d;
   }();
   const std::filesystem::path p = dir / ("input" + extension);
-  std::ofstream(p, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(data), std::streamsize(size));
+  std::ofstream(p, std::ios::binary | std::ios::trunc)
+      .write(reinterpret_cast<const char*>(data), std::streamsize(size));
   return p.string();
 }
 

@@ -91,7 +91,8 @@ AlignmentResult align_brackets(BracketSet& b, Alignment mode, int max_bits) {
     res.found[j] = s;
     int n0 = 0, n1 = 0;
     res.mismatch_before[j] = mismatch(tb[mid], eb[mid], tb[j], eb[j], cv::Point(0, 0), &n0);
-    res.mismatch_after[j] = s == cv::Point(0, 0) ? res.mismatch_before[j] : mismatch(tb[mid], eb[mid], tb[j], eb[j], s, &n1);
+    res.mismatch_after[j] =
+        s == cv::Point(0, 0) ? res.mismatch_before[j] : mismatch(tb[mid], eb[mid], tb[j], eb[j], s, &n1);
     if (s == cv::Point(0, 0)) continue;
     const double enough = kMinCompared * double(b.rows()) * double(b.cols());
     // Disagreeing pixels before and after: the drop must also stand out of their counting noise
@@ -104,7 +105,8 @@ AlignmentResult align_brackets(BracketSet& b, Alignment mode, int max_bits) {
     if (mode == Alignment::automatic && !b.fitted_sizes && !better) continue;
     res.shifts[j] = s;
     b.codes[j] = shifted(b.codes[j], s, cv::BORDER_REPLICATE);
-    if (j < b.saturated.size() && !b.saturated[j].empty()) b.saturated[j] = shifted(b.saturated[j], s, cv::BORDER_REPLICATE);
+    if (j < b.saturated.size() && !b.saturated[j].empty())
+      b.saturated[j] = shifted(b.saturated[j], s, cv::BORDER_REPLICATE);
     if (b.covered.size() < P) b.covered.resize(P);
     const cv::Mat cov = b.covered[j].empty() ? cv::Mat(b.codes[j].size(), CV_8UC1, cv::Scalar(255)) : b.covered[j];
     b.covered[j] = shifted(cov, s, cv::BORDER_CONSTANT, cv::Scalar(0));

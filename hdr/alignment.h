@@ -29,10 +29,10 @@ const char* to_string(Alignment a);
 Alignment parse_alignment(const std::string& s);
 
 struct AlignmentResult {
-  std::vector<cv::Point> shifts;         // applied, per bracket (pixels, x right, y down; the middle one (0, 0))
-  std::vector<cv::Point> found;          // what MTB found, per bracket
-  std::vector<double> mismatch_before;   // fraction of compared pixels whose bitmaps disagree, unshifted
-  std::vector<double> mismatch_after;    // ... at the found shift
+  std::vector<cv::Point> shifts;        // applied, per bracket (pixels, x right, y down; the middle one (0, 0))
+  std::vector<cv::Point> found;         // what MTB found, per bracket
+  std::vector<double> mismatch_before;  // fraction of compared pixels whose bitmaps disagree, unshifted
+  std::vector<double> mismatch_after;   // ... at the found shift
 };
 
 // Registers `brackets` in place (see above). max_bits: pyramid levels (shifts up to about

@@ -23,7 +23,12 @@ int to_codes(const cv::Mat& in, cv::Mat& out, const std::string& name, bool bgr)
   cv::Mat rgb;
   switch (in.channels()) {
     case 1: cv::cvtColor(in, rgb, cv::COLOR_GRAY2RGB); break;
-    case 3: if (bgr) cv::cvtColor(in, rgb, cv::COLOR_BGR2RGB); else rgb = in; break;
+    case 3:
+      if (bgr)
+        cv::cvtColor(in, rgb, cv::COLOR_BGR2RGB);
+      else
+        rgb = in;
+      break;
     case 4: cv::cvtColor(in, rgb, bgr ? cv::COLOR_BGRA2RGB : cv::COLOR_RGBA2RGB); break;
     default: throw std::runtime_error(name + ": unsupported channel count " + std::to_string(in.channels()));
   }
@@ -75,13 +80,15 @@ BracketSet assemble(std::vector<cv::Mat> codes, std::vector<int> ranges, std::ve
   }
   std::vector<std::size_t> order(n);
   std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return exposures[a] < exposures[b]; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return exposures[a] < exposures[b]; });
   BracketSet s;
   s.max_code = ranges[0];
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t j = order[k];
     if (k > 0 && exposures[j] == s.exposures.back())
-      throw std::runtime_error(names[j] + ": same exposure as " + s.files.back() + " (brackets need distinct exposures)");
+      throw std::runtime_error(names[j] + ": same exposure as " + s.files.back() +
+                               " (brackets need distinct exposures)");
     s.codes.push_back(std::move(codes[j]));
     s.exposures.push_back(exposures[j]);
     s.metadata.push_back(metadata[j]);
@@ -158,13 +165,14 @@ BracketSet load_brackets(const PhotoView& view, bool fit_sizes) {
   };
   std::vector<Keyed> keyed;
   for (std::size_t j = 0; j < raw_info.size(); ++j) keyed.push_back({exposures[j], raw_info[j], raw_saturated[j]});
-  BracketSet s =
-      assemble(std::move(codes), std::move(ranges), std::move(exposures), std::move(metadata), std::move(names), fit_sizes);
+  BracketSet s = assemble(std::move(codes), std::move(ranges), std::move(exposures), std::move(metadata),
+                          std::move(names), fit_sizes);
   if (raw_count > 0) {
     if (s.fitted_sizes)
       throw std::runtime_error("view " + view.name + ": RAW brackets of different sizes (one sensor makes one size)");
     s.raw = true;
-    std::stable_sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) { return a.exposure < b.exposure; });
+    std::stable_sort(keyed.begin(), keyed.end(),
+                     [](const Keyed& a, const Keyed& b) { return a.exposure < b.exposure; });
     for (Keyed& k : keyed) s.raw_info.push_back(std::move(k.info)), s.saturated.push_back(std::move(k.saturated));
   }
   for (const std::string& f : s.files) {
@@ -190,7 +198,8 @@ BracketSet make_brackets(std::vector<cv::Mat> images, std::vector<double> exposu
     m.source = "memory";
     metadata.push_back(m);
   }
-  BracketSet s = assemble(std::move(codes), std::move(ranges), std::move(exposures), std::move(metadata), std::move(names));
+  BracketSet s =
+      assemble(std::move(codes), std::move(ranges), std::move(exposures), std::move(metadata), std::move(names));
   s.lossy = lossy;
   return s;
 }

@@ -16,14 +16,14 @@
 namespace rsibr {
 
 struct BracketSet {
-  std::vector<cv::Mat> codes;               // CV_16UC3, RGB
-  std::vector<double> exposures;            // relative exposures e_j (ascending)
-  std::vector<ResolvedExposure> metadata;   // per bracket, same order
-  std::vector<std::string> files;           // per bracket, same order
-  int max_code = 255;                       // 255 (8-bit files) or 65535 (16-bit)
-  bool lossy = false;                       // some bracket is a lossy file (JPEG: .jpg, .jpeg)
-  bool raw = false;                         // every bracket a camera RAW file: linear codes
-  std::vector<RawInfo> raw_info;            // per bracket when raw, same order
+  std::vector<cv::Mat> codes;              // CV_16UC3, RGB
+  std::vector<double> exposures;           // relative exposures e_j (ascending)
+  std::vector<ResolvedExposure> metadata;  // per bracket, same order
+  std::vector<std::string> files;          // per bracket, same order
+  int max_code = 255;                      // 255 (8-bit files) or 65535 (16-bit)
+  bool lossy = false;                      // some bracket is a lossy file (JPEG: .jpg, .jpeg)
+  bool raw = false;                        // every bracket a camera RAW file: linear codes
+  std::vector<RawInfo> raw_info;           // per bracket when raw, same order
   // Per bracket (same order), or empty: CV_8UC1, non-zero where the file itself says the pixel is
   // saturated (RAW: hdr/raw_image.h), whatever its codes; the merge leaves those pixels out of
   // the bracket (and so, by the consistency rule, out of every longer one).
@@ -32,8 +32,8 @@ struct BracketSet {
   // of a smaller file, the edge a shift uncovered: hdr/alignment.h); the merge leaves those
   // pixels out of that bracket only.
   std::vector<cv::Mat> covered;
-  bool fitted_sizes = false;                // files of different sizes, centred on the middle bracket's frame
-  std::vector<cv::Size> file_sizes;         // per bracket, as read
+  bool fitted_sizes = false;         // files of different sizes, centred on the middle bracket's frame
+  std::vector<cv::Size> file_sizes;  // per bracket, as read
 
   int rows() const { return codes.empty() ? 0 : codes[0].rows; }
   int cols() const { return codes.empty() ? 0 : codes[0].cols; }

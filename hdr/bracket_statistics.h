@@ -28,25 +28,28 @@ namespace rsibr {
 inline float code_gradient(const cv::Mat& codes, int r, int x, int c) {
   const int up = std::max(r - 1, 0), down = std::min(r + 1, codes.rows - 1);
   const int left = std::max(x - 1, 0), right = std::min(x + 1, codes.cols - 1);
-  const float gx = 0.5f * (float(codes.ptr<std::uint16_t>(r)[3 * right + c]) - float(codes.ptr<std::uint16_t>(r)[3 * left + c]));
-  const float gy = 0.5f * (float(codes.ptr<std::uint16_t>(down)[3 * x + c]) - float(codes.ptr<std::uint16_t>(up)[3 * x + c]));
+  const float gx =
+      0.5f * (float(codes.ptr<std::uint16_t>(r)[3 * right + c]) - float(codes.ptr<std::uint16_t>(r)[3 * left + c]));
+  const float gy =
+      0.5f * (float(codes.ptr<std::uint16_t>(down)[3 * x + c]) - float(codes.ptr<std::uint16_t>(up)[3 * x + c]));
   return std::sqrt(gx * gx + gy * gy);
 }
 inline float code_activity(const cv::Mat& codes, int r, int x, int c) {
   float a = 0;
   for (int dr = -1; dr <= 1; ++dr)
     for (int dc = -1; dc <= 1; ++dc)
-      a = std::max(a, code_gradient(codes, std::clamp(r + dr, 0, codes.rows - 1), std::clamp(x + dc, 0, codes.cols - 1), c));
+      a = std::max(
+          a, code_gradient(codes, std::clamp(r + dr, 0, codes.rows - 1), std::clamp(x + dc, 0, codes.cols - 1), c));
   return a;
 }
 
 struct ViewStatistics {
-  std::vector<double> exposures;              // ascending
+  std::vector<double> exposures;  // ascending
   int brackets = 0;
-  std::vector<std::uint16_t> sample_codes;    // [candidate][bracket][channel]
-  std::vector<float> sample_roughness;        // [candidate][bracket]
-  std::vector<std::uint16_t> noise_codes;     // [pixel][bracket][channel]
-  std::vector<float> noise_activity;          // [pixel][bracket][channel], code_activity
+  std::vector<std::uint16_t> sample_codes;  // [candidate][bracket][channel]
+  std::vector<float> sample_roughness;      // [candidate][bracket]
+  std::vector<std::uint16_t> noise_codes;   // [pixel][bracket][channel]
+  std::vector<float> noise_activity;        // [pixel][bracket][channel], code_activity
 
   std::size_t candidates() const { return brackets ? sample_roughness.size() / std::size_t(brackets) : 0; }
   std::size_t noise_pixels() const { return brackets ? noise_codes.size() / (3 * std::size_t(brackets)) : 0; }
@@ -58,9 +61,9 @@ struct ViewStatistics {
 struct BracketStatistics {
   int max_code = 0;
   bool lossy = false;  // some view came from lossy files (BracketSet::lossy)
-  int shift = 0;  // histogram bin = code >> shift
+  int shift = 0;       // histogram bin = code >> shift
   int bins = 0;
-  std::vector<ViewStatistics> views;          // views with at least two brackets
+  std::vector<ViewStatistics> views;  // views with at least two brackets
   int single_bracket_views = 0;
   std::array<std::vector<long>, 3> pair_histogram;  // per channel, [bin of z_j * bins + bin of z_k]
 

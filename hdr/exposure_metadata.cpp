@@ -60,7 +60,8 @@ ResolvedExposure resolve_exposure(const BracketPhoto& photo) {
     return from_exif;
   };
   const auto t = pick(photo.exposure_s, exif ? exif->exposure_s : std::nullopt);
-  if (!t) throw std::runtime_error(file + ": no exposure time (neither exposure_s in photoset.yaml nor EXIF ExposureTime)");
+  if (!t)
+    throw std::runtime_error(file + ": no exposure time (neither exposure_s in photoset.yaml nor EXIF ExposureTime)");
   r.exposure_s = *t;
   r.iso = pick(photo.iso, exif ? exif->iso : std::nullopt).value_or(100.0);
   r.aperture = pick(photo.aperture, exif ? exif->aperture : std::nullopt).value_or(1.0);

@@ -12,9 +12,9 @@ namespace rsibr {
 struct ResolvedExposure {
   double exposure_s = 0;  // shutter time, seconds (> 0)
   double iso = 100;
-  double aperture = 1;    // f-number
-  double relative = 0;    // t * (iso/100) / N^2
-  std::string source;     // "yaml", "exif" or "yaml+exif" (RAW brackets: "raw", "yaml+raw", "raw+exif", ...)
+  double aperture = 1;  // f-number
+  double relative = 0;  // t * (iso/100) / N^2
+  std::string source;   // "yaml", "exif" or "yaml+exif" (RAW brackets: "raw", "yaml+raw", "raw+exif", ...)
 };
 
 // Values present in `photo` win; missing ones are read from the file's EXIF (ExposureTime,

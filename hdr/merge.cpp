@@ -25,7 +25,8 @@ RSIBR_AVX2_CLONES void gather_row(const std::uint16_t* __restrict z, const float
 }
 
 // V = a P+ + B (P+ = max(P, 0)): a bracket's variance for the radiance P.
-RSIBR_AVX2_CLONES void variance_row(const float* __restrict P, float a, const float* __restrict B, float* __restrict V, int W) {
+RSIBR_AVX2_CLONES void variance_row(const float* __restrict P, float a, const float* __restrict B, float* __restrict V,
+                                    int W) {
   for (int x = 0; x < W; ++x) V[x] = a * std::max(P[x], 0.f) + B[x];
 }
 
@@ -40,8 +41,8 @@ RSIBR_AVX2_CLONES void accumulate_row(const float* __restrict mk, const float* _
 }
 
 // s += mask sqrt(T) / V (the weights w = 1 / V times the texture standard deviation).
-RSIBR_AVX2_CLONES void texture_sigma_row(const float* __restrict mk, const float* __restrict V, const float* __restrict T,
-                                         float* __restrict s, int W) {
+RSIBR_AVX2_CLONES void texture_sigma_row(const float* __restrict mk, const float* __restrict V,
+                                         const float* __restrict T, float* __restrict s, int W) {
   for (int x = 0; x < W; ++x) s[x] += mk[x] * std::sqrt(T[x]) / V[x];
 }
 
@@ -92,9 +93,10 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
       shot_e[j][c] = float(noise.shot[std::size_t(c)] / e);
       for (std::size_t z = 0; z < codes; ++z) {
         Lt[(std::size_t(j) * 3 + std::size_t(c)) * codes + z] = float(tx[std::size_t(c)][z] / e);
-        Bt[(std::size_t(j) * 3 + std::size_t(c)) * codes + z] =
-            float((noise.read[std::size_t(c)] + tq[std::size_t(c)][z] * (1 + 12 * noise.code[std::size_t(c)])) / (e * e));
-        Tt[(std::size_t(j) * 3 + std::size_t(c)) * codes + z] = float(12 * tq[std::size_t(c)][z] * noise.texture[std::size_t(c)] / (e * e));
+        Bt[(std::size_t(j) * 3 + std::size_t(c)) * codes + z] = float(
+            (noise.read[std::size_t(c)] + tq[std::size_t(c)][z] * (1 + 12 * noise.code[std::size_t(c)])) / (e * e));
+        Tt[(std::size_t(j) * 3 + std::size_t(c)) * codes + z] =
+            float(12 * tq[std::size_t(c)][z] * noise.texture[std::size_t(c)] / (e * e));
       }
     }
   // One bracket's variance for the radiance p of channel c (scalar paths).
@@ -137,7 +139,8 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
     const unsigned char* file_sat[kMax] = {};  // the file's own saturation (RAW), when it has one
     for (int j = 0; j < P && j < int(b.saturated.size()); ++j)
       if (!b.saturated[std::size_t(j)].empty()) file_sat[j] = b.saturated[std::size_t(j)].ptr<unsigned char>(r);
-    const unsigned char* cover[kMax] = {};  // where the bracket holds data (a shifted or padded file), when not everywhere
+    const unsigned char* cover[kMax] =
+        {};  // where the bracket holds data (a shifted or padded file), when not everywhere
     for (int j = 0; j < P && j < int(b.covered.size()); ++j)
       if (!b.covered[std::size_t(j)].empty()) cover[j] = b.covered[std::size_t(j)].ptr<unsigned char>(r);
     auto covers = [&](int j, int x) { return !cover[j] || cover[j][x] != 0; };
@@ -154,7 +157,8 @@ MergedImage merge_brackets(const BracketSet& b, const ResponseCurve& curve, cons
       const std::uint16_t* z = row[j];
       for (int x = 0; x < W; ++x) {
         const bool here = covers(j, x);
-        if (here && (z[3 * x] >= sat[0] || z[3 * x + 1] >= sat[1] || z[3 * x + 2] >= sat[2] || (file_sat[j] && file_sat[j][x])))
+        if (here &&
+            (z[3 * x] >= sat[0] || z[3 * x + 1] >= sat[1] || z[3 * x + 2] >= sat[2] || (file_sat[j] && file_sat[j][x])))
           s.chain[std::size_t(x)] = 0;
         mk[x] = here && s.chain[std::size_t(x)] ? 1.f : 0.f;
       }

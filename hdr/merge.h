@@ -41,17 +41,17 @@ namespace rsibr {
 enum MergeFlag : unsigned char { kClipped = 1, kBlack = 2, kGhost = 4 };
 
 struct MergeOptions {
-  int saturation_code = -1;    // every channel's; -1: the curve's per-channel saturation codes
-  bool pilot_pass = true;      // false: weights from the measured X_j (biased; for comparisons)
-  double model_error = 0.03;   // relative error allowed for the curve in the ghost test
-  double ghost_sigmas = -1;    // -1: 6, or 8 for lossy files (compression errors have heavier tails)
-  bool deghost = false;        // ghost pixels take the longest usable bracket alone (value and variance)
+  int saturation_code = -1;   // every channel's; -1: the curve's per-channel saturation codes
+  bool pilot_pass = true;     // false: weights from the measured X_j (biased; for comparisons)
+  double model_error = 0.03;  // relative error allowed for the curve in the ghost test
+  double ghost_sigmas = -1;   // -1: 6, or 8 for lossy files (compression errors have heavier tails)
+  bool deghost = false;       // ghost pixels take the longest usable bracket alone (value and variance)
 };
 
 struct MergedImage {
-  cv::Mat radiance;  // CV_32FC3 RGB, X / e
-  cv::Mat variance;  // CV_32FC3, var of radiance per channel
-  cv::Mat flags;     // CV_8UC1, MergeFlag bits
+  cv::Mat radiance;                        // CV_32FC3 RGB, X / e
+  cv::Mat variance;                        // CV_32FC3, var of radiance per channel
+  cv::Mat flags;                           // CV_8UC1, MergeFlag bits
   long clipped = 0, black = 0, ghost = 0;  // pixel counts
 };
 

@@ -11,15 +11,17 @@ const std::vector<std::string> kFlags = {"clipped", "black", "ghost"};
 
 }  // namespace
 
-void write_merged_exr(const std::string& path, const MergedImage& m, const std::map<std::string, std::string>& attributes) {
+void write_merged_exr(const std::string& path, const MergedImage& m,
+                      const std::map<std::string, std::string>& attributes) {
   const int W = m.radiance.cols, H = m.radiance.rows;
   for (const cv::Mat* image : {&m.radiance, &m.variance})
     for (int r = 0; r < H; ++r) {
       const float* p = image->ptr<float>(r);
       for (int x = 0; x < 3 * W; ++x)
         if (!std::isfinite(p[x]))
-          throw FileError(path, "internal: non-finite value at pixel (" + std::to_string(x / 3) + ", " +
-                                    std::to_string(r) + ")", {}, FileRole::Output);
+          throw FileError(
+              path, "internal: non-finite value at pixel (" + std::to_string(x / 3) + ", " + std::to_string(r) + ")",
+              {}, FileRole::Output);
     }
   // The flag bits as 0/1 planes, one channel each.
   cv::Mat flags(H, W, CV_32FC3);

@@ -73,7 +73,8 @@ NoiseModel estimate_noise(const BracketStatistics& st, const ResponseCurve& curv
     // term a multiple of the read term: the two cannot be told apart, so code stays 0 then.
     double sr = 0, sc = 0, srr = 0, scc = 0, src = 0;
     for (const auto& row : rs)
-      sr += row.f_read, sc += row.f_code, srr += row.f_read * row.f_read, scc += row.f_code * row.f_code, src += row.f_read * row.f_code;
+      sr += row.f_read, sc += row.f_code, srr += row.f_read * row.f_read, scc += row.f_code * row.f_code,
+          src += row.f_read * row.f_code;
     const double nrow = double(rs.size());
     const double cov = src / nrow - sr * sc / (nrow * nrow), vr = srr / nrow - sr * sr / (nrow * nrow),
                  vc = scc / nrow - sc * sc / (nrow * nrow);

@@ -38,7 +38,8 @@ PhotoSetResponse recover_photo_set_response(const std::vector<const PhotoView*>&
     r.recovery.curve = ResponseCurve::identity(stats.max_code);
     if (raw) r.recovery.curve.saturation = {65535, 65535, 65535};
     for (int c = 0; c < 3; ++c)
-      if (options.saturation_code[std::size_t(c)] > 0) r.recovery.curve.saturation[std::size_t(c)] = options.saturation_code[std::size_t(c)];
+      if (options.saturation_code[std::size_t(c)] > 0)
+        r.recovery.curve.saturation[std::size_t(c)] = options.saturation_code[std::size_t(c)];
     r.recovery.chosen = raw ? "linear (camera RAW: identity response)" : "identity (given)";
     r.recovery.saturation.code = {r.recovery.curve.saturation_code(0), r.recovery.curve.saturation_code(1),
                                   r.recovery.curve.saturation_code(2)};

@@ -21,9 +21,9 @@
 namespace rsibr {
 
 struct PhotoSetResponse {
-  ResponseRecovery recovery;          // model "identity": the identity curve, no candidates
-  NoiseModel noise;                   // estimated from every view with that curve
-  std::vector<const PhotoView*> from; // the views with at least two brackets (what it was recovered from)
+  ResponseRecovery recovery;           // model "identity": the identity curve, no candidates
+  NoiseModel noise;                    // estimated from every view with that curve
+  std::vector<const PhotoView*> from;  // the views with at least two brackets (what it was recovered from)
 };
 
 // `views` non-empty. options.model "identity" skips the fit (linear input). `curve`: reuse this

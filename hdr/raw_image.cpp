@@ -35,9 +35,9 @@ void check(int code, const std::filesystem::path& file, const char* step) {
 bool is_raw_file(const std::filesystem::path& file) {
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  static const char* const kRaw[] = {".dng", ".cr2", ".cr3", ".crw", ".nef", ".nrw", ".arw", ".srf", ".sr2",
-                                     ".raf", ".orf", ".rw2", ".pef", ".srw", ".x3f", ".3fr", ".iiq", ".rwl",
-                                     ".mrw", ".kdc", ".dcr", ".erf", ".mef", ".mos"};
+  static const char* const kRaw[] = {".dng", ".cr2", ".cr3", ".crw", ".nef", ".nrw", ".arw", ".srf",
+                                     ".sr2", ".raf", ".orf", ".rw2", ".pef", ".srw", ".x3f", ".3fr",
+                                     ".iiq", ".rwl", ".mrw", ".kdc", ".dcr", ".erf", ".mef", ".mos"};
   return std::any_of(std::begin(kRaw), std::end(kRaw), [&](const char* e) { return ext == e; });
 }
 
@@ -51,7 +51,8 @@ cv::Mat camera_to_output_codes(const cv::Mat& camera, const Mat3& rgb_from_camer
     for (int x = 0; x < camera.cols; ++x)
       m[x] = (in[x][0] >= kCameraClip || in[x][1] >= kCameraClip || in[x][2] >= kCameraClip) ? 255 : 0;
   }
-  cv::dilate(clipped, saturated, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kClipSpread + 1, 2 * kClipSpread + 1)));
+  cv::dilate(clipped, saturated,
+             cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kClipSpread + 1, 2 * kClipSpread + 1)));
   cv::Mat out(camera.size(), CV_16UC3);
   float M[9];
   for (int i = 0; i < 9; ++i) M[i] = float(rgb_from_camera(i / 3, i % 3));
@@ -74,7 +75,7 @@ cv::Mat camera_to_output_codes(const cv::Mat& camera, const Mat3& rgb_from_camer
 RawImage read_raw_image(const std::filesystem::path& file, const RawOptions& options) {
   auto raw = std::make_unique<LibRaw>();
   libraw_output_params_t& p = raw->imgdata.params;
-  p.output_color = 0;        // the camera's RGB: the matrix is applied here, in float, unclipped
+  p.output_color = 0;  // the camera's RGB: the matrix is applied here, in float, unclipped
   p.output_bps = 16;
   p.gamm[0] = p.gamm[1] = 1.0;
   p.no_auto_bright = 1;
@@ -88,7 +89,8 @@ RawImage read_raw_image(const std::filesystem::path& file, const RawOptions& opt
     if (!(wb.minCoeff() > 0 && wb.allFinite()))
       throw std::invalid_argument(file.string() + ": white balance multipliers must be positive");
     p.use_camera_wb = 0;
-    p.user_mul[0] = float(wb[0]), p.user_mul[1] = float(wb[1]), p.user_mul[2] = float(wb[2]), p.user_mul[3] = float(wb[1]);
+    p.user_mul[0] = float(wb[0]), p.user_mul[1] = float(wb[1]), p.user_mul[2] = float(wb[2]),
+    p.user_mul[3] = float(wb[1]);
   } else {
     p.use_camera_wb = 1;
   }

@@ -39,12 +39,12 @@ struct RawOptions {
 
 struct RawInfo {
   std::string make, model;
-  int black = 0;                 // the file's black level (smallest over the channels), raw units
-  int white = 0;                 // the file's white level, raw units
+  int black = 0;                      // the file's black level (smallest over the channels), raw units
+  int white = 0;                      // the file's white level, raw units
   Vec3 white_balance = Vec3::Ones();  // multipliers applied, the smallest 1
   Mat3 rgb_from_camera = Mat3::Identity();
   double exposure_s = 0, iso = 0, aperture = 0;  // from the file (0 when absent)
-  double saturated_fraction = 0;  // pixels flagged saturated
+  double saturated_fraction = 0;                 // pixels flagged saturated
 };
 
 struct RawImage {

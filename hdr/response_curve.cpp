@@ -57,7 +57,8 @@ void ResponseCurve::validate() const {
     const std::string ch = "channel " + std::to_string(c);
     if (k.size() < 2) throw std::invalid_argument(ch + ": fewer than 2 knots");
     for (std::size_t i = 0; i < k.size(); ++i) {
-      if (!std::isfinite(k[i]) || k[i] < 0) throw std::invalid_argument(ch + ": knot " + std::to_string(i) + " is negative or not finite");
+      if (!std::isfinite(k[i]) || k[i] < 0)
+        throw std::invalid_argument(ch + ": knot " + std::to_string(i) + " is negative or not finite");
       if (i > 0 && k[i] < k[i - 1]) throw std::invalid_argument(ch + ": decreasing at knot " + std::to_string(i));
     }
     if (k.back() > 1.0 + 1e-6) throw std::invalid_argument(ch + ": the top knot must be at most 1");
@@ -102,7 +103,8 @@ ResponseCurve load_response(const std::filesystem::path& path) {
   if (!f) throw std::runtime_error(path.string() + ": cannot open the response curve");
   try {
     const nlohmann::json j = nlohmann::json::parse(f);
-    if (j.value("rsibr_response", 0) != 1) throw std::invalid_argument("not an rsibr response file (rsibr_response: 1 missing)");
+    if (j.value("rsibr_response", 0) != 1)
+      throw std::invalid_argument("not an rsibr response file (rsibr_response: 1 missing)");
     ResponseCurve r;
     r.model = j.at("model").get<std::string>();
     r.parameters = j.value("parameters", nlohmann::json::object());

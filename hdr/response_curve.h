@@ -16,10 +16,10 @@
 namespace rsibr {
 
 struct ResponseCurve {
-  std::string model = "identity";  // identity, gamma, polynomial, robertson, debevec
+  std::string model = "identity";                        // identity, gamma, polynomial, robertson, debevec
   nlohmann::json parameters = nlohmann::json::object();  // model parameters (gamma, coefficients, ...)
   int max_code = 255;
-  std::array<std::vector<double>, 3> knots;  // X at codes k * max_code / (K-1), K >= 2, non-decreasing
+  std::array<std::vector<double>, 3> knots;   // X at codes k * max_code / (K-1), K >= 2, non-decreasing
   std::array<int, 3> saturation{-1, -1, -1};  // per channel: codes at or above are saturated; -1: the default
 
   // The channel's saturation code (default_saturation_code(max_code) when not set).

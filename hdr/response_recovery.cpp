@@ -47,7 +47,8 @@ std::vector<Track> make_tracks(const ResponseSamples& s, bool held_out, int chan
       Track t;
       t.sample = int(i), t.channel = c;
       for (std::size_t j = 0; j < s.codes[i].size(); ++j)
-        if (usable(s, i, j, c) && s.codes[i][j][std::size_t(c)] >= min_code) t.obs.push_back({s.codes[i][j][std::size_t(c)], e[j]});
+        if (usable(s, i, j, c) && s.codes[i][j][std::size_t(c)] >= min_code)
+          t.obs.push_back({s.codes[i][j][std::size_t(c)], e[j]});
       if (t.obs.size() >= 2) out.push_back(std::move(t));
     }
   }
@@ -98,7 +99,8 @@ std::vector<double> fit_polynomial(const std::vector<Track>& tracks, int max_cod
       const double scale = 1.0 / (uj / ej + uk / ek);
       std::array<double, 8> row{};
       for (int n = 1; n < degree; ++n)
-        row[std::size_t(n - 1)] = ((std::pow(uj, n) - std::pow(uj, degree)) / ej - (std::pow(uk, n) - std::pow(uk, degree)) / ek) * scale;
+        row[std::size_t(n - 1)] =
+            ((std::pow(uj, n) - std::pow(uj, degree)) / ej - (std::pow(uk, n) - std::pow(uk, degree)) / ek) * scale;
       rows.push_back(row);
       rhs.push_back(-(std::pow(uj, degree) / ej - std::pow(uk, degree) / ek) * scale);
     }
@@ -108,7 +110,8 @@ std::vector<double> fit_polynomial(const std::vector<Track>& tracks, int max_cod
     for (int n = 0; n < degree - 1; ++n) A(r, n) = rows[std::size_t(r)][std::size_t(n)];
     b(r) = rhs[std::size_t(r)];
   }
-  const Eigen::VectorXd x = rows.empty() ? Eigen::VectorXd::Zero(degree - 1) : Eigen::VectorXd(A.colPivHouseholderQr().solve(b));
+  const Eigen::VectorXd x =
+      rows.empty() ? Eigen::VectorXd::Zero(degree - 1) : Eigen::VectorXd(A.colPivHouseholderQr().solve(b));
   std::vector<double> cf(std::size_t(degree), 0.0);
   double rest = 1.0;
   for (int n = 0; n < degree - 1; ++n) cf[std::size_t(n)] = x(n), rest -= x(n);
@@ -127,7 +130,10 @@ double knot_position(int z, int max_code) { return double(z) * (kKnots - 1) / ma
 // Isotonic regression (pool adjacent violators): the non-decreasing sequence nearest to x in
 // weighted least squares.
 void pool_adjacent_violators(std::vector<double>& x, const std::vector<double>& w) {
-  struct Block { double value, weight; std::size_t size; };
+  struct Block {
+    double value, weight;
+    std::size_t size;
+  };
   std::vector<Block> blocks;
   for (std::size_t i = 0; i < x.size(); ++i) {
     blocks.push_back({x[i], std::max(w[i], 1e-12), 1});
@@ -178,7 +184,10 @@ std::vector<double> fit_robertson(const std::vector<Track>& tracks, int max_code
   const int iterations = 30;
   std::vector<double> x(kKnots);
   for (int k = 0; k < kKnots; ++k) x[std::size_t(k)] = std::max(1e-6, double(k) / (kKnots - 1));
-  auto weight = [&](int k) { const double d = (k - 127.5) / 127.5; return std::exp(-4.0 * d * d); };
+  auto weight = [&](int k) {
+    const double d = (k - 127.5) / 127.5;
+    return std::exp(-4.0 * d * d);
+  };
   std::vector<double> sum(kKnots), count(kKnots);
   double total = 0;
   for (const Track& t : tracks) total += double(t.obs.size());
@@ -229,7 +238,10 @@ std::vector<double> fit_debevec(const std::vector<Track>& tracks, int max_code, 
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(K, K);
   Eigen::VectorXd h = Eigen::VectorXd::Zero(K);
   long data_rows = 0;
-  struct Term { int k0; double f, w, lne; };
+  struct Term {
+    int k0;
+    double f, w, lne;
+  };
   std::vector<Term> terms;
   std::vector<std::pair<int, double>> row;
   for (const Track& tr : tracks) {
@@ -352,7 +364,8 @@ HeldOutStats held_out_stats(const ResponseCurve& curve, const ResponseSamples& s
       if (v.size() < 2) continue;
       std::size_t ref = v[0];
       for (std::size_t j : v)
-        if (std::abs(s.codes[i][j][std::size_t(c)] - s.max_code / 2) < std::abs(s.codes[i][ref][std::size_t(c)] - s.max_code / 2))
+        if (std::abs(s.codes[i][j][std::size_t(c)] - s.max_code / 2) <
+            std::abs(s.codes[i][ref][std::size_t(c)] - s.max_code / 2))
           ref = j;
       const double L = curve.linear(c, s.codes[i][ref][std::size_t(c)]) / e[ref];
       for (std::size_t j : v) {
@@ -427,7 +440,8 @@ Cleaning clean_samples(ResponseSamples& s, const ResponseCurve& curve) {
       for (std::size_t j = 0; j < s.codes[i].size() && !gross; ++j)
         if (usable(s, i, j, c)) {
           const double p = predict(i, c, j, false);
-          gross = p >= 0 && std::abs(s.codes[i][j][std::size_t(c)] - p) > 8 * sigma && s.codes[i][j][std::size_t(c)] >= s.max_code / 8;
+          gross = p >= 0 && std::abs(s.codes[i][j][std::size_t(c)] - p) > 8 * sigma &&
+                  s.codes[i][j][std::size_t(c)] >= s.max_code / 8;
         }
     if (gross) s.saturated_from[i] = 0, ++removed;
   }
@@ -454,7 +468,8 @@ std::vector<Entry> all_entries(bool with_robertson) {
     if (with_robertson) e.push_back({"robertson", "robertson", shared, k, 1.0});
   }
   for (bool shared : {true, false})
-    for (int d = 2; d <= 5; ++d) e.push_back({"polynomial:" + std::to_string(d), "polynomial", shared, (shared ? 1 : 3) * (d - 1)});
+    for (int d = 2; d <= 5; ++d)
+      e.push_back({"polynomial:" + std::to_string(d), "polynomial", shared, (shared ? 1 : 3) * (d - 1)});
   return e;
 }
 
@@ -472,13 +487,20 @@ std::string label(const std::string& family, bool shared, const nlohmann::json& 
 
 }  // namespace
 
-ResponseSamples select_samples(const BracketStatistics& st, const std::array<int, 3>& saturation, const RecoveryOptions& o) {
-  if (st.views.empty()) throw std::runtime_error("one bracket: a response cannot be recovered (give --response or --model identity)");
+ResponseSamples select_samples(const BracketStatistics& st, const std::array<int, 3>& saturation,
+                               const RecoveryOptions& o) {
+  if (st.views.empty())
+    throw std::runtime_error("one bracket: a response cannot be recovered (give --response or --model identity)");
   ResponseSamples s;
   s.max_code = st.max_code;
   s.low_code = std::max(2, s.max_code / 128);
   s.saturation = saturation;
-  struct Candidate { int view; std::size_t index; int sat_from; double proxy, roughness; };
+  struct Candidate {
+    int view;
+    std::size_t index;
+    int sat_from;
+    double proxy, roughness;
+  };
   std::vector<Candidate> cand;
   for (std::size_t vi = 0; vi < st.views.size(); ++vi) {
     const ViewStatistics& v = st.views[vi];
@@ -506,12 +528,14 @@ ResponseSamples select_samples(const BracketStatistics& st, const std::array<int
         if (d < best_d) best_d = d, best = j, best_mean = mean;
       }
       if (!monotone || usable_brackets < 2) continue;
-      cand.push_back({int(vi), i, sat_from, std::log((best_mean + 1) / s.max_code) - std::log(v.exposures[std::size_t(best)]),
+      cand.push_back({int(vi), i, sat_from,
+                      std::log((best_mean + 1) / s.max_code) - std::log(v.exposures[std::size_t(best)]),
                       double(v.sample_roughness[i * std::size_t(P) + std::size_t(best)])});
     }
   }
   if (cand.size() < 20)
-    throw std::runtime_error("too few usable pixels for response recovery (every pixel saturated or black in every bracket?)");
+    throw std::runtime_error(
+        "too few usable pixels for response recovery (every pixel saturated or black in every bracket?)");
   // Reject the roughest quarter, then stratify over 128 bins of the log-radiance proxy (code and
   // exposure together: a radiance level fixes the codes in every bracket), keeping the smoothest
   // pixels of each bin, taken from the views in turn (ties: raster order).
@@ -548,7 +572,8 @@ ResponseSamples select_samples(const BracketStatistics& st, const std::array<int
   std::vector<std::size_t> chosen;
   for (auto& bin : binned) {
     for (auto& per : bin)
-      std::stable_sort(per.begin(), per.end(), [&](std::size_t a, std::size_t c) { return cand[a].roughness < cand[c].roughness; });
+      std::stable_sort(per.begin(), per.end(),
+                       [&](std::size_t a, std::size_t c) { return cand[a].roughness < cand[c].roughness; });
     std::size_t taken = 0;
     for (std::size_t round = 0; taken < quota; ++round) {
       bool any = false;
@@ -557,7 +582,8 @@ ResponseSamples select_samples(const BracketStatistics& st, const std::array<int
       if (!any) break;
     }
   }
-  std::stable_sort(chosen.begin(), chosen.end(), [&](std::size_t a, std::size_t c) { return cand[a].proxy < cand[c].proxy; });
+  std::stable_sort(chosen.begin(), chosen.end(),
+                   [&](std::size_t a, std::size_t c) { return cand[a].proxy < cand[c].proxy; });
   for (std::size_t n = 0; n < chosen.size(); ++n) {
     const Candidate& k = cand[chosen[n]];
     const ViewStatistics& v = st.views[std::size_t(k.view)];
@@ -574,8 +600,9 @@ ResponseSamples select_samples(const BracketStatistics& st, const std::array<int
 }
 
 ResponseCurve fit_response(const std::string& model, bool shared, const ResponseSamples& s, const RecoveryOptions& o) {
-  if (model == "identity") return finish_curve("identity", nlohmann::json::object(),
-                                               {std::vector<double>{0, 1}, std::vector<double>{0, 1}, std::vector<double>{0, 1}}, s);
+  if (model == "identity")
+    return finish_curve("identity", nlohmann::json::object(),
+                        {std::vector<double>{0, 1}, std::vector<double>{0, 1}, std::vector<double>{0, 1}}, s);
   // The parametric fits (unweighted in code) leave out the near-black codes, whose noise and
   // quantisation would dominate their log or ratio rows; the smooth curves weight them by the hat.
   const bool parametric = model == "gamma" || model.rfind("polynomial:", 0) == 0;
@@ -614,7 +641,8 @@ ResponseCurve fit_response(const std::string& model, bool shared, const Response
       k = sample_knots(parametric_knots(s.max_code), [&](double u) { return polynomial_at(cf[std::size_t(c)], u); });
       // Non-decreasing below saturation (above it the curve is replaced by a flat top).
       for (std::size_t i = 1; i < k.size(); ++i)
-        if (double(i) * s.max_code / double(k.size() - 1) <= s.saturation[std::size_t(c)] && k[i] < k[i - 1]) monotone = false;
+        if (double(i) * s.max_code / double(k.size() - 1) <= s.saturation[std::size_t(c)] && k[i] < k[i - 1])
+          monotone = false;
     }
     p["monotone"] = monotone;
     p["degree"] = degree;
@@ -627,7 +655,8 @@ ResponseCurve fit_response(const std::string& model, bool shared, const Response
     p["lambda"] = o.smoothness;
     p["knots"] = kKnots;
   } else {
-    throw std::invalid_argument("unknown response model '" + model + "' (identity, gamma, polynomial, robertson, debevec)");
+    throw std::invalid_argument("unknown response model '" + model +
+                                "' (identity, gamma, polynomial, robertson, debevec)");
   }
   std::string family = model.substr(0, model.find(':'));
   return finish_curve(family, p, std::move(knots), s);
@@ -686,7 +715,8 @@ std::size_t choose(ResponseRecovery& out, const std::vector<HeldOutStats>& stats
   };
   const std::size_t best_shared = best_of([&](std::size_t k) { return cand[k].shared; });
   const std::size_t best_separate = best_of([&](std::size_t k) { return !cand[k].shared; });
-  if (best_shared == N && best_separate == N) throw std::runtime_error("no response model fits these brackets (is the exposure data right?)");
+  if (best_shared == N && best_separate == N)
+    throw std::runtime_error("no response model fits these brackets (is the exposure data right?)");
   bool shared = best_separate == N;
   double channel_margin = kInf;
   std::string channel_rival;
@@ -699,7 +729,8 @@ std::size_t choose(ResponseRecovery& out, const std::vector<HeldOutStats>& stats
     const Comparison c = compare(stats[best_shared], stats[best_separate], kChannelRatio, neutral >= 200);
     shared = c.excess <= 0;
     channel_margin = c.se > 0 ? std::abs(c.excess) / c.se : kInf;
-    channel_rival = label(cand[shared ? best_separate : best_shared].model, !shared, cand[shared ? best_separate : best_shared].parameters);
+    channel_rival = label(cand[shared ? best_separate : best_shared].model, !shared,
+                          cand[shared ? best_separate : best_shared].parameters);
   }
   auto in_pool = [&](std::size_t k) { return cand[k].shared == shared || cand[k].model == "identity"; };
   const std::size_t best = best_of(in_pool);
@@ -743,7 +774,8 @@ std::size_t choose(ResponseRecovery& out, const std::vector<HeldOutStats>& stats
 }  // namespace
 
 ResponseRecovery recover_response(const BracketStatistics& st, const RecoveryOptions& o) {
-  if (st.views.empty()) throw std::runtime_error("one bracket: a response cannot be recovered (give --response or --model identity)");
+  if (st.views.empty())
+    throw std::runtime_error("one bracket: a response cannot be recovered (give --response or --model identity)");
   if (o.channels != "auto" && o.channels != "shared" && o.channels != "separate")
     throw std::invalid_argument("unknown channel mode '" + o.channels + "' (auto, shared, separate)");
   ResponseRecovery out;
@@ -799,20 +831,28 @@ ResponseRecovery recover_response(const BracketStatistics& st, const RecoveryOpt
     stats.push_back(std::move(h));
   }
   if (!known || out.candidates.empty())
-    throw std::invalid_argument("unknown response model '" + o.model + "' (auto, identity, gamma, polynomial, robertson, debevec)");
+    throw std::invalid_argument("unknown response model '" + o.model +
+                                "' (auto, identity, gamma, polynomial, robertson, debevec)");
   out.curve = curves[choose(out, stats, o)];
   return out;
 }
 
-ResponseRecovery recover_response(const BracketSet& b, const RecoveryOptions& o) { return recover_response(std::vector<const BracketSet*>{&b}, o); }
+ResponseRecovery recover_response(const BracketSet& b, const RecoveryOptions& o) {
+  return recover_response(std::vector<const BracketSet*>{&b}, o);
+}
 
 nlohmann::json recovery_json(const ResponseRecovery& r) {
   nlohmann::json cands = nlohmann::json::array();
   for (const auto& c : r.candidates)
-    cands.push_back({{"model", c.model}, {"shared", c.shared}, {"complexity", c.complexity},
-                     {"held_out_error", std::isfinite(c.held_out_error) ? nlohmann::json(c.held_out_error) : nlohmann::json("rejected")},
-                     {"excess_sigmas", std::isfinite(c.held_out_error) ? nlohmann::json(c.excess_sigmas) : nlohmann::json()},
-                     {"tied", c.tied}, {"parameters", c.parameters}});
+    cands.push_back(
+        {{"model", c.model},
+         {"shared", c.shared},
+         {"complexity", c.complexity},
+         {"held_out_error",
+          std::isfinite(c.held_out_error) ? nlohmann::json(c.held_out_error) : nlohmann::json("rejected")},
+         {"excess_sigmas", std::isfinite(c.held_out_error) ? nlohmann::json(c.excess_sigmas) : nlohmann::json()},
+         {"tied", c.tied},
+         {"parameters", c.parameters}});
   return {{"chosen", r.chosen},
           {"margin_sigmas", std::isfinite(r.margin_sigmas) ? nlohmann::json(r.margin_sigmas) : nlohmann::json()},
           {"near_tie", r.near_tie},

@@ -77,8 +77,8 @@ struct ResponseSamples {
   std::vector<std::vector<double>> exposures;  // per view, ascending
   std::vector<bool> held_out;                  // per sample
   int max_code = 255;
-  int low_code = 2;                            // codes below are black (max(2, max_code / 128)); the parametric
-                                               // fits also leave out those below max_code / 20
+  int low_code = 2;                              // codes below are black (max(2, max_code / 128)); the parametric
+                                                 // fits also leave out those below max_code / 20
   std::array<int, 3> saturation{254, 254, 254};  // per channel: codes at or above are saturated
 };
 
@@ -89,17 +89,17 @@ struct RecoveryOptions {
   double smoothness = 1000.0;     // lambda of debevec and robertson, relative to the data term per knot
                                   // (auto tries debevec at 10x and 1x it)
   std::array<int, 3> saturation_code{-1, -1, -1};  // per channel; -1: measured (saturation_level.h)
-  double tie_sigmas = 2.0;        // a simpler model within this many standard errors of the best wins
-  double tie_relative = 0.03;     // ... or within this fraction of the best's mean squared error
+  double tie_sigmas = 2.0;                         // a simpler model within this many standard errors of the best wins
+  double tie_relative = 0.03;                      // ... or within this fraction of the best's mean squared error
 };
 
 struct ModelCandidate {
-  std::string model;               // family: identity, gamma, polynomial, robertson, debevec
-  bool shared = false;             // one curve for the three channels
-  int complexity = 0;              // free parameters (all channels); the tie-break order
-  double held_out_error = 0;       // RMS code error / max_code on the held-out half (inf when rejected)
-  double excess_sigmas = 0;        // (its MSE - the best's) / standard error of the paired difference
-  bool tied = false;               // within the held-out noise of the best
+  std::string model;          // family: identity, gamma, polynomial, robertson, debevec
+  bool shared = false;        // one curve for the three channels
+  int complexity = 0;         // free parameters (all channels); the tie-break order
+  double held_out_error = 0;  // RMS code error / max_code on the held-out half (inf when rejected)
+  double excess_sigmas = 0;   // (its MSE - the best's) / standard error of the paired difference
+  bool tied = false;          // within the held-out noise of the best
   nlohmann::json parameters;
 };
 
@@ -107,11 +107,11 @@ struct ResponseRecovery {
   ResponseCurve curve;
   std::vector<ModelCandidate> candidates;  // every model tried, in order of complexity
   int train_samples = 0, held_out_samples = 0, views = 0;
-  long removed_observations = 0;           // brackets found saturated below the code, and moving pixels
-  std::string chosen;                      // "debevec (shared)", "gamma (per channel)", ...
-  double margin_sigmas = 0;                // distance of the choice from the tie threshold (inf: no rival)
-  bool near_tie = false;                   // margin under one standard error: another shoot may choose otherwise
-  std::string warning;                     // empty, or what the near tie is between
+  long removed_observations = 0;  // brackets found saturated below the code, and moving pixels
+  std::string chosen;             // "debevec (shared)", "gamma (per channel)", ...
+  double margin_sigmas = 0;       // distance of the choice from the tie threshold (inf: no rival)
+  bool near_tie = false;          // margin under one standard error: another shoot may choose otherwise
+  std::string warning;            // empty, or what the near tie is between
   SaturationLevel saturation;
 };
 

@@ -25,9 +25,9 @@
 namespace rsibr {
 
 struct SaturationLevel {
-  std::array<int, 3> code{0, 0, 0};   // per channel: codes at or above are saturated
+  std::array<int, 3> code{0, 0, 0};       // per channel: codes at or above are saturated
   std::array<long, 3> evidence{0, 0, 0};  // saturated codes measured per channel (0: default used)
-  std::string source;                 // "detected", "default" (too little evidence) or "given"
+  std::string source;                     // "detected", "default" (too little evidence) or "given"
 };
 
 int default_saturation_code(int max_code);

@@ -46,7 +46,9 @@ std::vector<Square> board_squares(const VignettingBoard& b, int board, const Res
   for (int j = 0; j + 1 < n; ++j)
     for (int i = 0; i + 1 < n; ++i) {
       const Vec2 p00 = corner(i, j), p10 = corner(i + 1, j), p01 = corner(i, j + 1), p11 = corner(i + 1, j + 1);
-      auto at = [&](double u, double v) { return Vec2((1 - v) * ((1 - u) * p00 + u * p10) + v * ((1 - u) * p01 + u * p11)); };
+      auto at = [&](double u, double v) {
+        return Vec2((1 - v) * ((1 - u) * p00 + u * p10) + v * ((1 - u) * p01 + u * p11));
+      };
       std::vector<double> samples;
       bool bad = false;
       for (int sv = 0; sv < 5 && !bad; ++sv)
@@ -181,7 +183,8 @@ double Vignetting::corner_stops() const { return -std::log2(std::max(kMinV, poly
 
 double vignetting_corner_radius(int width, int height, const Vec2& c) {
   double r2 = 0;
-  for (const Vec2& q : {Vec2(-0.5, -0.5), Vec2(width - 0.5, -0.5), Vec2(-0.5, height - 0.5), Vec2(width - 0.5, height - 0.5)})
+  for (const Vec2& q :
+       {Vec2(-0.5, -0.5), Vec2(width - 0.5, -0.5), Vec2(-0.5, height - 0.5), Vec2(width - 0.5, height - 0.5)})
     r2 = std::max(r2, (q - c).squaredNorm());
   return std::sqrt(r2);
 }
@@ -231,7 +234,8 @@ VignettingEstimate estimate_vignetting(const std::vector<VignettingBoard>& board
     int count = 0;
     for (int h = 0; h < used; ++h) s2 += held_out_sum2(sq, used, d, h, &count);
     est.held_out_rms[std::size_t(d - 1)] = count > 0 ? std::sqrt(s2 / count) : 0;
-    if (d == 1 || est.held_out_rms[std::size_t(d - 1)] < 0.98 * best_err) best = d, best_err = est.held_out_rms[std::size_t(d - 1)];
+    if (d == 1 || est.held_out_rms[std::size_t(d - 1)] < 0.98 * best_err)
+      best = d, best_err = est.held_out_rms[std::size_t(d - 1)];
   }
   const Fit f = fit_model(sq, used, best);
   est.degree = best;
@@ -246,12 +250,17 @@ cv::Mat read_board_codes(const std::filesystem::path& file) {
   if (is_raw_file(file)) return read_raw_image(file).codes;  // linear, as the RAW brackets
   cv::Mat img = cv::imread(file.string(), cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH);
   if (img.empty()) throw std::runtime_error(file.string() + ": cannot read the image");
-  if (img.depth() != CV_8U && img.depth() != CV_16U) throw std::runtime_error(file.string() + ": expected 8 or 16 bits");
+  if (img.depth() != CV_8U && img.depth() != CV_16U)
+    throw std::runtime_error(file.string() + ": expected 8 or 16 bits");
   cv::Mat rgb;
-  if (img.channels() == 1) cv::cvtColor(img, rgb, cv::COLOR_GRAY2RGB);
-  else if (img.channels() == 3) cv::cvtColor(img, rgb, cv::COLOR_BGR2RGB);
-  else if (img.channels() == 4) cv::cvtColor(img, rgb, cv::COLOR_BGRA2RGB);
-  else throw std::runtime_error(file.string() + ": unsupported channel count");
+  if (img.channels() == 1)
+    cv::cvtColor(img, rgb, cv::COLOR_GRAY2RGB);
+  else if (img.channels() == 3)
+    cv::cvtColor(img, rgb, cv::COLOR_BGR2RGB);
+  else if (img.channels() == 4)
+    cv::cvtColor(img, rgb, cv::COLOR_BGRA2RGB);
+  else
+    throw std::runtime_error(file.string() + ": unsupported channel count");
   cv::Mat out;
   rgb.convertTo(out, CV_16UC3);
   return out;
@@ -271,9 +280,13 @@ void divide_vignetting(MergedImage& image, const Vignetting& v) {
 }
 
 nlohmann::json vignetting_json(const Vignetting& v) {
-  return {{"model", "pa"}, {"formula", "v = 1 + k1 r^2 + k2 r^4 + k3 r^6, r = |p - centre| / r_corner"},
-          {"centre_px", {v.centre.x(), v.centre.y()}}, {"r_corner_px", v.r_corner}, {"k", v.k},
-          {"corner_stops", v.corner_stops()}, {"source", v.source}};
+  return {{"model", "pa"},
+          {"formula", "v = 1 + k1 r^2 + k2 r^4 + k3 r^6, r = |p - centre| / r_corner"},
+          {"centre_px", {v.centre.x(), v.centre.y()}},
+          {"r_corner_px", v.r_corner},
+          {"k", v.k},
+          {"corner_stops", v.corner_stops()},
+          {"source", v.source}};
 }
 
 Vignetting vignetting_from_json(const nlohmann::json& j, const std::string& what) {
@@ -290,7 +303,8 @@ Vignetting vignetting_from_json(const nlohmann::json& j, const std::string& what
     if (!v.centre.allFinite() || !(v.r_corner > 0) || !std::isfinite(v.k[0] + v.k[1] + v.k[2]))
       throw std::invalid_argument("non-finite or non-positive values");
     for (int i = 0; i <= 20; ++i)
-      if (!(poly(v.k, i / 20.0) > kMinV)) throw std::invalid_argument("the polynomial falls below 0.05 inside the image");
+      if (!(poly(v.k, i / 20.0) > kMinV))
+        throw std::invalid_argument("the polynomial falls below 0.05 inside the image");
     return v;
   } catch (const nlohmann::json::exception& e) {
     throw std::invalid_argument(what + ": " + e.what());

@@ -41,7 +41,7 @@ struct Vignetting {
   Vec2 centre = Vec2::Zero();  // principal point, pixels
   double r_corner = 1;         // pixels
   std::array<double, 3> k{0, 0, 0};
-  std::string source = "none"; // how it was obtained ("none", "chessboards", "given: <file>")
+  std::string source = "none";  // how it was obtained ("none", "chessboards", "given: <file>")
 
   // v at pixel (x, y), clamped to >= 0.05 (a polynomial extrapolated beyond its data can dive).
   double at(double x, double y) const;
@@ -67,14 +67,14 @@ struct VignettingBoard {
 };
 
 struct VignettingEstimate {
-  Vignetting model;                 // identity when there is no estimate (fewer than 3 boards)
-  int degree = 0;                   // polynomial terms used (0: no estimate)
-  int boards = 0, squares = 0;      // used
-  double rms = 0;                   // RMS of ln y residuals after the fit (relative error of a square)
-  double corner_sigma_stops = 0;    // std dev of corner_stops (the fit's covariance)
-  double max_r = 0;                 // the farthest square's r (beyond it the polynomial extrapolates)
+  Vignetting model;                             // identity when there is no estimate (fewer than 3 boards)
+  int degree = 0;                               // polynomial terms used (0: no estimate)
+  int boards = 0, squares = 0;                  // used
+  double rms = 0;                               // RMS of ln y residuals after the fit (relative error of a square)
+  double corner_sigma_stops = 0;                // std dev of corner_stops (the fit's covariance)
+  double max_r = 0;                             // the farthest square's r (beyond it the polynomial extrapolates)
   std::array<double, 3> held_out_rms{0, 0, 0};  // per degree 1..3, leave-one-board-out
-  std::string note;                 // why there is no estimate, when there is none
+  std::string note;                             // why there is no estimate, when there is none
 };
 
 // Throws std::invalid_argument for a board whose codes are not CV_16UC3 or whose corners are not

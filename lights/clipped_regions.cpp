@@ -72,9 +72,11 @@ std::vector<ClippedRegion> find_clipped_regions(const Probe& probe, double merge
       sums[std::size_t(idx)] += omega * w;
     }
   auto finish = [&](ClippedRegion& g, const Vec3& sum) {
-    g.direction = sum.norm() > 0 ? sum.normalized() : layout.texel_direction(int(g.texels[0] % W), int(g.texels[0] / W))->normalized();
+    g.direction = sum.norm() > 0 ? sum.normalized()
+                                 : layout.texel_direction(int(g.texels[0] % W), int(g.texels[0] / W))->normalized();
     double rad = 0;
-    for (long t : g.texels) rad = std::max(rad, angle_between(g.direction, *layout.texel_direction(int(t % W), int(t / W))));
+    for (long t : g.texels)
+      rad = std::max(rad, angle_between(g.direction, *layout.texel_direction(int(t % W), int(t / W))));
     g.radius = rad + half_diagonal;
   };
   for (std::size_t i = 0; i < regions.size(); ++i) finish(regions[i], sums[i]);
@@ -86,7 +88,8 @@ std::vector<ClippedRegion> find_clipped_regions(const Probe& probe, double merge
   // centroid (as merged so far) is within merge_deg of its own.
   std::vector<std::size_t> order(regions.size());
   std::iota(order.begin(), order.end(), std::size_t(0));
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return by_bound(regions[a], regions[b]); });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return by_bound(regions[a], regions[b]); });
   std::vector<ClippedRegion> merged;
   std::vector<Vec3> merged_sums;
   const double cos_merge = std::cos(merge_deg * kPi / 180);

@@ -21,12 +21,12 @@
 namespace rsibr {
 
 struct ClippedRegion {
-  std::vector<long> texels;    // r * width + c of the probe
-  Vec3 direction = Vec3::UnitY();  // world, unit
-  double solid_angle = 0;      // sr
-  double radius = 0;           // rad
+  std::vector<long> texels;         // r * width + c of the probe
+  Vec3 direction = Vec3::UnitY();   // world, unit
+  double solid_angle = 0;           // sr
+  double radius = 0;                // rad
   Vec3 lower_bound = Vec3::Zero();  // sum of Probe::lower_bound * Omega over the texels (RGB)
-  double weight = 0;           // sum of Probe::clipped (how strongly the views saw it)
+  double weight = 0;                // sum of Probe::clipped (how strongly the views saw it)
 };
 
 // `probe.clipped` and `probe.lower_bound` as assemble_probe fills them.

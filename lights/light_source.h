@@ -31,20 +31,20 @@
 namespace rsibr {
 
 struct LightSource {
-  Vec3 direction = Vec3::UnitY();  // world, unit
-  double radius = 0;               // the disc's angular radius (rad); 0: a point
-  Vec3 power = Vec3::Zero();       // RGB, L * Omega
-  Vec3 power_sigma = Vec3::Zero(); // 1-sigma of power (the larger of the fit's and the views' spread)
-  double direction_sigma = 0;      // 1-sigma of the direction (rad)
-  double radius_sigma = 0;         // 0 when the radius was not fitted
-  bool radius_fitted = false;      // a glossy ball constrained the radius
+  Vec3 direction = Vec3::UnitY();   // world, unit
+  double radius = 0;                // the disc's angular radius (rad); 0: a point
+  Vec3 power = Vec3::Zero();        // RGB, L * Omega
+  Vec3 power_sigma = Vec3::Zero();  // 1-sigma of power (the larger of the fit's and the views' spread)
+  double direction_sigma = 0;       // 1-sigma of the direction (rad)
+  double radius_sigma = 0;          // 0 when the radius was not fitted
+  bool radius_fitted = false;       // a glossy ball constrained the radius
   // Where it came from.
-  int region = -1;                 // index of the clipped region (lights/clipped_regions.h)
-  double region_solid_angle = 0;   // sr
-  double region_radius = 0;        // rad
-  Vec3 lower_bound = Vec3::Zero(); // the region's clipped values times solid angle (RGB): at least this
-  std::vector<std::string> balls;  // the balls whose maps constrained it
-  std::vector<std::string> views;  // the views (image names) whose maps it lit, with trusted texels
+  int region = -1;                  // index of the clipped region (lights/clipped_regions.h)
+  double region_solid_angle = 0;    // sr
+  double region_radius = 0;         // rad
+  Vec3 lower_bound = Vec3::Zero();  // the region's clipped values times solid angle (RGB): at least this
+  std::vector<std::string> balls;   // the balls whose maps constrained it
+  std::vector<std::string> views;   // the views (image names) whose maps it lit, with trusted texels
 
   double solid_angle() const { return 2 * kPi * (1 - std::cos(radius)); }
 };
@@ -78,9 +78,12 @@ T mean_clamped_cosine(const T& cos_theta, const T& rho) {
     const T t = rho * T(0.5 * (x + 1));
     const T a = cos(t) * ct, b = sin(t) * st;
     T g;
-    if (a >= b) g = T(2 * kPi) * a;
-    else if (a <= -b) g = T(0);
-    else g = T(2) * (a * acos(-a / b) + sqrt(b * b - a * a));
+    if (a >= b)
+      g = T(2 * kPi) * a;
+    else if (a <= -b)
+      g = T(0);
+    else
+      g = T(2) * (a * acos(-a / b) + sqrt(b * b - a * a));
     sum += T(wgt) * g * sin(t);
   }
   const T integral = sum * rho * T(0.5);

@@ -55,7 +55,8 @@ std::vector<std::pair<long, double>> disc_texels(const Layout& layout, const Vec
           ++total;
           inside += w->normalized().dot(d) >= cos_rho;
         }
-      if (inside > 0 && total > 0) out.push_back({long(r) * W + c, double(inside) / total * layout.texel_solid_angle(c, r)});
+      if (inside > 0 && total > 0)
+        out.push_back({long(r) * W + c, double(inside) / total * layout.texel_solid_angle(c, r)});
     }
   return out;
 }
@@ -72,13 +73,16 @@ std::vector<double> add_sources_to_probe(EnvMap& probe, const std::vector<LightS
     const Vec3 d = s.direction.normalized();
     std::vector<std::pair<long, double>> weights;  // (texel, w_t)
     const Vec2 p = layout.pixel(d);
-    const int c0 = std::clamp(int(std::lround(p.x())), 0, W - 1), r0 = std::clamp(int(std::lround(p.y())), 0, layout.height() - 1);
+    const int c0 = std::clamp(int(std::lround(p.x())), 0, W - 1),
+              r0 = std::clamp(int(std::lround(p.y())), 0, layout.height() - 1);
     if (s.radius > 0 && s.solid_angle() > 2 * layout.texel_solid_angle(c0, r0)) {
       weights = disc_texels(layout, d, s.radius);
       double sum = 0;
       for (const auto& [t, w] : weights) sum += w;
-      if (sum > 0) for (auto& tw : weights) tw.second /= sum;
-      else weights.clear();
+      if (sum > 0)
+        for (auto& tw : weights) tw.second /= sum;
+      else
+        weights.clear();
     }
     if (weights.empty()) weights = bilinear_texels(layout, d);
     double footprint = 0;
@@ -119,8 +123,11 @@ nlohmann::json light_sources_json(const std::vector<LightSource>& sources, const
                     {"direction_sigma_deg", s.direction_sigma * deg},
                     {"balls", s.balls},
                     {"views", s.views},
-                    {"region", {{"index", s.region}, {"solid_angle_sr", s.region_solid_angle},
-                                {"radius_deg", s.region_radius * deg}, {"lower_bound", vec(s.lower_bound)}}}});
+                    {"region",
+                     {{"index", s.region},
+                      {"solid_angle_sr", s.region_solid_angle},
+                      {"radius_deg", s.region_radius * deg},
+                      {"lower_bound", vec(s.lower_bound)}}}});
   }
   return list;
 }

@@ -36,9 +36,9 @@ std::shared_ptr<const Fresnel> chrome_fresnel_from_spec(const std::string& spec,
   }
 }
 
-RecoveredProbe recover_probe_sources(const MapSet& chrome, const ProbeOptions& probe, const std::vector<GreyBallMaps>& grey,
-                                     const std::vector<GlossyBallMaps>& glossy, const SourceRecoveryOptions& options,
-                                     bool recover) {
+RecoveredProbe recover_probe_sources(const MapSet& chrome, const ProbeOptions& probe,
+                                     const std::vector<GreyBallMaps>& grey, const std::vector<GlossyBallMaps>& glossy,
+                                     const SourceRecoveryOptions& options, bool recover) {
   RecoveredProbe out;
   out.measured = assemble_probe(chrome, probe);
   const Probe& measured = out.measured;
@@ -73,11 +73,14 @@ RecoveredProbe recover_probe_sources(const MapSet& chrome, const ProbeOptions& p
   for (std::size_t i = 0; i < out.regions.size(); ++i) {
     const ClippedRegion& g = out.regions[i];
     const Vec3 d = g.direction.normalized();
-    nlohmann::json rj = {{"index", i}, {"direction", vec(d)},
+    nlohmann::json rj = {{"index", i},
+                         {"direction", vec(d)},
                          {"azimuth_deg", std::atan2(d.x(), d.z()) * 180 / kPi},
                          {"elevation_deg", std::asin(std::clamp(d.y(), -1.0, 1.0)) * 180 / kPi},
-                         {"solid_angle_sr", g.solid_angle}, {"radius_deg", g.radius * 180 / kPi},
-                         {"texels", g.texels.size()}, {"lower_bound", vec(g.lower_bound)},
+                         {"solid_angle_sr", g.solid_angle},
+                         {"radius_deg", g.radius * 180 / kPi},
+                         {"texels", g.texels.size()},
+                         {"lower_bound", vec(g.lower_bound)},
                          {"recovered", done.count(int(i)) > 0}};
     if (!done.count(int(i))) bounds += g.lower_bound;
     regions.push_back(rj);
@@ -92,10 +95,15 @@ RecoveredProbe recover_probe_sources(const MapSet& chrome, const ProbeOptions& p
   for (const BallResidual& b : out.recovery.residuals) {
     nlohmann::json views = nlohmann::json::array();
     for (std::size_t v = 0; v < b.views.size(); ++v)
-      views.push_back({{"name", b.views[v]}, {"before", v < b.view_before.size() ? b.view_before[v] : 0.0},
+      views.push_back({{"name", b.views[v]},
+                       {"before", v < b.view_before.size() ? b.view_before[v] : 0.0},
                        {"after", v < b.view_after.size() ? b.view_after[v] : 0.0}});
-    residuals.push_back({{"ball", b.ball}, {"kind", b.kind}, {"texels", b.texels}, {"before", b.before},
-                         {"after", b.after}, {"views", views}});
+    residuals.push_back({{"ball", b.ball},
+                         {"kind", b.kind},
+                         {"texels", b.texels},
+                         {"before", b.before},
+                         {"after", b.after},
+                         {"views", views}});
   }
   out.summary = {{"enabled", recover},
                  {"clipped_fraction", measured.clipped_fraction},
@@ -124,7 +132,8 @@ std::string light_sources_line(const nlohmann::json& s) {
       << 100 * v[2].get<double>() << "% (R/G/B)";
     return p.str();
   };
-  o << regions << " clipped light source" << (regions == 1 ? "" : "s") << " (clipped in every chrome view that saw it); ";
+  o << regions << " clipped light source" << (regions == 1 ? "" : "s")
+    << " (clipped in every chrome view that saw it); ";
   if (sources > 0) {
     std::set<std::string> balls;
     for (const auto& src : s["sources"])
@@ -133,7 +142,8 @@ std::string light_sources_line(const nlohmann::json& s) {
     for (const std::string& b : balls) from += (from.empty() ? "" : ", ") + b;
     o << "recovered " << sources << " from " << (from.empty() ? "-" : from) << ": " << pct(s["missing_fraction"])
       << " of the probe's light";
-    if (sources < regions) o << "; " << regions - sources << " not recovered (at least " << pct(s["lower_bound_fraction"]) << " missing)";
+    if (sources < regions)
+      o << "; " << regions - sources << " not recovered (at least " << pct(s["lower_bound_fraction"]) << " missing)";
   } else {
     o << "none recovered: at least " << pct(s["lower_bound_fraction"]) << " of the light is missing from the probe";
   }

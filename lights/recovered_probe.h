@@ -29,8 +29,8 @@
 namespace rsibr {
 
 struct RecoveredProbe {
-  Probe measured;                      // the chrome maps' blend (calib/probe.h)
-  EnvMap env;                          // the probe with the sources added (a copy when none)
+  Probe measured;  // the chrome maps' blend (calib/probe.h)
+  EnvMap env;      // the probe with the sources added (a copy when none)
   std::vector<ClippedRegion> regions;
   SourceRecovery recovery;
   nlohmann::json summary;
@@ -43,9 +43,9 @@ std::shared_ptr<const Fresnel> chrome_fresnel_from_spec(const std::string& spec,
 // The chrome maps are blended (assemble_probe with `probe`), and once more without each view for
 // the jackknife's folds (lights/source_recovery.h). `recover` false: the regions are found and
 // summarised, nothing is added (today's probe).
-RecoveredProbe recover_probe_sources(const MapSet& chrome, const ProbeOptions& probe, const std::vector<GreyBallMaps>& grey,
-                                     const std::vector<GlossyBallMaps>& glossy, const SourceRecoveryOptions& options,
-                                     bool recover = true);
+RecoveredProbe recover_probe_sources(const MapSet& chrome, const ProbeOptions& probe,
+                                     const std::vector<GreyBallMaps>& grey, const std::vector<GlossyBallMaps>& glossy,
+                                     const SourceRecoveryOptions& options, bool recover = true);
 
 // One line for a terminal or a report: "2 clipped light sources; recovered 61% / 59% / 47% (R/G/B)
 // of the probe's light from grey", or "" when nothing was clipped.

@@ -34,8 +34,8 @@ struct Texel {
   Vec3 inv_scale;  // 1 / max(O, floor) per channel
   Vec3 gain;       // grey: albedo / pi; glossy: 1
   double sqrt_w = 1;
-  int ball = 0;    // index over grey then glossy balls
-  int view = 0;    // index over distinct image names
+  int ball = 0;                // index over grey then glossy balls
+  int view = 0;                // index over distinct image names
   const Brdf* brdf = nullptr;  // glossy only
   Vec3 mirror = Vec3::Zero();  // glossy: the mirror direction of v about n
   double lobe = 0;             // glossy: the lobe's width (rad, bake/brdf.h), 0 for a normal lobe
@@ -124,8 +124,8 @@ struct GlossyCost {
 };
 
 // The model's residual vector (3 per texel) at parameters x.
-void residuals(const std::vector<Texel>& texels, const std::vector<Frame>& frames, const std::vector<std::array<double, kBlock>>& x,
-               std::vector<double>* out) {
+void residuals(const std::vector<Texel>& texels, const std::vector<Frame>& frames,
+               const std::vector<std::array<double, kBlock>>& x, std::vector<double>* out) {
   out->assign(texels.size() * 3, 0.0);
   std::vector<Vec3> dirs;
   for (std::size_t s = 0; s < frames.size(); ++s) dirs.push_back(direction_of(frames[s], x[s].data()));
@@ -149,15 +149,16 @@ double mad_sigma(const std::vector<double>& r) {
 // Powers by non-negative least squares at fixed directions and radii, per channel, iteratively
 // reweighted for the Huber loss of scale `delta` on each texel's residual norm (delta <= 0: plain
 // least squares). `use` selects the texels (empty: all).
-void solve_powers(const std::vector<Texel>& texels, const std::vector<Frame>& frames, std::vector<std::array<double, kBlock>>& x,
-                  double delta, const std::vector<char>& use) {
+void solve_powers(const std::vector<Texel>& texels, const std::vector<Frame>& frames,
+                  std::vector<std::array<double, kBlock>>& x, double delta, const std::vector<char>& use) {
   const int S = int(frames.size());
   if (S == 0) return;
   std::vector<Vec3> dirs;
   for (int s = 0; s < S; ++s) dirs.push_back(direction_of(frames[std::size_t(s)], x[std::size_t(s)].data()));
   std::vector<std::vector<Vec3>> k(texels.size(), std::vector<Vec3>(std::size_t(S)));
   parallel_for_rows(int(texels.size()), [&](int i) {
-    for (int s = 0; s < S; ++s) k[std::size_t(i)][std::size_t(s)] = kernel(texels[std::size_t(i)], dirs[std::size_t(s)], x[std::size_t(s)][5]);
+    for (int s = 0; s < S; ++s)
+      k[std::size_t(i)][std::size_t(s)] = kernel(texels[std::size_t(i)], dirs[std::size_t(s)], x[std::size_t(s)][5]);
   });
   std::vector<double> h(texels.size(), 1.0);
   const int rounds = delta > 0 ? 6 : 1;
@@ -201,9 +202,9 @@ struct Fit {
 };
 
 // The joint Ceres refinement from x (directions within their bounds, P >= 0, rho when fitted).
-Fit refine(const std::vector<Texel>& texels, const std::vector<Frame>& frames, std::vector<std::array<double, kBlock>> x,
-           double delta, bool move_directions, bool fit_radius, bool want_covariance, const std::vector<char>& use,
-           int iterations = 50) {
+Fit refine(const std::vector<Texel>& texels, const std::vector<Frame>& frames,
+           std::vector<std::array<double, kBlock>> x, double delta, bool move_directions, bool fit_radius,
+           bool want_covariance, const std::vector<char>& use, int iterations = 50) {
   Fit fit;
   const int S = int(frames.size());
   ceres::Problem::Options po;
@@ -249,7 +250,8 @@ Fit refine(const std::vector<Texel>& texels, const std::vector<Frame>& frames, s
     if (!fit_radius) constant.push_back(5);
     if (!constant.empty()) problem.SetManifold(b, new ceres::SubsetManifold(kBlock, constant));
     if (move_directions)
-      for (int k = 0; k < 2; ++k) problem.SetParameterLowerBound(b, k, -f.bound), problem.SetParameterUpperBound(b, k, f.bound);
+      for (int k = 0; k < 2; ++k)
+        problem.SetParameterLowerBound(b, k, -f.bound), problem.SetParameterUpperBound(b, k, f.bound);
     for (int k = 2; k < 5; ++k) problem.SetParameterLowerBound(b, k, 0.0);
     if (fit_radius) {
       problem.SetParameterLowerBound(b, 5, 1e-4);
@@ -275,7 +277,8 @@ Fit refine(const std::vector<Texel>& texels, const std::vector<Frame>& frames, s
   for (int s = 0; s < S; ++s) pairs.emplace_back(blocks[std::size_t(s)], blocks[std::size_t(s)]);
   // The residuals are in units of their own sigma only after dividing by it: scale by the
   // variance of the (robustified) residuals per degree of freedom.
-  const double dof = std::max(1.0, 3.0 * double(used) - double(S) * (3 + (move_directions ? 2 : 0) + (fit_radius ? 1 : 0)));
+  const double dof =
+      std::max(1.0, 3.0 * double(used) - double(S) * (3 + (move_directions ? 2 : 0) + (fit_radius ? 1 : 0)));
   // The model's errors (the probe's known part, the extraction) are smooth over a ball, so the
   // texels of one ball in one view are not independent: a grey ball's shading is band-limited to
   // about 9 spherical-harmonic coefficients (the clamped cosine keeps ~99% of its energy in
@@ -312,7 +315,8 @@ std::string describe(const ClippedRegion& g) {
   const Vec3& d = g.direction;
   std::ostringstream s;
   s << "the clipped region at azimuth " << degrees(std::atan2(d.x(), d.z())) << ", elevation "
-    << degrees(std::asin(std::clamp(d.y(), -1.0, 1.0))) << " degrees (" << std::setprecision(3) << g.solid_angle << " sr)";
+    << degrees(std::asin(std::clamp(d.y(), -1.0, 1.0))) << " degrees (" << std::setprecision(3) << g.solid_angle
+    << " sr)";
   return s.str();
 }
 
@@ -333,7 +337,8 @@ struct KnownIrradiance {
             : resample(split.remainder, Layout(LayoutKind::LatLong, width, std::max(2, width / 2)), ro));
     const int W = known.layout.width();
     for (const BrightTexel& t : split.bright)
-      nodes.push_back({known.layout.texel_direction(int(t.texel % W), int(t.texel / W))->normalized(), t.radiance * t.solid_angle});
+      nodes.push_back(
+          {known.layout.texel_direction(int(t.texel % W), int(t.texel / W))->normalized(), t.radiance * t.solid_angle});
     for (const auto& q : nodes) {
       x.push_back(q.dir.x()), y.push_back(q.dir.y()), z.push_back(q.dir.z());
       r.push_back(q.radiance.x()), g.push_back(q.radiance.y()), b.push_back(q.radiance.z());
@@ -351,8 +356,9 @@ struct KnownIrradiance {
 
 }  // namespace
 
-SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedRegion>& regions, const std::vector<GreyBallMaps>& grey,
-                               const std::vector<GlossyBallMaps>& glossy, const SourceRecoveryOptions& options,
+SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedRegion>& regions,
+                               const std::vector<GreyBallMaps>& grey, const std::vector<GlossyBallMaps>& glossy,
+                               const SourceRecoveryOptions& options,
                                const std::map<std::string, EnvMap>& known_without) {
   SourceRecovery out;
   if (regions.empty()) return out;
@@ -377,7 +383,8 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
     for (std::size_t v = 0; v < maps.views.size(); ++v) {
       const MapView& mv = maps.views[v];
       if (mv.confidence.empty() || mv.rgb.type() != CV_32FC3)
-        throw std::invalid_argument("sources: " + name + " view." + std::to_string(v) + " has no confidence (not captured)");
+        throw std::invalid_argument("sources: " + name + " view." + std::to_string(v) +
+                                    " has no confidence (not captured)");
       const std::string image = image_of(mv, v);
       const auto [it, fresh] = view_index.emplace(image, int(view_names.size()));
       if (fresh) view_names.push_back(image);
@@ -395,7 +402,9 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
         for (int c = 0; c < W; ++c) {
           const float conf = mv.confidence.at<float>(r, c);
           const cv::Vec3f o = mv.rgb.at<cv::Vec3f>(r, c);
-          if (!(conf > 0) || !std::isfinite(conf) || !(std::isfinite(o[0]) && std::isfinite(o[1]) && std::isfinite(o[2]))) continue;
+          if (!(conf > 0) || !std::isfinite(conf) ||
+              !(std::isfinite(o[0]) && std::isfinite(o[1]) && std::isfinite(o[2])))
+            continue;
           const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), W, H);
           if (xy.squaredNorm() >= 1) continue;
           Texel t;
@@ -452,14 +461,16 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
       continue;
     }
     long lit = 0;
-    for (const Texel& t : texels) lit += light_kernels::mean_clamped_cosine(t.n.dot(g.direction), 0.0) > options.min_lit_kernel;
+    for (const Texel& t : texels)
+      lit += light_kernels::mean_clamped_cosine(t.n.dot(g.direction), 0.0) > options.min_lit_kernel;
     if (lit < options.min_lit_texels) {
       out.unrecovered.push_back(int(ri));
       out.notes.push_back(describe(g) + ": not recovered: " +
-                          (texels.empty() ? std::string("no grey or glossy ball with trusted texels")
-                                          : "the grey and glossy balls have " + std::to_string(lit) +
-                                                " trusted texel(s) it lights (at least " + std::to_string(options.min_lit_texels) +
-                                                " needed: the ball is missing, clipped or hidden there)") +
+                          (texels.empty()
+                               ? std::string("no grey or glossy ball with trusted texels")
+                               : "the grey and glossy balls have " + std::to_string(lit) +
+                                     " trusted texel(s) it lights (at least " + std::to_string(options.min_lit_texels) +
+                                     " needed: the ball is missing, clipped or hidden there)") +
                           "; the probe keeps it clipped");
       continue;
     }
@@ -483,7 +494,8 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
   const bool fit_radius = options.refine && !glossy.empty() &&
                           std::any_of(texels.begin(), texels.end(), [](const Texel& t) { return t.brdf != nullptr; });
   if (fit_radius)
-    for (int s = 0; s < S; ++s) x[std::size_t(s)][5] = std::max(x[std::size_t(s)][5], 0.25 * frames[std::size_t(s)].max_radius);
+    for (int s = 0; s < S; ++s)
+      x[std::size_t(s)][5] = std::max(x[std::size_t(s)][5], 0.25 * frames[std::size_t(s)].max_radius);
 
   // Before: the known part alone.
   auto ball_residuals = [&](const std::vector<std::array<double, kBlock>>& params, bool after) {
@@ -535,8 +547,10 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
   solve_powers(texels, frames, x, delta, {});
   Fit fit;
   fit.x = x;
-  if (options.refine) fit = refine(texels, frames, x, delta, true, fit_radius, true, {});
-  else fit = refine(texels, frames, x, delta, false, false, true, {});
+  if (options.refine)
+    fit = refine(texels, frames, x, delta, true, fit_radius, true, {});
+  else
+    fit = refine(texels, frames, x, delta, false, false, true, {});
   x = fit.x;
 
   // Leave-one-view-out solves (from the full solution).
@@ -557,7 +571,8 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
         });
       }
       // From the full solution, which a fold moves little: a few iterations.
-      folds.push_back(refine(refolded.empty() ? texels : refolded, frames, x, delta, options.refine, fit_radius, false, use, 8).x);
+      folds.push_back(
+          refine(refolded.empty() ? texels : refolded, frames, x, delta, options.refine, fit_radius, false, use, 8).x);
     }
   }
   ball_residuals(x, true);
@@ -588,7 +603,8 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
     if (!folds.empty()) {
       const double n = double(folds.size());
       Vec3 jp = Vec3::Zero(), mean = Vec3::Zero();
-      for (const auto& fo : folds) mean += Vec3(fo[std::size_t(s)][2], fo[std::size_t(s)][3], fo[std::size_t(s)][4]) / n;
+      for (const auto& fo : folds)
+        mean += Vec3(fo[std::size_t(s)][2], fo[std::size_t(s)][3], fo[std::size_t(s)][4]) / n;
       double jd = 0, jr = 0, mean_r = 0;
       for (const auto& fo : folds) mean_r += fo[std::size_t(s)][5] / n;
       for (const auto& fo : folds) {
@@ -612,7 +628,8 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
       double count = 0;
       for (const Texel& t : texels) {
         const Vec3 g = kernel(t, src.direction, xs[5]);
-        if (t.brdf || light_kernels::mean_clamped_cosine(t.n.dot(src.direction), 0.0) <= options.min_lit_kernel) continue;
+        if (t.brdf || light_kernels::mean_clamped_cosine(t.n.dot(src.direction), 0.0) <= options.min_lit_kernel)
+          continue;
         Vec3 m = t.known;
         for (int q = 0; q < S; ++q)
           m += kernel(t, direction_of(frames[std::size_t(q)], x[std::size_t(q)].data()), x[std::size_t(q)][5])
@@ -627,7 +644,8 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
         count += w;
       }
       for (int ch = 0; ch < 3 && count > 0; ++ch)
-        if (den[ch] > 0 && share[ch] > 0) sp[ch] = std::max(sp[ch], std::sqrt(num[ch] / den[ch]) * src.power[ch] / (share[ch] / count));
+        if (den[ch] > 0 && share[ch] > 0)
+          sp[ch] = std::max(sp[ch], std::sqrt(num[ch] / den[ch]) * src.power[ch] / (share[ch] / count));
     }
     src.power_sigma = sp;
     src.direction_sigma = sd;
@@ -643,10 +661,12 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
     for (std::size_t b = 0; b < ball_names.size(); ++b)
       if (lit_balls[b]) src.balls.push_back(ball_names[b]);
     const bool finite = src.direction.allFinite() && src.power.allFinite() && src.power_sigma.allFinite() &&
-                        std::isfinite(src.direction_sigma) && std::isfinite(src.radius) && std::isfinite(src.radius_sigma);
+                        std::isfinite(src.direction_sigma) && std::isfinite(src.radius) &&
+                        std::isfinite(src.radius_sigma);
     if (!finite) {
       out.unrecovered.push_back(src.region);
-      out.notes.push_back(describe(g) + ": not recovered: the solve did not give finite values; the probe keeps it clipped");
+      out.notes.push_back(describe(g) +
+                          ": not recovered: the solve did not give finite values; the probe keeps it clipped");
       continue;
     }
     out.sources.push_back(src);

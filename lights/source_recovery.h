@@ -50,7 +50,8 @@ namespace rsibr {
 
 struct GreyBallMaps {
   std::string name;
-  const MapSet* maps = nullptr;  // captured (confidence), world frame; texel p holds the ball's point of normal T g_normal(p)
+  const MapSet* maps =
+      nullptr;  // captured (confidence), world frame; texel p holds the ball's point of normal T g_normal(p)
   Vec3 albedo = Vec3::Constant(0.18);
 };
 
@@ -61,21 +62,21 @@ struct GlossyBallMaps {
 };
 
 struct SourceRecoveryOptions {
-  int max_sources = 8;           // the regions with the largest lower bounds; the rest are noted
-  bool refine = true;            // refine directions (and radii) with Ceres; false: centroids
-  double radius = 0;             // rad: each source's radius when no glossy ball fits it (a point)
+  int max_sources = 8;  // the regions with the largest lower bounds; the rest are noted
+  bool refine = true;   // refine directions (and radii) with Ceres; false: centroids
+  double radius = 0;    // rad: each source's radius when no glossy ball fits it (a point)
   int min_lit_texels = 30;
   double min_lit_kernel = 0.1;
   int known_width = 64;
-  int glossy_samples = 64;       // FIS samples per texel for the glossy ball's known part
+  int glossy_samples = 64;  // FIS samples per texel for the glossy ball's known part
   std::uint64_t seed = 0;
-  bool jackknife = true;         // the leave-one-view-out spread in the sigmas
+  bool jackknife = true;  // the leave-one-view-out spread in the sigmas
 };
 
 // Captured against computed over one ball's trusted texels (relative RMS over texels and
 // channels, weighted by confidence, no gain fitted), without and with the sources.
 struct BallResidual {
-  std::string ball, kind;        // kind: "grey" | "glossy"
+  std::string ball, kind;  // kind: "grey" | "glossy"
   long texels = 0;
   double before = 0, after = 0;
   std::vector<std::string> views;
@@ -83,12 +84,12 @@ struct BallResidual {
 };
 
 struct SourceRecovery {
-  std::vector<LightSource> sources;   // recovered (power may be 0 when the balls ask for nothing)
-  std::vector<int> unrecovered;       // indices of regions not recovered
-  std::vector<std::string> notes;     // one line per region not recovered or left out
+  std::vector<LightSource> sources;  // recovered (power may be 0 when the balls ask for nothing)
+  std::vector<int> unrecovered;      // indices of regions not recovered
+  std::vector<std::string> notes;    // one line per region not recovered or left out
   std::vector<BallResidual> residuals;
-  double robust_sigma = 0;            // the relative residuals' MAD sigma after the first solve
-  long texels = 0;                    // trusted texels used
+  double robust_sigma = 0;  // the relative residuals' MAD sigma after the first solve
+  long texels = 0;          // trusted texels used
 };
 
 // `known`: the probe without the clipped texels (they are 0), lat-long, L (the chrome ball's

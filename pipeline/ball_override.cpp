@@ -11,8 +11,7 @@ std::vector<BallOverride> parse_ball_overrides(const std::vector<std::string>& t
   for (const std::string& t : texts) {
     auto fail = [&](const std::string& why) { throw std::invalid_argument("--ball '" + t + "': " + why); };
     const auto colon = t.find(':'), eq = t.find('=');
-    if (colon == std::string::npos || eq == std::string::npos || eq < colon)
-      fail("expected VIEW:BALL=X,Y,R (pixels)");
+    if (colon == std::string::npos || eq == std::string::npos || eq < colon) fail("expected VIEW:BALL=X,Y,R (pixels)");
     BallOverride o;
     o.view = t.substr(0, colon);
     o.ball = t.substr(colon + 1, eq - colon - 1);
@@ -21,7 +20,8 @@ std::vector<BallOverride> parse_ball_overrides(const std::vector<std::string>& t
     char c1 = 0, c2 = 0;
     if (!(in >> x >> c1 >> y >> c2 >> r) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof())
       fail("expected VIEW:BALL=X,Y,R (pixels)");
-    if (!std::isfinite(x) || !std::isfinite(y) || !(r > 1) || !std::isfinite(r)) fail("the radius must be > 1 px and every value finite");
+    if (!std::isfinite(x) || !std::isfinite(y) || !(r > 1) || !std::isfinite(r))
+      fail("the radius must be > 1 px and every value finite");
     bool view_known = false, ball_known = false;
     for (const PhotoView& v : set.views) view_known |= v.name == o.view;
     for (const BallSpec& b : set.balls) ball_known |= b.name == o.ball;

@@ -28,8 +28,8 @@ cv::Mat raw_board_grey8(const std::filesystem::path& file) {
   cv::Mat out(grey.size(), CV_8UC1);
   for (int y = 0; y < grey.rows; ++y)
     for (int x = 0; x < grey.cols; ++x)
-      out.at<unsigned char>(y, x) =
-          cv::saturate_cast<unsigned char>(255.0 * std::pow(std::min(1.0, grey.at<std::uint16_t>(y, x) / top), 1 / 2.2));
+      out.at<unsigned char>(y, x) = cv::saturate_cast<unsigned char>(
+          255.0 * std::pow(std::min(1.0, grey.at<std::uint16_t>(y, x) / top), 1 / 2.2));
   return out;
 }
 
@@ -59,8 +59,9 @@ IntrinsicsProblem chessboard_problem(const PhotoSet& set, const std::string& nam
     const cv::Mat img = read_grey8(cb.files[i]);
     if (p.width == 0) p.width = img.cols, p.height = img.rows;
     if (img.cols != p.width || img.rows != p.height)
-      throw std::invalid_argument(cb.files[i].string() + ": " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
-                                  ", the other chessboards are " + std::to_string(p.width) + "x" + std::to_string(p.height));
+      throw std::invalid_argument(cb.files[i].string() + ": " + std::to_string(img.cols) + "x" +
+                                  std::to_string(img.rows) + ", the other chessboards are " + std::to_string(p.width) +
+                                  "x" + std::to_string(p.height));
     const auto corners = find_chessboard(img, cb.corners_x);
     if (corners) {
       p.boards.push_back({cb.files[i].filename().string(), *corners});
@@ -71,7 +72,8 @@ IntrinsicsProblem chessboard_problem(const PhotoSet& set, const std::string& nam
   }
   if (p.boards.size() < 4)
     throw std::invalid_argument(name + ": chessboards found in " + std::to_string(p.boards.size()) + " of " +
-                                std::to_string(cb.files.size()) + " images; need at least 4 (2 per cross-validation half)");
+                                std::to_string(cb.files.size()) +
+                                " images; need at least 4 (2 per cross-validation half)");
   return p;
 }
 

@@ -16,7 +16,8 @@ namespace rsibr {
 // names). Throws std::invalid_argument("<name>: ...") when the set lists no chessboards, the grid
 // is not square, the images differ in size, or fewer than 4 boards are found (2 per
 // cross-validation half); std::runtime_error("<image>: cannot read the image").
-IntrinsicsProblem chessboard_problem(const PhotoSet& set, const std::string& name, std::vector<std::string>* missed = nullptr,
+IntrinsicsProblem chessboard_problem(const PhotoSet& set, const std::string& name,
+                                     std::vector<std::string>* missed = nullptr,
                                      const std::function<void(double)>& progress = {});
 
 }  // namespace rsibr

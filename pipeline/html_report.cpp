@@ -71,7 +71,9 @@ std::string num(double v, int precision = 4) {
 }
 
 std::string jnum(const nlohmann::json& j, int precision = 4) {
-  return j.is_number() ? num(j.get<double>(), precision) : html_escape(j.is_string() ? j.get<std::string>() : j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+  return j.is_number() ? num(j.get<double>(), precision)
+                       : html_escape(j.is_string() ? j.get<std::string>()
+                                                   : j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
 }
 
 std::string img_tag(const std::vector<unsigned char>& png, const std::string& alt, const std::string& style = "") {
@@ -83,7 +85,8 @@ std::string img_tag(const std::vector<unsigned char>& png, const std::string& al
 // resolved): a record copied from elsewhere must not make the report carry files from outside it.
 std::vector<unsigned char> read_bytes(const fs::path& dir, const fs::path& file) {
   std::error_code ec1, ec2;
-  const fs::path root = fs::weakly_canonical(fs::absolute(dir), ec1), real = fs::weakly_canonical(fs::absolute(file), ec2);
+  const fs::path root = fs::weakly_canonical(fs::absolute(dir), ec1),
+                 real = fs::weakly_canonical(fs::absolute(file), ec2);
   const fs::path rel = real.lexically_relative(root);
   if (ec1 || ec2 || rel.empty() || *rel.begin() == "..")
     throw std::runtime_error(file.string() + ": listed in a step record but outside the run folder " + dir.string());
@@ -108,9 +111,9 @@ void write_vignetting_section(std::ostringstream& h, const nlohmann::json& v) {
     } else if (v.contains("estimate")) {
       const auto& e = v["estimate"];
       h << " Estimated from " << jnum(e["squares"]) << " white squares on " << jnum(e["boards"]) << " boards ("
-        << jnum(e["degree"]) << " term(s) chosen by leave-one-board-out error), fit RMS " << num(100 * e["rms"].get<double>(), 2)
-        << "%, corner &sigma; " << jnum(e["corner_sigma_stops"], 2) << " stops; squares reach r = " << jnum(e["max_r"], 2)
-        << " (beyond, the polynomial extrapolates).";
+        << jnum(e["degree"]) << " term(s) chosen by leave-one-board-out error), fit RMS "
+        << num(100 * e["rms"].get<double>(), 2) << "%, corner &sigma; " << jnum(e["corner_sigma_stops"], 2)
+        << " stops; squares reach r = " << jnum(e["max_r"], 2) << " (beyond, the polynomial extrapolates).";
     }
   } else {
     h << "Not corrected";
@@ -123,10 +126,10 @@ void write_vignetting_section(std::ostringstream& h, const nlohmann::json& v) {
 void write_orientation_notes(std::ostringstream& h, const nlohmann::json& s) {
   if (s.contains("world_up") && s["world_up"].is_object()) {
     const auto& w = s["world_up"];
-    h << "<p>World up estimated from the views (cameras held level in roll): " << jnum(w["tilt_from_first_camera_deg"], 3)
-      << " degrees from the first camera's up, &sigma; " << jnum(w["sigma_deg"], 2) << " degrees (roll scatter "
-      << jnum(w["roll_sigma_deg"], 2) << " degrees, " << (w.value("roll_sigma_estimated", false) ? "from the views" : "assumed")
-      << ").</p>";
+    h << "<p>World up estimated from the views (cameras held level in roll): "
+      << jnum(w["tilt_from_first_camera_deg"], 3) << " degrees from the first camera's up, &sigma; "
+      << jnum(w["sigma_deg"], 2) << " degrees (roll scatter " << jnum(w["roll_sigma_deg"], 2) << " degrees, "
+      << (w.value("roll_sigma_estimated", false) ? "from the views" : "assumed") << ").</p>";
   }
   if (s.contains("notes") && !s["notes"].empty()) {
     h << "<p><b>Chrome balls found across views:</b>";
@@ -156,12 +159,13 @@ void write_balls_section(std::ostringstream& h, const nlohmann::json& s, const f
     for (const auto& b : v["balls"]) {
       const bool found = b.contains("centre_px");
       h << "<tr><td>" << html_escape(name) << "</td><td>" << html_escape(b["ball"].get<std::string>()) << "</td><td"
-        << (found ? "" : " class=\"warn\"") << ">" << html_escape(b.value("status", "")) << (b.value("cut", false) ? ", cut by the frame" : "")
-        << "</td>";
+        << (found ? "" : " class=\"warn\"") << ">" << html_escape(b.value("status", ""))
+        << (b.value("cut", false) ? ", cut by the frame" : "") << "</td>";
       if (found)
-        h << "<td>(" << jnum(b["centre_px"][0], 5) << ", " << jnum(b["centre_px"][1], 5) << ")</td><td>" << jnum(b["radius_px"])
-          << "</td><td>" << jnum(b["outline_rms_px"]) << "</td><td>"
-          << (b.contains("confident_fraction") ? num(100 * b["confident_fraction"].get<double>(), 3) + "%" : "") << "</td>";
+        h << "<td>(" << jnum(b["centre_px"][0], 5) << ", " << jnum(b["centre_px"][1], 5) << ")</td><td>"
+          << jnum(b["radius_px"]) << "</td><td>" << jnum(b["outline_rms_px"]) << "</td><td>"
+          << (b.contains("confident_fraction") ? num(100 * b["confident_fraction"].get<double>(), 3) + "%" : "")
+          << "</td>";
       else
         h << "<td></td><td></td><td></td><td></td>";
       h << "<td style=\"text-align:left\">" << html_escape(b.value("note", "")) << "</td></tr>";
@@ -172,9 +176,10 @@ void write_balls_section(std::ostringstream& h, const nlohmann::json& s, const f
   for (const auto& v : s["views"])
     for (const auto& b : v["balls"])
       if (b.contains("mask")) {
-        if (!any) h << "<h3>Masks</h3><p>Each view's map of each ball (left) and its confidence (right): red is left out "
-                       "(chrome: the camera and photographer, the stands, the other balls; grey: what this view alone sees "
-                       "differently, a shadow of the photographer; both: a ball in front, clipped pixels, the rim).</p>";
+        if (!any)
+          h << "<h3>Masks</h3><p>Each view's map of each ball (left) and its confidence (right): red is left out "
+               "(chrome: the camera and photographer, the stands, the other balls; grey: what this view alone sees "
+               "differently, a shadow of the photographer; both: a ball in front, clipped pixels, the rim).</p>";
         any = true;
         h << "<p>" << html_escape(v["name"].get<std::string>() + " " + b["ball"].get<std::string>()) << "<br>"
           << img_tag(read_bytes(dir, dir / b["mask"].get<std::string>()), v["name"].get<std::string>()) << "</p>";
@@ -217,8 +222,8 @@ std::string svg_line_plot(const std::vector<PlotSeries>& series, const std::stri
     for (std::size_t i = 0; i < se.x.size() && i < se.y.size(); ++i)
       if (std::isfinite(se.x[i]) && std::isfinite(se.y[i])) s << px(se.x[i]) << "," << py(se.y[i]) << " ";
     s << "\"/>";
-    s << "<text x=\"" << l + 8 << "\" y=\"" << t + 16 + 14 * legend++ << "\" fill=\"" << html_escape(se.colour)
-      << "\">" << html_escape(se.name) << "</text>";
+    s << "<text x=\"" << l + 8 << "\" y=\"" << t + 16 + 14 * legend++ << "\" fill=\"" << html_escape(se.colour) << "\">"
+      << html_escape(se.name) << "</text>";
   }
   s << "</svg>";
   return s.str();
@@ -253,9 +258,10 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
 
   if (rec.count("calibrate")) {
     const auto& s = rec["calibrate"].summary;
-    h << "<h2>Lens</h2><p>Model <b>" << html_escape(s.value("model", "")) << "</b> (" << html_escape(s.value("source", ""))
-      << ")";
-    if (s.contains("rms_px")) h << ", reprojection RMS " << jnum(s["rms_px"]) << " px over " << jnum(s["boards_found"]) << " boards";
+    h << "<h2>Lens</h2><p>Model <b>" << html_escape(s.value("model", "")) << "</b> ("
+      << html_escape(s.value("source", "")) << ")";
+    if (s.contains("rms_px"))
+      h << ", reprojection RMS " << jnum(s["rms_px"]) << " px over " << jnum(s["boards_found"]) << " boards";
     if (s.value("source", "") == "exif" || s.value("source", "") == "lensfun")
       h << ": no chessboards and no camera model, so the photos' metadata (" << html_escape(s.value("focal_from", ""))
         << ") gives f = " << num(s.value("focal_px", 0.0), 4) << " px &plusmn; "
@@ -280,8 +286,8 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
     const auto& s = rec["lens"].summary;
     if (s.value("refined", false) && s.value("source", "") == "outlines") {
       h << "<p>Focal length measured from " << jnum(s["balls_used"]) << " ball outline(s) (" << jnum(s["points"])
-        << " points, RMS " << num(s.value("outline_rms_px", 0.0), 3) << " px): f = <b>" << num(s.value("focal_px", 0.0), 5)
-        << " &plusmn; " << num(s.value("sigma_px", 0.0), 3) << " px</b>.";
+        << " points, RMS " << num(s.value("outline_rms_px", 0.0), 3) << " px): f = <b>"
+        << num(s.value("focal_px", 0.0), 5) << " &plusmn; " << num(s.value("sigma_px", 0.0), 3) << " px</b>.";
       if (!s.value("note", "").empty()) h << " " << html_escape(s.value("note", "")) << ".";
       h << "</p>";
     } else if (s.value("refined", false)) {
@@ -290,12 +296,13 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
         << num(s.value("outline_focal_px", 0.0), 5) << " &plusmn; " << num(s.value("outline_sigma_px", 0.0), 3)
         << " px, the metadata " << num(s.value("prior_focal_px", 0.0), 5) << " &plusmn; "
         << num(s.value("prior_sigma_px", 0.0), 3) << " px; combined f = <b>" << num(s.value("focal_px", 0.0), 5)
-        << " &plusmn; " << num(s.value("sigma_px", 0.0), 3) << " px</b> (" << num(100 * s.value("change_relative", 0.0), 3)
-        << "% from the metadata's).";
+        << " &plusmn; " << num(s.value("sigma_px", 0.0), 3) << " px</b> ("
+        << num(100 * s.value("change_relative", 0.0), 3) << "% from the metadata's).";
       if (!s.value("note", "").empty()) h << " " << html_escape(s.value("note", "")) << ".";
       h << "</p>";
     } else if (s.value("source", "") == "exif" || s.value("source", "") == "lensfun") {
-      h << "<p>The focal length was not refined from the balls' outlines: " << html_escape(s.value("why", "")) << ".</p>";
+      h << "<p>The focal length was not refined from the balls' outlines: " << html_escape(s.value("why", ""))
+        << ".</p>";
     }
   }
 
@@ -308,7 +315,8 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
     h << response_choice_html(s.value("recovery", nlohmann::json::object()));
     std::vector<PlotSeries> series = {{"R", "#d33", {}, {}}, {"G", "#2a2", {}, {}}, {"B", "#33d", {}, {}}};
     for (const auto& p : s["curve"])
-      for (int ch = 0; ch < 3; ++ch) series[ch].x.push_back(p[0].get<double>()), series[ch].y.push_back(p[ch + 1].get<double>());
+      for (int ch = 0; ch < 3; ++ch)
+        series[ch].x.push_back(p[0].get<double>()), series[ch].y.push_back(p[ch + 1].get<double>());
     h << svg_line_plot(series, "pixel code", "relative exposure X (linear)");
     h << "<table><tr><th>view</th><th>brackets</th><th>clipped</th><th>ghost</th></tr>";
     for (const auto& v : s["views"])
@@ -322,10 +330,12 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
   if (rec.count("orient")) {
     const auto& s = rec["orient"].summary;
     h << "<h2>Orientations</h2><p>Source: " << html_escape(s.value("source", "")) << ", gauge "
-      << html_escape(s.value("gauge", "")) << ".</p><table><tr><th>view</th><th>forward (world)</th><th>&sigma; (deg)</th></tr>";
+      << html_escape(s.value("gauge", ""))
+      << ".</p><table><tr><th>view</th><th>forward (world)</th><th>&sigma; (deg)</th></tr>";
     for (const auto& v : s["views"])
       h << "<tr><td>" << html_escape(v["name"].get<std::string>()) << "</td><td>(" << jnum(v["forward"][0], 3) << ", "
-        << jnum(v["forward"][1], 3) << ", " << jnum(v["forward"][2], 3) << ")</td><td>" << jnum(v["sigma_deg"]) << "</td></tr>";
+        << jnum(v["forward"][1], 3) << ", " << jnum(v["forward"][2], 3) << ")</td><td>" << jnum(v["sigma_deg"])
+        << "</td></tr>";
     h << "</table>";
     write_orientation_notes(h, s);
   }
@@ -342,15 +352,18 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
       << num(100 * s["covered_fraction"].get<double>(), 3) << "% of the sphere seen";
     if (s.contains("well_seen_fraction"))
       h << ", " << num(100 * s["well_seen_fraction"].get<double>(), 3) << "% seen well (summed confidence at least 1/2"
-        << (s.value("views", 0) == 1 ? "; one view: behind the ball only its stretched rim, low confidence" : "") << ")";
+        << (s.value("views", 0) == 1 ? "; one view: behind the ball only its stretched rim, low confidence" : "")
+        << ")";
     h << " (lat-long, tone-mapped";
-    const bool sources = rec.count("sources") && !rec["sources"].summary.value("sources", nlohmann::json::array()).empty();
+    const bool sources =
+        rec.count("sources") && !rec["sources"].summary.value("sources", nlohmann::json::array()).empty();
     if (sources && fs::is_regular_file(dir / "probe-measured.exr")) {
       // Before (as measured) and after (with the recovered sources), at the final probe's exposure.
       const EnvMap measured = read_environment((dir / "probe-measured.exr").string());
       std::vector<unsigned char> before;
       cv::imencode(".png", display_encode(measured.pixels, stops), before);
-      h << "; as measured, then with the recovered sources).</p>" << img_tag(before, "probe as measured") << img_tag(png, "probe");
+      h << "; as measured, then with the recovered sources).</p>" << img_tag(before, "probe as measured")
+        << img_tag(png, "probe");
     } else {
       h << ").</p>" << img_tag(png, "probe");
     }
@@ -379,15 +392,16 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
       h << "<table><tr><th>view</th><th>rel RMS before</th><th>rel RMS after</th><th>log RMS after (stops)</th>"
            "<th>PSNR after (dB)</th></tr>";
       for (const auto& v : b["views"])
-        h << "<tr><td>" << html_escape(v["image"].get<std::string>()) << "</td><td>" << jnum(v["before"]["relative_rms"])
-          << "</td><td>" << jnum(v["after"]["relative_rms"]) << "</td><td>" << jnum(v["after"]["log_rms_stops"])
-          << "</td><td>" << jnum(v["after"]["psnr_db"]) << "</td></tr>";
+        h << "<tr><td>" << html_escape(v["image"].get<std::string>()) << "</td><td>"
+          << jnum(v["before"]["relative_rms"]) << "</td><td>" << jnum(v["after"]["relative_rms"]) << "</td><td>"
+          << jnum(v["after"]["log_rms_stops"]) << "</td><td>" << jnum(v["after"]["psnr_db"]) << "</td></tr>";
       h << "<tr><th>overall</th><th>" << jnum(b["overall"]["before"]["relative_rms"]) << "</th><th>"
         << jnum(b["overall"]["after"]["relative_rms"]) << "</th><th>" << jnum(b["overall"]["after"]["log_rms_stops"])
         << "</th><th>" << jnum(b["overall"]["after"]["psnr_db"]) << "</th></tr></table>";
       for (const auto& v : b["views"])
-        h << "<p>" << img_tag(read_bytes(dir, dir / fs::path(b["folder"].get<std::string>()) / v["picture"].get<std::string>()),
-                              v["image"].get<std::string>())
+        h << "<p>"
+          << img_tag(read_bytes(dir, dir / fs::path(b["folder"].get<std::string>()) / v["picture"].get<std::string>()),
+                     v["image"].get<std::string>())
           << "</p>";
     }
   }

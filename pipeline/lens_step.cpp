@@ -22,8 +22,9 @@ nlohmann::json run_lens_step(const LensStep& s) {
     throw std::invalid_argument("lens: the photos' metadata has no focal length and " + why +
                                 "; give the lens with --lens FILE (a .cameramodel, e.g. from rsibr calibrate)");
   };
-  if (!s.refine) return outlines_only ? unknown("--no-self-calibration keeps the balls from measuring it")
-                                      : keep("off (--no-self-calibration)");
+  if (!s.refine)
+    return outlines_only ? unknown("--no-self-calibration keeps the balls from measuring it")
+                         : keep("off (--no-self-calibration)");
   if (s.source != "exif" && s.source != "lensfun" && !outlines_only)
     return keep("the lens was measured (" + s.source + ")");
   if (!outlines_only && !(s.prior_sigma_relative > 0)) return keep("the calibrate step states no uncertainty");
@@ -46,8 +47,10 @@ nlohmann::json run_lens_step(const LensStep& s) {
       for (std::size_t i = 0; i < cand.loc.outline_px.size() && i < cand.loc.fit.residual_px.size(); ++i)
         if (std::abs(cand.loc.fit.residual_px[i]) < 1.0) pts.push_back(cand.loc.outline_px[i]);
       outlines.push_back(pts);
-      found.push_back({{"view", s.views[v]}, {"ball", s.balls[b].name},
-                       {"centre_px", {cand.loc.centre_px.x(), cand.loc.centre_px.y()}}, {"radius_px", cand.loc.radius_px}});
+      found.push_back({{"view", s.views[v]},
+                       {"ball", s.balls[b].name},
+                       {"centre_px", {cand.loc.centre_px.x(), cand.loc.centre_px.y()}},
+                       {"radius_px", cand.loc.radius_px}});
     }
   }
   if (outlines.empty())
@@ -68,25 +71,35 @@ nlohmann::json run_lens_step(const LensStep& s) {
   std::string left_out;
   for (std::size_t i = 0; i < found.size(); ++i) {
     const OutlineFocalBall& b = of.balls[i];
-    found[i].update({{"focal_px", b.focal_px}, {"sigma_px", std::isfinite(b.sigma_px) ? b.sigma_px : -1.0},
-                     {"points", b.points}, {"used", b.used}});
+    found[i].update({{"focal_px", b.focal_px},
+                     {"sigma_px", std::isfinite(b.sigma_px) ? b.sigma_px : -1.0},
+                     {"points", b.points},
+                     {"used", b.used}});
     if (!b.used && b.points > 0)
       left_out += (left_out.empty() ? "" : ", ") + found[i]["view"].get<std::string>() + ":" +
                   found[i]["ball"].get<std::string>();
   }
   // The outlines left out, by view and ball (the library's note names them by index).
   const std::string note = left_out.empty() ? "" : "Left out (their own focal length disagrees): " + left_out;
-  j.update({{"outlines", found}, {"outline_focal_px", of.focal_px},
-            {"outline_sigma_px", std::isfinite(of.sigma_px) ? of.sigma_px : -1.0}, {"outline_rms_px", of.rms_px}, {"birge_ratio", of.birge_ratio},
+  j.update({{"outlines", found},
+            {"outline_focal_px", of.focal_px},
+            {"outline_sigma_px", std::isfinite(of.sigma_px) ? of.sigma_px : -1.0},
+            {"outline_rms_px", of.rms_px},
+            {"birge_ratio", of.birge_ratio},
             {"outline_systematic_px", std::isfinite(of.systematic_px) ? of.systematic_px : -1.0},
-            {"balls_used", of.balls_used}, {"points", of.points}, {"note", note}});
+            {"balls_used", of.balls_used},
+            {"points", of.points},
+            {"note", note}});
   if (!std::isfinite(of.sigma_px))
     return outlines_only ? unknown("the balls' outlines do not constrain it (" + of.note + ")")
                          : keep("the outlines do not constrain the focal length: " + of.note);
   if (outlines_only) {
     with_focal(lens, of.focal_px).write(s.out);
-    j.update({{"refined", true}, {"focal_px", of.focal_px}, {"sigma_px", of.sigma_px},
-              {"sigma_relative", of.sigma_px / of.focal_px}, {"change_relative", of.focal_px / f0 - 1}});
+    j.update({{"refined", true},
+              {"focal_px", of.focal_px},
+              {"sigma_px", of.sigma_px},
+              {"sigma_relative", of.sigma_px / of.focal_px},
+              {"change_relative", of.focal_px / f0 - 1}});
     return j;
   }
   const double z = std::abs(of.focal_px - f0) / std::hypot(s0, of.sigma_px);
@@ -97,7 +110,10 @@ nlohmann::json run_lens_step(const LensStep& s) {
   const double w0 = 1 / (s0 * s0), wo = 1 / (of.sigma_px * of.sigma_px);
   const double f = (f0 * w0 + of.focal_px * wo) / (w0 + wo), sigma = 1 / std::sqrt(w0 + wo);
   with_focal(lens, f).write(s.out);
-  j.update({{"refined", true}, {"focal_px", f}, {"sigma_px", sigma}, {"sigma_relative", sigma / f},
+  j.update({{"refined", true},
+            {"focal_px", f},
+            {"sigma_px", sigma},
+            {"sigma_relative", sigma / f},
             {"change_relative", f / f0 - 1}});
   return j;
 }

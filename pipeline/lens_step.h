@@ -26,14 +26,14 @@
 namespace rsibr {
 
 struct LensStep {
-  std::filesystem::path calibrated;            // the calibrate step's camera.cameramodel
-  std::string source;                          // its source: "exif" and "lensfun" are refined, "outlines" measured
-  double prior_sigma_relative = 0;             // its focal length's stated 1 sigma (relative)
-  std::vector<std::string> views;              // view names
-  std::vector<std::filesystem::path> merged;   // their merged images (same order)
-  std::vector<ListedBall> balls;               // the photo set's balls
-  bool refine = true;                          // false: the calibrated lens unchanged
-  std::filesystem::path out;                   // lens.cameramodel
+  std::filesystem::path calibrated;           // the calibrate step's camera.cameramodel
+  std::string source;                         // its source: "exif" and "lensfun" are refined, "outlines" measured
+  double prior_sigma_relative = 0;            // its focal length's stated 1 sigma (relative)
+  std::vector<std::string> views;             // view names
+  std::vector<std::filesystem::path> merged;  // their merged images (same order)
+  std::vector<ListedBall> balls;              // the photo set's balls
+  bool refine = true;                         // false: the calibrated lens unchanged
+  std::filesystem::path out;                  // lens.cameramodel
 };
 
 // Writes `out` atomically and returns the step's summary.

@@ -43,7 +43,8 @@ std::string rgb(const nlohmann::json& v, bool percent = false) {
 }
 
 std::string where(const nlohmann::json& j) {
-  return "azimuth " + fixed(j.value("azimuth_deg", 0.0), 1) + "&deg;, elevation " + fixed(j.value("elevation_deg", 0.0), 1) + "&deg;";
+  return "azimuth " + fixed(j.value("azimuth_deg", 0.0), 1) + "&deg;, elevation " +
+         fixed(j.value("elevation_deg", 0.0), 1) + "&deg;";
 }
 
 // A crop of the lat-long probe around a direction (33 x 33 texels, wrapped in longitude, clamped at
@@ -89,10 +90,12 @@ std::string light_sources_warning(const nlohmann::json& s) {
     }
     std::string balls;
     for (const auto& b : src["balls"]) balls += (balls.empty() ? "" : ", ") + html_escape(b.get<std::string>());
-    h << "the source at " << where(src) << " was clipped in every bracket of every chrome view that saw it; without it the "
-      << "probe misses " << rgb(share, true) << " (R / G / B) of the light. Recovered from the " << (balls.empty() ? "-" : balls)
-      << " ball (" << src["views"].size() << " views): power " << rgb(src["power"]) << " &plusmn; " << rgb(src["power_sigma"])
-      << ", direction &plusmn; " << fixed(src.value("direction_sigma_deg", 0.0), 2) << "&deg;. ";
+    h << "the source at " << where(src)
+      << " was clipped in every bracket of every chrome view that saw it; without it the "
+      << "probe misses " << rgb(share, true) << " (R / G / B) of the light. Recovered from the "
+      << (balls.empty() ? "-" : balls) << " ball (" << src["views"].size() << " views): power " << rgb(src["power"])
+      << " &plusmn; " << rgb(src["power_sigma"]) << ", direction &plusmn; "
+      << fixed(src.value("direction_sigma_deg", 0.0), 2) << "&deg;. ";
   }
   for (const auto& r : s["regions"]) {
     if (r.value("recovered", false)) continue;
@@ -111,9 +114,11 @@ std::string light_sources_section(const fs::path& dir, const nlohmann::json& s) 
   if (!s.contains("regions") || s["regions"].empty()) return "";
   std::ostringstream h;
   h << "<h2>Clipped light sources</h2><p>" << s["regions"].size() << " region(s) of the probe, "
-    << fixed(100 * s.value("clipped_fraction", 0.0), 3) << "% of the sphere, were clipped in every bracket of every chrome "
+    << fixed(100 * s.value("clipped_fraction", 0.0), 3)
+    << "% of the sphere, were clipped in every bracket of every chrome "
     << "view that saw them. Each was modelled as a compact source (a disc) whose power was solved so that the grey"
-    << (s.value("glossy_used", false) ? " and glossy balls" : " ball") << " computed from the probe match the captured ones "
+    << (s.value("glossy_used", false) ? " and glossy balls" : " ball")
+    << " computed from the probe match the captured ones "
     << "in every view (robust, non-negative, the probe's measured part held fixed; sigma: the larger of the fit's "
     << "covariance and the spread of leave-one-view-out solves).";
   if (!s.value("enabled", true)) h << " <b>Recovery was off</b> (--no-sources): the probe keeps them clipped.";
@@ -128,27 +133,31 @@ std::string light_sources_section(const fs::path& dir, const nlohmann::json& s) 
       std::string balls, views;
       for (const auto& b : src["balls"]) balls += (balls.empty() ? "" : ", ") + b.get<std::string>();
       for (const auto& v : src["views"]) views += (views.empty() ? "" : ", ") + v.get<std::string>();
-      h << "<tr><td>" << i++ << "</td><td>" << where(src) << "</td><td>" << fixed(src.value("direction_sigma_deg", 0.0), 2)
-        << "</td><td>" << fixed(src.value("radius_deg", 0.0), 2) << (src.value("radius_fitted", false) ? "" : " (not resolved)")
-        << "</td><td>" << sci(src.value("solid_angle_sr", 0.0)) << "</td><td>" << rgb(src["radiance"]) << "</td><td>"
-        << rgb(src["power"]) << "</td><td>" << rgb(src["power_sigma"]) << "</td><td>" << html_escape(balls) << "</td><td>"
-        << html_escape(views) << "</td></tr>";
+      h << "<tr><td>" << i++ << "</td><td>" << where(src) << "</td><td>"
+        << fixed(src.value("direction_sigma_deg", 0.0), 2) << "</td><td>" << fixed(src.value("radius_deg", 0.0), 2)
+        << (src.value("radius_fitted", false) ? "" : " (not resolved)") << "</td><td>"
+        << sci(src.value("solid_angle_sr", 0.0)) << "</td><td>" << rgb(src["radiance"]) << "</td><td>"
+        << rgb(src["power"]) << "</td><td>" << rgb(src["power_sigma"]) << "</td><td>" << html_escape(balls)
+        << "</td><td>" << html_escape(views) << "</td></tr>";
     }
-    h << "</table><p>Measured probe's light " << rgb(s["measured_integral"]) << "; recovered " << rgb(s["recovered_power"])
-      << " &plusmn; " << rgb(s["recovered_power_sigma"]) << ": " << rgb(s["missing_fraction"], true)
+    h << "</table><p>Measured probe's light " << rgb(s["measured_integral"]) << "; recovered "
+      << rgb(s["recovered_power"]) << " &plusmn; " << rgb(s["recovered_power_sigma"]) << ": "
+      << rgb(s["missing_fraction"], true)
       << " (R / G / B) of the final probe's light was missing from the measured one.</p>";
   }
-  for (const auto& note : s.value("notes", nlohmann::json::array())) h << "<p class=\"warn\">" << html_escape(note.get<std::string>()) << "</p>";
+  for (const auto& note : s.value("notes", nlohmann::json::array()))
+    h << "<p class=\"warn\">" << html_escape(note.get<std::string>()) << "</p>";
   const auto& residuals = s.value("residuals", nlohmann::json::array());
   if (!residuals.empty() && !sources.empty()) {
     h << "<p>Captured balls against the balls computed from the probe (relative RMS over trusted texels, no gain fitted), "
          "before and after the recovery:</p><table><tr><th>ball</th><th>view</th><th>before</th><th>after</th></tr>";
     for (const auto& b : residuals) {
       for (const auto& v : b["views"])
-        h << "<tr><td>" << html_escape(b["ball"].get<std::string>()) << "</td><td>" << html_escape(v["name"].get<std::string>())
-          << "</td><td>" << fixed(v["before"].get<double>(), 4) << "</td><td>" << fixed(v["after"].get<double>(), 4) << "</td></tr>";
-      h << "<tr><th>" << html_escape(b["ball"].get<std::string>()) << "</th><th>all</th><th>" << fixed(b["before"].get<double>(), 4)
-        << "</th><th>" << fixed(b["after"].get<double>(), 4) << "</th></tr>";
+        h << "<tr><td>" << html_escape(b["ball"].get<std::string>()) << "</td><td>"
+          << html_escape(v["name"].get<std::string>()) << "</td><td>" << fixed(v["before"].get<double>(), 4)
+          << "</td><td>" << fixed(v["after"].get<double>(), 4) << "</td></tr>";
+      h << "<tr><th>" << html_escape(b["ball"].get<std::string>()) << "</th><th>all</th><th>"
+        << fixed(b["before"].get<double>(), 4) << "</th><th>" << fixed(b["after"].get<double>(), 4) << "</th></tr>";
     }
     h << "</table>";
   }
@@ -174,8 +183,8 @@ std::string light_sources_section(const fs::path& dir, const nlohmann::json& s) 
         }
       const float stops = peak > 0 ? float(-std::log2(peak)) : 0.f;
       h << "<p>" << label << " (33 x 33 probe texels, exposure " << fixed(stops, 1) << " stops): measured "
-        << img(crop_png(before, d, stops), "measured") << " with the recovered source " << img(crop_png(after, d, stops), "recovered")
-        << "</p>";
+        << img(crop_png(before, d, stops), "measured") << " with the recovered source "
+        << img(crop_png(after, d, stops), "recovered") << "</p>";
     }
   }
   return h.str();

@@ -11,7 +11,10 @@ nlohmann::json run_light_sources_step(const LightSourcesStep& s) {
   if (s.given_probe) {
     EnvMap env = read_environment(s.measured.string());
     write_environment(s.out.string(), env);
-    return {{"enabled", false}, {"given", true}, {"regions", nlohmann::json::array()}, {"sources", nlohmann::json::array()},
+    return {{"enabled", false},
+            {"given", true},
+            {"regions", nlohmann::json::array()},
+            {"sources", nlohmann::json::array()},
             {"notes", {"the probe is a given environment: nothing was clipped"}}};
   }
   MapSet chrome;

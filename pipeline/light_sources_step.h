@@ -15,16 +15,16 @@
 namespace rsibr {
 
 struct LightSourcesStep {
-  std::vector<std::filesystem::path> chrome;            // captured chrome map sets
+  std::vector<std::filesystem::path> chrome;                                // captured chrome map sets
   std::vector<std::pair<std::string, std::filesystem::path>> grey, glossy;  // (ball name, captured map set)
-  std::string glossy_brdf;       // the glossy balls' BRDF spec; empty: glossy balls unused
+  std::string glossy_brdf;         // the glossy balls' BRDF spec; empty: glossy balls unused
   std::filesystem::path measured;  // the probe step's output (the probe as the chrome balls saw it)
   std::filesystem::path out;       // probe.exr
   int probe_width = 256;
   std::string chrome_fresnel;
   double grey_albedo = 0.18;
   bool recover = true;
-  bool given_probe = false;        // the probe step used a given environment: nothing to recover
+  bool given_probe = false;  // the probe step used a given environment: nothing to recover
   std::uint64_t seed = 0;
 };
 

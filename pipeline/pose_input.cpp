@@ -17,7 +17,8 @@ Mat3 parse_rows(const YAML::Node& node, const std::string& where) {
   if (!node.IsSequence() || node.size() != 3) throw std::invalid_argument(where + ": expected 3 rows of 3 numbers");
   Mat3 m;
   for (int r = 0; r < 3; ++r) {
-    if (!node[r].IsSequence() || node[r].size() != 3) throw std::invalid_argument(where + ": expected 3 rows of 3 numbers");
+    if (!node[r].IsSequence() || node[r].size() != 3)
+      throw std::invalid_argument(where + ": expected 3 rows of 3 numbers");
     for (int c = 0; c < 3; ++c) {
       m(r, c) = node[r][c].as<double>();
       if (!std::isfinite(m(r, c))) throw std::invalid_argument(where + ": non-finite entry");

@@ -83,8 +83,11 @@ std::vector<unsigned char> png_bytes(const cv::Mat& bgr, const std::string& name
 }
 
 nlohmann::json metrics_json(const ErrorMetrics& m) {
-  return {{"relative_rms", m.relative_rms}, {"log_rms_stops", m.log_rms_stops}, {"psnr_db", m.psnr_db},
-          {"mean_a", m.mean_a}, {"mean_b", m.mean_b}};
+  return {{"relative_rms", m.relative_rms},
+          {"log_rms_stops", m.log_rms_stops},
+          {"psnr_db", m.psnr_db},
+          {"mean_a", m.mean_a},
+          {"mean_b", m.mean_b}};
 }
 
 // Runs `body` unless the step is up to date; body fills outputs and summary.
@@ -144,8 +147,12 @@ std::vector<const BallSpec*> balls_of(const Context& c, BallKind kind) {
   return out;
 }
 
-fs::path captured_path(const Context& c, const BallSpec& b) { return file_in_folder(c.dir / "maps", "captured-" + b.name + ".exr"); }
-fs::path computed_path(const Context& c, const BallSpec& b) { return file_in_folder(c.dir / "maps", "computed-" + b.name + ".exr"); }
+fs::path captured_path(const Context& c, const BallSpec& b) {
+  return file_in_folder(c.dir / "maps", "captured-" + b.name + ".exr");
+}
+fs::path computed_path(const Context& c, const BallSpec& b) {
+  return file_in_folder(c.dir / "maps", "computed-" + b.name + ".exr");
+}
 
 // ---- calibrate: the lens model.
 void step_calibrate(Context& c) {
@@ -175,8 +182,7 @@ void step_calibrate(Context& c) {
       // lensfun's profile of the lens the EXIF names (distortion included), else a pinhole.
       const std::optional<MetadataLens> meta = metadata_lens(inputs.front(), b.cols(), b.rows());
       const PhotoOptics optics = meta ? meta->optics : read_photo_optics(inputs.front());
-      const std::string lensfun_why =
-          meta ? meta->lensfun_why : "the photo's metadata has no usable focal length";
+      const std::string lensfun_why = meta ? meta->lensfun_why : "the photo's metadata has no usable focal length";
       const bool from_lensfun = meta && meta->source == "lensfun";
       const std::optional<OpticsLens> guess = meta ? std::optional<OpticsLens>(meta->lens) : std::nullopt;
       if (!guess) {
@@ -185,21 +191,32 @@ void step_calibrate(Context& c) {
         const double f = std::hypot(double(b.cols()), double(b.rows()));
         const LensModel lens = LensModel::pinhole(f, b.cols(), b.rows());
         lens.write(out);
-        s = {{"source", "outlines"}, {"model", lens.name()}, {"intrinsics", lens.intrinsics()}, {"focal_px", f},
-             {"focal_from", "none: no usable focal length in the photos' metadata (FocalLengthIn35mmFilm, or "
-                            "FocalLength of a camera lensfun knows)"},
-             {"camera", optics.make + " " + optics.model}, {"lens", optics.lens}, {"lensfun", lensfun_why},
-             {"assumed", "a pinhole: principal point at the image centre, no distortion, the focal length from the "
-                         "balls' outlines (the lens step)"}};
+        s = {{"source", "outlines"},
+             {"model", lens.name()},
+             {"intrinsics", lens.intrinsics()},
+             {"focal_px", f},
+             {"focal_from",
+              "none: no usable focal length in the photos' metadata (FocalLengthIn35mmFilm, or "
+              "FocalLength of a camera lensfun knows)"},
+             {"camera", optics.make + " " + optics.model},
+             {"lens", optics.lens},
+             {"lensfun", lensfun_why},
+             {"assumed",
+              "a pinhole: principal point at the image centre, no distortion, the focal length from the "
+              "balls' outlines (the lens step)"}};
         r.outputs = {out};
         r.summary = s;
         return;
       }
       guess->lens.write(out);
-      s = {{"source", from_lensfun ? "lensfun" : "exif"}, {"model", guess->lens.name()},
-           {"intrinsics", guess->lens.intrinsics()}, {"focal_px", guess->focal_px},
-           {"focal_sigma_relative", guess->sigma_relative}, {"focal_from", guess->source},
-           {"camera", optics.make + " " + optics.model}, {"lens", optics.lens},
+      s = {{"source", from_lensfun ? "lensfun" : "exif"},
+           {"model", guess->lens.name()},
+           {"intrinsics", guess->lens.intrinsics()},
+           {"focal_px", guess->focal_px},
+           {"focal_sigma_relative", guess->sigma_relative},
+           {"focal_from", guess->source},
+           {"camera", optics.make + " " + optics.model},
+           {"lens", optics.lens},
            {"assumed", from_lensfun ? "lensfun's distortion profile of the lens, its centre at lensfun's"
                                     : "a pinhole: principal point at the image centre, no distortion"}};
       if (!from_lensfun) s["lensfun"] = lensfun_why;
@@ -212,8 +229,7 @@ void step_calibrate(Context& c) {
     } else {
       std::vector<std::string> missed;
       Progress bar("calibrate", c.o.progress);
-      const IntrinsicsProblem p =
-          chessboard_problem(c.set, c.o.photoset, &missed, [&](double f) { bar.update(f); });
+      const IntrinsicsProblem p = chessboard_problem(c.set, c.o.photoset, &missed, [&](double f) { bar.update(f); });
       bar.done();
       const std::vector<std::string> models = settings["models"];
       int chosen = 0;
@@ -223,9 +239,14 @@ void step_calibrate(Context& c) {
       nlohmann::json sc = nlohmann::json::array();
       for (const ModelScore& m : scores)
         sc.push_back({{"model", m.model}, {"held_out_rms_px", m.held_out_rms_px}, {"fit_rms_px", m.fit_rms_px}});
-      s = {{"source", "chessboards"}, {"model", models[chosen]}, {"intrinsics", fit.lens.intrinsics()},
-           {"rms_px", fit.rms_px}, {"outliers", fit.outliers}, {"boards_found", p.boards.size()},
-           {"boards_missed", missed}, {"models", sc}};
+      s = {{"source", "chessboards"},
+           {"model", models[chosen]},
+           {"intrinsics", fit.lens.intrinsics()},
+           {"rms_px", fit.rms_px},
+           {"outliers", fit.outliers},
+           {"boards_found", p.boards.size()},
+           {"boards_missed", missed},
+           {"models", sc}};
     }
     r.outputs = {out};
     r.summary = s;
@@ -239,10 +260,14 @@ void step_calibrate(Context& c) {
 void step_given_radiance(Context& c) {
   std::vector<fs::path> inputs;
   for (const PhotoView& v : c.set.views) {
-    const fs::path a = fs::path(c.o.radiance_dir) / (v.name + "_radiance.exr"), b = fs::path(c.o.radiance_dir) / (v.name + ".exr");
-    if (fs::is_regular_file(a)) inputs.push_back(a);
-    else if (fs::is_regular_file(b)) inputs.push_back(b);
-    else throw std::invalid_argument(c.o.radiance_dir + ": no " + a.filename().string() + " or " + b.filename().string());
+    const fs::path a = fs::path(c.o.radiance_dir) / (v.name + "_radiance.exr"),
+                   b = fs::path(c.o.radiance_dir) / (v.name + ".exr");
+    if (fs::is_regular_file(a))
+      inputs.push_back(a);
+    else if (fs::is_regular_file(b))
+      inputs.push_back(b);
+    else
+      throw std::invalid_argument(c.o.radiance_dir + ": no " + a.filename().string() + " or " + b.filename().string());
   }
   run_step(c, "hdr", {{"response", "given radiance"}, {"radiance", c.o.radiance_dir}}, inputs, [&](StepRecord& r) {
     fs::create_directories(c.dir / "hdr");
@@ -254,13 +279,19 @@ void step_given_radiance(Context& c) {
       m.variance = cv::Mat::zeros(img.radiance.size(), CV_32FC3);
       m.flags = cv::Mat::zeros(img.radiance.size(), CV_8UC1);
       const fs::path exr = merged_path(c, c.set.views[i].name);
-      write_merged_exr(exr.string(), m, {{"version", RSIBR_VERSION}, {"view", c.set.views[i].name},
-                                          {"source", inputs[i].string()}, {"producer", "rsibr process (given radiance)"}});
+      write_merged_exr(exr.string(), m,
+                       {{"version", RSIBR_VERSION},
+                        {"view", c.set.views[i].name},
+                        {"source", inputs[i].string()},
+                        {"producer", "rsibr process (given radiance)"}});
       r.outputs.push_back(exr);
-      views.push_back({{"name", c.set.views[i].name}, {"brackets", 0}, {"clipped_fraction", 0.0}, {"ghost_fraction", 0.0}});
+      views.push_back(
+          {{"name", c.set.views[i].name}, {"brackets", 0}, {"clipped_fraction", 0.0}, {"ghost_fraction", 0.0}});
     }
-    r.summary = {{"model", "given radiance (" + c.o.radiance_dir + ")"}, {"recovered_from", "-"},
-                 {"curve", nlohmann::json::array()}, {"views", views}};
+    r.summary = {{"model", "given radiance (" + c.o.radiance_dir + ")"},
+                 {"recovered_from", "-"},
+                 {"curve", nlohmann::json::array()},
+                 {"views", views}};
   });
 }
 
@@ -275,71 +306,88 @@ void step_hdr(Context& c) {
   // The camera's colour space (hdr/merged_colour.h): the option, else the photo set's; RAW views
   // are developed to linear Rec.709 (hdr/raw_image.h) whatever the photo set says.
   const std::string input_space = !c.o.input_colour_space.empty() ? c.o.input_colour_space : c.set.camera_colour_space;
-  run_step(c, "hdr", {{"response", "auto"}, {"vignetting", c.o.vignetting}, {"input_colour_space", input_space}}, inputs,
-           [&](StepRecord& r) {
-    fs::create_directories(c.dir / "hdr");
-    std::vector<const PhotoView*> all;
-    for (const PhotoView& v : c.set.views) all.push_back(&v);
-    const PhotoSetResponse psr = recover_photo_set_response(all, RecoveryOptions{}, Alignment::automatic);
-    const ResponseRecovery& rec = psr.recovery;
-    const std::string from = std::to_string(psr.from.size()) + " views (all with brackets)";
-    const ResponseCurve& curve = rec.curve;
-    nlohmann::json cands = nlohmann::json::array();
-    for (const auto& k : rec.candidates)
-      cands.push_back({{"model", k.model},
-                       {"held_out_error", std::isfinite(k.held_out_error) ? nlohmann::json(k.held_out_error)
-                                                                          : nlohmann::json("rejected")}});
-    const fs::path response = c.dir / "hdr" / "response.json";
-    save_response(response, curve, {{"camera", c.set.camera_name}, {"recovered_from", from}, {"recovery", recovery_json(rec)}});
-    nlohmann::json plot = nlohmann::json::array();
-    for (int k = 0; k <= 64; ++k) {
-      const double z = double(k) * curve.max_code / 64;
-      plot.push_back({z, curve.linear(0, z), curve.linear(1, z), curve.linear(2, z)});
-    }
-    r.outputs.push_back(response);
-    nlohmann::json vignetting;
-    const Vignetting vig = photo_set_vignetting(c.set, c.o.vignetting, curve, LensModel::read(c.dir / "camera.cameramodel"),
-                                                &vignetting);
-    const fs::path vfile = c.dir / "hdr" / "vignetting.json";
-    write_atomically(vfile, [&](const std::string& tmp) {
-      std::ofstream f(tmp);
-      f << vignetting["model"].dump(2) << "\n";
-      if (!f) throw std::runtime_error(tmp + ": cannot write");
-    });
-    r.outputs.push_back(vfile);
-    nlohmann::json views = nlohmann::json::array();
-    Progress bar("hdr", c.o.progress);
-    for (std::size_t i = 0; i < c.set.views.size(); ++i) {
-      const PhotoView& v = c.set.views[i];
-      ViewMerge vm = merge_photo_view(v, curve, psr.noise, Alignment::automatic, {}, &vig);
-      const BracketSet& b = vm.brackets;
-      const NoiseModel& noise = vm.noise;
-      MergedImage& m = vm.image;
-      const std::string from = merged_colour_space(b.raw && c.o.input_colour_space.empty() ? "" : input_space, b.raw);
-      merged_to_working_space(m, from);
-      const fs::path exr = merged_path(c, v.name);
-      write_merged_exr(exr.string(), m,
-                       {{"version", RSIBR_VERSION}, {"view", v.name}, {"responseModel", curve.model},
-                        {"responseFile", "response.json (next to this file)"}, {"colourSpace", working_space()},
-                        {"inputColourSpace", from.empty() ? working_space() : from},
-                        {"radianceUnit", "X/e: signal over saturation per relative exposure t*iso/100/N^2"},
-                        {"producer", "rsibr process (hdr step)"}});
-      r.outputs.push_back(exr);
-      const double px = double(m.radiance.total());
-      nlohmann::json shifts = nlohmann::json::array();
-      for (const cv::Point& s : vm.shifts) shifts.push_back({s.x, s.y});
-      views.push_back({{"name", v.name}, {"brackets", b.size()}, {"clipped_fraction", m.clipped / px},
-                       {"clipped_pixels", m.clipped},
-                       {"ghost_fraction", m.ghost / px}, {"noise_read", noise.read}, {"noise_shot", noise.shot},
-                       {"alignment_shifts", shifts}, {"sizes_fitted", b.fitted_sizes}});
-      bar.update(double(i + 1) / double(c.set.views.size()));
-    }
-    bar.done();
-    r.summary = {{"model", curve.model}, {"recovered_from", from}, {"candidates", cands}, {"recovery", recovery_json(rec)},
-                 {"curve", plot}, {"max_code", curve.max_code}, {"views", views}, {"vignetting", vignetting},
-                 {"camera", c.set.camera_name}, {"input_colour_space", input_space.empty() ? working_space() : input_space},
-                 {"colour_space", working_space()}};
-  });
+  run_step(c, "hdr", {{"response", "auto"}, {"vignetting", c.o.vignetting}, {"input_colour_space", input_space}},
+           inputs, [&](StepRecord& r) {
+             fs::create_directories(c.dir / "hdr");
+             std::vector<const PhotoView*> all;
+             for (const PhotoView& v : c.set.views) all.push_back(&v);
+             const PhotoSetResponse psr = recover_photo_set_response(all, RecoveryOptions{}, Alignment::automatic);
+             const ResponseRecovery& rec = psr.recovery;
+             const std::string from = std::to_string(psr.from.size()) + " views (all with brackets)";
+             const ResponseCurve& curve = rec.curve;
+             nlohmann::json cands = nlohmann::json::array();
+             for (const auto& k : rec.candidates)
+               cands.push_back({{"model", k.model},
+                                {"held_out_error", std::isfinite(k.held_out_error) ? nlohmann::json(k.held_out_error)
+                                                                                   : nlohmann::json("rejected")}});
+             const fs::path response = c.dir / "hdr" / "response.json";
+             save_response(response, curve,
+                           {{"camera", c.set.camera_name}, {"recovered_from", from}, {"recovery", recovery_json(rec)}});
+             nlohmann::json plot = nlohmann::json::array();
+             for (int k = 0; k <= 64; ++k) {
+               const double z = double(k) * curve.max_code / 64;
+               plot.push_back({z, curve.linear(0, z), curve.linear(1, z), curve.linear(2, z)});
+             }
+             r.outputs.push_back(response);
+             nlohmann::json vignetting;
+             const Vignetting vig = photo_set_vignetting(c.set, c.o.vignetting, curve,
+                                                         LensModel::read(c.dir / "camera.cameramodel"), &vignetting);
+             const fs::path vfile = c.dir / "hdr" / "vignetting.json";
+             write_atomically(vfile, [&](const std::string& tmp) {
+               std::ofstream f(tmp);
+               f << vignetting["model"].dump(2) << "\n";
+               if (!f) throw std::runtime_error(tmp + ": cannot write");
+             });
+             r.outputs.push_back(vfile);
+             nlohmann::json views = nlohmann::json::array();
+             Progress bar("hdr", c.o.progress);
+             for (std::size_t i = 0; i < c.set.views.size(); ++i) {
+               const PhotoView& v = c.set.views[i];
+               ViewMerge vm = merge_photo_view(v, curve, psr.noise, Alignment::automatic, {}, &vig);
+               const BracketSet& b = vm.brackets;
+               const NoiseModel& noise = vm.noise;
+               MergedImage& m = vm.image;
+               const std::string from =
+                   merged_colour_space(b.raw && c.o.input_colour_space.empty() ? "" : input_space, b.raw);
+               merged_to_working_space(m, from);
+               const fs::path exr = merged_path(c, v.name);
+               write_merged_exr(exr.string(), m,
+                                {{"version", RSIBR_VERSION},
+                                 {"view", v.name},
+                                 {"responseModel", curve.model},
+                                 {"responseFile", "response.json (next to this file)"},
+                                 {"colourSpace", working_space()},
+                                 {"inputColourSpace", from.empty() ? working_space() : from},
+                                 {"radianceUnit", "X/e: signal over saturation per relative exposure t*iso/100/N^2"},
+                                 {"producer", "rsibr process (hdr step)"}});
+               r.outputs.push_back(exr);
+               const double px = double(m.radiance.total());
+               nlohmann::json shifts = nlohmann::json::array();
+               for (const cv::Point& s : vm.shifts) shifts.push_back({s.x, s.y});
+               views.push_back({{"name", v.name},
+                                {"brackets", b.size()},
+                                {"clipped_fraction", m.clipped / px},
+                                {"clipped_pixels", m.clipped},
+                                {"ghost_fraction", m.ghost / px},
+                                {"noise_read", noise.read},
+                                {"noise_shot", noise.shot},
+                                {"alignment_shifts", shifts},
+                                {"sizes_fitted", b.fitted_sizes}});
+               bar.update(double(i + 1) / double(c.set.views.size()));
+             }
+             bar.done();
+             r.summary = {{"model", curve.model},
+                          {"recovered_from", from},
+                          {"candidates", cands},
+                          {"recovery", recovery_json(rec)},
+                          {"curve", plot},
+                          {"max_code", curve.max_code},
+                          {"views", views},
+                          {"vignetting", vignetting},
+                          {"camera", c.set.camera_name},
+                          {"input_colour_space", input_space.empty() ? working_space() : input_space},
+                          {"colour_space", working_space()}};
+           });
 }
 
 // ---- lens: the calibrated lens, its focal length refined from the balls' outlines when it came
@@ -362,8 +410,8 @@ void step_lens(Context& c) {
   }
   nlohmann::json balls = nlohmann::json::array();
   for (const ListedBall& b : s.balls) balls.push_back({b.name, to_string(b.kind)});
-  const nlohmann::json settings = {{"refine", s.refine}, {"source", s.source},
-                                   {"prior_sigma_relative", s.prior_sigma_relative}, {"balls", balls}};
+  const nlohmann::json settings = {
+      {"refine", s.refine}, {"source", s.source}, {"prior_sigma_relative", s.prior_sigma_relative}, {"balls", balls}};
   run_step(c, "lens", settings, inputs, [&](StepRecord& r) {
     r.summary = run_lens_step(s);
     r.outputs = {s.out};
@@ -375,9 +423,13 @@ void step_lens(Context& c) {
 // camera's frame), or given (--poses: the file's chrome balls, refined here by the features with
 // the rotations held when the file has none; a first-view file levelled by the estimated up).
 nlohmann::json world_up_json(const WorldUp& w) {
-  return {{"up_in_first_camera", {w.up.x(), w.up.y(), w.up.z()}}, {"sigma_deg", w.sigma_deg},
-          {"roll_sigma_deg", w.roll_sigma_deg}, {"roll_sigma_estimated", w.roll_sigma_estimated},
-          {"roll_deg", w.roll_deg}, {"tilt_from_first_camera_deg", w.tilt_from_first_deg}, {"lines", w.lines}};
+  return {{"up_in_first_camera", {w.up.x(), w.up.y(), w.up.z()}},
+          {"sigma_deg", w.sigma_deg},
+          {"roll_sigma_deg", w.roll_sigma_deg},
+          {"roll_sigma_estimated", w.roll_sigma_estimated},
+          {"roll_deg", w.roll_deg},
+          {"tilt_from_first_camera_deg", w.tilt_from_first_deg},
+          {"lines", w.lines}};
 }
 
 void step_orient(Context& c) {
@@ -403,10 +455,11 @@ void step_orient(Context& c) {
   }
   nlohmann::json balls = nlohmann::json::array();
   for (const BallSpec& b : c.set.balls) balls.push_back({b.name, to_string(b.kind), b.diameter_m.value_or(0.0)});
-  const nlohmann::json settings = {
-      {"source", c.o.poses.empty() ? "solve" : "given"},
-      {"up", c.o.up ? nlohmann::json{c.o.up->x(), c.o.up->y(), c.o.up->z()} : nlohmann::json(c.o.estimate_up ? "auto" : "none")},
-      {"balls", balls}, {"chrome_overrides", chrome_overrides}};
+  const nlohmann::json settings = {{"source", c.o.poses.empty() ? "solve" : "given"},
+                                   {"up", c.o.up ? nlohmann::json{c.o.up->x(), c.o.up->y(), c.o.up->z()}
+                                                 : nlohmann::json(c.o.estimate_up ? "auto" : "none")},
+                                   {"balls", balls},
+                                   {"chrome_overrides", chrome_overrides}};
   run_step(c, "orient", settings, inputs, [&](StepRecord& r) {
     PoseSet poses;
     std::string source;
@@ -454,9 +507,9 @@ void step_orient(Context& c) {
       vo.estimate_up = c.o.estimate_up;
       poses = orient_views(names, images, lens, vo, &report);
       source = "solved (chrome-ball features)";
-      solve = {{"tracks", report.tracks}, {"observations", report.observations}, {"inliers", report.inliers},
-               {"rms_sigmas", report.rms_sigmas}, {"features", report.features},
-               {"tracks_relocated", report.track_refinement.tracks_refined}};
+      solve = {{"tracks", report.tracks},     {"observations", report.observations},
+               {"inliers", report.inliers},   {"rms_sigmas", report.rms_sigmas},
+               {"features", report.features}, {"tracks_relocated", report.track_refinement.tracks_refined}};
       for (const std::string& w : report.left_out) left_out.push_back(w);
       for (const std::string& w : report.notes) notes.push_back(w);
       if (report.world_up) up = world_up_json(*report.world_up);
@@ -471,7 +524,8 @@ void step_orient(Context& c) {
     nlohmann::json views = nlohmann::json::array();
     for (const ViewPose& p : ordered.views) {
       const Vec3 forward = p.world_from_cam.col(2);
-      nlohmann::json vj = {{"name", p.name}, {"sigma_deg", p.sigma_deg}, {"forward", {forward.x(), forward.y(), forward.z()}}};
+      nlohmann::json vj = {
+          {"name", p.name}, {"sigma_deg", p.sigma_deg}, {"forward", {forward.x(), forward.y(), forward.z()}}};
       if (p.ball) {
         const Vec2 cp = lens.project(p.ball->axis);
         vj["chrome_centre_px"] = {cp.x(), cp.y()};
@@ -479,8 +533,8 @@ void step_orient(Context& c) {
       views.push_back(vj);
     }
     r.outputs = {out};
-    r.summary = {{"source", source}, {"gauge", ordered.gauge}, {"views", views}, {"solve", solve},
-                 {"left_out", left_out}, {"notes", notes}, {"world_up", up}};
+    r.summary = {{"source", source},     {"gauge", ordered.gauge}, {"views", views}, {"solve", solve},
+                 {"left_out", left_out}, {"notes", notes},         {"world_up", up}};
   });
 }
 
@@ -494,10 +548,15 @@ nlohmann::json finding_json(const std::string& ball, const BallFinding& f) {
   if (f.disagreement >= 0) j["disagreement_radii"] = f.disagreement;
   if (!f.ball) return j;
   const BallCandidate& b = *f.ball;
-  j.update({{"centre_px", {b.loc.centre_px.x(), b.loc.centre_px.y()}}, {"radius_px", b.loc.radius_px},
-            {"outline_rms_px", b.loc.fit.rms_px}, {"inlier_fraction", b.inlier_fraction}, {"texture", b.texture},
-            {"mirror_score", b.mirror_score}, {"diffuse_residual", std::isfinite(b.diffuse_residual) ? b.diffuse_residual : -1.0},
-            {"frame_fraction", b.frame_fraction}, {"cut", b.cut}});
+  j.update({{"centre_px", {b.loc.centre_px.x(), b.loc.centre_px.y()}},
+            {"radius_px", b.loc.radius_px},
+            {"outline_rms_px", b.loc.fit.rms_px},
+            {"inlier_fraction", b.inlier_fraction},
+            {"texture", b.texture},
+            {"mirror_score", b.mirror_score},
+            {"diffuse_residual", std::isfinite(b.diffuse_residual) ? b.diffuse_residual : -1.0},
+            {"frame_fraction", b.frame_fraction},
+            {"cut", b.cut}});
   return j;
 }
 
@@ -508,8 +567,10 @@ void step_extract(Context& c) {
   const std::vector<BallOverride> overrides = parse_ball_overrides(c.o.ball_overrides, c.set);
   nlohmann::json balls = nlohmann::json::array(), given = nlohmann::json::array();
   for (const BallSpec& b : c.set.balls) balls.push_back({b.name, to_string(b.kind), b.diameter_m.value_or(0.0)});
-  for (const BallOverride& o : overrides) given.push_back({o.view, o.ball, o.guess.centre_px.x(), o.guess.centre_px.y(), o.guess.radius_px});
-  const nlohmann::json settings = {{"map_size", c.o.map_size}, {"balls", balls}, {"given", given}, {"identification", 4}};
+  for (const BallOverride& o : overrides)
+    given.push_back({o.view, o.ball, o.guess.centre_px.x(), o.guess.centre_px.y(), o.guess.radius_px});
+  const nlohmann::json settings = {
+      {"map_size", c.o.map_size}, {"balls", balls}, {"given", given}, {"identification", 4}};
   run_step(c, "extract", settings, inputs, [&](StepRecord& r) {
     if (c.set.balls.empty()) throw std::invalid_argument(c.o.photoset + ": balls: the photo set lists no ball");
     const LensModel lens = LensModel::read(c.dir / "lens.cameramodel");
@@ -520,8 +581,9 @@ void step_extract(Context& c) {
     int chrome_index = -1;
     for (std::size_t b = 0; b < listed.size(); ++b)
       if (listed[b].kind == BallKind::chrome && chrome_index < 0) chrome_index = int(b);
-    const double chrome_radius_m =
-        chrome_index >= 0 && listed[std::size_t(chrome_index)].diameter_m ? 0.5 * *listed[std::size_t(chrome_index)].diameter_m : 0.05;
+    const double chrome_radius_m = chrome_index >= 0 && listed[std::size_t(chrome_index)].diameter_m
+                                       ? 0.5 * *listed[std::size_t(chrome_index)].diameter_m
+                                       : 0.05;
     auto read_view = [&](const PhotoView& v) {
       const std::string file = merged_path(c, v.name).string();
       ViewImage img = read_view_image(file);
@@ -541,7 +603,8 @@ void step_extract(Context& c) {
       const PhotoView& v = c.set.views[vi];
       const ViewPose* pose = poses.find(v.name);
       if (!pose) {
-        views.push_back({{"name", v.name}, {"left_out", "no pose (the orient step found no chrome ball in it)"},
+        views.push_back({{"name", v.name},
+                         {"left_out", "no pose (the orient step found no chrome ball in it)"},
                          {"balls", nlohmann::json::array()}});
         continue;
       }
@@ -557,7 +620,8 @@ void step_extract(Context& c) {
           one.chrome = pose->ball;  // refined with the orientations (the outline lies inside its limb)
         } else {
           const std::vector<int> pick = assign_balls_in_view(one.candidates, listed);
-          if (pick[std::size_t(chrome_index)] >= 0) one.chrome = one.candidates[std::size_t(pick[std::size_t(chrome_index)])].loc.fit.cone;
+          if (pick[std::size_t(chrome_index)] >= 0)
+            one.chrome = one.candidates[std::size_t(pick[std::size_t(chrome_index)])].loc.fit.cone;
         }
       }
       vb.push_back(std::move(one));
@@ -593,8 +657,10 @@ void step_extract(Context& c) {
       const Vec3 down_cam = world_from_cam.transpose() * world_down;
       std::vector<OtherBall> others;
       for (std::size_t b = 0; b < listed.size(); ++b)
-        if (int(b) != chrome_index && found[b].found() && chrome_index >= 0 && found[std::size_t(chrome_index)].found()) {
-          const BallCone chrome = found[std::size_t(chrome_index)].ball->loc.fit.cone, cone = found[b].ball->loc.fit.cone;
+        if (int(b) != chrome_index && found[b].found() && chrome_index >= 0 &&
+            found[std::size_t(chrome_index)].found()) {
+          const BallCone chrome = found[std::size_t(chrome_index)].ball->loc.fit.cone,
+                         cone = found[b].ball->loc.fit.cone;
           // The radius over the chrome's: the rig's, else the listed diameters', else the same distance as the chrome ball.
           double scale = rig.size() == listed.size() && rig[b].known ? rig[b].scale : 0;
           if (!(scale > 0) && listed[b].diameter_m && listed[std::size_t(chrome_index)].diameter_m)
@@ -624,7 +690,8 @@ void step_extract(Context& c) {
           if (o.name == ball.name) own_scale = o.scale;
         std::vector<OtherBall> rest;
         if (chrome_index >= 0 && int(b) != chrome_index && found[std::size_t(chrome_index)].found())
-          rest.push_back({listed[std::size_t(chrome_index)].name, found[std::size_t(chrome_index)].ball->loc.fit.cone, 1.0});
+          rest.push_back(
+              {listed[std::size_t(chrome_index)].name, found[std::size_t(chrome_index)].ball->loc.fit.cone, 1.0});
         for (const OtherBall& o : others)
           if (o.name != ball.name) rest.push_back(o);
         for (const OtherBall& o : rest) {
@@ -671,15 +738,18 @@ void step_extract(Context& c) {
         MapView& mv = sets[b].views[k];
         nlohmann::json* bj = ball_entry(mv.attributes["image"], listed[b].name);
         if (bj) {
-          (*bj)["consensus"] = {{"judged", cons[k].judged}, {"masked", cons[k].masked}, {"median_stops", cons[k].median_stops}};
-          (*bj)["confident_fraction"] = cv::countNonZero(mv.confidence > 0.5) / (kPiD / 4 * c.o.map_size * c.o.map_size);
+          (*bj)["consensus"] = {
+              {"judged", cons[k].judged}, {"masked", cons[k].masked}, {"median_stops", cons[k].median_stops}};
+          (*bj)["confident_fraction"] =
+              cv::countNonZero(mv.confidence > 0.5) / (kPiD / 4 * c.o.map_size * c.o.map_size);
         }
         if (cons[k].left_out) {
           if (bj) {
             (*bj)["status"] = "left out: inconsistent with the other views";
             (*bj)["note"] = std::to_string(cons[k].masked) + " of " + std::to_string(cons[k].judged) +
                             " texels differ from the other views' median by more than 0.12 stops (median " +
-                            std::to_string(cons[k].median_stops).substr(0, 5) + "): a shadow or occluder of this view alone";
+                            std::to_string(cons[k].median_stops).substr(0, 5) +
+                            "): a shadow or occluder of this view alone";
           }
           continue;
         }
@@ -697,8 +767,10 @@ void step_extract(Context& c) {
       }
     for (std::size_t b = 0; b < listed.size(); ++b)
       if (sets[b].views.empty())
-        throw std::runtime_error("ball '" + listed[b].name + "' was found in no view (see the balls' notes with --json; "
-                                 "give it with --ball VIEW:" + listed[b].name + "=X,Y,R)");
+        throw std::runtime_error("ball '" + listed[b].name +
+                                 "' was found in no view (see the balls' notes with --json; "
+                                 "give it with --ball VIEW:" +
+                                 listed[b].name + "=X,Y,R)");
     fs::create_directories(c.dir / "maps");
     for (std::size_t bi = 0; bi < c.set.balls.size(); ++bi) {
       const fs::path out = captured_path(c, c.set.balls[bi]);
@@ -712,12 +784,21 @@ void step_extract(Context& c) {
     nlohmann::json rj = nlohmann::json::array();
     for (std::size_t b = 0; b < listed.size(); ++b) {
       const RigMember& m = rig.size() == listed.size() ? rig[b] : RigMember{};
-      rj.push_back({{"ball", listed[b].name}, {"known", m.known}, {"offset_chrome_radii", {m.offset.x(), m.offset.y(), m.offset.z()}},
-                    {"scale", m.scale}, {"scale_from_diameters", m.scale_given}, {"views_agreeing", m.support}, {"rms_radii", m.rms}});
+      rj.push_back({{"ball", listed[b].name},
+                    {"known", m.known},
+                    {"offset_chrome_radii", {m.offset.x(), m.offset.y(), m.offset.z()}},
+                    {"scale", m.scale},
+                    {"scale_from_diameters", m.scale_given},
+                    {"views_agreeing", m.support},
+                    {"rms_radii", m.rms}});
     }
-    r.summary = {{"views", views}, {"map_size", c.o.map_size}, {"rig", rj},
-                 {"chrome_radius_m", chrome_radius_m},
-                 {"chrome_radius_source", chrome_index >= 0 && listed[std::size_t(chrome_index)].diameter_m ? "listed diameter" : "assumed 5 cm"}};
+    r.summary = {
+        {"views", views},
+        {"map_size", c.o.map_size},
+        {"rig", rj},
+        {"chrome_radius_m", chrome_radius_m},
+        {"chrome_radius_source",
+         chrome_index >= 0 && listed[std::size_t(chrome_index)].diameter_m ? "listed diameter" : "assumed 5 cm"}};
   });
 }
 
@@ -731,12 +812,14 @@ void step_probe(Context& c) {
     // The stage swapped for a given environment (the truth, for the error budget): resampled
     // (area-weighted, core/resample.h) to the probe's lat-long size.
     run_step(c, "probe", {{"width", c.o.probe_width}, {"given", c.o.probe_file}}, {c.o.probe_file}, [&](StepRecord& r) {
-      EnvMap env = resample(read_environment(c.o.probe_file), Layout(LayoutKind::LatLong, c.o.probe_width, c.o.probe_width / 2));
+      EnvMap env =
+          resample(read_environment(c.o.probe_file), Layout(LayoutKind::LatLong, c.o.probe_width, c.o.probe_width / 2));
       env.attributes["producer"] = "rsibr process (given probe " + fs::path(c.o.probe_file).filename().string() + ")";
       const fs::path out = c.dir / "probe-measured.exr";
       write_environment(out.string(), env);
       r.outputs = {out};
-      r.summary = {{"views", 0}, {"width", c.o.probe_width}, {"covered_fraction", 1.0}, {"fresnel", "given: " + c.o.probe_file}};
+      r.summary = {
+          {"views", 0}, {"width", c.o.probe_width}, {"covered_fraction", 1.0}, {"fresnel", "given: " + c.o.probe_file}};
     });
     return;
   }
@@ -766,8 +849,11 @@ void step_probe(Context& c) {
         if (p.weight.at<float>(y, x) >= 0.5f) well += sa;
       }
     }
-    r.summary = {{"views", all.views.size()}, {"width", c.o.probe_width}, {"covered_fraction", p.covered_fraction},
-                 {"well_seen_fraction", all_sa > 0 ? well / all_sa : 0.0}, {"clipped_fraction", p.clipped_fraction},
+    r.summary = {{"views", all.views.size()},
+                 {"width", c.o.probe_width},
+                 {"covered_fraction", p.covered_fraction},
+                 {"well_seen_fraction", all_sa > 0 ? well / all_sa : 0.0},
+                 {"clipped_fraction", p.clipped_fraction},
                  {"fresnel", fresnel ? fresnel->spec() : "none (the probe holds F L)"}};
   });
 }
@@ -797,8 +883,11 @@ void step_sources(Context& c) {
   s.grey_albedo = c.o.grey_albedo;
   s.recover = c.o.recover_sources;
   s.seed = c.o.seed;
-  nlohmann::json settings = {{"recover", s.recover}, {"width", s.probe_width}, {"fresnel", s.chrome_fresnel},
-                             {"given", s.given_probe}, {"clipped", clipped}};
+  nlohmann::json settings = {{"recover", s.recover},
+                             {"width", s.probe_width},
+                             {"fresnel", s.chrome_fresnel},
+                             {"given", s.given_probe},
+                             {"clipped", clipped}};
   if (clipped) settings.update({{"albedo", s.grey_albedo}, {"glossy_brdf", s.glossy_brdf}, {"seed", s.seed}});
   run_step(c, "sources", settings, inputs, [&](StepRecord& r) {
     r.summary = run_light_sources_step(s);
@@ -815,8 +904,8 @@ void step_bake(Context& c) {
   std::vector<fs::path> inputs = {c.dir / "probe.exr"};
   const auto greys = balls_of(c, BallKind::grey);
   for (const BallSpec* b : greys) inputs.push_back(captured_path(c, *b));
-  const nlohmann::json settings = {{"albedo", c.o.grey_albedo}, {"method", c.o.bake_method},
-                                   {"samples", c.o.bake_samples}, {"seed", c.o.seed}};
+  const nlohmann::json settings = {
+      {"albedo", c.o.grey_albedo}, {"method", c.o.bake_method}, {"samples", c.o.bake_samples}, {"seed", c.o.seed}};
   run_step(c, "bake", settings, inputs, [&](StepRecord& r) {
     const EnvMap probe = read_environment((c.dir / "probe.exr").string());
     const auto integrator = make_integrator(c.o.bake_method, probe);
@@ -838,8 +927,11 @@ void step_bake(Context& c) {
         mv.warp = CentralDirection::Normal;
         mv.source = MapSource::Computed;
         mv.material = brdf->spec();
-        mv.attributes = {{"version", RSIBR_VERSION}, {"environment", "probe.exr"}, {"method", c.o.bake_method},
-                         {"samples", std::to_string(c.o.bake_samples)}, {"seed", std::to_string(c.o.seed)},
+        mv.attributes = {{"version", RSIBR_VERSION},
+                         {"environment", "probe.exr"},
+                         {"method", c.o.bake_method},
+                         {"samples", std::to_string(c.o.bake_samples)},
+                         {"seed", std::to_string(c.o.seed)},
                          {"image", cv.attributes.count("image") ? cv.attributes.at("image") : ""}};
         mv.rgb = integrator->radiance_map(*brdf, mv.view, mv.world_from_view, cv.rgb.cols, io);
         computed.views.push_back(std::move(mv));
@@ -871,7 +963,7 @@ void step_compare(Context& c) {
         for (std::size_t i = 0; i < captured.views.size(); ++i) {
           if (cv::countNonZero(captured.views[i].confidence > 0) == 0) {
             untrusted.push_back(captured.views[i].attributes.count("image") ? captured.views[i].attributes.at("image")
-                                                                             : "view." + std::to_string(i));
+                                                                            : "view." + std::to_string(i));
             continue;
           }
           a.views.push_back(std::move(captured.views[i]));
@@ -909,26 +1001,35 @@ void step_compare(Context& c) {
         in.exposure_stops = exposure;
         in.heat_max = heat_max;
         const std::string image = captured.views[p.index_a].attributes.count("image")
-                                      ? captured.views[p.index_a].attributes.at("image") : p.name;
+                                      ? captured.views[p.index_a].attributes.at("image")
+                                      : p.name;
         in.title = b->name + " " + image;
         in.a_label = "captured x gains";
         in.b_label = "computed";
         in.heat_label = "log2 error";
         const std::string name = p.name + ".png";
         files[name] = png_bytes(side_by_side(in), name);
-        views.push_back({{"name", p.name}, {"image", image}, {"picture", name},
+        views.push_back({{"name", p.name},
+                         {"image", image},
+                         {"picture", name},
                          {"view", {p.view.x(), p.view.y(), p.view.z()}},
-                         {"before", metrics_json(p.before)}, {"after", metrics_json(p.after)}});
+                         {"before", metrics_json(p.before)},
+                         {"after", metrics_json(p.after)}});
       }
       const fs::path folder = c.dir / "compare" / b->name;
       fs::create_directories(folder.parent_path());
       write_folder_atomically(folder, files);
       for (const auto& [name, bytes] : files) r.outputs.push_back(folder / name);
-      nlohmann::json bj = {{"ball", b->name}, {"folder", "compare/" + b->name}, {"views", views}, {"untrusted_views", untrusted},
+      nlohmann::json bj = {{"ball", b->name},
+                           {"folder", "compare/" + b->name},
+                           {"views", views},
+                           {"untrusted_views", untrusted},
                            {"overall", {{"before", metrics_json(cmp.before)}, {"after", metrics_json(cmp.after)}}},
-                           {"heat_max_stops", heat_max}, {"log_epsilon", cmp.settings.log_epsilon}};
+                           {"heat_max_stops", heat_max},
+                           {"log_epsilon", cmp.settings.log_epsilon}};
       if (cmp.fit)
-        bj["fit"] = {{"gains", cmp.fit->gains}, {"exposure_stops", cmp.fit->exposure_stops}, {"chroma", cmp.fit->chroma}};
+        bj["fit"] = {
+            {"gains", cmp.fit->gains}, {"exposure_stops", cmp.fit->exposure_stops}, {"chroma", cmp.fit->chroma}};
       balls.push_back(bj);
     }
     r.summary = {{"balls", balls}};
@@ -939,9 +1040,9 @@ void step_compare(Context& c) {
 void step_render(Context& c) {
   std::vector<fs::path> inputs = {c.dir / "probe.exr"};
   if (!c.o.mesh.empty()) inputs.push_back(c.o.mesh);
-  const nlohmann::json settings = {{"brdf", c.o.render_brdf}, {"res", c.o.render_views_res}, {"frames", c.o.turntable},
-                                   {"size", {c.o.render_width, c.o.render_height}}, {"seed", c.o.seed},
-                                   {"mesh", c.o.mesh.empty() ? "built-in torus" : c.o.mesh}};
+  const nlohmann::json settings = {{"brdf", c.o.render_brdf}, {"res", c.o.render_views_res},
+                                   {"frames", c.o.turntable}, {"size", {c.o.render_width, c.o.render_height}},
+                                   {"seed", c.o.seed},        {"mesh", c.o.mesh.empty() ? "built-in torus" : c.o.mesh}};
   run_step(c, "render", settings, inputs, [&](StepRecord& r) {
     const EnvMap probe = read_environment((c.dir / "probe.exr").string());
     const auto brdf = parse_brdf(c.o.render_brdf);
@@ -958,8 +1059,11 @@ void step_render(Context& c) {
       mv.warp = brdf->central_direction();
       mv.source = MapSource::Computed;
       mv.material = brdf->spec();
-      mv.attributes = {{"version", RSIBR_VERSION}, {"environment", "probe.exr"}, {"method", "fis"},
-                       {"samples", "32"}, {"seed", std::to_string(c.o.seed)}};
+      mv.attributes = {{"version", RSIBR_VERSION},
+                       {"environment", "probe.exr"},
+                       {"method", "fis"},
+                       {"samples", "32"},
+                       {"seed", std::to_string(c.o.seed)}};
       mv.rgb = integrator->radiance_map(*brdf, v, mv.world_from_view, c.o.render_views_res, io);
       maps.views.push_back(std::move(mv));
     }
@@ -991,8 +1095,11 @@ void step_render(Context& c) {
     write_folder_atomically(folder, files);
     r.outputs.push_back(folder / "maps.exr");
     for (const auto& [name, bytes] : files) r.outputs.push_back(folder / name);
-    r.summary = {{"mesh", c.o.mesh.empty() ? "built-in torus" : c.o.mesh}, {"triangles", mesh.triangles.size()},
-                 {"material", brdf->spec()}, {"frames", c.o.turntable}, {"seconds_per_frame", seconds / c.o.turntable},
+    r.summary = {{"mesh", c.o.mesh.empty() ? "built-in torus" : c.o.mesh},
+                 {"triangles", mesh.triangles.size()},
+                 {"material", brdf->spec()},
+                 {"frames", c.o.turntable},
+                 {"seconds_per_frame", seconds / c.o.turntable},
                  {"display_exposure_stops", stops}};
   });
 }
@@ -1008,19 +1115,23 @@ const std::vector<std::string>& process_steps() {
 ProcessResult run_process(const ProcessOptions& o) {
   for (const std::string& f : o.force)
     if (f != "all" && std::find(process_steps().begin(), process_steps().end(), f) == process_steps().end())
-      throw std::invalid_argument("--force '" + f + "': not a step (calibrate, hdr, lens, orient, extract, probe, sources, "
+      throw std::invalid_argument("--force '" + f +
+                                  "': not a step (calibrate, hdr, lens, orient, extract, probe, sources, "
                                   "bake, compare, render, report, all)");
   if (!o.lens.empty() && !fs::is_regular_file(o.lens)) throw std::invalid_argument(o.lens + ": no such file");
   if (!o.mesh.empty() && !fs::is_regular_file(o.mesh)) throw std::invalid_argument(o.mesh + ": no such file");
-  if (!o.probe_file.empty() && !fs::is_regular_file(o.probe_file)) throw std::invalid_argument(o.probe_file + ": no such file");
+  if (!o.probe_file.empty() && !fs::is_regular_file(o.probe_file))
+    throw std::invalid_argument(o.probe_file + ": no such file");
   if (!o.radiance_dir.empty() && !fs::is_directory(o.radiance_dir))
     throw std::invalid_argument(o.radiance_dir + ": no such folder");
   if (!o.poses.empty()) read_given_poses(o.poses);  // errors before any work
   if (o.vignetting != "auto" && o.vignetting != "none") {
     if (!fs::is_regular_file(o.vignetting)) throw std::invalid_argument(o.vignetting + ": no such file (--vignetting)");
-    photo_set_vignetting(PhotoSet{}, o.vignetting, ResponseCurve::identity(255), LensModel::pinhole(100, 64, 64), nullptr);
+    photo_set_vignetting(PhotoSet{}, o.vignetting, ResponseCurve::identity(255), LensModel::pinhole(100, 64, 64),
+                         nullptr);
   }
-  if (o.up && !(o.up->norm() > 0 && o.up->allFinite())) throw std::invalid_argument("--up: expected a non-zero direction");
+  if (o.up && !(o.up->norm() > 0 && o.up->allFinite()))
+    throw std::invalid_argument("--up: expected a non-zero direction");
   if (!o.input_colour_space.empty() && o.input_colour_space != working_space()) {
     try {
       colour_conversion_matrix(o.input_colour_space, working_space());  // errors before any work
@@ -1041,7 +1152,8 @@ ProcessResult run_process(const ProcessOptions& o) {
   Context c{o, fs::absolute(o.out).lexically_normal(), load_photo_set(o.photoset), result};
   if (c.set.views.empty()) throw std::invalid_argument(o.photoset + ": views: none");
   parse_ball_overrides(o.ball_overrides, c.set);  // errors before any work
-  if (o.input_colour_space.empty() && !c.set.camera_colour_space.empty() && c.set.camera_colour_space != working_space()) {
+  if (o.input_colour_space.empty() && !c.set.camera_colour_space.empty() &&
+      c.set.camera_colour_space != working_space()) {
     try {
       colour_conversion_matrix(c.set.camera_colour_space, working_space());
     } catch (const std::runtime_error& e) {

@@ -45,51 +45,54 @@
 namespace rsibr {
 
 struct ProcessOptions {
-  std::string photoset;      // photoset.yaml or its folder
-  std::filesystem::path out; // DIR (created; its parent must exist)
-  std::string lens;          // given .cameramodel (skips the chessboards)
-  bool self_calibrate = true; // lens step: refine a metadata lens's focal length from the balls' outlines
-  std::string poses;         // given poses (pipeline/pose_input.h); empty: the orientation solve
-  std::optional<Vec3> up;    // world up in the first camera's frame (e.g. 0,-1,0 for a levelled camera)
-  bool estimate_up = true;   // without `up`: estimated from the views (calib/world_up.h); false: first-view gauge
-  std::vector<std::string> ball_overrides;  // "VIEW:BALL=X,Y,R": that ball of that view located there (pipeline/ball_override.h)
-  std::string input_colour_space;  // OCIO space of the linearised camera RGB; empty: the photo set's camera.colour_space, else the working space
-  std::string vignetting = "auto";  // "auto" (from the chessboards when there are 3 or more), "none", or a JSON file (hdr/vignetting.h)
+  std::string photoset;        // photoset.yaml or its folder
+  std::filesystem::path out;   // DIR (created; its parent must exist)
+  std::string lens;            // given .cameramodel (skips the chessboards)
+  bool self_calibrate = true;  // lens step: refine a metadata lens's focal length from the balls' outlines
+  std::string poses;           // given poses (pipeline/pose_input.h); empty: the orientation solve
+  std::optional<Vec3> up;      // world up in the first camera's frame (e.g. 0,-1,0 for a levelled camera)
+  bool estimate_up = true;     // without `up`: estimated from the views (calib/world_up.h); false: first-view gauge
+  std::vector<std::string>
+      ball_overrides;  // "VIEW:BALL=X,Y,R": that ball of that view located there (pipeline/ball_override.h)
+  std::string
+      input_colour_space;  // OCIO space of the linearised camera RGB; empty: the photo set's camera.colour_space, else the working space
+  std::string vignetting =
+      "auto";  // "auto" (from the chessboards when there are 3 or more), "none", or a JSON file (hdr/vignetting.h)
   // Stages swapped for given data (the truth of a synthetic capture: the error budget):
-  std::string radiance_dir;  // hdr: linear EXRs <view>_radiance.exr or <view>.exr instead of the merge
-  std::string probe_file;    // probe: this environment (resampled) instead of the chrome maps' blend
-  std::string mesh;          // render: .glb/.gltf/.obj; empty: a built-in torus
+  std::string radiance_dir;        // hdr: linear EXRs <view>_radiance.exr or <view>.exr instead of the merge
+  std::string probe_file;          // probe: this environment (resampled) instead of the chrome maps' blend
+  std::string mesh;                // render: .glb/.gltf/.obj; empty: a built-in torus
   std::vector<std::string> force;  // steps to re-run ("all" for every step)
-  int map_size = 64;         // extracted and computed sphere maps (texels a side)
-  int probe_width = 256;     // lat-long probe width
+  int map_size = 64;               // extracted and computed sphere maps (texels a side)
+  int probe_width = 256;           // lat-long probe width
   // The chrome ball's Fresnel spec (YAML text), divided out of the probe; "" or "none": none (F L).
   std::string chrome_fresnel = kDefaultChromeFresnel;
   bool recover_sources = true;  // sources step: false writes the measured probe unchanged
   std::string glossy_brdf;      // the glossy balls' BRDF spec (YAML text); empty: they are not used
-  double grey_albedo = 0.18; // the grey ball's Lambert albedo (compare fits a gain anyway)
+  double grey_albedo = 0.18;    // the grey ball's Lambert albedo (compare fits a gain anyway)
   std::string bake_method = "mis";
   int bake_samples = 128;
   std::uint64_t seed = 0;
   std::string render_brdf = "{type: ggx, roughness: 0.25, fresnel: {type: schlick, f0: [0.95, 0.64, 0.54]}}";
-  int render_views_res = 64; // map size of the render's computed map set (icosa views)
-  int turntable = 8;         // frames
+  int render_views_res = 64;  // map size of the render's computed map set (icosa views)
+  int turntable = 8;          // frames
   int render_width = 320, render_height = 240;
-  bool progress = false;     // progress bars on stderr
+  bool progress = false;                        // progress bars on stderr
   std::function<void(const std::string&)> log;  // one line per step (empty: silent)
 };
 
 struct StepOutcome {
   std::string step;
   bool ran = false;
-  std::string reason;        // why it ran ("" when skipped: up to date)
-  double seconds = 0;        // this run's time (0 when skipped)
+  std::string reason;           // why it ran ("" when skipped: up to date)
+  double seconds = 0;           // this run's time (0 when skipped)
   double recorded_seconds = 0;  // the time of the run that made the outputs
 };
 
 struct ProcessResult {
   std::vector<StepOutcome> steps;
   std::filesystem::path report;
-  nlohmann::json summary;    // every step's summary by name
+  nlohmann::json summary;  // every step's summary by name
 };
 
 // The step names in order.

@@ -89,8 +89,8 @@ nlohmann::json file_stamp(const fs::path& file, const RecordRoots& roots) {
   if (ec) throw std::runtime_error(file.string() + ": " + ec.message());
   nlohmann::json j = located(file, roots);
   j["size"] = static_cast<std::uint64_t>(size);
-  j["mtime_ns"] = static_cast<std::int64_t>(
-      std::chrono::duration_cast<std::chrono::nanoseconds>(mtime.time_since_epoch()).count());
+  j["mtime_ns"] =
+      static_cast<std::int64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(mtime.time_since_epoch()).count());
   j["sha256"] = file_sha256(file);
   return j;
 }
@@ -183,7 +183,8 @@ void write_step_record(const fs::path& dir, const StepRecord& r, const RecordRoo
   j["summary"] = r.summary;
   fs::create_directories(dir / "steps");
   // Input text (names, the camera) is not always UTF-8: bad bytes are replaced.
-  write_text_atomically(step_record_path(dir, r.step), j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  write_text_atomically(step_record_path(dir, r.step),
+                        j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 }  // namespace rsibr

@@ -23,9 +23,9 @@ namespace rsibr {
 struct StepRecord {
   std::string step;
   nlohmann::json settings = nlohmann::json::object();
-  std::vector<std::filesystem::path> inputs, outputs;   // absolute (resolved against the roots when read)
-  double seconds = 0;                                    // how long the step took when it ran
-  nlohmann::json summary = nlohmann::json::object();     // what the step reports (for the report)
+  std::vector<std::filesystem::path> inputs, outputs;  // absolute (resolved against the roots when read)
+  double seconds = 0;                                  // how long the step took when it ran
+  nlohmann::json summary = nlohmann::json::object();   // what the step reports (for the report)
 };
 
 // The folders that paths in records are relative to: the run folder and (optional) the photo folder.
@@ -48,9 +48,8 @@ std::filesystem::path step_record_path(const std::filesystem::path& dir, const s
 // Why the step must run ("" when it is up to date): "no record", "settings changed", "inputs
 // changed", "<input> changed", "<input> missing", "<output> missing", "<output> changed".
 // roots.run is the run folder DIR (empty: `dir`).
-std::string step_stale_reason(const std::filesystem::path& dir, const std::string& step,
-                              const nlohmann::json& settings, const std::vector<std::filesystem::path>& inputs,
-                              const RecordRoots& roots = {});
+std::string step_stale_reason(const std::filesystem::path& dir, const std::string& step, const nlohmann::json& settings,
+                              const std::vector<std::filesystem::path>& inputs, const RecordRoots& roots = {});
 
 // Writes DIR/steps/<step>.json (stamps of inputs and outputs taken now).
 void write_step_record(const std::filesystem::path& dir, const StepRecord& record, const RecordRoots& roots = {});

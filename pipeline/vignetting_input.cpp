@@ -46,8 +46,9 @@ Vignetting photo_set_vignetting(const PhotoSet& set, const std::string& mode, co
         v.source = "lensfun: " + lf->lens;
         rep["estimate"] = {{"lensfun_lens", lf->lens}, {"fit_rms", lf->fit_rms}};
       } else {
-        rep["note"] = "not corrected: no chessboard images to estimate it from and no lensfun profile for the lens "
-                      "the EXIF names (give --vignetting FILE)";
+        rep["note"] =
+            "not corrected: no chessboard images to estimate it from and no lensfun profile for the lens "
+            "the EXIF names (give --vignetting FILE)";
       }
     } else {
       std::vector<VignettingBoard> boards;
@@ -55,15 +56,20 @@ Vignetting photo_set_vignetting(const PhotoSet& set, const std::string& mode, co
         const IntrinsicsProblem p = chessboard_problem(set, set.folder.string());
         for (const ChessboardObservation& b : p.boards)
           for (const fs::path& f : set.chessboards->files)
-            if (f.filename().string() == b.name) boards.push_back({b.name, read_board_codes(f), b.corners, p.corners_x});
+            if (f.filename().string() == b.name)
+              boards.push_back({b.name, read_board_codes(f), b.corners, p.corners_x});
       } catch (const std::invalid_argument& e) {
         rep["note"] = std::string("not corrected: ") + e.what();
       }
       if (!boards.empty()) {
         const VignettingEstimate e = estimate_vignetting(boards, curve, c, lens.width(), lens.height());
         v = e.model;
-        rep["estimate"] = {{"degree", e.degree}, {"boards", e.boards}, {"squares", e.squares}, {"rms", e.rms},
-                           {"corner_sigma_stops", e.corner_sigma_stops}, {"max_r", e.max_r},
+        rep["estimate"] = {{"degree", e.degree},
+                           {"boards", e.boards},
+                           {"squares", e.squares},
+                           {"rms", e.rms},
+                           {"corner_sigma_stops", e.corner_sigma_stops},
+                           {"max_r", e.max_r},
                            {"held_out_rms", e.held_out_rms}};
         if (!e.note.empty()) rep["note"] = "not corrected: " + e.note;
       }

@@ -41,15 +41,20 @@ void bind_bake(py::module_& m) {
       .def("pdf", &Brdf::pdf, py::arg("wo"), py::arg("wi"), "Solid-angle density of the BRDF's sampler.")
       .def("albedo", &Brdf::albedo, py::arg("wo"),
            "Directional albedo: the integral of eval(wo, .) over the hemisphere, RGB (a white furnace's answer).")
-      .def_property_readonly("central_direction", [](const Brdf& b) { return std::string(to_string(b.central_direction())); },
-                             "'normal' or 'mirror': the direction the lobe follows (the warp of its maps).")
-      .def("has_lobe", [](const Brdf& b, const std::string& part) { return b.has_lobe(central_direction_from_string(part)); },
-           py::arg("part"), "True when the 'normal' or 'mirror' part is not identically zero.")
-      .def("lobe_width", &Brdf::lobe_width, py::arg("wo"), "Half-angle (radians) of the cone holding 90% of the energy.")
+      .def_property_readonly(
+          "central_direction", [](const Brdf& b) { return std::string(to_string(b.central_direction())); },
+          "'normal' or 'mirror': the direction the lobe follows (the warp of its maps).")
+      .def(
+          "has_lobe",
+          [](const Brdf& b, const std::string& part) { return b.has_lobe(central_direction_from_string(part)); },
+          py::arg("part"), "True when the 'normal' or 'mirror' part is not identically zero.")
+      .def("lobe_width", &Brdf::lobe_width, py::arg("wo"),
+           "Half-angle (radians) of the cone holding 90% of the energy.")
       .def("__repr__", [](const Brdf& b) { return "Brdf(" + b.spec() + ")"; });
 
-  m.def("parse_brdf", [](const std::string& text) { return std::shared_ptr<Brdf>(parse_brdf(text)); }, py::arg("spec"),
-        "A Brdf from YAML text; ValueError naming the key path (e.g. 'brdf.fresnel.f0: ...') for a bad spec.");
+  m.def(
+      "parse_brdf", [](const std::string& text) { return std::shared_ptr<Brdf>(parse_brdf(text)); }, py::arg("spec"),
+      "A Brdf from YAML text; ValueError naming the key path (e.g. 'brdf.fresnel.f0: ...') for a bad spec.");
   m.def(
       "load_brdf",
       [](const std::string& path) {

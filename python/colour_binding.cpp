@@ -21,7 +21,8 @@ void bind_colour(py::module_& m) {
           cv::cvtColor(display_encode(linear, exposure, display, view), bgr, cv::COLOR_BGR2RGB);
         }
         py::array_t<std::uint8_t> out({py::ssize_t(bgr.rows), py::ssize_t(bgr.cols), py::ssize_t(3)});
-        for (int r = 0; r < bgr.rows; ++r) std::copy(bgr.ptr<std::uint8_t>(r), bgr.ptr<std::uint8_t>(r) + 3 * bgr.cols, out.mutable_data(r));
+        for (int r = 0; r < bgr.rows; ++r)
+          std::copy(bgr.ptr<std::uint8_t>(r), bgr.ptr<std::uint8_t>(r) + 3 * bgr.cols, out.mutable_data(r));
         return out;
       },
       py::arg("rgb"), py::arg("exposure") = 0.0f, py::arg("display") = "", py::arg("view") = "",

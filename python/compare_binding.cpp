@@ -21,8 +21,8 @@ void bind_compare(py::module_& m) {
       .def_readonly("mean_a", &ErrorMetrics::mean_a, "Weighted channel means of A.")
       .def_readonly("mean_b", &ErrorMetrics::mean_b, "Weighted channel means of B.")
       .def("__repr__", [](const ErrorMetrics& e) {
-        return "ErrorMetrics(relative_rms=" + std::to_string(e.relative_rms) + ", log_rms_stops=" +
-               std::to_string(e.log_rms_stops) + ", psnr_db=" + std::to_string(e.psnr_db) + ")";
+        return "ErrorMetrics(relative_rms=" + std::to_string(e.relative_rms) +
+               ", log_rms_stops=" + std::to_string(e.log_rms_stops) + ", psnr_db=" + std::to_string(e.psnr_db) + ")";
       });
   py::class_<GainFit>(m, "GainFit", "The global exposure / white-balance fit g_c a_c ~ b_c (Cauchy loss).")
       .def_readonly("gains", &GainFit::gains, "Per-channel gains applied to A.")
@@ -46,11 +46,12 @@ void bind_compare(py::module_& m) {
       .def_readonly("b_resampled", &PairComparison::b_resampled, "B was resampled into A's frame.")
       .def_readonly("before", &PairComparison::before, "ErrorMetrics before the gain fit.")
       .def_readonly("after", &PairComparison::after, "ErrorMetrics after it.")
-      .def_property_readonly("a", [](const PairComparison& p) { return to_array(p.images.a); }, "A's (H, W, 3) image.")
-      .def_property_readonly("b", [](const PairComparison& p) { return to_array(p.images.b); },
-                             "B's (H, W, 3) image, in A's frame.")
-      .def_property_readonly("weight", [](const PairComparison& p) { return to_array(p.images.weight); },
-                             "(H, W) texel weights.");
+      .def_property_readonly(
+          "a", [](const PairComparison& p) { return to_array(p.images.a); }, "A's (H, W, 3) image.")
+      .def_property_readonly(
+          "b", [](const PairComparison& p) { return to_array(p.images.b); }, "B's (H, W, 3) image, in A's frame.")
+      .def_property_readonly(
+          "weight", [](const PairComparison& p) { return to_array(p.images.weight); }, "(H, W) texel weights.");
   py::class_<Comparison>(m, "Comparison", "The result of compare(): per pair and overall, before and after the fit.")
       .def_readonly("pairs", &Comparison::pairs, "PairComparison per pair, in the smaller set's order.")
       .def_readonly("before", &Comparison::before, "Overall ErrorMetrics before the fit.")

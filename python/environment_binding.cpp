@@ -17,8 +17,8 @@ namespace {
 Layout layout_of(const py::object& layout, const cv::Mat& pixels) {
   if (py::isinstance<Layout>(layout)) return layout.cast<Layout>();
   if (pixels.empty()) throw py::value_error("Environment: a layout name needs pixels to take the size from");
-  const LayoutKind kind = py::isinstance<py::str>(layout) ? parse_layout_kind(layout.cast<std::string>())
-                                                          : layout.cast<LayoutKind>();
+  const LayoutKind kind =
+      py::isinstance<py::str>(layout) ? parse_layout_kind(layout.cast<std::string>()) : layout.cast<LayoutKind>();
   return Layout(kind, pixels.cols, pixels.rows);
 }
 
@@ -34,8 +34,10 @@ std::vector<float> sample(const EnvMap& e, const Vec3& dir, bool nearest) {
   if (e.pixels.empty()) throw py::value_error("Environment: no pixels");
   if (!dir.allFinite() || !(dir.norm() > 0)) throw py::value_error("direction must be a non-zero finite vector");
   std::vector<float> out(std::size_t(e.channels()));
-  if (nearest) sample_nearest(e, dir, out.data());
-  else sample_bilinear(e, dir, out.data());
+  if (nearest)
+    sample_nearest(e, dir, out.data());
+  else
+    sample_bilinear(e, dir, out.data());
   return out;
 }
 
@@ -45,17 +47,20 @@ void bind_environment(py::module_& m) {
   py::class_<EnvMap>(m, "Environment",
                      "An environment map: pixels in one layout. Texel p holds L_i(w), the radiance arriving at the "
                      "origin FROM direction w = layout.direction(p); scene-linear, linear Rec.709 / D65, RGB(A).")
-      .def(py::init([](const py::object& pixels, const py::object& layout, std::map<std::string, std::string> attributes) {
-             EnvMap e;
-             e.pixels = to_mat(pixels, 0, "pixels");
-             e.layout = layout_of(layout, e.pixels);
-             e.attributes = std::move(attributes);
-             check_pixels(e);
-             return e;
-           }),
-           py::arg("pixels"), py::arg("layout") = "latlong", py::arg("attributes") = std::map<std::string, std::string>{},
-           "Environment(pixels, layout='latlong', attributes={}): pixels a float32 (H, W, C) array, C in 1..4 (shared, "
-           "not copied, when float32 and C-contiguous); layout a Layout, or a LayoutKind or name sized from the pixels.")
+      .def(
+          py::init(
+              [](const py::object& pixels, const py::object& layout, std::map<std::string, std::string> attributes) {
+                EnvMap e;
+                e.pixels = to_mat(pixels, 0, "pixels");
+                e.layout = layout_of(layout, e.pixels);
+                e.attributes = std::move(attributes);
+                check_pixels(e);
+                return e;
+              }),
+          py::arg("pixels"), py::arg("layout") = "latlong",
+          py::arg("attributes") = std::map<std::string, std::string>{},
+          "Environment(pixels, layout='latlong', attributes={}): pixels a float32 (H, W, C) array, C in 1..4 (shared, "
+          "not copied, when float32 and C-contiguous); layout a Layout, or a LayoutKind or name sized from the pixels.")
       .def_static("zeros", &EnvMap::zeros, py::arg("layout"), py::arg("channels") = 3, "Zeroed pixels of a layout.")
       .def_readwrite("layout", &EnvMap::layout, "The Layout.")
       .def_property(
@@ -68,14 +73,17 @@ void bind_environment(py::module_& m) {
           },
           "(H, W, C) float32 array sharing the environment's memory (writes are seen by C++). Assigning an array "
           "shares it too (a copy only for other dtypes or non-contiguous arrays); its shape must match the layout.")
-      .def_readwrite("attributes", &EnvMap::attributes,
-                     "Provenance strings written to the EXR header as rsibr.<key> (a dict; assign a new dict to change).")
+      .def_readwrite(
+          "attributes", &EnvMap::attributes,
+          "Provenance strings written to the EXR header as rsibr.<key> (a dict; assign a new dict to change).")
       .def_property_readonly("channels", &EnvMap::channels, "Channel count.")
       .def("integral", &integral, "Solid-angle-weighted integral over the sphere per channel: sum_p L(p) Omega(p).")
-      .def("sample", [](const EnvMap& e, const Vec3& d) { return sample(e, d, false); }, py::arg("direction"),
-           "Bilinear sample at a world direction, continuous over every seam (a list of channel values).")
-      .def("sample_nearest", [](const EnvMap& e, const Vec3& d) { return sample(e, d, true); }, py::arg("direction"),
-           "The texel whose cell contains the direction.")
+      .def(
+          "sample", [](const EnvMap& e, const Vec3& d) { return sample(e, d, false); }, py::arg("direction"),
+          "Bilinear sample at a world direction, continuous over every seam (a list of channel values).")
+      .def(
+          "sample_nearest", [](const EnvMap& e, const Vec3& d) { return sample(e, d, true); }, py::arg("direction"),
+          "The texel whose cell contains the direction.")
       .def("__repr__", [](const EnvMap& e) {
         return "Environment(" + to_string(e.layout.kind()) + ", " + std::to_string(e.layout.width()) + " x " +
                std::to_string(e.layout.height()) + ", " + std::to_string(e.pixels.channels()) + " channels)";
@@ -85,7 +93,8 @@ void bind_environment(py::module_& m) {
       "read_environment",
       [](const std::string& path, const std::optional<std::string>& layout, bool sanitize) {
         check_input_file(path);
-        const std::optional<LayoutKind> hint = layout ? std::optional<LayoutKind>(parse_layout_kind(*layout)) : std::nullopt;
+        const std::optional<LayoutKind> hint =
+            layout ? std::optional<LayoutKind>(parse_layout_kind(*layout)) : std::nullopt;
         EnvReadReport report;
         EnvMap env;
         {

@@ -53,35 +53,40 @@ void bind_layout(py::module_& m) {
       .def(py::init([](const py::object& kind, int width, int height) { return Layout(kind_of(kind), width, height); }),
            py::arg("kind"), py::arg("width"), py::arg("height"),
            "Layout(kind, width, height): kind a LayoutKind or its name; the size is validated for the kind.")
-      .def_static("with_size", [](const py::object& kind, int size) { return Layout::with_size(kind_of(kind), size); },
-                  py::arg("kind"), py::arg("size"),
-                  "Conventional shape from one size: lat-long size x size/2, cube size x 6*size, octahedral and "
-                  "sphere size x size.")
+      .def_static(
+          "with_size", [](const py::object& kind, int size) { return Layout::with_size(kind_of(kind), size); },
+          py::arg("kind"), py::arg("size"),
+          "Conventional shape from one size: lat-long size x size/2, cube size x 6*size, octahedral and "
+          "sphere size x size.")
       .def_property_readonly("kind", &Layout::kind, "The LayoutKind.")
-      .def_property_readonly("name", [](const Layout& l) { return to_string(l.kind()); }, "The kind's name.")
+      .def_property_readonly(
+          "name", [](const Layout& l) { return to_string(l.kind()); }, "The kind's name.")
       .def_property_readonly("width", &Layout::width, "Width in texels.")
       .def_property_readonly("height", &Layout::height, "Height in texels.")
       .def_property_readonly("size", &Layout::size, "The one-number size of with_size.")
       .def_property_readonly("texel_count", &Layout::texel_count, "width * height.")
-      .def("direction", [](const Layout& l, const Vec2& p) { return l.direction(p); }, py::arg("pixel"),
-           "Unit direction of a continuous pixel position (column, row); None outside the sphere layout's disc.")
+      .def(
+          "direction", [](const Layout& l, const Vec2& p) { return l.direction(p); }, py::arg("pixel"),
+          "Unit direction of a continuous pixel position (column, row); None outside the sphere layout's disc.")
       .def("texel_direction", &Layout::texel_direction, py::arg("column"), py::arg("row"),
            "A direction representing texel (column, row); None for texels without solid angle.")
       .def("pixel", &Layout::pixel, py::arg("direction"), "Continuous pixel position (column, row) of a direction.")
       .def("texel_solid_angle", &Layout::texel_solid_angle, py::arg("column"), py::arg("row"),
            "Solid angle (sr) of a texel; the texels partition the sphere (sum 4 pi).")
-      .def("texel_directions",
-           [](const Layout& l) {
-             return texel_field(l.width(), l.height(), [&](int c, int r, Vec3& v) {
-               const auto d = l.texel_direction(c, r);
-               if (d) v = *d;
-               return bool(d);
-             });
-           },
-           "(directions, mask): (H, W, 3) float64 texel_direction of every texel (0 where there is none) and "
-           "the (H, W) bool mask of texels that have one.")
-      .def("solid_angles", [](const Layout& l) { return to_array(texel_solid_angles(l)); },
-           "(H, W) float64 texel solid angles (sr).")
+      .def(
+          "texel_directions",
+          [](const Layout& l) {
+            return texel_field(l.width(), l.height(), [&](int c, int r, Vec3& v) {
+              const auto d = l.texel_direction(c, r);
+              if (d) v = *d;
+              return bool(d);
+            });
+          },
+          "(directions, mask): (H, W, 3) float64 texel_direction of every texel (0 where there is none) and "
+          "the (H, W) bool mask of texels that have one.")
+      .def(
+          "solid_angles", [](const Layout& l) { return to_array(texel_solid_angles(l)); },
+          "(H, W) float64 texel solid angles (sr).")
       .def(py::self == py::self)
       .def("__repr__", [](const Layout& l) {
         return "Layout('" + to_string(l.kind()) + "', " + std::to_string(l.width()) + ", " +
@@ -91,7 +96,8 @@ void bind_layout(py::module_& m) {
   m.def("world_from_view_for", &world_from_view_for, py::arg("view"), py::arg("up") = Vec3(0, 1, 0),
         "The view frame T of a view direction (world, toward the viewer): columns x right, y up, z = view, "
         "in world; a fixed fallback up when up is parallel to view (always a rotation).");
-  m.def("octahedral_direction", &octahedral_direction, py::arg("uv"), "Octahedral (u, v) in [-1,1]^2 -> unit direction.");
+  m.def("octahedral_direction", &octahedral_direction, py::arg("uv"),
+        "Octahedral (u, v) in [-1,1]^2 -> unit direction.");
   m.def("octahedral_uv", &octahedral_uv, py::arg("direction"), "Unit direction -> octahedral (u, v).");
 
   py::module_ s = m.def_submodule(
@@ -113,27 +119,29 @@ void bind_layout(py::module_& m) {
         "Disc point whose mirror direction is `direction` (through the half vector; -z maps to (0, -1)).");
   s.def("disc_rect_area", &sphere_map::disc_rect_area, py::arg("x0"), py::arg("x1"), py::arg("y0"), py::arg("y1"),
         "Exact area of [x0,x1] x [y0,y1] intersected with the unit disc.");
-  s.def("normals",
-        [](int width, int height) {
-          return texel_field(width, height, [&](int c, int r, Vec3& v) {
-            const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), width, height);
-            v = sphere_map::g_normal(xy);
-            return xy.squaredNorm() < 1.0;
-          });
-        },
-        py::arg("width"), py::arg("height"),
-        "(normals, inside): g_normal at every texel centre of a W x H sphere map, (H, W, 3) float64 in the view "
-        "frame, and the (H, W) bool mask of centres inside the disc (outside: the clamped rim normal).");
-  s.def("mirror_directions",
-        [](int width, int height) {
-          return texel_field(width, height, [&](int c, int r, Vec3& v) {
-            const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), width, height);
-            v = sphere_map::g_mirror(xy);
-            return xy.squaredNorm() < 1.0;
-          });
-        },
-        py::arg("width"), py::arg("height"),
-        "(directions, inside): g_mirror at every texel centre, as normals() lays them out.");
+  s.def(
+      "normals",
+      [](int width, int height) {
+        return texel_field(width, height, [&](int c, int r, Vec3& v) {
+          const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), width, height);
+          v = sphere_map::g_normal(xy);
+          return xy.squaredNorm() < 1.0;
+        });
+      },
+      py::arg("width"), py::arg("height"),
+      "(normals, inside): g_normal at every texel centre of a W x H sphere map, (H, W, 3) float64 in the view "
+      "frame, and the (H, W) bool mask of centres inside the disc (outside: the clamped rim normal).");
+  s.def(
+      "mirror_directions",
+      [](int width, int height) {
+        return texel_field(width, height, [&](int c, int r, Vec3& v) {
+          const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), width, height);
+          v = sphere_map::g_mirror(xy);
+          return xy.squaredNorm() < 1.0;
+        });
+      },
+      py::arg("width"), py::arg("height"),
+      "(directions, inside): g_mirror at every texel centre, as normals() lays them out.");
 }
 
 }  // namespace rsibr::python

@@ -79,7 +79,8 @@ void bind_map_set(py::module_& m) {
              s.views = std::move(views);
              return s;
            }),
-           py::arg("views") = std::vector<MapView>{}, "MapSet(views=[]): the views are copied (their pixels are shared).")
+           py::arg("views") = std::vector<MapView>{},
+           "MapSet(views=[]): the views are copied (their pixels are shared).")
       .def("__len__", [](const MapSet& s) { return s.views.size(); })
       .def(
           "__getitem__",
@@ -93,7 +94,9 @@ void bind_map_set(py::module_& m) {
       .def(
           "__iter__", [](MapSet& s) { return py::make_iterator(s.views.begin(), s.views.end()); },
           py::keep_alive<0, 1>())
-      .def("append", [](MapSet& s, const MapView& v) { s.views.push_back(v); }, py::arg("view"), "Appends a copy of a view.")
+      .def(
+          "append", [](MapSet& s, const MapView& v) { s.views.push_back(v); }, py::arg("view"),
+          "Appends a copy of a view.")
       .def_property_readonly("width", &MapSet::width, "Width of the maps (0 when empty).")
       .def_property_readonly("height", &MapSet::height, "Height of the maps (0 when empty).")
       .def("view_set", &MapSet::view_set, "The triangulated ViewSet of the views' directions.")

@@ -20,8 +20,10 @@ void check_input_file(const std::string& path) {
     const auto status = std::filesystem::status(path, ec);
     PyObject* type = PyExc_OSError;
     int code = EINVAL;
-    if (!std::filesystem::exists(status)) type = PyExc_FileNotFoundError, code = ENOENT;
-    else if (std::filesystem::is_directory(status)) type = PyExc_IsADirectoryError, code = EISDIR;
+    if (!std::filesystem::exists(status))
+      type = PyExc_FileNotFoundError, code = ENOENT;
+    else if (std::filesystem::is_directory(status))
+      type = PyExc_IsADirectoryError, code = EISDIR;
     PyErr_SetObject(type, py::make_tuple(code, e.what(), path).ptr());
     throw py::error_already_set();
   }

@@ -19,8 +19,8 @@ class NumpyAllocator : public cv::MatAllocator {
     Py_INCREF(array);
     return u;
   }
-  cv::UMatData* allocate(int dims, const int* sizes, int type, void* data, std::size_t* step,
-                         cv::AccessFlag flags, cv::UMatUsageFlags usage) const override {
+  cv::UMatData* allocate(int dims, const int* sizes, int type, void* data, std::size_t* step, cv::AccessFlag flags,
+                         cv::UMatUsageFlags usage) const override {
     return cv::Mat::getStdAllocator()->allocate(dims, sizes, type, data, step, flags, usage);
   }
   bool allocate(cv::UMatData* u, cv::AccessFlag flags, cv::UMatUsageFlags usage) const override {
@@ -45,7 +45,8 @@ NumpyAllocator& numpy_allocator() {
 
 py::object to_array(const cv::Mat& mat) {
   if (mat.empty()) return py::none();
-  if (mat.depth() != CV_32F && mat.depth() != CV_64F) throw std::logic_error("to_array: only float images are exported");
+  if (mat.depth() != CV_32F && mat.depth() != CV_64F)
+    throw std::logic_error("to_array: only float images are exported");
   auto* owner = new cv::Mat(mat);  // shares the buffer (reference counted)
   py::capsule keep(owner, [](void* p) { delete static_cast<cv::Mat*>(p); });
   const auto rows = py::ssize_t(mat.rows), cols = py::ssize_t(mat.cols), ch = py::ssize_t(mat.channels());
@@ -60,14 +61,16 @@ cv::Mat to_mat(const py::handle& object, int channels, const std::string& what) 
   auto array = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(object);
   if (!array) throw py::value_error(what + ": expected an array of numbers");
   int ch = 0;
-  if (array.ndim() == 2) ch = 1;
-  else if (array.ndim() == 3) ch = int(array.shape(2));
+  if (array.ndim() == 2)
+    ch = 1;
+  else if (array.ndim() == 3)
+    ch = int(array.shape(2));
   const bool ok = ch >= 1 && ch <= 4 && (channels == 0 || ch == channels) && array.shape(0) > 0 && array.shape(1) > 0;
   if (!ok) {
     std::string shape = "(";
     for (py::ssize_t i = 0; i < array.ndim(); ++i) shape += (i ? ", " : "") + std::to_string(array.shape(i));
     shape += array.ndim() == 1 ? ",)" : ")";
-    const std::string want = channels == 3 ? "(height, width, 3)"
+    const std::string want = channels == 3   ? "(height, width, 3)"
                              : channels == 1 ? "(height, width)"
                                              : "(height, width) or (height, width, 1..4)";
     throw py::value_error(what + ": expected a float32 array of shape " + want + ", got shape " + shape);

@@ -32,8 +32,8 @@ std::vector<MapSet> sets_of(const py::object& maps) {
 }
 
 std::unique_ptr<OwningRenderer> make_renderer(const Mesh& mesh, const py::object& maps, const std::string& mode,
-                                              int spp, const std::string& warp, int map_size, int rings, double rim_fade,
-                                              const std::optional<EnvMap>& environment) {
+                                              int spp, const std::string& warp, int map_size, int rings,
+                                              double rim_fade, const std::optional<EnvMap>& environment) {
   auto r = std::make_unique<OwningRenderer>();
   r->mesh = mesh;
   r->sets = sets_of(maps);
@@ -70,26 +70,31 @@ void bind_render(py::module_& m) {
   py::class_<Mesh>(m, "Mesh",
                    "An indexed triangle mesh (object space as stored, right-handed, +Y up; triangles counter-clockwise "
                    "from the front; one unit normal per vertex).")
-      .def_property_readonly("positions", [](const Mesh& s) { return rows_of(s.positions.data()->data(), s.positions.size(), 3); },
-                             "(N, 3) float32 vertex positions (a copy).")
-      .def_property_readonly("normals", [](const Mesh& s) { return rows_of(s.normals.data()->data(), s.normals.size(), 3); },
-                             "(N, 3) float32 unit vertex normals (a copy).")
-      .def_property_readonly("triangles",
-                             [](const Mesh& s) {
-                               py::array_t<std::uint32_t> out({py::ssize_t(s.triangles.size()), py::ssize_t(3)});
-                               std::copy(s.triangles.data()->data(), s.triangles.data()->data() + 3 * s.triangles.size(),
-                                         out.mutable_data());
-                               return out;
-                             },
-                             "(M, 3) uint32 vertex indices (a copy).")
-      .def_property_readonly("bounds",
-                             [](const Mesh& s) {
-                               const auto b = s.bounds();
-                               return py::make_tuple(Eigen::Vector3d(b.min().cast<double>()), Eigen::Vector3d(b.max().cast<double>()));
-                             },
-                             "(min, max) corners of the axis-aligned bounds.")
+      .def_property_readonly(
+          "positions", [](const Mesh& s) { return rows_of(s.positions.data()->data(), s.positions.size(), 3); },
+          "(N, 3) float32 vertex positions (a copy).")
+      .def_property_readonly(
+          "normals", [](const Mesh& s) { return rows_of(s.normals.data()->data(), s.normals.size(), 3); },
+          "(N, 3) float32 unit vertex normals (a copy).")
+      .def_property_readonly(
+          "triangles",
+          [](const Mesh& s) {
+            py::array_t<std::uint32_t> out({py::ssize_t(s.triangles.size()), py::ssize_t(3)});
+            std::copy(s.triangles.data()->data(), s.triangles.data()->data() + 3 * s.triangles.size(),
+                      out.mutable_data());
+            return out;
+          },
+          "(M, 3) uint32 vertex indices (a copy).")
+      .def_property_readonly(
+          "bounds",
+          [](const Mesh& s) {
+            const auto b = s.bounds();
+            return py::make_tuple(Eigen::Vector3d(b.min().cast<double>()), Eigen::Vector3d(b.max().cast<double>()));
+          },
+          "(min, max) corners of the axis-aligned bounds.")
       .def("__repr__", [](const Mesh& s) {
-        return "Mesh(" + std::to_string(s.positions.size()) + " vertices, " + std::to_string(s.triangles.size()) + " triangles)";
+        return "Mesh(" + std::to_string(s.positions.size()) + " vertices, " + std::to_string(s.triangles.size()) +
+               " triangles)";
       });
   m.def(
       "load_mesh",
@@ -113,18 +118,21 @@ void bind_render(py::module_& m) {
       .def_readwrite("cx", &Camera::cx, "Principal point, pixels.")
       .def_readwrite("cy", &Camera::cy, "Principal point, pixels.")
       .def_readwrite("eye", &Camera::eye, "Camera centre, world.")
-      .def_readwrite("world_from_cam", &Camera::world_from_cam, "Columns: camera x (right), y (down), z (forward) in world.")
-      .def("ray_direction", &Camera::ray_direction, py::arg("px"), py::arg("py"), "Unit world ray through an image point.")
+      .def_readwrite("world_from_cam", &Camera::world_from_cam,
+                     "Columns: camera x (right), y (down), z (forward) in world.")
+      .def("ray_direction", &Camera::ray_direction, py::arg("px"), py::arg("py"),
+           "Unit world ray through an image point.")
       .def_property_readonly("forward", &Camera::forward)
       .def_property_readonly("view_direction", &Camera::view_direction, "-forward: the paper mode's view direction.")
       .def_property_readonly("up", &Camera::up, "-y of the camera frame, world.")
-      .def("project",
-           [](const Camera& c, const Vec3& p) -> std::optional<Vec2> {
-             Vec2 px;
-             if (!c.project(p, &px)) return std::nullopt;
-             return px;
-           },
-           py::arg("point"), "Image point of a world point; None when it is not in front of the camera.");
+      .def(
+          "project",
+          [](const Camera& c, const Vec3& p) -> std::optional<Vec2> {
+            Vec2 px;
+            if (!c.project(p, &px)) return std::nullopt;
+            return px;
+          },
+          py::arg("point"), "Image point of a world point; None when it is not in front of the camera.");
   m.def("look_at", &look_at, py::arg("eye"), py::arg("at"), py::arg("up"), py::arg("vfov_deg"), py::arg("width"),
         py::arg("height"),
         "A Camera at eye looking at `at`, `up` toward the image's top, vertical field of view vfov_deg degrees.");
@@ -140,18 +148,20 @@ void bind_render(py::module_& m) {
   m.def("orbit", &orbit, py::arg("camera"), py::arg("pivot"), py::arg("axis"), py::arg("k"), py::arg("n"),
         "Frame k of n of a turntable: the camera rotated about the axis through pivot by 2 pi k / n.");
 
-  py::class_<OwningRenderer>(m, "Renderer",
-                             "Renders a mesh with one or more map sets (summed, each with its own warps) from any camera.")
-      .def(py::init(&make_renderer), py::arg("mesh"), py::arg("maps"), py::arg("mode") = "per-pixel", py::arg("spp") = 1,
-           py::arg("warp") = "precomputed", py::arg("map_size") = 0, py::arg("rings") = 16, py::arg("rim_fade") = 0.4,
-           py::arg("environment") = py::none(),
+  py::class_<OwningRenderer>(
+      m, "Renderer", "Renders a mesh with one or more map sets (summed, each with its own warps) from any camera.")
+      .def(py::init(&make_renderer), py::arg("mesh"), py::arg("maps"), py::arg("mode") = "per-pixel",
+           py::arg("spp") = 1, py::arg("warp") = "precomputed", py::arg("map_size") = 0, py::arg("rings") = 16,
+           py::arg("rim_fade") = 0.4, py::arg("environment") = py::none(),
            "Renderer(mesh, maps, mode='per-pixel', spp=1, warp='precomputed', map_size=0, rings=16, rim_fade=0.4, "
            "environment=None): maps a MapSet or a list of them. mode 'per-pixel' (exact) or 'paper' (one destination "
            "map per frame, map_size and warp). spp a perfect square. environment is shown where rays miss. Builds "
            "the ray scene and lookups once; the mesh and the views are copied (pixels shared).")
-      .def("render", [](const OwningRenderer& r, const Camera& c) { return to_array(render_frame(r, c)); }, py::arg("camera"),
-           "One frame: (H, W, 4) float32 RGBA, scene-linear, alpha-premultiplied; misses black with alpha 0 unless "
-           "an environment was given. Releases the GIL.");
+      .def(
+          "render", [](const OwningRenderer& r, const Camera& c) { return to_array(render_frame(r, c)); },
+          py::arg("camera"),
+          "One frame: (H, W, 4) float32 RGBA, scene-linear, alpha-premultiplied; misses black with alpha 0 unless "
+          "an environment was given. Releases the GIL.");
   m.def(
       "render",
       [](const Mesh& mesh, const py::object& maps, const Camera& camera, const std::string& mode, int spp,

@@ -28,7 +28,8 @@ void check_blend_inputs(const MapSet& maps, const ViewSet& view_set) {
 void check_blend_source(const MapSet& maps, int index) {
   const MapView& v = maps.views[std::size_t(index)];
   const std::string who = "blend: view " + std::to_string(index) + ": ";
-  if (v.rgb.empty() || v.rgb.type() != CV_32FC3) throw std::invalid_argument(who + "map must be a non-empty CV_32FC3 image");
+  if (v.rgb.empty() || v.rgb.type() != CV_32FC3)
+    throw std::invalid_argument(who + "map must be a non-empty CV_32FC3 image");
   if (v.rgb.cols < 2 || v.rgb.rows < 2) throw std::invalid_argument(who + "map must be at least 2 x 2");
   if (!v.confidence.empty() && (v.confidence.type() != CV_32FC1 || v.confidence.size() != v.rgb.size()))
     throw std::invalid_argument(who + "confidence must be one float channel of the map's size");

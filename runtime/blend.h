@@ -76,10 +76,10 @@ struct MapRequest {
 struct BlendOptions : BlendRule, MapRequest {};
 
 struct BlendResult {
-  cv::Mat rgb;              // CV_32FC3, RGB, sphere-map layout; 0 outside the disc
-  cv::Mat weight;           // CV_32FC1, sum_i a_i in [0, 1]; 0 outside the disc and where the fallback was used
-  Mat3 world_from_view;     // the destination frame T_d
-  ViewWeights located;      // the sources and their barycentric weights
+  cv::Mat rgb;           // CV_32FC3, RGB, sphere-map layout; 0 outside the disc
+  cv::Mat weight;        // CV_32FC1, sum_i a_i in [0, 1]; 0 outside the disc and where the fallback was used
+  Mat3 world_from_view;  // the destination frame T_d
+  ViewWeights located;   // the sources and their barycentric weights
   std::array<cv::Mat, 3> source_weight;  // when requested: a_i per texel (CV_32FC1) for located.views[i]
 };
 

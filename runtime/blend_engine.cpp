@@ -388,7 +388,9 @@ Vec3 BlendEngine::radiance(const ViewWeights& located, const Vec3& v, const Vec3
     contribute(s, taps(s.grid, x, y, a), a, x, y, acc);
   }
   float out[3], total = 0;
-  if (!finish(acc, out, &total)) fallback(sources, located.count, [&](int k) { return samples[k]; }, out);
+  if (!finish(acc, out, &total))
+    fallback(
+        sources, located.count, [&](int k) { return samples[k]; }, out);
   if (weight) *weight = total;
   return Vec3(out[0], out[1], out[2]).cwiseProduct(A);
 }
@@ -469,9 +471,12 @@ BlendResult BlendEngine::map(const Vec3& view_dir, const Vec3& up, const MapRequ
         if (finish(acc[r - r0][i], out + 3 * i, out_w + i)) continue;
         out_w[i] = 0.0f;
         const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c0 + i, r), W, H);
-        fallback(sources, n, [&](int q) {
-          return warp_direction(sources[q]->kind, source_from_dest[q] * central_direction(sources[q]->kind, xy));
-        }, out + 3 * i);
+        fallback(
+            sources, n,
+            [&](int q) {
+              return warp_direction(sources[q]->kind, source_from_dest[q] * central_direction(sources[q]->kind, xy));
+            },
+            out + 3 * i);
       }
     }
   };

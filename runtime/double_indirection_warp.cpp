@@ -40,8 +40,9 @@ DoubleIndirectionWarp::DoubleIndirectionWarp(int width, int height, const Double
   lat_ = options.latitudes > 0 ? options.latitudes : std::max(width / 2 + 1, 3);
   if (lon_ < 3 || lat_ < 3) throw std::invalid_argument("DoubleIndirectionWarp: the table needs at least 3 x 3 nodes");
   if (double(lon_) * double(lat_) > kMaxNodes)
-    throw std::invalid_argument("DoubleIndirectionWarp: a table of " + std::to_string(lon_) + " x " + std::to_string(lat_) +
-                                " nodes is larger than " + std::to_string(long(kMaxNodes)) + " nodes");
+    throw std::invalid_argument("DoubleIndirectionWarp: a table of " + std::to_string(lon_) + " x " +
+                                std::to_string(lat_) + " nodes is larger than " + std::to_string(long(kMaxNodes)) +
+                                " nodes");
   axis_from_view_ = axis_frame(options.axis.normalized());
 
   // Screen tables: each texel's central direction (clamped to the disc) as table coordinates.
@@ -63,8 +64,10 @@ DoubleIndirectionWarp::DoubleIndirectionWarp(int width, int height, const Double
   node_dirs_.resize(std::size_t(lon_) * std::size_t(lat_));
   for (int j = 0; j < lat_; ++j)
     for (int i = 0; i < lon_; ++i)
-      node_dirs_[std::size_t(j) * std::size_t(lon_) + std::size_t(i)] = direction(2 * kPi * i / lon_, kPi * j / (lat_ - 1));
-  for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal}) base_[kind_index(kind)] = build(kind, Mat3::Identity());
+      node_dirs_[std::size_t(j) * std::size_t(lon_) + std::size_t(i)] =
+          direction(2 * kPi * i / lon_, kPi * j / (lat_ - 1));
+  for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal})
+    base_[kind_index(kind)] = build(kind, Mat3::Identity());
 }
 
 std::pair<double, double> DoubleIndirectionWarp::address(const Vec3& dir) const {
@@ -76,7 +79,8 @@ std::pair<double, double> DoubleIndirectionWarp::address(const Vec3& dir) const 
 }
 
 Vec3 DoubleIndirectionWarp::direction(double lon, double lat) const {
-  return axis_from_view_.transpose() * Vec3(std::sin(lat) * std::cos(lon), std::sin(lat) * std::sin(lon), std::cos(lat));
+  return axis_from_view_.transpose() *
+         Vec3(std::sin(lat) * std::cos(lon), std::sin(lat) * std::sin(lon), std::cos(lat));
 }
 
 double DoubleIndirectionWarp::twist(const Mat3& source_from_dest) const {
@@ -99,9 +103,12 @@ DoubleIndirectionWarp::Split DoubleIndirectionWarp::split(const Mat3& m) const {
   return s;
 }
 
-bool DoubleIndirectionWarp::offset_only(const Mat3& source_from_dest) const { return split(source_from_dest).twist_only; }
+bool DoubleIndirectionWarp::offset_only(const Mat3& source_from_dest) const {
+  return split(source_from_dest).twist_only;
+}
 
-std::shared_ptr<const DoubleIndirectionWarp::Table> DoubleIndirectionWarp::build(CentralDirection kind, const Mat3& swing) const {
+std::shared_ptr<const DoubleIndirectionWarp::Table> DoubleIndirectionWarp::build(CentralDirection kind,
+                                                                                 const Mat3& swing) const {
   auto t = std::make_shared<Table>();
   t->kind = kind;
   t->swing = swing;
@@ -133,7 +140,8 @@ std::shared_ptr<const DoubleIndirectionWarp::Table> DoubleIndirectionWarp::build
   return t;
 }
 
-std::shared_ptr<const DoubleIndirectionWarp::Table> DoubleIndirectionWarp::table(CentralDirection kind, const Split& s) const {
+std::shared_ptr<const DoubleIndirectionWarp::Table> DoubleIndirectionWarp::table(CentralDirection kind,
+                                                                                 const Split& s) const {
   if (s.twist_only) return base_[kind_index(kind)];
   std::lock_guard<std::mutex> lock(mutex_);
   for (const auto& t : cache_)
@@ -181,17 +189,19 @@ float DoubleIndirectionWarp::wrapped(double u) const {
   return w < float(lon_) ? w : 0.f;
 }
 
-WarpSample DoubleIndirectionWarp::lookup(CentralDirection kind, const Mat3& source_from_dest, double lon, double lat) const {
+WarpSample DoubleIndirectionWarp::lookup(CentralDirection kind, const Mat3& source_from_dest, double lon,
+                                         double lat) const {
   const Split s = split(source_from_dest);
   WarpSample o;
   const float v = float(std::clamp(lat, 0.0, kPi) * (lat_ - 1) / kPi);
   const auto t = table(kind, s);
-  if (interpolate(t->nodes.data(), t->safe.data(), lon_, lat_, wrapped(lon * lon_ / (2 * kPi) + s.offset), v, o)) return o;
+  if (interpolate(t->nodes.data(), t->safe.data(), lon_, lat_, wrapped(lon * lon_ / (2 * kPi) + s.offset), v, o))
+    return o;
   return warp_direction(kind, source_from_dest * direction(lon, lat));
 }
 
-void DoubleIndirectionWarp::warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row,
-                                     int c_begin, int c_end, WarpSample* out) const {
+void DoubleIndirectionWarp::warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height,
+                                     int row, int c_begin, int c_end, WarpSample* out) const {
   if (width != width_ || height != height_)
     throw std::invalid_argument("DoubleIndirectionWarp: built for " + std::to_string(width_) + "x" +
                                 std::to_string(height_) + ", asked for " + std::to_string(width) + "x" +

@@ -40,7 +40,7 @@ struct DoubleIndirectionOptions {
   int longitudes = 0;         // table columns; 0 = the destination width
   int latitudes = 0;          // table rows, poles included; 0 = half the destination width + 1
   double max_spread = 0.05;   // source disc units (the disc has radius 1)
-  double min_rim = 0.05;       // mirror warp only
+  double min_rim = 0.05;      // mirror warp only
 };
 
 class DoubleIndirectionWarp final : public Warp {
@@ -50,8 +50,8 @@ class DoubleIndirectionWarp final : public Warp {
   DoubleIndirectionWarp(int width, int height, const DoubleIndirectionOptions& options = {});
   const char* name() const override { return "double-indirection"; }
   bool supports(int width, int height) const override { return width == width_ && height == height_; }
-  void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
-                WarpSample* out) const override;
+  void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
+                int c_end, WarpSample* out) const override;
 
   int longitudes() const { return lon_; }
   int latitudes() const { return lat_; }
@@ -98,9 +98,9 @@ class DoubleIndirectionWarp final : public Warp {
 
   int width_, height_, lon_, lat_;
   DoubleIndirectionOptions options_;
-  Mat3 axis_from_view_;             // B
-  std::vector<float> screen_[2];    // per kind: (u, v) in table units per destination texel, row-major
-  std::vector<Vec3> node_dirs_;     // B^T n(lon_i, lat_j): each node's direction in the view frame
+  Mat3 axis_from_view_;                   // B
+  std::vector<float> screen_[2];          // per kind: (u, v) in table units per destination texel, row-major
+  std::vector<Vec3> node_dirs_;           // B^T n(lon_i, lat_j): each node's direction in the view frame
   std::shared_ptr<const Table> base_[2];  // S = I, per kind
 
   mutable std::mutex mutex_;

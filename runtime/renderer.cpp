@@ -57,7 +57,8 @@ struct TileGrid {
 
 int spp_side(int spp) {
   const int k = int(std::lround(std::sqrt(double(spp))));
-  if (spp < 1 || k * k != spp) throw std::invalid_argument("render: spp must be a perfect square (1, 4, 9, ...), not " + std::to_string(spp));
+  if (spp < 1 || k * k != spp)
+    throw std::invalid_argument("render: spp must be a perfect square (1, 4, 9, ...), not " + std::to_string(spp));
   return k;
 }
 
@@ -67,7 +68,9 @@ int spp_side(int spp) {
 struct ImageRect {
   double x0 = -1e300, y0 = -1e300, x1 = 1e300, y1 = 1e300;
   bool contains(double x, double y) const { return x >= x0 && x <= x1 && y >= y0 && y <= y1; }
-  bool overlaps(double ax, double ay, double bx, double by) const { return ax <= x1 && bx >= x0 && ay <= y1 && by >= y0; }
+  bool overlaps(double ax, double ay, double bx, double by) const {
+    return ax <= x1 && bx >= x0 && ay <= y1 && by >= y0;
+  }
 };
 
 ImageRect projected_bounds(const Camera& cam, const Eigen::AlignedBox3f& box) {

@@ -72,11 +72,11 @@ struct RenderOptions {
 };
 
 struct RenderStats {
-  long long samples = 0;       // pixel samples (width x height x spp), traced or culled
-  long long hits = 0;          // of which hit the mesh
+  long long samples = 0;         // pixel samples (width x height x spp), traced or culled
+  long long hits = 0;            // of which hit the mesh
   long long covered_pixels = 0;  // pixels with alpha > 0 from the mesh
-  double seconds = 0;          // the whole frame
-  double seconds_blend = 0;    // paper mode: the destination maps
+  double seconds = 0;            // the whole frame
+  double seconds_blend = 0;      // paper mode: the destination maps
 };
 
 class Renderer {

@@ -43,7 +43,7 @@ TessellatedWarp::TessellatedWarp(int width, int height, const TessellationOption
       const double t = std::asin(rho) * 2.0 * R / kPi;  // ring parameter, 0..R
       double a = std::atan2(xy.y(), xy.x());
       if (a < 0) a += 2 * kPi;
-      const double s = a * S / (2 * kPi);                 // segment parameter, 0..S
+      const double s = a * S / (2 * kPi);  // segment parameter, 0..S
       const int k = std::clamp(int(std::floor(t)), 0, R - 1);
       const int j = std::clamp(int(std::floor(s)), 0, S - 1);
       const float u = float(std::clamp(t - k, 0.0, 1.0)), v = float(std::clamp(s - j, 0.0, 1.0));

@@ -42,8 +42,8 @@ class TessellatedWarp final : public Warp {
   TessellatedWarp(int width, int height, const TessellationOptions& options = {});
   const char* name() const override { return "tessellated"; }
   bool supports(int width, int height) const override { return width == width_ && height == height_; }
-  void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
-                WarpSample* out) const override;
+  void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
+                int c_end, WarpSample* out) const override;
 
   int vertex_count() const { return int(vertices_.size()); }
   // Cells warped per texel (singular) in the last frame computed for this kind and rotation.
@@ -51,9 +51,9 @@ class TessellatedWarp final : public Warp {
 
  private:
   struct Corners {
-    std::array<int, 4> v;      // vertex indices: (k,j), (k+1,j), (k,j+1), (k+1,j+1)
-    std::array<float, 4> w;    // bilinear weights
-    int cell;                  // cell index for the safety flag
+    std::array<int, 4> v;    // vertex indices: (k,j), (k+1,j), (k,j+1), (k+1,j+1)
+    std::array<float, 4> w;  // bilinear weights
+    int cell;                // cell index for the safety flag
   };
   struct Frame {
     CentralDirection kind;
@@ -66,8 +66,8 @@ class TessellatedWarp final : public Warp {
 
   int width_, height_;
   TessellationOptions options_;
-  std::vector<Vec2> vertices_;    // destination disc coordinates
-  std::vector<Corners> texels_;   // row-major width_ * height_ (unused outside the disc)
+  std::vector<Vec2> vertices_;   // destination disc coordinates
+  std::vector<Corners> texels_;  // row-major width_ * height_ (unused outside the disc)
   int cells_ = 0;
   std::vector<std::array<int, 4>> cell_vertices_;
 

@@ -48,7 +48,9 @@ WarpSample warp_direction(CentralDirection kind, const Vec3& dir_in_source) {
 // The inside test is monotone in |x| along a row, so the span is found from the analytic guess
 // x^2 <= 1 - y^2 and then corrected by the exact test (a few steps at most).
 std::pair<int, int> disc_span(int row, int width, int height) {
-  const auto inside = [&](int c) { return sphere_map::disc_from_pixel(Vec2(c, row), width, height).squaredNorm() <= 1.0; };
+  const auto inside = [&](int c) {
+    return sphere_map::disc_from_pixel(Vec2(c, row), width, height).squaredNorm() <= 1.0;
+  };
   const double y = sphere_map::disc_from_pixel(Vec2(0, row), width, height).y();
   if (!(y * y <= 1.0)) return {0, 0};
   const double half = std::sqrt(1.0 - y * y);  // |x| <= half inside
@@ -65,9 +67,9 @@ std::pair<int, int> disc_span(int row, int width, int height) {
 
 // Computed in double and rounded once: for texels near the rim, z = sqrt(1 - x^2 - y^2) cancels, and
 // float's x alone would move z (and the mirror direction) by ~1e-5 at 129^2.
-RSIBR_AVX2_CLONES void central_directions_row(
-    CentralDirection kind, int width, int height, int row, int c_begin, int c_end, float* __restrict out_x,
-    float* __restrict out_y, float* __restrict out_z) {
+RSIBR_AVX2_CLONES void central_directions_row(CentralDirection kind, int width, int height, int row, int c_begin,
+                                              int c_end, float* __restrict out_x, float* __restrict out_y,
+                                              float* __restrict out_z) {
   const double y = 1.0 - (2.0 * row + 1.0) / height;
   const double inv_w = 1.0 / width;
   const int n = c_end - c_begin;
@@ -90,8 +92,8 @@ RSIBR_AVX2_CLONES void central_directions_row(
 // Also built for AVX2 (8 floats a vector; chosen at load time where the CPU has it). No FMA: the
 // results are the same to the bit on either path.
 RSIBR_AVX2_CLONES void warp_directions(CentralDirection kind, const float m[9], int n, const float* __restrict x,
-                                       const float* __restrict y, const float* __restrict z,
-                                       float* __restrict disc_x, float* __restrict disc_y, float* __restrict rim) {
+                                       const float* __restrict y, const float* __restrict z, float* __restrict disc_x,
+                                       float* __restrict disc_y, float* __restrict rim) {
   const float m0 = m[0], m1 = m[1], m2 = m[2], m3 = m[3], m4 = m[4], m5 = m[5], m6 = m[6], m7 = m[7], m8 = m[8];
   if (kind == CentralDirection::Mirror) {
     for (int i = 0; i < n; ++i) {
@@ -148,8 +150,8 @@ void Warp::warp_block(CentralDirection kind, const Mat3& source_from_dest, int w
   }
 }
 
-void ExactWarp::warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
-                           int c_end, float* disc_x, float* disc_y, float* rim) const {
+void ExactWarp::warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row,
+                           int c_begin, int c_end, float* disc_x, float* disc_y, float* rim) const {
   float m[9];
   to_floats(source_from_dest, m);
   float x[kBlock], y[kBlock], z[kBlock];
@@ -160,8 +162,8 @@ void ExactWarp::warp_block(CentralDirection kind, const Mat3& source_from_dest, 
   }
 }
 
-void ExactWarp::warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
-                         int c_end, WarpSample* out) const {
+void ExactWarp::warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row,
+                         int c_begin, int c_end, WarpSample* out) const {
   for (int c = c_begin; c < c_end; ++c) {
     const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, row), width, height);
     out[c - c_begin] = warp_direction(kind, source_from_dest * central_direction(kind, xy));
@@ -198,7 +200,8 @@ void PrecomputedWarp::check_size(int width, int height) const {
 void PrecomputedWarp::warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row,
                                int c_begin, int c_end, WarpSample* out) const {
   check_size(width, height);
-  const Vec3* table = (kind == CentralDirection::Mirror ? mirror_.data() : normal_.data()) + std::size_t(row) * std::size_t(width);
+  const Vec3* table =
+      (kind == CentralDirection::Mirror ? mirror_.data() : normal_.data()) + std::size_t(row) * std::size_t(width);
   if (kind == CentralDirection::Mirror) {
     for (int c = c_begin; c < c_end; ++c) out[c - c_begin] = mirror_inverse(source_from_dest * table[c]);
   } else {

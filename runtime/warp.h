@@ -30,7 +30,6 @@
 
 namespace rsibr {
 
-
 // Where one central direction lands in a source map.
 struct WarpSample {
   Vec2 disc = Vec2(0, 0);  // source disc coordinates (x right, y up), |disc| <= 1
@@ -76,24 +75,24 @@ class Warp {
   virtual const char* name() const = 0;
   // Whether warp_row may be called for a width x height destination.
   virtual bool supports(int width, int height) const { return width > 0 && height > 0; }
-  virtual void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
-                        int c_end, WarpSample* out) const = 0;
+  virtual void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row,
+                        int c_begin, int c_end, WarpSample* out) const = 0;
   // The same map in single precision, structure of arrays (the blend engine's form): for texels
   // (c, row), c in [c_begin, c_end), disc_x/disc_y/rim[c - c_begin]. The default converts warp_row's
   // samples; the exact and precomputed warps compute it in vectorised float loops.
-  virtual void warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
-                          int c_end, float* disc_x, float* disc_y, float* rim) const;
+  virtual void warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row,
+                          int c_begin, int c_end, float* disc_x, float* disc_y, float* rim) const;
 };
 
 // Per texel, from scratch: disc coordinates, g, rotation, g^-1.
 class ExactWarp final : public Warp {
  public:
   const char* name() const override { return "exact"; }
-  void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
-                WarpSample* out) const override;
+  void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
+                int c_end, WarpSample* out) const override;
   // central_directions_row then warp_directions, in blocks of 64 texels on the stack.
-  void warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
-                  float* disc_x, float* disc_y, float* rim) const override;
+  void warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
+                  int c_end, float* disc_x, float* disc_y, float* rim) const override;
 };
 
 // The destination texels' central directions (g_mirror and g_normal of every texel centre, in the
@@ -109,10 +108,10 @@ class PrecomputedWarp final : public Warp {
   int width() const { return width_; }
   int height() const { return height_; }
   bool supports(int width, int height) const override { return width == width_ && height == height_; }
-  void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
-                WarpSample* out) const override;
-  void warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin, int c_end,
-                  float* disc_x, float* disc_y, float* rim) const override;
+  void warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
+                int c_end, WarpSample* out) const override;
+  void warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
+                  int c_end, float* disc_x, float* disc_y, float* rim) const override;
 
  private:
   void check_size(int width, int height) const;

@@ -125,9 +125,9 @@ struct Axis {
   cv::Scalar colour;  // BGR
 };
 const std::vector<Axis> kAxes = {
-    {Vec3(1, 0, 0), "+X", cv::Scalar(40, 40, 255)},   {Vec3(-1, 0, 0), "-X", cv::Scalar(255, 255, 0)},
-    {Vec3(0, 1, 0), "+Y", cv::Scalar(40, 220, 40)},   {Vec3(0, -1, 0), "-Y", cv::Scalar(255, 60, 255)},
-    {Vec3(0, 0, 1), "+Z", cv::Scalar(255, 120, 30)},  {Vec3(0, 0, -1), "-Z", cv::Scalar(0, 230, 255)},
+    {Vec3(1, 0, 0), "+X", cv::Scalar(40, 40, 255)},  {Vec3(-1, 0, 0), "-X", cv::Scalar(255, 255, 0)},
+    {Vec3(0, 1, 0), "+Y", cv::Scalar(40, 220, 40)},  {Vec3(0, -1, 0), "-Y", cv::Scalar(255, 60, 255)},
+    {Vec3(0, 0, 1), "+Z", cv::Scalar(255, 120, 30)}, {Vec3(0, 0, -1), "-Z", cv::Scalar(0, 230, 255)},
 };
 
 void axis_dot(cv::Mat& img, const cv::Point2d& p, const Axis& a, const std::string& label, cv::Point2d offset) {
@@ -159,10 +159,11 @@ cv::Mat coded(const Layout& layout, int k) {
 
 void save(const std::filesystem::path& dir, const std::string& name, const cv::Mat& img) {
   const auto path = dir / name;
-  if (!cv::imwrite(path.string(), img, {cv::IMWRITE_PNG_COMPRESSION, 9, cv::IMWRITE_PNG_STRATEGY, cv::IMWRITE_PNG_STRATEGY_DEFAULT}))
+  if (!cv::imwrite(path.string(), img,
+                   {cv::IMWRITE_PNG_COMPRESSION, 9, cv::IMWRITE_PNG_STRATEGY, cv::IMWRITE_PNG_STRATEGY_DEFAULT}))
     throw std::runtime_error(path.string() + ": cannot write");
-  std::cout << path.string() << "  " << img.cols << "x" << img.rows << "  "
-            << std::filesystem::file_size(path) / 1024 << " KiB\n";
+  std::cout << path.string() << "  " << img.cols << "x" << img.rows << "  " << std::filesystem::file_size(path) / 1024
+            << " KiB\n";
 }
 
 cv::Mat canvas(int w, int h) { return cv::Mat(h, w, CV_8UC3, cv::Scalar(30, 30, 30)); }
@@ -199,8 +200,14 @@ void latlong_figure(const std::filesystem::path& dir) {
     auto p = *P.at(a.d);
     std::string label = a.name;
     cv::Point2d off(9, -12);
-    if (a.name == "+Y") { label = "+Y = whole row 0"; off = {9, 14}; }
-    if (a.name == "-Y") { label = "-Y = whole row H-1"; off = {9, -14}; }
+    if (a.name == "+Y") {
+      label = "+Y = whole row 0";
+      off = {9, 14};
+    }
+    if (a.name == "-Y") {
+      label = "-Y = whole row H-1";
+      off = {9, -14};
+    }
     if (a.name == "-Z") {
       label = "-Z (col 0)";
       off = {9, -12};
@@ -216,12 +223,17 @@ void latlong_figure(const std::filesystem::path& dir) {
   dot(img, c00, 3, kWhite);
   dot(img, c11, 3, kWhite);
   const int ty = my + L.height() * k + 22;
-  text(img, "Lat-long 512x256 (OpenEXR LatLongMap). World +Y up; view from inside: lon +90 (+X) is LEFT of the centre (+Z).",
+  text(img,
+       "Lat-long 512x256 (OpenEXR LatLongMap). World +Y up; view from inside: lon +90 (+X) is LEFT of the centre (+Z).",
        {double(mx), double(ty)}, 0.45);
-  text(img, "pixel (0,0) = lat +90, lon +180;  pixel (W-1,H-1) = lat -90, lon -180.   lat = pi/2 - pi*y/(H-1),  lon = pi - 2pi*x/(W-1)",
-       {double(mx), ty + 22.0}, 0.45);
-  text(img, "Pixel is point: columns 0 and W-1 both lie ON the seam (lon +-180, through -Z); rows 0 and H-1 lie ON the poles.",
-       {double(mx), ty + 44.0}, 0.45);
+  text(
+      img,
+      "pixel (0,0) = lat +90, lon +180;  pixel (W-1,H-1) = lat -90, lon -180.   lat = pi/2 - pi*y/(H-1),  lon = pi - 2pi*x/(W-1)",
+      {double(mx), ty + 22.0}, 0.45);
+  text(
+      img,
+      "Pixel is point: columns 0 and W-1 both lie ON the seam (lon +-180, through -Z); rows 0 and H-1 lie ON the poles.",
+      {double(mx), ty + 44.0}, 0.45);
   text(img, "Texel (c,r) is centred at continuous pixel (c,r). Grid: 30 deg; thick = equator and lon 0.",
        {double(mx), ty + 66.0}, 0.45);
   text(img, "Colour = 0.2 + 0.6 (d+1)/2 (R from x, G from y, B from z).", {double(mx), ty + 88.0}, 0.45);
@@ -246,8 +258,10 @@ void cube_figures(const std::filesystem::path& dir) {
     const Vec3 d0 = *L.direction(c), dr = *L.direction(c + Vec2(8, 0)) - d0, dd = *L.direction(c + Vec2(0, 8)) - d0;
     text(img, std::to_string(f), {mx - 10.0, y0 + n / 2.0}, 0.5, kWhite, 2);
     const double tx = mx + n + 16;
-    text(img, std::string("face ") + face_names[f] + ": rows " + std::to_string(f * n) + ".." + std::to_string(f * n + n - 1),
-         {tx, y0 + 30}, 0.5);
+    text(
+        img,
+        std::string("face ") + face_names[f] + ": rows " + std::to_string(f * n) + ".." + std::to_string(f * n + n - 1),
+        {tx, y0 + 30}, 0.5);
     text(img, "image right = " + axis_name(dr) + ",  image down = " + axis_name(dd) + ",  up = " + axis_name(-dd),
          {tx, y0 + 56}, 0.45);
     const Vec3 corner = *L.direction(Vec2(0, f * n));
@@ -267,10 +281,15 @@ void cube_figures(const std::filesystem::path& dir) {
   save(dir, "layout_cube.png", img);
 
   // The same texels unfolded into a cross as seen from inside (+Y up, looking at +Z: +X left).
-  struct Cell { Vec3 fwd, up; int col, row; const char* name; };
-  const std::vector<Cell> cells = {{Vec3(0, 1, 0), Vec3(0, 0, -1), 1, 0, "+Y"}, {Vec3(1, 0, 0), Vec3(0, 1, 0), 0, 1, "+X"},
-                                   {Vec3(0, 0, 1), Vec3(0, 1, 0), 1, 1, "+Z"},  {Vec3(-1, 0, 0), Vec3(0, 1, 0), 2, 1, "-X"},
-                                   {Vec3(0, 0, -1), Vec3(0, 1, 0), 3, 1, "-Z"}, {Vec3(0, -1, 0), Vec3(0, 0, 1), 1, 2, "-Y"}};
+  struct Cell {
+    Vec3 fwd, up;
+    int col, row;
+    const char* name;
+  };
+  const std::vector<Cell> cells = {
+      {Vec3(0, 1, 0), Vec3(0, 0, -1), 1, 0, "+Y"}, {Vec3(1, 0, 0), Vec3(0, 1, 0), 0, 1, "+X"},
+      {Vec3(0, 0, 1), Vec3(0, 1, 0), 1, 1, "+Z"},  {Vec3(-1, 0, 0), Vec3(0, 1, 0), 2, 1, "-X"},
+      {Vec3(0, 0, -1), Vec3(0, 1, 0), 3, 1, "-Z"}, {Vec3(0, -1, 0), Vec3(0, 0, 1), 1, 2, "-Y"}};
   const int s = 160, ox = 20, oy = 30;
   cv::Mat cross = canvas(4 * s + 2 * ox, 3 * s + oy + 100);
   const cv::Mat strip = coded(L, 1);
@@ -280,7 +299,8 @@ void cube_figures(const std::filesystem::path& dir) {
       for (int i = 0; i < s; ++i) {
         const Vec3 d = cell_dir(c, 2.0 * (i + 0.5) / s - 1.0, 1.0 - 2.0 * (j + 0.5) / s);
         const Vec2 p = L.pixel(d);  // nearest stored texel
-        const int pc = std::clamp(int(std::lround(p.x())), 0, n - 1), pr = std::clamp(int(std::lround(p.y())), 0, 6 * n - 1);
+        const int pc = std::clamp(int(std::lround(p.x())), 0, n - 1),
+                  pr = std::clamp(int(std::lround(p.y())), 0, 6 * n - 1);
         cross.at<cv::Vec3b>(oy + c.row * s + j, ox + c.col * s + i) = strip.at<cv::Vec3b>(pr, pc);
       }
   Panel C{{0, 0}, 1.0, [&](const Vec3& d) -> std::optional<Vec2> {
@@ -307,18 +327,18 @@ void cube_figures(const std::filesystem::path& dir) {
     dot(cross, *q, 3, kWhite);
     const bool right = q->x - ox - std::floor((q->x - ox) / s) * s > s / 2;
     const bool low = q->y - oy - std::floor((q->y - oy) / s) * s > s / 2;
-    text(cross, "(0," + std::to_string(f * n) + ")", *q + cv::Point2d(right ? -6 : 6, low ? -10 : 10), 0.38,
-         kWhite, right ? 2 : 0);
+    text(cross, "(0," + std::to_string(f * n) + ")", *q + cv::Point2d(right ? -6 : 6, low ? -10 : 10), 0.38, kWhite,
+         right ? 2 : 0);
   }
   const double ty = oy + 3 * s + 20;
-  text(cross, "Cube 128 x 768 unfolded as seen from INSIDE (+Y up, looking at +Z: +X to the left).",
-       {double(ox), ty}, 0.42);
+  text(cross, "Cube 128 x 768 unfolded as seen from INSIDE (+Y up, looking at +Z: +X to the left).", {double(ox), ty},
+       0.42);
   text(cross, "Each cell shows the stored texels (nearest). White dots: each face's stored first texel",
        {double(ox), ty + 20}, 0.42);
   text(cross, "(0, 128 f). Every face is stored as seen from inside (no mirror); the stored +Y and -Y",
        {double(ox), ty + 40}, 0.42);
-  text(cross, "faces are rotated 180 deg from these cells (both: right = +X). Grid: 30 deg.",
-       {double(ox), ty + 60}, 0.42);
+  text(cross, "faces are rotated 180 deg from these cells (both: right = +X). Grid: 30 deg.", {double(ox), ty + 60},
+       0.42);
   save(dir, "layout_cube_cross.png", cross);
 }
 
@@ -389,7 +409,10 @@ void sphere_figure(const std::filesystem::path& dir) {
     cv::Point2d off(9, -12);
     std::string label = a.name;
     if (a.name == "+Z") label = "+Z (centre)";
-    if (a.name == "-Z") { label = "-Z = the whole rim (drawn at (x,y) = (0,-1))"; off = {-150, 16}; }
+    if (a.name == "-Z") {
+      label = "-Z = the whole rim (drawn at (x,y) = (0,-1))";
+      off = {-150, 16};
+    }
     if (a.name == "-X") off = {-32, -12};
     axis_dot(img, *P.at(a.d), a, label, off);
   }
@@ -432,7 +455,9 @@ void sphere_coords_figure(const std::filesystem::path& dir) {
     for (int c = 0; c < n; ++c) {
       const auto d = L.direction(Vec2(c, r));
       cv::Scalar col(45, 45, 45);
-      if (d) col = cv::Scalar(255 * (0.2 + 0.3 * (d->z() + 1)), 255 * (0.2 + 0.3 * (d->y() + 1)), 255 * (0.2 + 0.3 * (d->x() + 1)));
+      if (d)
+        col = cv::Scalar(255 * (0.2 + 0.3 * (d->z() + 1)), 255 * (0.2 + 0.3 * (d->y() + 1)),
+                         255 * (0.2 + 0.3 * (d->x() + 1)));
       cv::rectangle(img, cv::Rect(mx + c * k, my + r * k, k, k), col, -1);
       cv::rectangle(img, cv::Rect(mx + c * k, my + r * k, k + 1, k + 1), kGrey, 1);
       dot(img, P.at(Vec2(c, r)), 2, d ? kWhite : kGrey);
@@ -479,7 +504,8 @@ void sphere_coords_figure(const std::filesystem::path& dir) {
     std::snprintf(buf, sizeof buf, "y=%+.1f", 2 * s - 1);
     text(img, buf, {mx - 10.0, py + 8}, 0.42, kLightGrey, 2, false);
   }
-  cv::arrowedLine(img, {mx + side / 2 - 40, int(by) + 58}, {mx + side / 2 + 40, int(by) + 58}, kWhite, 1, cv::LINE_AA, 0, 0.2);
+  cv::arrowedLine(img, {mx + side / 2 - 40, int(by) + 58}, {mx + side / 2 + 40, int(by) + 58}, kWhite, 1, cv::LINE_AA,
+                  0, 0.2);
   text(img, "s", {mx + side / 2 + 48.0, by + 58}, 0.5);
   // First texel.
   const cv::Point2d t00 = P.at(Vec2(0, 0));
@@ -542,7 +568,8 @@ void viewset_figure(const std::filesystem::path& dir, const ViewSet& set, const 
   if (small)
     for (std::size_t t = 0; t < tris.size(); ++t) {
       const Vec3 c = (set.views()[std::size_t(tris[t][0])] + set.views()[std::size_t(tris[t][1])] +
-                      set.views()[std::size_t(tris[t][2])]).normalized();
+                      set.views()[std::size_t(tris[t][2])])
+                         .normalized();
       text(img, "T" + std::to_string(t), *P.at(c) + cv::Point2d(0, 16), 0.4, kLightGrey, 1);
     }
   for (std::size_t i = 0; i < set.views().size(); ++i) {
@@ -555,7 +582,8 @@ void viewset_figure(const std::filesystem::path& dir, const ViewSet& set, const 
       std::string label = std::to_string(i) + " (";
       for (int k = 0; k < 3; ++k) {
         const double c = v[k] * scale;
-        label += std::abs(c) < 1e-6 ? "0" : std::string(c > 0 ? "+" : "-") + (std::abs(std::abs(c) - 1) < 1e-6 ? "1" : "phi");
+        label += std::abs(c) < 1e-6 ? "0"
+                                    : std::string(c > 0 ? "+" : "-") + (std::abs(std::abs(c) - 1) < 1e-6 ? "1" : "phi");
         label += k < 2 ? "," : ")";
       }
       text(img, label, p + cv::Point2d(8, -11), 0.42, kWhite);
@@ -571,12 +599,14 @@ void viewset_figure(const std::filesystem::path& dir, const ViewSet& set, const 
     text(img, std::to_string(lon), {P.at(p).x, my - 12.0}, 0.4, kLightGrey, 1, false);
   }
   for (int lat = -60; lat <= 60; lat += 30)
-    text(img, std::to_string(lat), {mx - 8.0, P.at(L.pixel(from_lat_lon(lat * kDeg, 0.3))).y}, 0.4, kLightGrey, 2, false);
+    text(img, std::to_string(lat), {mx - 8.0, P.at(L.pixel(from_lat_lon(lat * kDeg, 0.3))).y}, 0.4, kLightGrey, 2,
+         false);
   text(img, "+Z", *P.at(Vec3(0, 0, 1)) + cv::Point2d(0, 14), 0.4, kLightGrey, 1);
   const double ty = my + L.height() + 20;
   text(img, title, {double(mx), ty}, 0.45);
-  text(img, std::to_string(set.views().size()) + " views, " + std::to_string(tris.size()) +
-                " triangles: convex hull of the unit view vectors (qhull), counter-clockwise seen from outside, sorted.",
+  text(img,
+       std::to_string(set.views().size()) + " views, " + std::to_string(tris.size()) +
+           " triangles: convex hull of the unit view vectors (qhull), counter-clockwise seen from outside, sorted.",
        {double(mx), ty + 22}, 0.45);
   text(img, "Drawn in lat-long (lon 0 = +Z at the centre, +X left of it); background: ViewSet::locate's triangle.",
        {double(mx), ty + 44}, 0.45, kLightGrey);

@@ -20,7 +20,10 @@ void nearest(GLenum target) {
 }  // namespace
 
 GlMapSet::GlMapSet(const MapSet& maps, const BlendOptions& blend, const std::string& warp, int map_size, int rings)
-    : maps_(maps), view_set_(maps.view_set()), blend_(blend), warp_name_(warp),
+    : maps_(maps),
+      view_set_(maps.view_set()),
+      blend_(blend),
+      warp_name_(warp),
       map_size_(map_size > 0 ? map_size : maps.width()) {
   check_blend_inputs(maps, view_set_);
   if (blend.barycentric != Barycentric::Gnomonic)
@@ -83,7 +86,8 @@ GlMapSet::GlMapSet(const MapSet& maps, const BlendOptions& blend, const std::str
     const auto& tri = tris[std::size_t(t)];
     idx.insert(idx.end(), {tri[0], tri[1], tri[2], 0});
     for (int e = 0; e < 3; ++e) {
-      const Vec3 n = views[std::size_t(tri[std::size_t(e)])].cross(views[std::size_t(tri[std::size_t((e + 1) % 3)])]).normalized();
+      const Vec3 n =
+          views[std::size_t(tri[std::size_t(e)])].cross(views[std::size_t(tri[std::size_t((e + 1) % 3)])]).normalized();
       for (int k = 0; k < 3; ++k) planes[(std::size_t(e) * T + t) * 4 + k] = float(n[k]);
     }
   }

@@ -16,8 +16,7 @@ GlMesh::GlMesh(const Mesh& mesh) : count_(GLsizei(3 * mesh.triangles.size())) {
   glEnableVertexAttribArray(1);
   glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 12, nullptr);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, buffers_[2]);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(mesh.triangles.size() * 12), mesh.triangles.data(),
-               GL_STATIC_DRAW);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(mesh.triangles.size() * 12), mesh.triangles.data(), GL_STATIC_DRAW);
   glBindVertexArray(0);
 }
 

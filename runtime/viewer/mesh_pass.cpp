@@ -50,8 +50,8 @@ void MeshPass::draw(const Camera& camera, const Eigen::AlignedBox3f& bounds, con
   program_.set("uCamFromWorld", Mat3(camera.world_from_cam.transpose()));
   program_.set("uWorldFromCam", camera.world_from_cam);
   program_.set("uEye", camera.eye);
-  glUniform4f(glGetUniformLocation(program_.id(), "uIntrinsics"), float(camera.fx), float(camera.fy),
-              float(camera.cx), float(camera.cy));
+  glUniform4f(glGetUniformLocation(program_.id(), "uIntrinsics"), float(camera.fx), float(camera.fy), float(camera.cx),
+              float(camera.cy));
   program_.set("uSize", Vec2(camera.width, camera.height));
   program_.set("uOrigin", Vec2(x0, y0));
   program_.set("uDepth", Vec2(A, B));

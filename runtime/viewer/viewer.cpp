@@ -158,13 +158,16 @@ void draw_globe(const ViewSet& views, const ViewWeights& located, const Camera& 
   auto project = [&](const Vec3& v) { return ImVec2(c.x + R * float(v.dot(right)), c.y - R * float(v.dot(up))); };
   for (const auto& T : views.triangles())
     for (int e = 0; e < 3; ++e) {
-      const Vec3 &a = views.views()[std::size_t(T[std::size_t(e)])], &b = views.views()[std::size_t(T[std::size_t((e + 1) % 3)])];
+      const Vec3 &a = views.views()[std::size_t(T[std::size_t(e)])],
+                 &b = views.views()[std::size_t(T[std::size_t((e + 1) % 3)])];
       if (a.dot(toward) > 0 && b.dot(toward) > 0) dl->AddLine(project(a), project(b), IM_COL32(90, 90, 110, 255));
     }
   for (std::size_t i = 0; i < views.views().size(); ++i) {
     const Vec3& v = views.views()[i];
-    if (v.dot(toward) >= 0) dl->AddCircleFilled(project(v), 3.f, IM_COL32(200, 200, 200, 255));
-    else dl->AddCircle(project(v), 3.f, IM_COL32(110, 110, 110, 255));
+    if (v.dot(toward) >= 0)
+      dl->AddCircleFilled(project(v), 3.f, IM_COL32(200, 200, 200, 255));
+    else
+      dl->AddCircle(project(v), 3.f, IM_COL32(110, 110, 110, 255));
   }
   for (int k = 0; k < located.count; ++k) {
     const Vec3& v = views.views()[std::size_t(located.views[std::size_t(k)])];
@@ -256,8 +259,7 @@ int run_interactive(const ViewerScene& scene, const ViewerSettings& initial) {
       if (ImGui::IsKeyPressed(GLFW_KEY_F)) s.show_weight = !s.show_weight;
       if (ImGui::IsKeyPressed(GLFW_KEY_D)) show_dest = !show_dest;
       if (ImGui::IsKeyPressed(GLFW_KEY_G)) show_globe = !show_globe;
-      if (ImGui::IsKeyPressed(GLFW_KEY_S))
-        s.compare = s.compare == Compare::Wipe ? Compare::SideBySide : Compare::Wipe;
+      if (ImGui::IsKeyPressed(GLFW_KEY_S)) s.compare = s.compare == Compare::Wipe ? Compare::SideBySide : Compare::Wipe;
       if (ImGui::IsKeyPressed(GLFW_KEY_LEFT_BRACKET)) s.exposure -= 0.5f;
       if (ImGui::IsKeyPressed(GLFW_KEY_RIGHT_BRACKET)) s.exposure += 0.5f;
       if (ImGui::IsKeyPressed(GLFW_KEY_R)) orbit_cam = reset();
@@ -349,7 +351,7 @@ int run_interactive(const ViewerScene& scene, const ViewerSettings& initial) {
     ImGui::Text("%dx%d, %s", fw, fh, renderer.c_str());
     ImGui::End();
     if (stage.sets.size() > 1 && s.compare == Compare::Wipe) {  // the wipe's edge
-      const float x = s.wipe * io.DisplaySize.x;  // window coordinates
+      const float x = s.wipe * io.DisplaySize.x;                // window coordinates
       ImGui::GetBackgroundDrawList()->AddLine(ImVec2(x, 0), ImVec2(x, io.DisplaySize.y), IM_COL32(255, 255, 255, 160));
     }
     ImGui::Render();

@@ -39,8 +39,8 @@ struct ViewerSettings {
   float exposure = 0;                      // stops
   std::string display, view;               // OCIO (empty: the config's defaults)
   Compare compare = Compare::Wipe;
-  float wipe = 0.5f;                       // fraction of the width showing the first set
-  bool show_weight = false;                // the singularity fades (sum_i a_i) instead of radiance
+  float wipe = 0.5f;         // fraction of the width showing the first set
+  bool show_weight = false;  // the singularity fades (sum_i a_i) instead of radiance
   // The camera of the first frame (its size is the frame's), and the orbit's pivot and axis.
   Camera camera;
   Vec3 pivot = Vec3::Zero();

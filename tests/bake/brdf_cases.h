@@ -60,7 +60,8 @@ inline std::vector<BrdfCase> sampler_cases() {
       {"ggx_a0.6", ggx(0.6)},
       {"ggx_a1", ggx(1.0)},
       {"clearcoat", car_paint()},
-      {"clearcoat_rough", car_paint(0.4, 0.7, 0.08, Vec3(0.9, 0.9, 0.9), std::make_shared<SchlickFresnel>(Vec3(0.95, 0.9, 0.8)))},
+      {"clearcoat_rough",
+       car_paint(0.4, 0.7, 0.08, Vec3(0.9, 0.9, 0.9), std::make_shared<SchlickFresnel>(Vec3(0.95, 0.9, 0.8)))},
   };
 }
 

@@ -43,7 +43,9 @@ TEST(Chi2Harness, AcceptsAnExactSampler) {
 TEST(Chi2Harness, RejectsASlightlyWrongPdf) {
   // Samples from cos^1 but the pdf claims cos^1.1 (normalised): a 3% change of shape.
   const auto r = chi2_test(
-      [](const Vec2& u) -> std::optional<DirectionSample> { return DirectionSample{warp::square_to_power_cosine(u, 1.0)}; },
+      [](const Vec2& u) -> std::optional<DirectionSample> {
+        return DirectionSample{warp::square_to_power_cosine(u, 1.0)};
+      },
       [](const Vec3& w) { return warp::power_cosine_pdf(w.z(), 1.1); }, Chi2Options{});
   EXPECT_LT(r.p_value, 1e-6) << r.summary();
 }

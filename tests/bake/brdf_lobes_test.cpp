@@ -89,7 +89,8 @@ TEST(BrdfLobes, WhiteFurnaceOfEachPartIsItsAlbedoAndTheyAddUp) {
   std::vector<Job> jobs;
   std::vector<std::pair<std::string, std::shared_ptr<const Brdf>>> parents = {
       {"clearcoat", car_paint()},
-      {"clearcoat_rough", car_paint(0.4, 0.7, 0.08, Vec3(0.9, 0.9, 0.9), std::make_shared<SchlickFresnel>(Vec3(0.95, 0.9, 0.8)))},
+      {"clearcoat_rough",
+       car_paint(0.4, 0.7, 0.08, Vec3(0.9, 0.9, 0.9), std::make_shared<SchlickFresnel>(Vec3(0.95, 0.9, 0.8)))},
       {"paint", parse_brdf(kPaint)},
       {"lambert", std::make_shared<LambertBrdf>(Vec3(0.5, 0.6, 0.7))},
       {"ggx_a0.3", ggx(0.3)}};
@@ -115,8 +116,8 @@ TEST(BrdfLobes, WhiteFurnaceOfEachPartIsItsAlbedoAndTheyAddUp) {
   double worst = 0;
   for (const Job& j : jobs) {
     const double err = (j.albedo - j.furnace).cwiseAbs().maxCoeff();
-    EXPECT_LT(err, 1e-3) << j.name << " cos_o = " << j.wo.z() << ": albedo " << j.albedo.transpose()
-                         << " vs furnace " << j.furnace.transpose();
+    EXPECT_LT(err, 1e-3) << j.name << " cos_o = " << j.wo.z() << ": albedo " << j.albedo.transpose() << " vs furnace "
+                         << j.furnace.transpose();
     worst = std::max(worst, err);
   }
   std::printf("  max |part albedo() - part furnace integral| = %.2e over %zu parts x views\n", worst, jobs.size());
@@ -158,7 +159,8 @@ TEST(BrdfLobes, PartSamplersMatchTheirPdfChiSquare) {
   };
   std::vector<Job> jobs;
   for (const auto& p : parts)
-    for (const Vec3& wo : {dir(0.7, 0.3), dir(0.2, 2.0)}) jobs.push_back({to_string(p->central_direction()), p.get(), wo, {}});
+    for (const Vec3& wo : {dir(0.7, 0.3), dir(0.2, 2.0)})
+      jobs.push_back({to_string(p->central_direction()), p.get(), wo, {}});
   const double alpha = sidak(0.01, int(jobs.size()));
   std::uint64_t seed = 77;
   for (Job& j : jobs) {
@@ -200,8 +202,8 @@ TEST(BrdfLobes, PartMapsBakedWithOneSeedSumToTheWholeMap) {
   const auto parts = split_lobes(paint);
   const Vec3 view = Vec3(0.3, 0.4, 0.866).normalized();
   const Mat3 T = world_from_view_for(view);
-  for (const auto& [env_name, env] : {std::pair{"smooth", latlong_env(smooth_radiance())},
-                                      std::pair{"sunny", latlong_env(sunny_radiance())}}) {
+  for (const auto& [env_name, env] :
+       {std::pair{"smooth", latlong_env(smooth_radiance())}, std::pair{"sunny", latlong_env(sunny_radiance())}}) {
     for (const std::string method : {"mis", "fis", "reference"}) {
       const auto integrator = make_integrator(method, env);
       IntegratorOptions o;
@@ -209,7 +211,8 @@ TEST(BrdfLobes, PartMapsBakedWithOneSeedSumToTheWholeMap) {
       o.seed = 5;
       o.reference_width = 32;
       const cv::Mat whole = integrator->radiance_map(*paint, view, T, 16, o);
-      cv::Mat sum = integrator->radiance_map(*parts[0], view, T, 16, o) + integrator->radiance_map(*parts[1], view, T, 16, o);
+      cv::Mat sum =
+          integrator->radiance_map(*parts[0], view, T, 16, o) + integrator->radiance_map(*parts[1], view, T, 16, o);
       const bool sun_quadrature = std::string(env_name) == "sunny" && method != "reference";
       EXPECT_LT(relative_rms(sum, whole), sun_quadrature ? 2e-3 : 1e-5) << env_name << " " << method;
     }
@@ -217,12 +220,13 @@ TEST(BrdfLobes, PartMapsBakedWithOneSeedSumToTheWholeMap) {
 }
 
 TEST(BrdfLobes, LobeSpecRoundTrips) {
-  for (const std::string& parent : {kPaint, std::string("{type: lambert, albedo: [0.2, 0.3, 0.4]}"),
-                                    std::string("{type: ggx, roughness: 0.25, fresnel: {type: dielectric, ior: 1.5}}")}) {
+  for (const std::string& parent :
+       {kPaint, std::string("{type: lambert, albedo: [0.2, 0.3, 0.4]}"),
+        std::string("{type: ggx, roughness: 0.25, fresnel: {type: dielectric, ior: 1.5}}")}) {
     for (const auto& part : split_lobes(parse_brdf(parent))) {
       const std::string text = part->spec();
-      EXPECT_TRUE(starts_with(text, std::string("{type: lobe, part: ") + to_string(part->central_direction()) +
-                                        ", of: {type: "))
+      EXPECT_TRUE(starts_with(
+          text, std::string("{type: lobe, part: ") + to_string(part->central_direction()) + ", of: {type: "))
           << text;
       const auto back = parse_brdf(text);
       EXPECT_EQ(back->spec(), text);
@@ -239,12 +243,13 @@ TEST(BrdfLobes, LobeSpecRoundTrips) {
 TEST(BrdfLobes, LobeSpecParsingIsStrict) {
   EXPECT_TRUE(starts_with(error_of("{type: lobe, part: diffuse, of: " + kPaint + "}"),
                           "brdf.part: expected normal or mirror, got 'diffuse'"));
-  EXPECT_TRUE(starts_with(error_of("{type: lobe, part: normal, of: " + kPaint + ", extra: 1}"),
-                          "brdf.extra: unknown key"));
+  EXPECT_TRUE(
+      starts_with(error_of("{type: lobe, part: normal, of: " + kPaint + ", extra: 1}"), "brdf.extra: unknown key"));
   EXPECT_TRUE(starts_with(error_of("{type: lobe, part: normal}"), "brdf.of: missing"));
   EXPECT_TRUE(starts_with(error_of("{type: lobe, of: " + kPaint + "}"), "brdf.part: missing"));
-  EXPECT_TRUE(starts_with(error_of("{type: lobe, part: normal, of: {type: ggx, roughness: 0.3, fresnel: {type: none}}}"),
-                          "brdf.part: the BRDF in 'of' has no normal lobe"));
+  EXPECT_TRUE(
+      starts_with(error_of("{type: lobe, part: normal, of: {type: ggx, roughness: 0.3, fresnel: {type: none}}}"),
+                  "brdf.part: the BRDF in 'of' has no normal lobe"));
   EXPECT_TRUE(starts_with(error_of("{type: lobe, part: mirror, of: {type: lambert, albedo: [1, 1, 2]}}"),
                           "brdf.of.albedo[2]: must be in"));
 }

@@ -47,8 +47,8 @@ TEST(BrdfSpec, SpecParsingRejectsUnknownKeys) {
   EXPECT_TRUE(starts_with(
       error_of("{type: ggx, roughness: 0.3, fresnel: {type: conductor, eta: [1,1,1], k: [1,1,1], etaa: 2}}"),
       "brdf.fresnel.etaa: unknown key"));
-  EXPECT_TRUE(starts_with(error_of("{type: lambert, albedo: [0.1,0.1,0.1], roughness: 0.3}"),
-                          "brdf.roughness: unknown key"));
+  EXPECT_TRUE(
+      starts_with(error_of("{type: lambert, albedo: [0.1,0.1,0.1], roughness: 0.3}"), "brdf.roughness: unknown key"));
   EXPECT_TRUE(starts_with(error_of("{type: clearcoat, coat: {ior: 1.5, roughness: 0.1, thickness: 1}, "
                                    "flakes: {coverage: 0.3, roughness: 0.2, fresnel: {type: none}}, "
                                    "base: {albedo: [0.5,0.5,0.5]}}"),
@@ -62,8 +62,8 @@ TEST(BrdfSpec, SpecParsingRejectsWrongTypes) {
   EXPECT_TRUE(starts_with(error_of("{type: ggx, roughness: rough, fresnel: {type: none}}"),
                           "brdf.roughness: expected a number"));
   EXPECT_TRUE(starts_with(error_of("{type: lambert, albedo: 0.5}"), "brdf.albedo: expected a sequence of 3 numbers"));
-  EXPECT_TRUE(starts_with(error_of("{type: lambert, albedo: [0.5, 0.5]}"),
-                          "brdf.albedo: expected a sequence of 3 numbers"));
+  EXPECT_TRUE(
+      starts_with(error_of("{type: lambert, albedo: [0.5, 0.5]}"), "brdf.albedo: expected a sequence of 3 numbers"));
   EXPECT_TRUE(starts_with(error_of("{type: lambert, albedo: [0.5, x, 0.5]}"), "brdf.albedo[1]: expected a number"));
   EXPECT_TRUE(starts_with(error_of("{type: ggx, roughness: 0.3, fresnel: 3}"), "brdf.fresnel: expected a mapping"));
   EXPECT_TRUE(starts_with(error_of("{type: ggx, roughness: [0.3], fresnel: {type: none}}"),
@@ -84,16 +84,21 @@ TEST(BrdfSpec, AliasCyclesInAClearCoatOrALobeAreErrorsNotCrashes) {
 TEST(BrdfSpec, SpecParsingRejectsMissingAndOutOfRangeValues) {
   EXPECT_TRUE(starts_with(error_of("{albedo: [1,1,1]}"), "brdf.type: missing"));
   EXPECT_TRUE(starts_with(error_of("{type: ggx, fresnel: {type: none}}"), "brdf.roughness: missing"));
-  EXPECT_TRUE(starts_with(error_of("{type: ggx, roughness: 0, fresnel: {type: none}}"), "brdf.roughness: must be in (0,1]"));
-  EXPECT_TRUE(starts_with(error_of("{type: ggx, roughness: 1.5, fresnel: {type: none}}"), "brdf.roughness: must be in (0,1]"));
-  EXPECT_TRUE(starts_with(error_of("{type: ggx, roughness: .nan, fresnel: {type: none}}"), "brdf.roughness: must be finite"));
+  EXPECT_TRUE(
+      starts_with(error_of("{type: ggx, roughness: 0, fresnel: {type: none}}"), "brdf.roughness: must be in (0,1]"));
+  EXPECT_TRUE(
+      starts_with(error_of("{type: ggx, roughness: 1.5, fresnel: {type: none}}"), "brdf.roughness: must be in (0,1]"));
+  EXPECT_TRUE(
+      starts_with(error_of("{type: ggx, roughness: .nan, fresnel: {type: none}}"), "brdf.roughness: must be finite"));
   EXPECT_TRUE(starts_with(error_of("{type: lambert, albedo: [0.5, 1.2, 0.5]}"), "brdf.albedo[1]: must be in [0,1]"));
   EXPECT_TRUE(starts_with(error_of("{type: lambert, albedo: [-0.1, 0.2, 0.5]}"), "brdf.albedo[0]: must be in [0,1]"));
-  EXPECT_TRUE(starts_with(error_of("{type: phong, albedo: [1,1,1], exponent: 0}"), "brdf.exponent: must be in (0,inf)"));
+  EXPECT_TRUE(
+      starts_with(error_of("{type: phong, albedo: [1,1,1], exponent: 0}"), "brdf.exponent: must be in (0,inf)"));
   EXPECT_TRUE(starts_with(error_of("{type: ggx, roughness: 0.3, fresnel: {type: dielectric, ior: 0}}"),
                           "brdf.fresnel.ior: must be in (0,inf)"));
-  EXPECT_TRUE(starts_with(error_of("{type: ggx, roughness: 0.3, fresnel: {type: conductor, eta: [1,1,1], k: [1,-1,1]}}"),
-                          "brdf.fresnel.k[1]: must be in [0,inf)"));
+  EXPECT_TRUE(
+      starts_with(error_of("{type: ggx, roughness: 0.3, fresnel: {type: conductor, eta: [1,1,1], k: [1,-1,1]}}"),
+                  "brdf.fresnel.k[1]: must be in [0,inf)"));
   EXPECT_TRUE(starts_with(error_of("{type: clearcoat, coat: {ior: 1.0, roughness: 0.1}, "
                                    "flakes: {coverage: 0.3, roughness: 0.2, fresnel: {type: none}}, "
                                    "base: {albedo: [0.5,0.5,0.5]}}"),
@@ -102,8 +107,9 @@ TEST(BrdfSpec, SpecParsingRejectsMissingAndOutOfRangeValues) {
                                    "flakes: {coverage: 2, roughness: 0.2, fresnel: {type: none}}, "
                                    "base: {albedo: [0.5,0.5,0.5]}}"),
                           "brdf.flakes.coverage: must be in [0,1]"));
-  EXPECT_TRUE(starts_with(error_of("{type: clearcoat, coat: {ior: 1.5, roughness: 0.1}, base: {albedo: [0.5,0.5,0.5]}}"),
-                          "brdf.flakes: missing"));
+  EXPECT_TRUE(
+      starts_with(error_of("{type: clearcoat, coat: {ior: 1.5, roughness: 0.1}, base: {albedo: [0.5,0.5,0.5]}}"),
+                  "brdf.flakes: missing"));
 }
 
 TEST(BrdfSpec, SpecRoundTrips) {

@@ -26,8 +26,8 @@ namespace {
 Vec3 hemisphere_integral(const Brdf& b, const Vec3& wo, double tol = 1e-7) {
   QuadratureOptions q;
   q.tol = tol;
-  return integrate_sphere<Vec3>([&](const Vec3& wi) { return b.eval(wo, wi); }, peak_breaks(lobe_peaks(wo)), 0.0,
-                                1.0, q);
+  return integrate_sphere<Vec3>([&](const Vec3& wi) { return b.eval(wo, wi); }, peak_breaks(lobe_peaks(wo)), 0.0, 1.0,
+                                q);
 }
 
 // Integral of pdf(wo, .) over the sphere, with a break on the visible-normal cutoff z = -cos_o.
@@ -136,8 +136,8 @@ TEST(WhiteFurnace, AlbedoMatchesHemisphereIntegralForEveryBrdf) {
   std::string worst_name;
   for (const Job& j : jobs) {
     const double err = (j.albedo - j.furnace).cwiseAbs().maxCoeff();
-    EXPECT_LT(err, 1e-3) << j.name << " cos_o = " << j.wo.z() << ": albedo " << j.albedo.transpose()
-                         << " vs integral " << j.furnace.transpose();
+    EXPECT_LT(err, 1e-3) << j.name << " cos_o = " << j.wo.z() << ": albedo " << j.albedo.transpose() << " vs integral "
+                         << j.furnace.transpose();
     if (err > worst) {
       worst = err;
       worst_name = j.name + " cos_o = " + std::to_string(j.wo.z());
@@ -263,11 +263,20 @@ TEST(BrdfSampling, SampleWeightEqualsEvalOverPdf) {
 
 TEST(BrdfExtremes, NoNaNAtGrazingAndNormalIncidence) {
   const Vec3 n(0, 0, 1);
-  std::vector<Vec3> dirs = {n, dir(1e-7, 0.0), dir(1e-7, 2.0), dir(1e-7, -kPi), dir(0.7071, 1.0), dir(0.0, 0.5),
-                            dir(-1e-7, 0.3), dir(-0.5, 1.0), -n, Vec3(1, 0, 0), dir(0.999999999, 0.2)};
+  std::vector<Vec3> dirs = {n,
+                            dir(1e-7, 0.0),
+                            dir(1e-7, 2.0),
+                            dir(1e-7, -kPi),
+                            dir(0.7071, 1.0),
+                            dir(0.0, 0.5),
+                            dir(-1e-7, 0.3),
+                            dir(-0.5, 1.0),
+                            -n,
+                            Vec3(1, 0, 0),
+                            dir(0.999999999, 0.2)};
   const double below1 = std::nextafter(1.0, 0.0);
-  const std::vector<Vec2> us = {Vec2(0, 0), Vec2(below1, below1), Vec2(0.5, 0.5), Vec2(0, below1), Vec2(below1, 0),
-                                Vec2(0.25, 0.0), Vec2(1e-300, 0.75)};
+  const std::vector<Vec2> us = {Vec2(0, 0),      Vec2(below1, below1), Vec2(0.5, 0.5),    Vec2(0, below1),
+                                Vec2(below1, 0), Vec2(0.25, 0.0),      Vec2(1e-300, 0.75)};
   for (const auto& c : all_cases()) {
     for (const Vec3& wo : dirs) {
       std::vector<Vec3> wis = dirs;
@@ -277,7 +286,8 @@ TEST(BrdfExtremes, NoNaNAtGrazingAndNormalIncidence) {
       for (const Vec3& wi : wis) {
         const Vec3 e = c.brdf->eval(wo, wi);
         const double p = c.brdf->pdf(wo, wi);
-        ASSERT_TRUE(e.allFinite() && e.minCoeff() >= 0) << c.name << " wo " << wo.transpose() << " wi " << wi.transpose();
+        ASSERT_TRUE(e.allFinite() && e.minCoeff() >= 0)
+            << c.name << " wo " << wo.transpose() << " wi " << wi.transpose();
         ASSERT_TRUE(std::isfinite(p) && p >= 0) << c.name << " wo " << wo.transpose() << " wi " << wi.transpose();
         if (!(wo.z() > 0) || !(wi.z() > 0)) {
           EXPECT_TRUE(e.isZero()) << c.name << " below the horizon";

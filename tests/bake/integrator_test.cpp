@@ -216,14 +216,15 @@ TEST(Integrators, ShMatchesReferenceForLambert) {
     std::printf("sh vs reference, 1e5 sun: rel RMS %.3e\n", e);
     EXPECT_LT(e, 0.25);
   }
-  EXPECT_THROW(make_integrator("sh", latlong_env(smooth_radiance(), 16))->radiance_map(
-                   *ggx(0.3), kView, world_from_view_for(kView), 8, IntegratorOptions{}),
+  EXPECT_THROW(make_integrator("sh", latlong_env(smooth_radiance(), 16))
+                   ->radiance_map(*ggx(0.3), kView, world_from_view_for(kView), 8, IntegratorOptions{}),
                std::invalid_argument);
 }
 
 TEST(Integrators, NoNaNAtTheRim) {
   const EnvMap env = latlong_env(sunny_radiance(), 64, 8);
-  const std::vector<BrdfCase> brdfs = {{"lambert", lambert()}, {"ggx_a0.01", ggx(0.01)}, {"clearcoat", car_paint(0.01)}};
+  const std::vector<BrdfCase> brdfs = {
+      {"lambert", lambert()}, {"ggx_a0.01", ggx(0.01)}, {"clearcoat", car_paint(0.01)}};
   for (const char* method : {"reference", "mis", "fis", "sh"}) {
     const auto in = make_integrator(method, env);
     for (const auto& bc : brdfs) {

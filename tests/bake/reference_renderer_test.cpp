@@ -93,8 +93,8 @@ TEST(ReferenceRenderer, WhiteFurnaceGivesAlbedoTimesCoverageWithAndWithoutShadow
     // sliver between the shading and geometric hemispheres, ~1e-4 for this tessellation).
     EXPECT_LT(worst, 0.05) << "shadows " << shadows;
     EXPECT_LT(std::abs(sum / covered), 3e-3) << "shadows " << shadows;
-    std::printf("furnace (shadows %d): worst pixel %.2e, mean relative error %.2e over %ld pixels\n", shadows,
-                worst, sum / covered, covered);
+    std::printf("furnace (shadows %d): worst pixel %.2e, mean relative error %.2e over %ld pixels\n", shadows, worst,
+                sum / covered, covered);
   }
 }
 
@@ -146,14 +146,14 @@ TEST(ReferenceRenderer, MirrorBallPixelIsFresnelTimesEnvironmentInTheReflectedDi
       // dip of ~1/spp (3%) in that pixel. Such pixels are counted, not failed.
       if (rel > 0.01) ++outliers;
       EXPECT_LT(rel, 0.05) << "pixel " << c << "," << r << " got " << got.transpose() << " expected "
-                          << expected.transpose();
+                           << expected.transpose();
       ++checked;
     }
   EXPECT_GT(checked, 300);
   EXPECT_LT(outliers, checked / 8);
   EXPECT_LT(std::abs(signed_sum / checked), 2e-3);
-  std::printf("mirror ball: %d of %d pixels beyond 1%%, worst %.2e, mean signed error %.2e\n", outliers, checked,
-              worst, signed_sum / checked);
+  std::printf("mirror ball: %d of %d pixels beyond 1%%, worst %.2e, mean signed error %.2e\n", outliers, checked, worst,
+              signed_sum / checked);
 }
 
 // Bilinear lookup of a sphere map at the world normal n (view frame T).
@@ -165,8 +165,7 @@ Vec3 sphere_map_at(const cv::Mat& map, const Mat3& world_from_view, const Vec3& 
   const double fx = px - c0, fy = py - r0;
   Vec3 sum = Vec3::Zero();
   for (int dr = 0; dr < 2; ++dr)
-    for (int dc = 0; dc < 2; ++dc)
-      sum += (dc ? fx : 1 - fx) * (dr ? fy : 1 - fy) * at3(map, r0 + dr, c0 + dc);
+    for (int dc = 0; dc < 2; ++dc) sum += (dc ? fx : 1 - fx) * (dr ? fy : 1 - fy) * at3(map, r0 + dr, c0 + dc);
   return sum;
 }
 
@@ -204,8 +203,8 @@ TEST(ReferenceRenderer, WithoutShadowsADistantSphereReproducesTheBakedMap) {
     const double rms = std::sqrt(num / den);
     EXPECT_LT(rms, 0.01) << brdf->spec();
     EXPECT_LT(worst, 0.05) << brdf->spec();
-    std::printf("vs baked map (%s): relative RMS %.2e, worst %.2e over %d pixels\n", brdf->spec().c_str(), rms,
-                worst, checked);
+    std::printf("vs baked map (%s): relative RMS %.2e, worst %.2e over %d pixels\n", brdf->spec().c_str(), rms, worst,
+                checked);
   }
 }
 
@@ -219,9 +218,9 @@ struct ConcaveScene {
   ConcaveScene() {
     mesh = icosphere(3, 0.5, centre);
     add_ground(mesh, 3.0);
-    env = latlong_env(patterns::sun_and_sky(sun_dir, 3.0 * kPi / 180, Vec3::Constant(2e3), Vec3(0.3, 0.5, 1.0),
-                                            Vec3(0.9, 0.9, 0.85)),
-                      128);
+    env = latlong_env(
+        patterns::sun_and_sky(sun_dir, 3.0 * kPi / 180, Vec3::Constant(2e3), Vec3(0.3, 0.5, 1.0), Vec3(0.9, 0.9, 0.85)),
+        128);
     cam = look_at(Vec3(0, 3, 4), Vec3(0, 0.3, 0), Vec3(0, 1, 0), 50, 48, 36);
   }
   // Whether the ground point p is in the sphere's shadow (the ray toward the sun meets the sphere).

@@ -9,8 +9,12 @@ namespace rsibr {
 namespace {
 
 std::vector<Vec3> normals() {
-  std::vector<Vec3> n = {Vec3(0, 0, 1), Vec3(0, 0, -1), Vec3(1, 0, 0), Vec3(0, -1, 0),
-                         Vec3(1e-9, 0, -1).normalized(), Vec3(0, 1e-9, 1).normalized(),
+  std::vector<Vec3> n = {Vec3(0, 0, 1),
+                         Vec3(0, 0, -1),
+                         Vec3(1, 0, 0),
+                         Vec3(0, -1, 0),
+                         Vec3(1e-9, 0, -1).normalized(),
+                         Vec3(0, 1e-9, 1).normalized(),
                          Vec3(0.3, -0.2, std::nextafter(0.0, 1.0)).normalized(),
                          Vec3(0.3, -0.2, -std::nextafter(0.0, 1.0)).normalized()};
   for (int i = 0; i < 200; ++i) {  // a Fibonacci sphere

@@ -56,8 +56,8 @@ T gauss_rect(F& f, double z0, double z1, double p0, double p1, QuadratureStats& 
 }
 
 template <class T, class F>
-T adapt(F& f, double z0, double z1, double p0, double p1, T whole, double tol, int depth, int min_depth,
-        int max_depth, QuadratureStats& st) {
+T adapt(F& f, double z0, double z1, double p0, double p1, T whole, double tol, int depth, int min_depth, int max_depth,
+        QuadratureStats& st) {
   const double zm = 0.5 * (z0 + z1), pm = 0.5 * (p0 + p1);
   const T q[4] = {gauss_rect<T>(f, z0, zm, p0, pm, st), gauss_rect<T>(f, zm, z1, p0, pm, st),
                   gauss_rect<T>(f, z0, zm, pm, p1, st), gauss_rect<T>(f, zm, z1, pm, p1, st)};
@@ -147,8 +147,8 @@ inline Breaks peak_breaks(const std::vector<Vec3>& peaks, int nz = 32, int nphi 
 
 // Integral of f over the part of the sphere with z in [z0, z1].
 template <class T, class F>
-T integrate_sphere(F&& f, const Breaks& breaks, double z0 = -1.0, double z1 = 1.0,
-                   const QuadratureOptions& opt = {}, QuadratureStats* stats = nullptr) {
+T integrate_sphere(F&& f, const Breaks& breaks, double z0 = -1.0, double z1 = 1.0, const QuadratureOptions& opt = {},
+                   QuadratureStats* stats = nullptr) {
   return integrate_rect<T>(f, z0, z1, 0.0, 2 * kPi, breaks, opt, stats);
 }
 

@@ -24,7 +24,8 @@ struct View {
 // One chrome ball of radius_px in the lobby, no noise.
 View render(double radius_px) {
   const double distance = 0.5, f = radius_px * distance / 0.05;
-  SynthScene scene = testing::rig_scene(LensModel::pinhole(f, int(2.5 * radius_px), int(2.3 * radius_px)), distance, false);
+  SynthScene scene =
+      testing::rig_scene(LensModel::pinhole(f, int(2.5 * radius_px), int(2.3 * radius_px)), distance, false);
   scene.balls.resize(1);
   scene.environment.file = kLobby;
   scene.environment.sanitize = true;

@@ -47,8 +47,10 @@ TEST(BallFeatures, RenderedViewsAreOrientedToWithinThreeDegreesFromFeaturesInThe
     std::map<int, Vec3> first;
     for (const auto& ob : obs) {
       const Vec3 w = truth[ob.view] * ob.direction;
-      if (!first.count(ob.feature)) first[ob.feature] = w;
-      else good += angle_between(first[ob.feature], w) < 1.0 * kPi / 180;
+      if (!first.count(ob.feature))
+        first[ob.feature] = w;
+      else
+        good += angle_between(first[ob.feature], w) < 1.0 * kPi / 180;
     }
     std::printf("  features per view:");
     for (const auto& f : feats) std::printf(" %zu", f.directions.size());
@@ -59,7 +61,8 @@ TEST(BallFeatures, RenderedViewsAreOrientedToWithinThreeDegreesFromFeaturesInThe
   const OrientationSolution s = solve_orientations(4, features, obs, o);
   std::printf("  features per view:");
   for (const auto& f : feats) std::printf(" %zu", f.directions.size());
-  std::printf("; %d tracks, %zu observations, %d inliers, RMS %.2f sigmas\n", features, obs.size(), s.inliers, s.rms_sigmas);
+  std::printf("; %d tracks, %zu observations, %d inliers, RMS %.2f sigmas\n", features, obs.size(), s.inliers,
+              s.rms_sigmas);
   for (int v = 1; v < 4; ++v) {
     const double e = Eigen::AngleAxisd(s.world_from_cam[v].transpose() * truth[v]).angle() * 180 / kPi;
     std::printf("  view %d: orientation error %.4f deg, reported sigma %.4f deg\n", v, e, s.sigma_deg[v]);

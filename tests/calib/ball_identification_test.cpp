@@ -24,7 +24,8 @@ SynthScene clutter_scene() {
   const std::string text = R"(
 rsibr_synth: 1
 seed: 9
-environment: {file: )" + kLobby.string() + R"(, sanitize: true}
+environment: {file: )" + kLobby.string() +
+                           R"(, sanitize: true}
 balls:
   - {name: chrome, kind: chrome, diameter_m: 0.1, centre: [-0.07, 1.3, 0]}
   - {name: grey, kind: grey, diameter_m: 0.1, centre: [0.07, 1.3, 0]}
@@ -97,7 +98,8 @@ TEST(BallIdentification, TheChromeBallIsFoundAmongBackgroundCirclesInEveryView) 
     ASSERT_GE(pick[0], 0) << "view " << i;
     const BallCandidate& c = r.candidates[i][std::size_t(pick[0])];
     // The outline of a mirror lies up to a few pixels inside its limb (the orientation refines it).
-    EXPECT_LT((c.loc.centre_px - testing::ball_centre_px(r.views[i], 0)).norm(), 0.15 * c.loc.radius_px) << "view " << i;
+    EXPECT_LT((c.loc.centre_px - testing::ball_centre_px(r.views[i], 0)).norm(), 0.15 * c.loc.radius_px)
+        << "view " << i;
     EXPECT_TRUE(looks_like(c, BallKind::chrome));
     EXPECT_FALSE(looks_like(c, BallKind::grey));
   }
@@ -119,7 +121,8 @@ TEST(BallIdentification, AcrossViewsEveryBallIsFoundAndNothingElseIsTaken) {
   EXPECT_GE(rig[1].support, 3);
   int found = 0, hidden = 0, cut = 0;
   for (std::size_t i = 0; i < r.views.size(); ++i) {
-    const std::vector<BallFinding> f = identify_view_balls(vb[i], rig, r.listed, r.views[i].radiance, r.scene.camera.lens);
+    const std::vector<BallFinding> f =
+        identify_view_balls(vb[i], rig, r.listed, r.views[i].radiance, r.scene.camera.lens);
     ASSERT_EQ(f.size(), 2u);
     const Vec2 truth = testing::ball_centre_px(r.views[i], 1);
     if (!vb[i].chrome) {
@@ -139,7 +142,8 @@ TEST(BallIdentification, AcrossViewsEveryBallIsFoundAndNothingElseIsTaken) {
       }
     } else {
       // Missing only where it cannot be seen whole enough: hidden behind the chrome ball, or the frame.
-      EXPECT_TRUE(!visible(r.views[i], 1) || !r.scene.camera.lens.in_image(truth, 0)) << "view " << i << ": " << f[1].note;
+      EXPECT_TRUE(!visible(r.views[i], 1) || !r.scene.camera.lens.in_image(truth, 0))
+          << "view " << i << ": " << f[1].note;
       hidden += !visible(r.views[i], 1);
       EXPECT_FALSE(f[1].note.empty());
     }
@@ -190,9 +194,9 @@ TEST(BallIdentification, DrawnBallsAreMeasuredAndMatchedByAppearanceAndSize) {
         img.at<cv::Vec3f>(y, x) = cv::Vec3f(v, v, v);
       }
   };
-  draw(Vec2(50, 90), 20, 0);    // "chrome"
-  draw(Vec2(120, 95), 21, 1);   // grey
-  draw(Vec2(195, 60), 40, 2);   // a flat disc
+  draw(Vec2(50, 90), 20, 0);   // "chrome"
+  draw(Vec2(120, 95), 21, 1);  // grey
+  draw(Vec2(195, 60), 40, 2);  // a flat disc
   const std::vector<BallCandidate> c = find_ball_candidates(img, lens);
   ASSERT_GE(c.size(), 3u);
   const std::vector<ListedBall> listed = {{"chrome", BallKind::chrome, 0.1}, {"grey", BallKind::grey, 0.1}};

@@ -12,8 +12,8 @@ namespace rsibr {
 namespace {
 
 LensModel wide_lens(int w, int h) {
-  return LensModel("LENSMODEL_OPENCV8", {260, 262, w / 2.0 - 0.3, h / 2.0 + 0.4, -0.2, 0.04, 0.001, -0.0005, 0, 0, 0, 0},
-                   w, h);
+  return LensModel("LENSMODEL_OPENCV8",
+                   {260, 262, w / 2.0 - 0.3, h / 2.0 + 0.4, -0.2, 0.04, 0.001, -0.0005, 0, 0, 0, 0}, w, h);
 }
 
 // Rays exactly on a cone (through a distorted lens), plus 20% wild outliers: the robust fit

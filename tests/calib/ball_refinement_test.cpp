@@ -21,12 +21,13 @@ namespace {
 
 // A cost's autodiff Jacobian in each block's tangent space against central differences along the
 // manifold (written out: ceres::GradientChecker breaks under ASan, see orientation_solve_test.cpp).
-void expect_gradient_matches(ceres::CostFunction& cost, std::vector<double*> x, const std::vector<const ceres::Manifold*>& m,
-                             int residuals) {
+void expect_gradient_matches(ceres::CostFunction& cost, std::vector<double*> x,
+                             const std::vector<const ceres::Manifold*>& m, int residuals) {
   const auto& sizes = cost.parameter_block_sizes();
   std::vector<std::vector<double>> jac(sizes.size());
   std::vector<double*> jp;
-  for (std::size_t b = 0; b < sizes.size(); ++b) jac[b].resize(std::size_t(residuals * sizes[b])), jp.push_back(jac[b].data());
+  for (std::size_t b = 0; b < sizes.size(); ++b)
+    jac[b].resize(std::size_t(residuals * sizes[b])), jp.push_back(jac[b].data());
   std::vector<double> r0(static_cast<std::size_t>(residuals));
   ASSERT_TRUE(cost.Evaluate(x.data(), r0.data(), jp.data()));
   for (std::size_t b = 0; b < sizes.size(); ++b) {
@@ -50,7 +51,8 @@ void expect_gradient_matches(ceres::CostFunction& cost, std::vector<double*> x, 
         double analytic = 0;
         for (int a = 0; a < n; ++a) analytic += jac[b][std::size_t(i * n + a)] * P[std::size_t(a * t + k)];
         const double numeric = (rp[std::size_t(i)] - rm[std::size_t(i)]) / (2 * h);
-        EXPECT_NEAR(analytic, numeric, 1e-5 * std::max(1.0, std::abs(numeric))) << "block " << b << " (" << i << "," << k << ")";
+        EXPECT_NEAR(analytic, numeric, 1e-5 * std::max(1.0, std::abs(numeric)))
+            << "block " << b << " (" << i << "," << k << ")";
       }
     }
   }
@@ -160,8 +162,15 @@ Rig make_rig(int views, double centre_px, std::uint64_t seed, double radius_bias
       // Per-observation std dev: the reflection's angular gain at this pixel times the pixel noise.
       const Vec3 t = noisy.unitOrthogonal();
       const double h = 1e-6;
-      const double gain = std::max(angle_between(dir, reflect_off_ball<double>((noisy + h * t).normalized(), p.axis, std::sin(p.half_angle)).normalized()),
-                                   angle_between(dir, reflect_off_ball<double>((noisy + h * noisy.cross(t)).normalized(), p.axis, std::sin(p.half_angle)).normalized())) / h;
+      const double gain =
+          std::max(
+              angle_between(
+                  dir,
+                  reflect_off_ball<double>((noisy + h * t).normalized(), p.axis, std::sin(p.half_angle)).normalized()),
+              angle_between(dir, reflect_off_ball<double>((noisy + h * noisy.cross(t)).normalized(), p.axis,
+                                                          std::sin(p.half_angle))
+                                     .normalized())) /
+          h;
       rig.obs.push_back({v, k, dir, gain * pixel_noise, noisy});
     }
   }
@@ -184,8 +193,10 @@ TEST(BallRefinement, MisplacedBallCentresAreCorrectedAndTheUncertaintyIsHonest) 
     const OrientationSolution refined = solve_orientations(4, rig.features, rig.obs, o);
     ASSERT_EQ(refined.ball_axes.size(), 4u);
     for (int v = 1; v < 4; ++v) {
-      const double ef = Eigen::AngleAxisd(fixed.world_from_cam[v].transpose() * rig.world_from_cam[v]).angle() * 180 / kPi;
-      const double er = Eigen::AngleAxisd(refined.world_from_cam[v].transpose() * rig.world_from_cam[v]).angle() * 180 / kPi;
+      const double ef =
+          Eigen::AngleAxisd(fixed.world_from_cam[v].transpose() * rig.world_from_cam[v]).angle() * 180 / kPi;
+      const double er =
+          Eigen::AngleAxisd(refined.world_from_cam[v].transpose() * rig.world_from_cam[v]).angle() * 180 / kPi;
       chi2_fixed += std::pow(ef / fixed.sigma_deg[v], 2);
       chi2_refined += std::pow(er / refined.sigma_deg[v], 2);
       sum_fixed += ef, sum_refined += er, ++n;
@@ -221,15 +232,18 @@ TEST(BallRefinement, ARadiusFoundInsideTheLimbIsCorrectedByRefiningTheHalfAngle)
       radius_refined += std::abs(refined.ball_half_angles[v] - alpha) * f / std::pow(std::cos(alpha), 2), ++balls;
     }
     for (int v = 1; v < 4; ++v) {
-      const double eh = Eigen::AngleAxisd(held.world_from_cam[v].transpose() * rig.world_from_cam[v]).angle() * 180 / kPi;
-      const double er = Eigen::AngleAxisd(refined.world_from_cam[v].transpose() * rig.world_from_cam[v]).angle() * 180 / kPi;
+      const double eh =
+          Eigen::AngleAxisd(held.world_from_cam[v].transpose() * rig.world_from_cam[v]).angle() * 180 / kPi;
+      const double er =
+          Eigen::AngleAxisd(refined.world_from_cam[v].transpose() * rig.world_from_cam[v]).angle() * 180 / kPi;
       chi2_held += std::pow(eh / held.sigma_deg[v], 2);
       chi2_refined += std::pow(er / refined.sigma_deg[v], 2);
       sum_held += eh, sum_refined += er, ++n;
     }
   }
-  std::printf("  half angle held: mean error %.4f deg, (err/sigma)^2 %.2f; refined: %.4f deg, %.2f; radius error %.3f px\n",
-              sum_held / n, chi2_held / n, sum_refined / n, chi2_refined / n, radius_refined / balls);
+  std::printf(
+      "  half angle held: mean error %.4f deg, (err/sigma)^2 %.2f; refined: %.4f deg, %.2f; radius error %.3f px\n",
+      sum_held / n, chi2_held / n, sum_refined / n, chi2_refined / n, radius_refined / balls);
   EXPECT_GT(chi2_held / n, 4.0);
   EXPECT_GT(chi2_refined / n, 0.3);
   EXPECT_LT(chi2_refined / n, 3.0);

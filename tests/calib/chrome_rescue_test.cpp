@@ -48,10 +48,9 @@ ViewCandidates view_of(const Vec3& eye, bool smooth, std::vector<BallCandidate> 
 }
 
 TEST(ChromeRescue, AChromeBallTooSmoothForTheAppearanceTestIsTakenAtTheRigsDistance) {
-  std::vector<std::optional<ViewCandidates>> views = {view_of(Vec3(0.1, 0.2, -1.0), false),
-                                                      view_of(Vec3(-0.2, 0.1, -1.2), false),
-                                                      view_of(Vec3(0.0, 0.3, -0.9), false),
-                                                      view_of(Vec3(0.3, 0.2, -1.1), true)};
+  std::vector<std::optional<ViewCandidates>> views = {
+      view_of(Vec3(0.1, 0.2, -1.0), false), view_of(Vec3(-0.2, 0.1, -1.2), false), view_of(Vec3(0.0, 0.3, -0.9), false),
+      view_of(Vec3(0.3, 0.2, -1.1), true)};
   ASSERT_EQ(views[3]->pick[0], -1);  // the appearance test misses it
   ASSERT_EQ(views[3]->pick[1], 1);
   const std::vector<ChromeRescue> r = rescue_chrome_balls(views, kBalls);
@@ -76,9 +75,8 @@ TEST(ChromeRescue, ACircleAtAnotherDistanceIsNotTakenAndTwoAtTheRightOneAreAmbig
 }
 
 TEST(ChromeRescue, WithoutDiametersOrOtherViewsThatAgreeNothingIsRescued) {
-  std::vector<std::optional<ViewCandidates>> views = {view_of(Vec3(0.1, 0.2, -1.0), false),
-                                                      view_of(Vec3(-0.2, 0.1, -1.2), false),
-                                                      view_of(Vec3(0.3, 0.2, -1.1), true)};
+  std::vector<std::optional<ViewCandidates>> views = {
+      view_of(Vec3(0.1, 0.2, -1.0), false), view_of(Vec3(-0.2, 0.1, -1.2), false), view_of(Vec3(0.3, 0.2, -1.1), true)};
   const std::vector<ListedBall> no_sizes = {{"chrome", BallKind::chrome, {}}, {"grey", BallKind::grey, {}}};
   EXPECT_EQ(rescue_chrome_balls(views, no_sizes)[2].candidate, -1);
   // One view with both balls is no agreement.

@@ -105,7 +105,9 @@ TEST(Intrinsics, CrossValidationChoosesTheTrueModelFamily) {
     const IntrinsicsProblem p = board_problem(opencv4_truth(), 12, 0.1, 5);
     int chosen = -1;
     const auto scores = cross_validate_models(p, models, &chosen);
-    for (const auto& s : scores) std::printf("  distorted: %-20s held-out %.4f px, fit %.4f px\n", s.model.c_str(), s.held_out_rms_px, s.fit_rms_px);
+    for (const auto& s : scores)
+      std::printf("  distorted: %-20s held-out %.4f px, fit %.4f px\n", s.model.c_str(), s.held_out_rms_px,
+                  s.fit_rms_px);
     EXPECT_EQ(models.at(chosen), "LENSMODEL_OPENCV4");
     EXPECT_GT(scores[0].held_out_rms_px, 3 * scores[1].held_out_rms_px);
   }
@@ -113,7 +115,9 @@ TEST(Intrinsics, CrossValidationChoosesTheTrueModelFamily) {
     const IntrinsicsProblem p = board_problem(LensModel::pinhole(500, 640, 480), 12, 0.1, 6);
     int chosen = -1;
     const auto scores = cross_validate_models(p, models, &chosen);
-    for (const auto& s : scores) std::printf("  pinhole:   %-20s held-out %.4f px, fit %.4f px\n", s.model.c_str(), s.held_out_rms_px, s.fit_rms_px);
+    for (const auto& s : scores)
+      std::printf("  pinhole:   %-20s held-out %.4f px, fit %.4f px\n", s.model.c_str(), s.held_out_rms_px,
+                  s.fit_rms_px);
     EXPECT_EQ(models.at(chosen), "LENSMODEL_PINHOLE");
   }
 }
@@ -167,8 +171,7 @@ TEST(Intrinsics, MrginghamFindsTheRenderedCorners) {
 // (1 + 0.1 r^2) / (1 + 0.4 r^2) is monotonic for every r (its derivative's numerator 1 - 0.1 r^2 +
 // 0.04 r^4 has no real root), so the lens is invertible over the whole image.
 LensModel wide_opencv8_truth() {
-  return LensModel("LENSMODEL_OPENCV8", {300, 301, 322.0, 236.5, 0.1, 0, 0.0005, -0.0003, 0, 0.4, 0, 0},
-                   640, 480);
+  return LensModel("LENSMODEL_OPENCV8", {300, 301, 322.0, 236.5, 0.1, 0, 0.0005, -0.0003, 0, 0.4, 0, 0}, 640, 480);
 }
 
 // The splined model is a full citizen of core/lens_model.h: written to a .cameramodel and read back
@@ -238,7 +241,8 @@ TEST(Intrinsics, CrossValidationWithASplinedCandidatePicksAModelThatFits) {
 std::vector<Vec3> probe_directions(const LensModel& truth) {
   std::vector<Vec3> v;
   for (double fx : {0.2, 0.5, 0.8})
-    for (double fy : {0.2, 0.5, 0.8}) v.push_back(truth.unproject(Vec2(fx * (truth.width() - 1), fy * (truth.height() - 1))));
+    for (double fy : {0.2, 0.5, 0.8})
+      v.push_back(truth.unproject(Vec2(fx * (truth.width() - 1), fy * (truth.height() - 1))));
   return v;
 }
 
@@ -310,7 +314,8 @@ TEST(Intrinsics, UncertaintyShrinksAsBoardsAreAdded) {
   for (int boards : {5, 10, 20}) {
     const IntrinsicsFit fit = fit_intrinsics(board_problem(truth, boards, 0.2, 31), "LENSMODEL_OPENCV4");
     std::vector<double> now;
-    for (const Vec3& d : v) now.push_back(std::sqrt(projection_covariance(fit.lens, fit.intrinsics_covariance, d).trace()));
+    for (const Vec3& d : v)
+      now.push_back(std::sqrt(projection_covariance(fit.lens, fit.intrinsics_covariance, d).trace()));
     std::printf("  %2d boards: 1-sigma %.4f px at the centre, %.4f px near the corner\n", boards, now[0], now[1]);
     for (std::size_t k = 0; k < now.size(); ++k) {
       EXPECT_GT(now[k], 0);

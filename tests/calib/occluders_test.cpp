@@ -29,12 +29,12 @@ TEST(Occluders, ARayMeetsACapsuleWithinItsRadiusOfTheSegmentOnly) {
   c.axis = Vec3(0, 1, 0);
   c.length = 4;
   c.radius = 0.5;
-  EXPECT_TRUE(ray_hits(c, Vec3::Zero(), Vec3(0, 0.4, 1).normalized()));    // meets the segment
+  EXPECT_TRUE(ray_hits(c, Vec3::Zero(), Vec3(0, 0.4, 1).normalized()));     // meets the segment
   EXPECT_TRUE(ray_hits(c, Vec3::Zero(), Vec3(0.09, 0.2, 1).normalized()));  // passes 0.45 beside it
   EXPECT_FALSE(ray_hits(c, Vec3::Zero(), Vec3(0.11, 0.2, 1).normalized()));
-  EXPECT_FALSE(ray_hits(c, Vec3::Zero(), Vec3(0, -0.2, 1).normalized()));   // above its top (1 from it)
-  EXPECT_TRUE(ray_hits(c, Vec3::Zero(), Vec3(0, -0.09, 1).normalized()));   // within the top's cap
-  EXPECT_FALSE(ray_hits(c, Vec3::Zero(), Vec3(0, 1.2, 1).normalized()));    // below its bottom
+  EXPECT_FALSE(ray_hits(c, Vec3::Zero(), Vec3(0, -0.2, 1).normalized()));  // above its top (1 from it)
+  EXPECT_TRUE(ray_hits(c, Vec3::Zero(), Vec3(0, -0.09, 1).normalized()));  // within the top's cap
+  EXPECT_FALSE(ray_hits(c, Vec3::Zero(), Vec3(0, 1.2, 1).normalized()));   // below its bottom
   // Parallel to the segment, beside it and along it.
   EXPECT_TRUE(ray_hits(c, Vec3(0.3, -1, 5), Vec3(0, 1, 0)));
   EXPECT_FALSE(ray_hits(c, Vec3(0.6, -1, 5), Vec3(0, 1, 0)));

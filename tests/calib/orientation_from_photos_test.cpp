@@ -32,7 +32,8 @@ SynthScene photo_ring_scene() {
   const std::string text = R"(
 rsibr_synth: 1
 seed: 4
-environment: {file: )" + kLobby.string() + R"(, sanitize: true}
+environment: {file: )" + kLobby.string() +
+                           R"(, sanitize: true}
 balls:
   - {name: chrome, kind: chrome, diameter_m: 0.1, centre: [0, 1.3, 0]}
 stand: true
@@ -100,11 +101,11 @@ TEST(OrientationFromPhotos, AnEightViewBracketedRingIsOrientedWithinTheIssuesFiv
     ASSERT_GT(p.views[v].sigma_deg, 0);
     chi2 += std::pow(errors.back() / p.views[v].sigma_deg, 2) / double(truth.size() - 1);
   }
-  std::printf("  %d tracks (%d re-located); orientation error median %.4f, max %.4f deg; mean (error/sigma)^2 %.2f; "
-              "centre error median %.3f, max %.3f px\n",
-              rep.tracks, rep.track_refinement.tracks_refined, median(errors),
-              *std::max_element(errors.begin(), errors.end()), chi2, median(centres),
-              *std::max_element(centres.begin(), centres.end()));
+  std::printf(
+      "  %d tracks (%d re-located); orientation error median %.4f, max %.4f deg; mean (error/sigma)^2 %.2f; "
+      "centre error median %.3f, max %.3f px\n",
+      rep.tracks, rep.track_refinement.tracks_refined, median(errors), *std::max_element(errors.begin(), errors.end()),
+      chi2, median(centres), *std::max_element(centres.begin(), centres.end()));
   EXPECT_LE(median(errors), 0.05);
   EXPECT_LT(*std::max_element(errors.begin(), errors.end()), 0.1);
   // Honest sigmas: the mean of 7 (error/sigma)^2, each ~ chi2_3 / 3 when honest, lies in [0.4, 1.9]

@@ -49,7 +49,8 @@ TEST(OrientationSolve, CostFunctionPassesTheGradientCheck) {
       for (int k = 0; k < t; ++k) {
         const double h = 1e-6;
         double rp[3], rm[3];
-        std::vector<double> delta(static_cast<std::size_t>(t), 0.0), xp(static_cast<std::size_t>(n)), xm(static_cast<std::size_t>(n));
+        std::vector<double> delta(static_cast<std::size_t>(t), 0.0), xp(static_cast<std::size_t>(n)),
+            xm(static_cast<std::size_t>(n));
         delta[std::size_t(k)] = h;
         ASSERT_TRUE(m.Plus(x[b], delta.data(), xp.data()));
         delta[std::size_t(k)] = -h;
@@ -74,9 +75,9 @@ TEST(OrientationSolve, CostFunctionPassesTheGradientCheck) {
 
 struct Case {
   int views = 8, features = 400;
-  double sigma_deg = 0.2;     // per observed direction: ~0.15 px (SIFT) on a 100 px ball, doubled by the reflection
-  double visible = 0.6;       // fraction of features each view sees
-  double outliers = 0.05;     // mismatched observations (random directions)
+  double sigma_deg = 0.2;  // per observed direction: ~0.15 px (SIFT) on a 100 px ball, doubled by the reflection
+  double visible = 0.6;    // fraction of features each view sees
+  double outliers = 0.05;  // mismatched observations (random directions)
 };
 
 struct Truth {

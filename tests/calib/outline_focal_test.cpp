@@ -84,11 +84,16 @@ TEST(OutlineFocal, TheShapeSystematicSetsAFloorThatMoreBallsDoNotLower) {
   // The balls sit 14-33 degrees off the axis: a floor of a fraction of a percent to a percent.
   EXPECT_GT(f.systematic_px, 0.001 * 420);
   EXPECT_LT(f.systematic_px, 0.02 * 420);
-  const auto twice = [&] { auto t = o; t.insert(t.end(), o.begin(), o.end()); return t; }();
+  const auto twice = [&] {
+    auto t = o;
+    t.insert(t.end(), o.begin(), o.end());
+    return t;
+  }();
   const OutlineFocal g = focal_from_outlines(twice, with_focal(truth, 400), opt);
   EXPECT_NEAR(g.systematic_px, f.systematic_px, 0.05 * f.systematic_px);
   opt.shape_systematic_px = 0.1;
-  EXPECT_NEAR(focal_from_outlines(o, with_focal(truth, 400), opt).systematic_px, 2 * f.systematic_px, 0.05 * f.systematic_px);
+  EXPECT_NEAR(focal_from_outlines(o, with_focal(truth, 400), opt).systematic_px, 2 * f.systematic_px,
+              0.05 * f.systematic_px);
 }
 
 // Through a distorted lens (the distortion held, in normalised coordinates) the same holds.

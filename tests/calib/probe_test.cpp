@@ -65,8 +65,8 @@ TEST(Probe, FourChromeViewsGiveTheEnvironmentWithoutTheCamera) {
   MapSet one;
   one.views.push_back(set.views.front());
   const Probe single = assemble_probe(one, po);
-  std::printf("  probe of 4 views: relative RMS %.4f, covered %.3f; one view: covered %.3f\n", e.relative_rms, e.covered,
-              single.covered_fraction);
+  std::printf("  probe of 4 views: relative RMS %.4f, covered %.3f; one view: covered %.3f\n", e.relative_rms,
+              e.covered, single.covered_fraction);
   EXPECT_LT(e.relative_rms, 0.01);
   EXPECT_GT(e.covered, 0.95);
   EXPECT_GT(e.covered, single.covered_fraction + 0.03);  // the others fill view 0's camera

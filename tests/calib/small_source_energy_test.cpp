@@ -91,7 +91,8 @@ TEST(SmallSourceEnergy, ASubTexelSunKeepsItsEnergyInEveryViewAndInTheProbe) {
       }
     on.push_back(sun_energy_ratio(mv, truth_sky, sun, power, *fresnel));
     off.push_back(sun_energy_ratio(point, truth_sky, sun, power, *fresnel));
-    std::printf("  view %d: sun energy %.3f with the samples' mean, %.3f at the texel centres\n", v, on.back(), off.back());
+    std::printf("  view %d: sun energy %.3f with the samples' mean, %.3f at the texel centres\n", v, on.back(),
+                off.back());
     set.views.push_back(std::move(mv));
   }
   for (double e : on) EXPECT_NEAR(e, 1.0, 0.15);

@@ -61,7 +61,8 @@ Extracted extract_against_truth(const std::string& kind, double distance, int si
   const auto v = testing::render_view(scene);
   const LensModel& lens = scene.camera.lens;
   const Vec3 c = testing::ball_centre_cam(v, 0);
-  const BallLocation loc = locate_ball(v.radiance, lens, {testing::ball_centre_px(v, 0) + Vec2(1, 1), 1.1 * f * 0.05 / c.norm()});
+  const BallLocation loc =
+      locate_ball(v.radiance, lens, {testing::ball_centre_px(v, 0) + Vec2(1, 1), 1.1 * f * 0.05 / c.norm()});
   MapSet truth;
   truth.views.push_back(true_sphere_map(keep.front(), v.pose.eye, v.env, size));
   Extracted out;

@@ -19,7 +19,8 @@ SynthScene stand_scene(bool stand) {
   const std::string text = R"(
 rsibr_synth: 1
 seed: 5
-environment: {file: )" + kLobby.string() + R"(, sanitize: true}
+environment: {file: )" + kLobby.string() +
+                           R"(, sanitize: true}
 balls:
   - {name: chrome, kind: chrome, diameter_m: 0.1, centre: [-0.07, 1.3, 0]}
   - {name: grey, kind: grey, diameter_m: 0.1, centre: [0.07, 1.3, 0]}
@@ -43,8 +44,9 @@ TEST(StandLine, ThePolesPlaneContainsTheTrueUp) {
     ASSERT_TRUE(line.has_value()) << "view " << v;
     const Vec3 up_cam = r.pose.world_from_cam.transpose() * Vec3(0, 1, 0);
     const double off_deg = std::asin(std::abs(line->plane_normal.dot(up_cam))) * 180 / kPi;
-    std::printf("  view %d: up %.3f degrees off the pole's plane (sigma %.3f), line at %.1f degrees, half width %.1f px\n",
-                v, off_deg, line->sigma_deg, line->angle_deg, line->half_width_px);
+    std::printf(
+        "  view %d: up %.3f degrees off the pole's plane (sigma %.3f), line at %.1f degrees, half width %.1f px\n", v,
+        off_deg, line->sigma_deg, line->angle_deg, line->half_width_px);
     EXPECT_LT(off_deg, 0.5) << v;
     EXPECT_LT(off_deg, 4 * line->sigma_deg + 0.05) << v;
     EXPECT_LT(line->sigma_deg, 1.0);
@@ -56,7 +58,8 @@ TEST(StandLine, WithoutAStandThereIsNoLine) {
   const SynthScene scene = stand_scene(false);
   const testing::RenderedView r = testing::render_view(scene, 0, 0.002, 5, 2);
   const Vec3 c = testing::ball_centre_cam(r, 0);
-  EXPECT_FALSE(find_stand_line(r.radiance, scene.camera.lens, {c.normalized(), std::asin(0.05 / c.norm())}).has_value());
+  EXPECT_FALSE(
+      find_stand_line(r.radiance, scene.camera.lens, {c.normalized(), std::asin(0.05 / c.norm())}).has_value());
 }
 
 }  // namespace

@@ -100,10 +100,11 @@ TEST(TrackRefinement, ReLocatedTracksAgreeWithTheTruthToHundredthsOfAPixelWithHo
     ASSERT_TRUE(std::isfinite(o.sigma) && o.sigma > 0);
   }
   const double mean_whitened = std::accumulate(whitened.begin(), whitened.end(), 0.0) / whitened.size();
-  std::printf("  %d tracks, %d re-located (%d observations, %d dropped); median error SIFT %.3f px, re-located %.3f px; "
-              "mean (error/sigma)^2/2 %.2f; sigma ratio %.3f\n",
-              p.tracks, rep.tracks_refined, rep.observations_refined, rep.observations_dropped, median(sift),
-              median(relocated), mean_whitened, rep.median_sigma_ratio);
+  std::printf(
+      "  %d tracks, %d re-located (%d observations, %d dropped); median error SIFT %.3f px, re-located %.3f px; "
+      "mean (error/sigma)^2/2 %.2f; sigma ratio %.3f\n",
+      p.tracks, rep.tracks_refined, rep.observations_refined, rep.observations_dropped, median(sift), median(relocated),
+      mean_whitened, rep.median_sigma_ratio);
   EXPECT_GT(rep.tracks_refined, 0.8 * p.tracks);
   EXPECT_GT(median(sift), 0.1);
   EXPECT_LT(median(relocated), 0.08);
@@ -118,7 +119,8 @@ TEST(TrackRefinement, ATrackNothingReLocatesKeepsItsObservations) {
   TrackRefinementOptions o;
   o.min_ncc = 1.5;  // no alignment can pass
   TrackRefinementReport rep;
-  const std::vector<DirectionObservation> out = refine_tracks(p.sets, p.cones, p.cones, p.lens, p.features, p.truth, p.obs, o, &rep);
+  const std::vector<DirectionObservation> out =
+      refine_tracks(p.sets, p.cones, p.cones, p.lens, p.features, p.truth, p.obs, o, &rep);
   ASSERT_EQ(out.size(), p.obs.size());
   for (std::size_t i = 0; i < out.size(); ++i) {
     EXPECT_EQ(out[i].direction, p.obs[i].direction);
@@ -141,7 +143,8 @@ TEST(TrackRefinement, InvalidTexelsAreNeverSampledAndTheirTracksKeepTheirObserva
   // (as the first test shows it does) and change the observations.
   for (CubeFace& f : sets[1].faces) f.valid = cv::Mat::zeros(f.valid.size(), CV_8UC1);
   TrackRefinementReport rep;
-  const std::vector<DirectionObservation> out = refine_tracks(sets, p.cones, p.cones, p.lens, p.features, p.truth, p.obs, {}, &rep);
+  const std::vector<DirectionObservation> out =
+      refine_tracks(sets, p.cones, p.cones, p.lens, p.features, p.truth, p.obs, {}, &rep);
   ASSERT_EQ(out.size(), p.obs.size());
   for (std::size_t i = 0; i < out.size(); ++i) {
     EXPECT_EQ(out[i].direction, p.obs[i].direction);

@@ -23,7 +23,7 @@ struct Rendered {
   std::vector<ViewImage> views;
   std::vector<Mat3> truth;
   std::vector<std::string> names;
-  std::vector<Vec2> centre_px;  // the chrome ball's true centre pixel
+  std::vector<Vec2> centre_px;     // the chrome ball's true centre pixel
   std::vector<double> half_angle;  // and its true angular radius, radians
 };
 
@@ -33,7 +33,8 @@ struct Rendered {
 Rendered render(const std::filesystem::path& env, const std::vector<double>& azimuths, double radius_px = 120,
                 bool chrome_only = false) {
   const double distance = 0.5, f = radius_px * distance / 0.05;
-  SynthScene scene = testing::rig_scene(LensModel::pinhole(f, int(2.5 * radius_px), int(2.3 * radius_px)), distance, false);
+  SynthScene scene =
+      testing::rig_scene(LensModel::pinhole(f, int(2.5 * radius_px), int(2.3 * radius_px)), distance, false);
   if (chrome_only) scene.balls.resize(1);
   scene.environment.file = env;
   scene.environment.sanitize = true;
@@ -97,9 +98,10 @@ TEST(ViewOrientation, RenderedViewsAreRecoveredUpToTheGaugeWithDetectedBalls) {
   for (int v = 0; v < 4; ++v) {
     EXPECT_EQ(p.views[v].name, r.names[v]);
     const double e = angle_deg(p.views[v].world_from_cam, g * r.truth[v]);
-    std::printf("  view %d: ball (%.2f, %.2f) [truth (%.2f, %.2f)] r %.2f, %d features, error %.3f deg, sigma %.3f deg\n", v,
-                rep.balls[v].centre_px.x(), rep.balls[v].centre_px.y(), r.centre_px[v].x(), r.centre_px[v].y(), rep.balls[v].radius_px, rep.features[v], e,
-                p.views[v].sigma_deg);
+    std::printf(
+        "  view %d: ball (%.2f, %.2f) [truth (%.2f, %.2f)] r %.2f, %d features, error %.3f deg, sigma %.3f deg\n", v,
+        rep.balls[v].centre_px.x(), rep.balls[v].centre_px.y(), r.centre_px[v].x(), r.centre_px[v].y(),
+        rep.balls[v].radius_px, rep.features[v], e, p.views[v].sigma_deg);
     // The ball located from the image alone is off by ~0.5-3 px on this textured background, ~1
     // degree per pixel on a 120-px ball; refined with the re-located tracks it comes within 0.05 px
     // and the errors to 0.02-0.06 degrees (0.2-0.5 with SIFT's keypoints as they are). Guarded at
@@ -115,7 +117,8 @@ TEST(ViewOrientation, RenderedViewsAreRecoveredUpToTheGaugeWithDetectedBalls) {
   // The sigmas include the ball centres' uncertainty: the errors are within a few sigmas (mean
   // (error/sigma)^2 below 10; with the centres held fixed it is 25-60 on these views).
   double chi2 = 0;
-  for (int v = 1; v < 4; ++v) chi2 += std::pow(angle_deg(p.views[v].world_from_cam, g * r.truth[v]) / p.views[v].sigma_deg, 2) / 3;
+  for (int v = 1; v < 4; ++v)
+    chi2 += std::pow(angle_deg(p.views[v].world_from_cam, g * r.truth[v]) / p.views[v].sigma_deg, 2) / 3;
   std::printf("  mean (error/sigma)^2 = %.2f\n", chi2);
   EXPECT_LT(chi2, 10.0);
 }
@@ -165,15 +168,17 @@ TEST(ViewOrientation, ARingOfViewsAroundALightProbeSizedBallIsOrientedToAHundred
   for (std::size_t v = 0; v < azimuths.size(); ++v) {
     centres.push_back((rep.balls[v].centre_px - r.centre_px[v]).norm());
     const double a = r.half_angle[v];
-    radius_error = std::max(radius_error, std::abs(rep.balls[v].fit.cone.half_angle - a) * f / (std::cos(a) * std::cos(a)));
+    radius_error =
+        std::max(radius_error, std::abs(rep.balls[v].fit.cone.half_angle - a) * f / (std::cos(a) * std::cos(a)));
     if (v == 0) continue;
     errors.push_back(angle_deg(p.views[v].world_from_cam, g * r.truth[v]));
     chi2 += std::pow(errors.back() / p.views[v].sigma_deg, 2) / double(azimuths.size() - 1);
   }
-  std::printf("  %d tracks; orientation error median %.4f, max %.4f deg; mean (error/sigma)^2 %.2f; centre error median %.3f, "
-              "max %.3f px; radius error max %.3f px\n",
-              rep.tracks, median(errors), *std::max_element(errors.begin(), errors.end()), chi2, median(centres),
-              *std::max_element(centres.begin(), centres.end()), radius_error);
+  std::printf(
+      "  %d tracks; orientation error median %.4f, max %.4f deg; mean (error/sigma)^2 %.2f; centre error median %.3f, "
+      "max %.3f px; radius error max %.3f px\n",
+      rep.tracks, median(errors), *std::max_element(errors.begin(), errors.end()), chi2, median(centres),
+      *std::max_element(centres.begin(), centres.end()), radius_error);
   EXPECT_LE(median(errors), 0.025);
   EXPECT_LT(*std::max_element(errors.begin(), errors.end()), 0.05);
   // Honest sigmas: the mean of 7 (error/sigma)^2, each ~ chi2_3 / 3 when honest (chi2_21 / 21), lies
@@ -268,10 +273,14 @@ TEST(ViewOrientation, OneViewIsAShootAndNoBallOrNothingSharedGiveOneClearError) 
   // No ball: a featureless flat image.
   ViewImage flat;
   flat.radiance = cv::Mat(r.views[0].radiance.size(), CV_32FC3, cv::Scalar(0.5, 0.5, 0.5));
-  EXPECT_NE(error_of([&] { orient_views({"flat"}, {flat}, r.lens); }).find("found in 0 of 1 views, need at least 1 (flat: no chrome ball"),
+  EXPECT_NE(error_of([&] {
+              orient_views({"flat"}, {flat}, r.lens);
+            }).find("found in 0 of 1 views, need at least 1 (flat: no chrome ball"),
             std::string::npos);
   // (A view without a chrome ball is left out; with fewer than 2 left, one line names it.)
-  EXPECT_NE(error_of([&] { orient_views({"a", "empty"}, {r.views[0], flat}, r.lens); }).find("empty: no chrome ball found"),
+  EXPECT_NE(error_of([&] {
+              orient_views({"a", "empty"}, {r.views[0], flat}, r.lens);
+            }).find("empty: no chrome ball found"),
             std::string::npos);
   // Two views of different worlds share no feature.
   const std::filesystem::path other = std::filesystem::path(RSIBR_CACHE_DIR) / "assets/hdri/forest.exr";

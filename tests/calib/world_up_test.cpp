@@ -25,7 +25,8 @@ balls:
   - {name: chrome, kind: chrome, diameter_m: 0.1, centre: [-0.07, 1.3, 0]}
 camera: {width: 64, height: 48, lens: {model: LENSMODEL_PINHOLE, focal_px: 100}}
 views:
-  - {plan: handheld, count: )" + std::to_string(count) + ", elevation_deg: " + std::to_string(elevation_deg) +
+  - {plan: handheld, count: )" +
+                           std::to_string(count) + ", elevation_deg: " + std::to_string(elevation_deg) +
                            ", distance_m: 0.6, jitter_m: " + std::to_string(jitter_m) +
                            ", jitter_deg: " + std::to_string(jitter_deg) + "}\n";
   return parse_synth_scene(text, "handheld.yaml", ".");

@@ -71,7 +71,7 @@ TEST(CameraProcessing, FilmicCurveHasAToeAndAShoulder) {
   const CameraResponse filmic("filmic"), srgb("srgb");
   const double h = 1e-8;
   auto slope = [&](const CameraResponse& r, double x) { return (r.code(x + h, 1) - r.code(x, 1)) / h; };
-  EXPECT_NEAR(slope(filmic, 1e-6), 0.5 * slope(srgb, 1e-6), 0.01 * slope(srgb, 1e-6));          // toe
+  EXPECT_NEAR(slope(filmic, 1e-6), 0.5 * slope(srgb, 1e-6), 0.01 * slope(srgb, 1e-6));                 // toe
   EXPECT_NEAR(slope(filmic, 1 - 2 * h), 0.5 * slope(srgb, 1 - 2 * h), 0.02 * slope(srgb, 1 - 2 * h));  // shoulder
   EXPECT_GT(slope(filmic, 0.18), slope(srgb, 0.18));  // more contrast in the mid-tones
   EXPECT_NEAR(filmic.code(0.18, 0) * 255, 115, 1);
@@ -82,8 +82,9 @@ TEST(CameraProcessing, JpegErrorGrowsAsQualityFallsAndStaysSmallAtNinetyFive) {
   cv::Mat codes(64, 64, CV_16UC3);
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x)
-      codes.at<cv::Vec3w>(y, x) = cv::Vec3w(std::uint16_t(128 + 60 * std::sin(x * 0.4)), std::uint16_t(100 + 50 * std::cos(y * 0.3)),
-                                            std::uint16_t((x * 7 + y * 3) % 200 + 20));
+      codes.at<cv::Vec3w>(y, x) =
+          cv::Vec3w(std::uint16_t(128 + 60 * std::sin(x * 0.4)), std::uint16_t(100 + 50 * std::cos(y * 0.3)),
+                    std::uint16_t((x * 7 + y * 3) % 200 + 20));
   auto rms = [&](int q) {
     const cv::Mat back = jpeg_compress(codes, q);
     cv::Mat d;
@@ -177,8 +178,9 @@ TEST(CameraProcessing, SpecErrorsNameTheirKey) {
   };
   EXPECT_NE(error_of(", jpeg_quality: 80").find("camera.jpeg_quality"), std::string::npos);  // not a JPEG camera
   EXPECT_NE(error_of(", format: jpeg, jpeg_quality: 0").find("camera.jpeg_quality"), std::string::npos);
-  EXPECT_NE(error_of(", processing: {saturation: 1.2, colour_matrix: [1, 0, 0, 0, 1, 0, 0, 0, 1]}").find("colour_matrix"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(", processing: {saturation: 1.2, colour_matrix: [1, 0, 0, 0, 1, 0, 0, 0, 1]}").find("colour_matrix"),
+      std::string::npos);
   EXPECT_NE(error_of(", processing: {sensitivity: [0, 1, 1]}").find("processing.sensitivity"), std::string::npos);
   EXPECT_NE(error_of(", processing: {tone: 1}").find("processing"), std::string::npos);
 }

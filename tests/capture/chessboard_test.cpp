@@ -51,7 +51,8 @@ TEST(Chessboard, MrginghamFindsEveryCornerWhereTheTruthPutsIt) {
   for (int i = 0; i < boards.count; ++i) {
     const ChessboardShot shot = render_chessboard(lens, rays, boards, i, 42, 3);
     ASSERT_EQ(shot.corners.size(), 100u);
-    const cv::Mat codes = expose_bracket(shot.reflectance, 1.0, noise, CameraResponse("srgb"), 255, 42, std::uint64_t(i));
+    const cv::Mat codes =
+        expose_bracket(shot.reflectance, 1.0, noise, CameraResponse("srgb"), 255, 42, std::uint64_t(i));
     cv::Mat png;
     codes.convertTo(png, CV_8U);
     const std::string file = dir.file("board" + std::to_string(i) + ".png");
@@ -81,7 +82,8 @@ TEST(Chessboard, PosesAreSeededAndKeepEveryCornerInside) {
   SynthChessboards boards;
   boards.corners = 6;
   boards.spacing_m = 0.02;
-  const ChessboardShot a = render_chessboard(lens, rays, boards, 0, 1, 1), b = render_chessboard(lens, rays, boards, 0, 1, 1);
+  const ChessboardShot a = render_chessboard(lens, rays, boards, 0, 1, 1),
+                       b = render_chessboard(lens, rays, boards, 0, 1, 1);
   const ChessboardShot c = render_chessboard(lens, rays, boards, 1, 1, 1);
   EXPECT_EQ(cv::norm(a.reflectance, b.reflectance, cv::NORM_INF), 0);
   EXPECT_NE(a.corners[0], c.corners[0]);

@@ -101,7 +101,8 @@ TEST(LensModel, MalformedTextsThatMrcalReadsPastTheirEndAreRefusedBeforeMrcalSee
       {"{\n    'lensmodel':  'LENSMODEL_PINHOLE',\n    'intrinsics': [ 100, 100, 47.5, 31.5 ],\n"
        "    'imagersize': [ 96, 64 ],\n    'extrinsic 0, 0, 0, 0, 0 ],\n# generated for the",
        "line 5: a string that spans lines"},
-      {"# a comment\n{\n    'lensmodel':  'LENSMODEL_OPENCV8',\n    'intrinsics':# comment  [ 7t0", "line 4: expected a number"},
+      {"# a comment\n{\n    'lensmodel':  'LENSMODEL_OPENCV8',\n    'intrinsics':# comment  [ 7t0",
+       "line 4: expected a number"},
       {"{ 'lensmodel': 'LENSMODEL_PINHOLE', # x", "expected a quoted key"},
       {"{ 'lensmodel': 'LENSMODEL_PINHOLE' } trailing", "text after the closing '}'"},
       {"{ 'a': [[[[[1]]]]] }", "nested too deep"},

@@ -198,7 +198,8 @@ TEST(RigRenderer, SupersampledEdgeIsAntialiased) {
     for (int x = 1; x + 1 < img.cols; ++x) {
       const float a = img.at<cv::Vec3f>(y, x)[1], p = point.at<cv::Vec3f>(y, x)[1];
       const float l = point.at<cv::Vec3f>(y, x - 1)[1], r = point.at<cv::Vec3f>(y, x + 1)[1];
-      if (std::abs(l - r) > 0.2f * std::max(l, r) && std::abs(a - p) > 1e-4f && a > std::min(l, r) && a < std::max(l, r))
+      if (std::abs(l - r) > 0.2f * std::max(l, r) && std::abs(a - p) > 1e-4f && a > std::min(l, r) &&
+          a < std::max(l, r))
         ++mixed;
     }
   EXPECT_GT(mixed, 10);

@@ -38,7 +38,8 @@ std::map<std::string, std::string> folder_bytes(const fs::path& root) {
 
 TEST(SynthCapture, SameSeedGivesSameBytes) {
   testing::TempDir dir;
-  SynthScene scene = testing::small_scene(", response: measured, vignetting: 0.3", "chessboards: {count: 1, corners: 4, spacing_m: 0.01}\n");
+  SynthScene scene = testing::small_scene(", response: measured, vignetting: 0.3",
+                                          "chessboards: {count: 1, corners: 4, spacing_m: 0.01}\n");
   write_synth_capture(scene, dir.path() / "a");
   write_synth_capture(scene, dir.path() / "b");
   scene.seed = 8;
@@ -158,17 +159,21 @@ TEST(SynthScene, UnknownKeysAndBadValuesNameTheirPath) {
     }
     return std::string("no error");
   };
-  EXPECT_NE(error_of(testing::small_scene_text(", colour: 3")).find("scene.camera.colour: unknown key"), std::string::npos);
-  EXPECT_NE(error_of(testing::small_scene_text(", vignetting: 1.5")).find("scene.camera.vignetting"), std::string::npos);
+  EXPECT_NE(error_of(testing::small_scene_text(", colour: 3")).find("scene.camera.colour: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error_of(testing::small_scene_text(", vignetting: 1.5")).find("scene.camera.vignetting"),
+            std::string::npos);
   EXPECT_NE(error_of(testing::small_scene_text(", response: gamma")).find("scene.camera.response"), std::string::npos);
-  EXPECT_NE(error_of(testing::small_scene_text("", "chessboards: {count: -1}\n")).find("s.yaml: scene.chessboards.count"), std::string::npos);
+  EXPECT_NE(
+      error_of(testing::small_scene_text("", "chessboards: {count: -1}\n")).find("s.yaml: scene.chessboards.count"),
+      std::string::npos);
   const std::string bad_name = testing::small_scene_text();
   EXPECT_NE(error_of(std::string(bad_name).replace(bad_name.find("name: grey"), 10, "name: a/b")).find("balls[1].name"),
             std::string::npos);
-  EXPECT_NE(error_of(std::string(bad_name).replace(bad_name.find("name: grey, kind: grey"), 22,
-                                                    "name: grey, kind: glossy"))
-                .find("balls[1].albedo: glossy balls take a brdf"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(std::string(bad_name).replace(bad_name.find("name: grey, kind: grey"), 22, "name: grey, kind: glossy"))
+          .find("balls[1].albedo: glossy balls take a brdf"),
+      std::string::npos);
   EXPECT_NE(error_of("rsibr_synth: 2\n").find("rsibr_synth"), std::string::npos);
 }
 
@@ -177,7 +182,8 @@ TEST(SynthScene, UnknownKeysAndBadValuesNameTheirPath) {
 // vignettes as the profile says at the exposure's aperture unless the spec gives a vignetting.
 TEST(SynthScene, ALensfunLensIsTheDatabasesProfileWithItsVignetting) {
   auto with_lens = [](const std::string& lens, const std::string& extra = "") {
-    std::string text = testing::small_scene_text(", make: Canon, name: Canon EOS 600D, lens_name: Canon EF-S 18-55mm f/3.5-5.6 IS" + extra);
+    std::string text = testing::small_scene_text(
+        ", make: Canon, name: Canon EOS 600D, lens_name: Canon EF-S 18-55mm f/3.5-5.6 IS" + extra);
     const std::string pinhole = "lens: {model: LENSMODEL_PINHOLE, focal_px: 200}";
     return text.replace(text.find(pinhole), pinhole.size(), "lens: " + lens);
   };
@@ -192,7 +198,8 @@ TEST(SynthScene, ALensfunLensIsTheDatabasesProfileWithItsVignetting) {
   for (int i = 0; i < 3; ++i) EXPECT_EQ((*s.camera.vignetting_poly)[i], v->k[std::size_t(i)]);
   EXPECT_LT(v->k[0], 0) << "the EF-S 18-55mm darkens toward the corners at 18 mm";
   // A given vignetting wins; the profile may name another lens than the EXIF does.
-  const SynthScene g = parse_synth_scene(with_lens("{model: lensfun, focal_mm: 18}", ", vignetting: 0.1"), "s.yaml", ".");
+  const SynthScene g =
+      parse_synth_scene(with_lens("{model: lensfun, focal_mm: 18}", ", vignetting: 0.1"), "s.yaml", ".");
   EXPECT_FALSE(g.camera.vignetting_poly);
   const SynthScene other = parse_synth_scene(
       with_lens("{model: lensfun, focal_mm: 18, lens: Canon EF-S 18-55mm f/3.5-5.6 IS}"), "s.yaml", ".");
@@ -206,7 +213,8 @@ TEST(SynthScene, ALensfunLensIsTheDatabasesProfileWithItsVignetting) {
     return std::string("no error");
   };
   EXPECT_NE(error_of("{model: lensfun}").find("focal_mm"), std::string::npos) << error_of("{model: lensfun}");
-  EXPECT_NE(error_of("{model: lensfun, focal_mm: 18, focal_px: 300}").find("not with model: lensfun"), std::string::npos);
+  EXPECT_NE(error_of("{model: lensfun, focal_mm: 18, focal_px: 300}").find("not with model: lensfun"),
+            std::string::npos);
   EXPECT_NE(error_of("{model: LENSMODEL_PINHOLE, focal_px: 200, focal_mm: 18}").find("only with model: lensfun"),
             std::string::npos);
   EXPECT_NE(error_of("{model: lensfun, focal_mm: 18, lens: Acme Wonderlens}").find("does not know the lens"),
@@ -260,7 +268,8 @@ TEST(CameraPoses, PanKeepsTheHorizonLevelWhereYawTiltsIt) {
   }
   EXPECT_LT(std::abs(poses[1].world_from_cam.col(0).y()), 1e-12);
   EXPECT_GT(std::abs(poses[2].world_from_cam.col(0).y()), 0.05);
-  EXPECT_NEAR(poses[1].world_from_cam.col(2).y(), poses[0].world_from_cam.col(2).y(), 1e-12);  // still aimed down as much
+  EXPECT_NEAR(poses[1].world_from_cam.col(2).y(), poses[0].world_from_cam.col(2).y(),
+              1e-12);  // still aimed down as much
 }
 
 }  // namespace

@@ -22,7 +22,8 @@ long brute_row_weight(int r, int res) {
 
 TEST(BakePartition, RowWeightIsTheCountOfTexelCentresInsideTheDisc) {
   for (int res = 1; res <= 130; ++res)
-    for (int r = 0; r < res; ++r) ASSERT_EQ(row_weight(r, res), brute_row_weight(r, res)) << "res " << res << " row " << r;
+    for (int r = 0; r < res; ++r)
+      ASSERT_EQ(row_weight(r, res), brute_row_weight(r, res)) << "res " << res << " row " << r;
   EXPECT_EQ(row_weight(0, 1), 1);  // the one texel of a 1x1 map sits at the centre
   EXPECT_EQ(row_weight(0, 2), 2);
 }

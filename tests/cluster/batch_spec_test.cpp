@@ -30,7 +30,8 @@ std::string error_of(const std::string& name, const std::string& text) {
 }
 
 TEST(BatchSpec, BothJobFormsReadWithDefaultNames) {
-  const auto p = spec_file("forms", "jobs:\n  - name: a\n    args: [bake, a.exr, --res, 8]\n  - [process, shoot, --out, run]\n");
+  const auto p =
+      spec_file("forms", "jobs:\n  - name: a\n    args: [bake, a.exr, --res, 8]\n  - [process, shoot, --out, run]\n");
   const auto jobs = read_batch_spec(p, kVerbs);
   std::filesystem::remove(p);
   ASSERT_EQ(jobs.size(), 2u);
@@ -43,12 +44,14 @@ TEST(BatchSpec, BothJobFormsReadWithDefaultNames) {
 TEST(BatchSpec, BadSpecsNameTheFileAndThePlace) {
   EXPECT_NE(error_of("nojobs", "jobs: []\n").find("batch.jobs: must be a non-empty list"), std::string::npos);
   EXPECT_NE(error_of("key", "job: []\n").find("job"), std::string::npos);
-  EXPECT_NE(error_of("verb", "jobs:\n  - [bakee, x]\n").find("batch.jobs[0]: 'bakee' is not a verb"), std::string::npos);
+  EXPECT_NE(error_of("verb", "jobs:\n  - [bakee, x]\n").find("batch.jobs[0]: 'bakee' is not a verb"),
+            std::string::npos);
   EXPECT_NE(error_of("nested", "jobs:\n  - [batch, other.yaml]\n").find("cannot run in a batch"), std::string::npos);
   EXPECT_NE(error_of("view", "jobs:\n  - [view, maps.exr]\n").find("cannot run in a batch"), std::string::npos);
   EXPECT_NE(error_of("word", "jobs:\n  - [bake, [x]]\n").find("batch.jobs[0][1]: must be a word"), std::string::npos);
   EXPECT_NE(error_of("noargs", "jobs:\n  - name: a\n").find("batch.jobs[0].args"), std::string::npos);
-  EXPECT_NE(error_of("twice", "jobs:\n  - {name: a, args: [bake]}\n  - {name: a, args: [bake]}\n").find("a second job named 'a'"),
+  EXPECT_NE(error_of("twice", "jobs:\n  - {name: a, args: [bake]}\n  - {name: a, args: [bake]}\n")
+                .find("a second job named 'a'"),
             std::string::npos);
   const std::string e = error_of("syntax", "jobs: [\n");
   EXPECT_NE(e.find("rsibr_batch_spec_syntax.yaml"), std::string::npos) << e;

@@ -54,7 +54,8 @@ TEST(DistributedBake, AnyNumberOfRanksGivesTheSerialBytesForEveryIntegrator) {
       const MapSet split = bake_as_ranks(brdf, *integrator, views, options, ranks);
       ASSERT_EQ(split.views.size(), serial.views.size());
       for (std::size_t i = 0; i < serial.views.size(); ++i) {
-        EXPECT_TRUE(same_bytes(split.views[i].rgb, serial.views[i].rgb)) << method << ", " << ranks << " ranks, view " << i;
+        EXPECT_TRUE(same_bytes(split.views[i].rgb, serial.views[i].rgb))
+            << method << ", " << ranks << " ranks, view " << i;
         EXPECT_EQ(split.views[i].attributes, serial.views[i].attributes);
         EXPECT_EQ(split.views[i].albedo, serial.views[i].albedo);
       }
@@ -69,8 +70,8 @@ TEST(DistributedBake, OneRankSessionIsTheSerialBake) {
   MapSetBakeOptions options;
   options.res = 8;
   DistributedBakeTimes times;
-  const MapSet a = bake_map_set_distributed(*grey, *integrator, ViewSet::named("tetra"), options,
-                                            Session::current(), {}, &times);
+  const MapSet a =
+      bake_map_set_distributed(*grey, *integrator, ViewSet::named("tetra"), options, Session::current(), {}, &times);
   const MapSet b = bake_map_set(*grey, *integrator, ViewSet::named("tetra"), options);
   ASSERT_EQ(a.views.size(), 4u);
   for (std::size_t i = 0; i < a.views.size(); ++i) EXPECT_TRUE(same_bytes(a.views[i].rgb, b.views[i].rgb));

@@ -39,8 +39,8 @@ TEST(ComparePictures, HeatScaleIsARoundedQuantile) {
   cv::Mat e(10, 10, CV_32FC1);
   for (int i = 0; i < 100; ++i) e.at<float>(i / 10, i % 10) = 0.003f * float(i + 1);  // 0.003 .. 0.3
   const cv::Mat w(10, 10, CV_32FC1, cv::Scalar(1));
-  EXPECT_DOUBLE_EQ(heat_scale_max({e}, {w}, 0.5), 0.2);   // median 0.15 -> 0.2
-  EXPECT_DOUBLE_EQ(heat_scale_max({e}, {w}, 1.0), 0.5);   // 0.3 -> 0.5
+  EXPECT_DOUBLE_EQ(heat_scale_max({e}, {w}, 0.5), 0.2);                                     // median 0.15 -> 0.2
+  EXPECT_DOUBLE_EQ(heat_scale_max({e}, {w}, 1.0), 0.5);                                     // 0.3 -> 0.5
   EXPECT_DOUBLE_EQ(heat_scale_max({cv::Mat(10, 10, CV_32FC1, cv::Scalar(0))}, {w}), 0.01);  // identical maps
 }
 

@@ -72,8 +72,10 @@ TEST(GainFit, RecoversAKnownGainWithNoiseAndOutliers) {
       cv::Vec3f& pa = a.at<cv::Vec3f>(r, c);
       for (int k = 0; k < 3; ++k) pa[k] *= 1 + noise(rng);
       const float x = u(rng);
-      if (x < 0.03f) b.at<cv::Vec3f>(r, c) *= 1000.f;  // a sun clipped in A
-      else if (x < 0.05f) pa *= 0.05f;                  // the camera's dark reflection in A
+      if (x < 0.03f)
+        b.at<cv::Vec3f>(r, c) *= 1000.f;  // a sun clipped in A
+      else if (x < 0.05f)
+        pa *= 0.05f;  // the camera's dark reflection in A
     }
   const cv::Mat w(n, n, CV_32FC1, cv::Scalar(1));
   GainFitOptions o;

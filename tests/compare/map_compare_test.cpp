@@ -84,7 +84,8 @@ TEST(MapCompare, AOneViewSetIsComparedWithItsMatchingView) {
   MapSet one;
   one.views.push_back(full.views[4]);
   one.views[0].rgb = apply_gains(one.views[0].rgb, {1.1, 1.1, 1.1});
-  for (const Comparison& c : {compare_map_sets(one, full, CompareOptions{}), compare_map_sets(full, one, CompareOptions{})}) {
+  for (const Comparison& c :
+       {compare_map_sets(one, full, CompareOptions{}), compare_map_sets(full, one, CompareOptions{})}) {
     ASSERT_EQ(c.pairs.size(), 1u);
     EXPECT_EQ(c.pairs[0].index_a + c.pairs[0].index_b, 4);
     EXPECT_GT(c.before.relative_rms, 0.05);

@@ -51,7 +51,7 @@ TEST(AlbedoNormalisation, DenormaliseUndoesNormaliseInsideTheDiscAndLeavesTheOut
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(0.0f, 1e4f);
   cv::Mat map(31, 31, CV_32FC3);
-  for (float* p = map.ptr<float>(), *e = p + 31 * 31 * 3; p != e; ++p) *p = u(rng);
+  for (float *p = map.ptr<float>(), *e = p + 31 * 31 * 3; p != e; ++p) *p = u(rng);
   cv::Mat m = map.clone();
   const std::vector<float> t = ramp_table();
   normalise_by_albedo(m, t);

@@ -64,9 +64,7 @@ TEST_F(Colour, EmbeddedConfigIsValid) {
   EXPECT_TRUE(config->getColorSpace("raw")->isData());
 }
 
-TEST_F(Colour, ConfigIsCached) {
-  EXPECT_EQ(rsibr::colour_config().get(), rsibr::colour_config().get());
-}
+TEST_F(Colour, ConfigIsCached) { EXPECT_EQ(rsibr::colour_config().get(), rsibr::colour_config().get()); }
 
 TEST_F(Colour, WorkingSpaceIsLinearRec709) {
   EXPECT_EQ(rsibr::working_space(), "lin_rec709");
@@ -89,24 +87,20 @@ TEST_F(Colour, AcesCgRoundTripIsIdentity) {
 TEST_F(Colour, WhiteStaysWhiteThroughAcesCg) {
   const cv::Vec3f white(1.0f, 1.0f, 1.0f);
   expect_near(converted(white, "lin_rec709", "ACEScg"), white, 1e-5f);
-  expect_near(converted(converted(white, "lin_rec709", "ACEScg"), "ACEScg", "lin_rec709"), white,
-              1e-5f);
+  expect_near(converted(converted(white, "lin_rec709", "ACEScg"), "ACEScg", "lin_rec709"), white, 1e-5f);
   expect_near(converted(white, "lin_rec709", "ACES2065-1"), white, 1e-5f);
   expect_near(converted(white, "lin_rec709", "lin_p3d65"), white, 1e-5f);
   // Published Bradford-adapted sRGB -> ACEScg matrix, first column.
-  expect_near(converted({1.0f, 0.0f, 0.0f}, "lin_rec709", "ACEScg"), {0.6131f, 0.0702f, 0.0206f},
-              1e-3f);
+  expect_near(converted({1.0f, 0.0f, 0.0f}, "lin_rec709", "ACEScg"), {0.6131f, 0.0702f, 0.0206f}, 1e-3f);
   // ACES AP0 -> AP1 (published ACES matrix, independent of D65) via the two config spaces.
-  expect_near(converted({1.0f, 0.0f, 0.0f}, "ACES2065-1", "ACEScg"),
-              {1.4514393161f, -0.0765537734f, 0.0083161484f}, 1e-4f);
+  expect_near(converted({1.0f, 0.0f, 0.0f}, "ACES2065-1", "ACEScg"), {1.4514393161f, -0.0765537734f, 0.0083161484f},
+              1e-4f);
 }
 
 TEST_F(Colour, SrgbTextureDecodesWithTheSrgbCurve) {
   // 0.5 encoded -> ((0.5 + 0.055) / 1.055)^2.4 = 0.21404; 0.02 encoded is on the linear toe.
-  expect_near(converted({0.5f, 1.0f, 0.0f}, "srgb_texture", "lin_rec709"),
-              {0.21404f, 1.0f, 0.0f}, 1e-5f);
-  EXPECT_NEAR(converted({0.02f, 0.02f, 0.02f}, "srgb_texture", "lin_rec709")[0], 0.02f / 12.92f,
-              2e-5f);
+  expect_near(converted({0.5f, 1.0f, 0.0f}, "srgb_texture", "lin_rec709"), {0.21404f, 1.0f, 0.0f}, 1e-5f);
+  EXPECT_NEAR(converted({0.02f, 0.02f, 0.02f}, "srgb_texture", "lin_rec709")[0], 0.02f / 12.92f, 2e-5f);
 }
 
 TEST_F(Colour, AlphaIsUntouched) {
@@ -132,8 +126,7 @@ TEST_F(Colour, ChromaticitiesOfRec709GiveIdentity) {
 }
 
 TEST_F(Colour, ChromaticitiesOfAcesAp0MatchConfigMatrix) {
-  const Imf::Chromaticities ap0({0.7347f, 0.2653f}, {0.0f, 1.0f}, {0.0001f, -0.0770f},
-                                {0.32168f, 0.33767f});
+  const Imf::Chromaticities ap0({0.7347f, 0.2653f}, {0.0f, 1.0f}, {0.0001f, -0.0770f}, {0.32168f, 0.33767f});
   const Eigen::Matrix3d m = rsibr::working_from_chromaticities(ap0);
   for (int col = 0; col < 3; ++col) {
     cv::Vec3f unit(0.0f, 0.0f, 0.0f);
@@ -147,16 +140,14 @@ TEST_F(Colour, ChromaticitiesOfAcesAp0MatchConfigMatrix) {
 }
 
 TEST_F(Colour, ChromaticitiesOfP3D65NeedNoAdaptation) {
-  const Imf::Chromaticities p3({0.680f, 0.320f}, {0.265f, 0.690f}, {0.150f, 0.060f},
-                               {0.3127f, 0.3290f});
+  const Imf::Chromaticities p3({0.680f, 0.320f}, {0.265f, 0.690f}, {0.150f, 0.060f}, {0.3127f, 0.3290f});
   const Eigen::Matrix3d m = rsibr::working_from_chromaticities(p3);
   const cv::Vec3f g = converted({0.0f, 1.0f, 0.0f}, "lin_p3d65", "lin_rec709");
   for (int row = 0; row < 3; ++row) EXPECT_NEAR(m(row, 1), g[row], 1e-4);
 }
 
 TEST_F(Colour, OcioEnvironmentVariableIsHonoured) {
-  const fs::path path = fs::temp_directory_path() / ("rsibr_colour_test_" +
-                                                     std::to_string(::getpid()) + ".ocio");
+  const fs::path path = fs::temp_directory_path() / ("rsibr_colour_test_" + std::to_string(::getpid()) + ".ocio");
   {
     std::ofstream out(path);
     out << R"(ocio_profile_version: 2

@@ -51,8 +51,11 @@ TEST(ExrFile, PartsChannelsAndEveryAttributeTypeRoundTripExactly) {
   ExrPartOut a;
   a.name = "first";
   a.channels = {{"R", rgb, 0}, {"G", rgb, 1}, {"B", rgb, 2}, {"extra", single, 0}};
-  a.attributes = {{"rsibr.text", std::string("caf\xc3\xa9")}, {"rsibr.count", -7}, {"rsibr.v", Vec3(0.5, -2, 8)},
-                  {"rsibr.m", m}, {"rsibr.list", std::vector<float>{1.5f, -2.f, 1e-20f}}};
+  a.attributes = {{"rsibr.text", std::string("caf\xc3\xa9")},
+                  {"rsibr.count", -7},
+                  {"rsibr.v", Vec3(0.5, -2, 8)},
+                  {"rsibr.m", m},
+                  {"rsibr.list", std::vector<float>{1.5f, -2.f, 1e-20f}}};
   ExrPartOut b;
   b.name = "second";
   b.channels = {{"u", other, 1}, {"v", other, 0}};
@@ -98,7 +101,7 @@ TEST(ExrFile, StridedAndRegionOfInterestImagesAreWrittenAsTheirPixels) {
 TEST(ExrFile, HalfKeepsTheLargestHalfAndRefusesBeyondItLeavingNoFile) {
   TempDir dir;
   cv::Mat px(2, 2, CV_32FC1, cv::Scalar(1.0f));
-  px.at<float>(0, 0) = 65504.f;  // the largest half: kept exactly
+  px.at<float>(0, 0) = 65504.f;                                 // the largest half: kept exactly
   px.at<float>(1, 1) = std::numeric_limits<float>::infinity();  // Inf is representable: kept
   const std::string ok = (dir.path() / "ok.exr").string();
   write_exr(ok, {ExrPartOut{"", {{"Y", px, 0}}, {}, ExrEnvmap::None, true}});
@@ -109,7 +112,9 @@ TEST(ExrFile, HalfKeepsTheLargestHalfAndRefusesBeyondItLeavingNoFile) {
   EXPECT_TRUE(std::isinf(back.at<float>(1, 1)));
   px.at<float>(0, 1) = 65520.f;  // would round to Inf
   const std::string bad = (dir.path() / "bad.exr").string();
-  const std::string msg = message_of([&] { write_exr(bad, {ExrPartOut{"", {{"Y", px, 0}}, {}, ExrEnvmap::None, true}}); });
+  const std::string msg = message_of([&] {
+    write_exr(bad, {ExrPartOut{"", {{"Y", px, 0}}, {}, ExrEnvmap::None, true}});
+  });
   EXPECT_EQ(msg.rfind(bad + ": value 65520 at pixel (1, 0) exceeds the half-float range", 0), 0u) << msg;
   EXPECT_FALSE(fs::exists(bad));
   EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 1);  // only ok.exr

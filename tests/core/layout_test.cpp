@@ -33,13 +33,13 @@ std::vector<Vec3> special_directions() {
       for (int c = -1; c <= 1; ++c)
         if (a || b || c) d.push_back(Vec3(a, b, c).normalized());  // axes, cube edges and corners
   for (double e : {1e-9, 1e-7, 1e-5, 1e-3}) {
-    d.push_back(Vec3(e, 1, 0).normalized());         // next to the poles
+    d.push_back(Vec3(e, 1, 0).normalized());  // next to the poles
     d.push_back(Vec3(0, -1, e).normalized());
-    d.push_back(Vec3(-e, 0, -1).normalized());       // either side of the lat-long seam
+    d.push_back(Vec3(-e, 0, -1).normalized());  // either side of the lat-long seam
     d.push_back(Vec3(e, 0, -1).normalized());
-    d.push_back(Vec3(e, -e, -1).normalized());       // next to the sphere map's singular direction
-    d.push_back(Vec3(1, 1 + e, 0).normalized());     // near a cube edge
-    d.push_back(Vec3(1, 1, 1 - e).normalized());     // near a cube corner
+    d.push_back(Vec3(e, -e, -1).normalized());    // next to the sphere map's singular direction
+    d.push_back(Vec3(1, 1 + e, 0).normalized());  // near a cube edge
+    d.push_back(Vec3(1, 1, 1 - e).normalized());  // near a cube corner
   }
   d.push_back(Vec3(0, 0, 1));   // sphere-map centre
   d.push_back(Vec3(0, 0, -1));  // sphere-map rim (singular)
@@ -145,8 +145,8 @@ TEST(Layout, TexelSolidAngleEqualsTheIntegralOfTheDensity) {
       sum /= double(n) * n;
       // Seam columns and pole rows of the lat-long own half a texel; the density does not know.
       if (L.kind() == LayoutKind::LatLong && (c == 0 || c == L.width() - 1 || r == 0 || r == L.height() - 1)) continue;
-      if (L.kind() == LayoutKind::Cube && (c == 0 || c == L.width() - 1 || r % L.width() == 0 ||
-                                           r % L.width() == L.width() - 1))
+      if (L.kind() == LayoutKind::Cube &&
+          (c == 0 || c == L.width() - 1 || r % L.width() == 0 || r % L.width() == L.width() - 1))
         continue;
       EXPECT_NEAR(L.texel_solid_angle(c, r), sum, 2e-3 * sum + 1e-12) << to_string(L.kind()) << " " << c << "," << r;
     }
@@ -200,7 +200,8 @@ TEST(Layout, PixelIsAreaTexelsNestExactly) {
           double sum = 0;
           for (int j = 0; j < 2; ++j)
             for (int i = 0; i < 2; ++i) sum += fine.texel_solid_angle(2 * c + i, 2 * r + j);
-          ASSERT_NEAR(coarse.texel_solid_angle(c, r), sum, 1e-14) << to_string(kind) << " " << n << " " << c << "," << r;
+          ASSERT_NEAR(coarse.texel_solid_angle(c, r), sum, 1e-14)
+              << to_string(kind) << " " << n << " " << c << "," << r;
         }
     }
   }

@@ -79,9 +79,12 @@ TEST(LensfunLens, TheModelReproducesLensfunsMappingForEveryDistortionModel) {
   const Case cases[] = {
       {"Canon", "Canon EOS 600D", "Canon EF-S 18-55mm f/3.5-5.6 IS", 18, 5184 / 8, 3456 / 8},  // ptlens, barrel
       {"Canon", "Canon EOS 600D", "Canon EF-S 18-55mm f/3.5-5.6 IS", 55, 5184 / 8, 3456 / 8},  // ptlens, pincushion
-      {"NIKON CORPORATION", "NIKON D7000", "Nikon AF-S Nikkor 16-35mm f/4G ED VR", 16, 4928 / 8, 3264 / 8},  // ptlens, strong
-      {"NIKON CORPORATION", "NIKON D7000", "Nikon AF-S DX Zoom-Nikkor 17-55mm f/2.8G IF-ED", 17, 4928 / 8, 3264 / 8},  // poly3
-      {"Canon", "Canon PowerShot G12", "Canon PowerShot G12 & compatibles (Standard)", 6.1, 3648 / 8, 2736 / 8},  // poly5
+      {"NIKON CORPORATION", "NIKON D7000", "Nikon AF-S Nikkor 16-35mm f/4G ED VR", 16, 4928 / 8,
+       3264 / 8},  // ptlens, strong
+      {"NIKON CORPORATION", "NIKON D7000", "Nikon AF-S DX Zoom-Nikkor 17-55mm f/2.8G IF-ED", 17, 4928 / 8,
+       3264 / 8},  // poly3
+      {"Canon", "Canon PowerShot G12", "Canon PowerShot G12 & compatibles (Standard)", 6.1, 3648 / 8,
+       2736 / 8},                                                                     // poly5
       {"Canon", "Canon EOS 600D", "Canon EF-S 18-55mm f/3.5-5.6 IS", 21, 1200, 800},  // between profiles, larger
   };
   for (const Case& c : cases) {
@@ -139,10 +142,13 @@ TEST(LensfunLens, UnknownLensesCamerasAndFisheyesSayWhy) {
   EXPECT_NE(why.find("does not know the camera"), std::string::npos) << why;
   EXPECT_FALSE(lensfun_lens("Canon", "Canon EOS 600D", "", 18, 648, 432, &why));
   EXPECT_NE(why.find("names no lens"), std::string::npos) << why;
-  EXPECT_FALSE(lensfun_lens("NIKON CORPORATION", "NIKON D7000", "Nikon AI-S Fisheye-Nikkor 6mm f/2.8", 6, 648, 432, &why));
+  EXPECT_FALSE(
+      lensfun_lens("NIKON CORPORATION", "NIKON D7000", "Nikon AI-S Fisheye-Nikkor 6mm f/2.8", 6, 648, 432, &why));
   EXPECT_NE(why.find("not rectilinear"), std::string::npos) << why;
-  EXPECT_THROW(lensfun_lens("Canon", "Canon EOS 600D", "Canon EF-S 18-55mm f/3.5-5.6 IS", 0, 648, 432), std::invalid_argument);
-  EXPECT_THROW(lensfun_lens("Canon", "Canon EOS 600D", "Canon EF-S 18-55mm f/3.5-5.6 IS", 18, 0, 432), std::invalid_argument);
+  EXPECT_THROW(lensfun_lens("Canon", "Canon EOS 600D", "Canon EF-S 18-55mm f/3.5-5.6 IS", 0, 648, 432),
+               std::invalid_argument);
+  EXPECT_THROW(lensfun_lens("Canon", "Canon EOS 600D", "Canon EF-S 18-55mm f/3.5-5.6 IS", 18, 0, 432),
+               std::invalid_argument);
 }
 
 }  // namespace

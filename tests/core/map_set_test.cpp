@@ -57,7 +57,7 @@ MapSet make_set(unsigned seed = 1, int size = 33) {
     v.material = "brdf: ggx\nroughness: 0.3\n# view " + std::to_string(i) + "\n";
     v.attributes = {{"tool", "rsibr bake"}, {"seed", std::to_string(seed)}, {"note", "line 1\nline 2\t\"quoted\""}};
     v.rgb = cv::Mat(size, size, CV_32FC3);
-    for (float* p = v.rgb.ptr<float>(), *e = p + size * size * 3; p != e; ++p) *p = u(rng);
+    for (float *p = v.rgb.ptr<float>(), *e = p + size * size * 3; p != e; ++p) *p = u(rng);
     v.rgb.at<cv::Vec3f>(0, 0) = cv::Vec3f(1e9f, 1e-30f, -0.f);
     if (v.source == MapSource::Captured) {
       v.confidence = cv::Mat(size, size, CV_32FC1);
@@ -176,7 +176,8 @@ TEST(MapSet, ValidationRejectsBadSets) {
       {"view.005", "size", [](MapView& v) { v.rgb = cv::Mat(5, 4, CV_32FC3, cv::Scalar(1, 1, 1)); }},
       {"view.004", "pixels", [](MapView& v) { v.rgb = cv::Mat(4, 4, CV_8UC3, cv::Scalar(1, 1, 1)); }},
       {"view.003", "confidence", [](MapView& v) { v.confidence = cv::Mat(3, 4, CV_32FC1, cv::Scalar(1)); }},
-      {"view.002", "unit", [](MapView& v) {
+      {"view.002", "unit",
+       [](MapView& v) {
          v.view *= 1.01;
          v.world_from_view.col(2) = v.view;
        }},

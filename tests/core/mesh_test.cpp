@@ -101,12 +101,12 @@ TEST_P(MeshRealModel, LoadsWithExpectedCountsUnitNormalsAndFiniteBounds) {
   EXPECT_GT(front_facing_fraction(mesh), 0.95);
 }
 
-INSTANTIATE_TEST_SUITE_P(Mesh, MeshRealModel,
-                         // pmndrs stores one truly zero-area triangle (three collinear corners along z at x=-1.505, y=0.995).
-                         ::testing::Values(RealModel{"bunny", 2826, 5648, 0, false},
-                                           RealModel{"suzi", 7503, 14842, 0, false},
-                                           RealModel{"pmndrs", 1074, 1552, 1, true}),
-                         [](const auto& info) { return std::string(info.param.name); });
+INSTANTIATE_TEST_SUITE_P(
+    Mesh, MeshRealModel,
+    // pmndrs stores one truly zero-area triangle (three collinear corners along z at x=-1.505, y=0.995).
+    ::testing::Values(RealModel{"bunny", 2826, 5648, 0, false}, RealModel{"suzi", 7503, 14842, 0, false},
+                      RealModel{"pmndrs", 1074, 1552, 1, true}),
+    [](const auto& info) { return std::string(info.param.name); });
 
 TEST(MeshBunny, BoundsMatchTheAccessorMinMax) {
   const auto path = testing::assets_dir() / "models" / "bunny.glb";
@@ -183,7 +183,7 @@ TEST(MeshObj, DegenerateTrianglesAreDroppedAndCounted) {
   write_text(path,
              "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\n"
              "f 1 2 3\n"
-             "f 1 2 4\n"   // collinear: zero area
+             "f 1 2 4\n"    // collinear: zero area
              "f 1 1 3\n");  // repeated corner
   MeshLoadReport report;
   const Mesh mesh = load_mesh(path, &report);
@@ -274,31 +274,29 @@ std::string triangle_json(bool normals, std::size_t buffer_bytes, const std::str
   const std::string uri = buffer_uri.empty() ? "" : "\"uri\": \"" + buffer_uri + "\", ";
   std::string attributes = normals ? "{\"POSITION\": 0, \"NORMAL\": 2}" : "{\"POSITION\": 0}";
   const std::size_t index_offset = normals ? 72 : 36;
-  std::string json = "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0, 2]}],"
-                     "\"nodes\": ["
-                     "{\"mesh\": 0, \"translation\": [10, 0, 0], \"children\": [1]},"
-                     "{\"mesh\": 0, \"matrix\": [0,0,-1,0, 0,1,0,0, 1,0,0,0, 0,0,0,1]},"
-                     "{\"mesh\": 0, \"scale\": [-1, 1, 1]}],"
-                     "\"meshes\": [{\"primitives\": [{\"attributes\": " +
-                     attributes +
-                     ", \"indices\": 1, \"mode\": 4}]}],"
-                     "\"buffers\": [{" +
-                     uri + "\"byteLength\": " + std::to_string(buffer_bytes) +
-                     "}],"
-                     "\"bufferViews\": ["
-                     "{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 36},"
-                     "{\"buffer\": 0, \"byteOffset\": " +
-                     std::to_string(index_offset) +
-                     ", \"byteLength\": 6}" +
-                     (normals ? ", {\"buffer\": 0, \"byteOffset\": 36, \"byteLength\": 36}" : "") +
-                     "],"
-                     "\"accessors\": ["
-                     "{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\","
-                     " \"min\": [0,0,0], \"max\": [1,1,0]},"
-                     "{\"bufferView\": 1, \"componentType\": 5123, \"count\": 3, \"type\": \"SCALAR\"}" +
-                     (normals ? ", {\"bufferView\": 2, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\"}"
-                              : "") +
-                     "]}";
+  std::string json =
+      "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0, 2]}],"
+      "\"nodes\": ["
+      "{\"mesh\": 0, \"translation\": [10, 0, 0], \"children\": [1]},"
+      "{\"mesh\": 0, \"matrix\": [0,0,-1,0, 0,1,0,0, 1,0,0,0, 0,0,0,1]},"
+      "{\"mesh\": 0, \"scale\": [-1, 1, 1]}],"
+      "\"meshes\": [{\"primitives\": [{\"attributes\": " +
+      attributes +
+      ", \"indices\": 1, \"mode\": 4}]}],"
+      "\"buffers\": [{" +
+      uri + "\"byteLength\": " + std::to_string(buffer_bytes) +
+      "}],"
+      "\"bufferViews\": ["
+      "{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 36},"
+      "{\"buffer\": 0, \"byteOffset\": " +
+      std::to_string(index_offset) + ", \"byteLength\": 6}" +
+      (normals ? ", {\"buffer\": 0, \"byteOffset\": 36, \"byteLength\": 36}" : "") +
+      "],"
+      "\"accessors\": ["
+      "{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\","
+      " \"min\": [0,0,0], \"max\": [1,1,0]},"
+      "{\"bufferView\": 1, \"componentType\": 5123, \"count\": 3, \"type\": \"SCALAR\"}" +
+      (normals ? ", {\"bufferView\": 2, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\"}" : "") + "]}";
   return json;
 }
 
@@ -398,9 +396,7 @@ TEST(MeshGltf, TruncatedBufferIsAOneLineError) {
   expect_one_line_naming(msg, path);
 }
 
-TEST(MeshBounds, EmptyMeshHasEmptyBounds) {
-  EXPECT_TRUE(Mesh{}.bounds().isEmpty());
-}
+TEST(MeshBounds, EmptyMeshHasEmptyBounds) { EXPECT_TRUE(Mesh{}.bounds().isEmpty()); }
 
 }  // namespace
 }  // namespace rsibr

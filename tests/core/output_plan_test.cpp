@@ -32,7 +32,9 @@ class OutputPlanTest : public ::testing::Test {
     std::ofstream(dir_ / "in.exr") << "input";
   }
   void TearDown() override { fs::remove_all(dir_); }
-  std::size_t entries() const { return std::size_t(std::distance(fs::directory_iterator(dir_), fs::directory_iterator())); }
+  std::size_t entries() const {
+    return std::size_t(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()));
+  }
   fs::path dir_;
 };
 
@@ -76,14 +78,16 @@ TEST_F(OutputPlanTest, AnOutputThatIsAnInputIsRefusedByIdentityNotSpelling) {
 TEST_F(OutputPlanTest, TwoOutputsThatAreOneFileAreRefused) {
   OutputPlan plan;
   plan.file((dir_ / "a.json").string());
-  EXPECT_NE(error_of([&] { plan.file((dir_ / "sub" / ".." / "a.json").string()); }).find("named twice"), std::string::npos);
+  EXPECT_NE(error_of([&] { plan.file((dir_ / "sub" / ".." / "a.json").string()); }).find("named twice"),
+            std::string::npos);
   plan.folder((dir_ / "pictures").string());
   EXPECT_NE(error_of([&] { plan.file((dir_ / "pictures").string()); }).find("named twice"), std::string::npos);
 }
 
 TEST_F(OutputPlanTest, MissingFoldersFoldersAndFifosAreRefusedBeforeAnyWork) {
   OutputPlan plan;
-  EXPECT_NE(error_of([&] { plan.file((dir_ / "nofolder" / "a.json").string()); }).find("does not exist"), std::string::npos);
+  EXPECT_NE(error_of([&] { plan.file((dir_ / "nofolder" / "a.json").string()); }).find("does not exist"),
+            std::string::npos);
   EXPECT_NE(error_of([&] { plan.file((dir_ / "sub").string()); }).find("is a folder"), std::string::npos);
   ASSERT_EQ(::mkfifo((dir_ / "pipe.json").c_str(), 0600), 0);
   EXPECT_NE(error_of([&] { plan.file((dir_ / "pipe.json").string()); }).find("not a regular file"), std::string::npos);

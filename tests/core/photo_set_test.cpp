@@ -101,7 +101,8 @@ TEST_F(PhotoSetTest, ExposuresFrom1Over32000To60SecondsRoundTripExactly) {
   s.views.push_back(v);
   save_photo_set(s);
   const PhotoSet r = load_photo_set(dir_);
-  for (std::size_t i = 0; i < v.brackets.size(); ++i) EXPECT_EQ(*r.views[0].brackets[i].exposure_s, *v.brackets[i].exposure_s);
+  for (std::size_t i = 0; i < v.brackets.size(); ++i)
+    EXPECT_EQ(*r.views[0].brackets[i].exposure_s, *v.brackets[i].exposure_s);
 }
 
 TEST_F(PhotoSetTest, BadInputNamesTheFileAndTheKey) {
@@ -116,7 +117,8 @@ TEST_F(PhotoSetTest, BadInputNamesTheFileAndTheKey) {
       {"rsibr_photoset: 1\nviews: [{name: v0, brackets: [{file: v0/a.png}]}, {name: v0, brackets: [{file: v0/b.png}]}]\n",
        "photoset.views[1].name: duplicate view name 'v0'"},
       {"rsibr_photoset: 1\nviews: [{name: v0, brackets: []}]\n", "photoset.views[0].brackets: expected a non-empty"},
-      {"rsibr_photoset: 2\nviews: [{name: v0, brackets: [{file: v0/a.png}]}]\n", "photoset.rsibr_photoset: unsupported"},
+      {"rsibr_photoset: 2\nviews: [{name: v0, brackets: [{file: v0/a.png}]}]\n",
+       "photoset.rsibr_photoset: unsupported"},
       {"rsibr_photoset: 1\nballs: [{name: b, kind: copper}]\nviews: [{name: v0, brackets: [{file: v0/a.png}]}]\n",
        "photoset.balls[0].kind: unknown value 'copper'"},
       {"rsibr_photoset: 1\nviews: [{name: v0, brackets: [{file: v0/a.png}]}]\nchessboards: {corners: [1, 7], spacing_m: 0.03, files: [board0.png]}\n",
@@ -168,7 +170,9 @@ TEST_F(PhotoSetTest, ViewAndBallNamesThatAreNotSafeFileNamesAreRefusedNamingTheF
 
 TEST_F(PhotoSetTest, ACameraNameThatIsNotUtf8IsKeptWithItsBadBytesReplaced) {
   // A Latin-1 byte (0xE9) in the raw file: not UTF-8.
-  write("rsibr_photoset: 1\ncamera: {name: \"Caf\xE9" " cam\"}\nviews: [{name: v0, brackets: [{file: v0/a.png}]}]\n");
+  write(
+      "rsibr_photoset: 1\ncamera: {name: \"Caf\xE9"
+      " cam\"}\nviews: [{name: v0, brackets: [{file: v0/a.png}]}]\n");
   const PhotoSet s = load_photo_set(dir_);
   EXPECT_TRUE(is_utf8(s.camera_name)) << s.camera_name;
   EXPECT_NE(s.camera_name.find("cam"), std::string::npos);

@@ -50,12 +50,14 @@ TEST(PreviewExposure, NothingToMeterGivesZeroAndBadInputIsAnError) {
   EXPECT_EQ(preview_exposure(cv::Mat(8, 8, CV_32FC3, cv::Scalar::all(0))), 0.f);
   EXPECT_EQ(preview_exposure(cv::Mat()), 0.f);
   EXPECT_THROW(preview_exposure(cv::Mat(8, 8, CV_8UC3)), std::invalid_argument);
-  EXPECT_THROW(preview_exposure(cv::Mat(8, 8, CV_32FC3, cv::Scalar::all(1)), cv::Mat(4, 4, CV_8UC1)), std::invalid_argument);
+  EXPECT_THROW(preview_exposure(cv::Mat(8, 8, CV_32FC3, cv::Scalar::all(1)), cv::Mat(4, 4, CV_8UC1)),
+               std::invalid_argument);
 }
 
 TEST(PreviewExposure, PanelsShownTogetherAreMeteredTogether) {
   const cv::Mat dark(10, 10, CV_32FC3, cv::Scalar::all(0.045)), bright(10, 30, CV_32FC3, cv::Scalar::all(0.72));
-  EXPECT_NEAR(preview_exposure(std::vector<cv::Mat>{dark, bright}), -2.0, 1e-6);  // 300 of 400 pixels are the bright panel
+  EXPECT_NEAR(preview_exposure(std::vector<cv::Mat>{dark, bright}), -2.0,
+              1e-6);  // 300 of 400 pixels are the bright panel
   // Large pictures are read on a grid: the same answer as every pixel for a smooth image.
   cv::Mat big(2048, 1024, CV_32FC3);
   for (int y = 0; y < big.rows; ++y) big.row(y).setTo(cv::Scalar::all(0.01 + 0.001 * y));

@@ -38,7 +38,8 @@ TEST(Resample, ConstantEnvironmentStaysConstantInEveryLayout) {
             EXPECT_EQ(p[0], 0.f);  // outside a sphere map's disc
             continue;
           }
-          ASSERT_NEAR(p[0], 1.7f, 2e-6f) << to_string(from.kind()) << "->" << to_string(to.kind()) << " " << c << "," << r;
+          ASSERT_NEAR(p[0], 1.7f, 2e-6f) << to_string(from.kind()) << "->" << to_string(to.kind()) << " " << c << ","
+                                         << r;
           ASSERT_NEAR(p[2], 30.f, 4e-5f);
         }
     }
@@ -113,8 +114,8 @@ TEST(Resample, SamplingIsContinuousAcrossSeamsFoldsAndTheRim) {
   for (const Layout& L : targets()) {
     const EnvMap map = render_pattern(f, L, 1);
     const double texel = std::sqrt(4 * kPi / L.texel_count());
-    std::vector<Vec3> probes = {Vec3(0, 0, -1), Vec3(0, 1, 0), Vec3(0, -1, 0), Vec3(1, 1, 0), Vec3(1, 1, 1),
-                                Vec3(-1, -1, 1), Vec3(1, -1, -1), Vec3(0.5, -0.2, -1)};
+    std::vector<Vec3> probes = {Vec3(0, 0, -1), Vec3(0, 1, 0),   Vec3(0, -1, 0),  Vec3(1, 1, 0),
+                                Vec3(1, 1, 1),  Vec3(-1, -1, 1), Vec3(1, -1, -1), Vec3(0.5, -0.2, -1)};
     std::mt19937 rng(2);
     std::normal_distribution<double> n;
     for (const Vec3& p0 : probes)
@@ -162,7 +163,8 @@ TEST(Resample, RoundTripThroughEveryLayoutKeepsTheIntegralOfRealEnvironments) {
 
 TEST(MipPyramid, NestedLevelsKeepTheEnergyExactly) {
   // Sizes that nest from the start: every level has level 0's energy to rounding.
-  const auto sky = patterns::sun_and_sky(Vec3(0.2, 0.5, 0.6), 0.01, Vec3(5e3, 5e3, 5e3), Vec3(0.2, 0.4, 1), Vec3(1, 1, 1));
+  const auto sky =
+      patterns::sun_and_sky(Vec3(0.2, 0.5, 0.6), 0.01, Vec3(5e3, 5e3, 5e3), Vec3(0.2, 0.4, 1), Vec3(1, 1, 1));
   for (const Layout& L : {Layout(LayoutKind::LatLong, 257, 129), Layout::with_size(LayoutKind::Cube, 65),
                           Layout::with_size(LayoutKind::Octahedral, 128), Layout::with_size(LayoutKind::Sphere, 128)}) {
     const EnvMap base = render_pattern(sky, L, 4);
@@ -177,7 +179,8 @@ TEST(MipPyramid, NestedLevelsKeepTheEnergyExactly) {
 }
 
 TEST(MipPyramid, UnnestedBaseIsResampledOnceThenReducedExactly) {
-  const auto sky = patterns::sun_and_sky(Vec3(0.2, 0.5, 0.6), 0.01, Vec3(5e3, 5e3, 5e3), Vec3(0.2, 0.4, 1), Vec3(1, 1, 1));
+  const auto sky =
+      patterns::sun_and_sky(Vec3(0.2, 0.5, 0.6), 0.01, Vec3(5e3, 5e3, 5e3), Vec3(0.2, 0.4, 1), Vec3(1, 1, 1));
   for (const Layout& L : {Layout::with_size(LayoutKind::LatLong, 256), Layout::with_size(LayoutKind::Cube, 64),
                           Layout::with_size(LayoutKind::Octahedral, 90), Layout::with_size(LayoutKind::Sphere, 100)}) {
     const MipPyramid pyr(render_pattern(sky, L, 4));
@@ -186,7 +189,8 @@ TEST(MipPyramid, UnnestedBaseIsResampledOnceThenReducedExactly) {
     EXPECT_LT(max_relative_change(integral(pyr.level(0)), first), 1e-3) << to_string(L.kind());
     for (int i = 2; i < pyr.levels(); ++i)
       EXPECT_LT(max_relative_change(first, integral(pyr.level(i))), 1e-6)
-          << to_string(L.kind()) << " level " << i << " " << pyr.level(i).layout.width() << "x" << pyr.level(i).layout.height();
+          << to_string(L.kind()) << " level " << i << " " << pyr.level(i).layout.width() << "x"
+          << pyr.level(i).layout.height();
   }
 }
 

@@ -28,9 +28,9 @@ TEST(SafeName, NamesOfLettersDigitsDotsDashesAndUnderscoresAreSafe) {
 
 TEST(SafeName, EveryNameThatCouldLeaveTheFolderOrHideIsRefused) {
   const std::string nul("a\0b", 3);
-  for (const std::string& name : std::vector<std::string>{"", ".", "..", "../x", "../../esc/stolen", "/abs", "a/b", "a\\b", ".hidden", "-v",
-                                 "_x", "a b", "a\tb", nul, "caf\xC3\xA9", "\xFF", "x:y", "<script>",
-                                 std::string(kMaxNameLength + 1, 'x')})
+  for (const std::string& name : std::vector<std::string>{
+           "", ".", "..", "../x", "../../esc/stolen", "/abs", "a/b", "a\\b", ".hidden", "-v", "_x", "a b", "a\tb", nul,
+           "caf\xC3\xA9", "\xFF", "x:y", "<script>", std::string(kMaxNameLength + 1, 'x')})
     EXPECT_NE(name_problem(name), "") << quoted_for_message(name);
 }
 
@@ -48,8 +48,9 @@ TEST(SafeName, DistinctNamesRefuseDuplicatesAndNamesEqualUpToLetterCase) {
   DistinctNames names;
   names.add("North", "f: views[0].name", "view");
   names.add("south", "f: views[1].name", "view");
-  EXPECT_NE(error_of([&] { names.add("north", "f: views[2].name", "view"); })
-                .find("f: views[2].name: view name 'north' clashes with 'North'"),
+  EXPECT_NE(error_of([&] {
+              names.add("north", "f: views[2].name", "view");
+            }).find("f: views[2].name: view name 'north' clashes with 'North'"),
             std::string::npos);
   EXPECT_NE(error_of([&] { names.add("south", "f: views[3].name", "view"); }).find("duplicate view name 'south'"),
             std::string::npos);
@@ -73,7 +74,9 @@ TEST(Utf8, IllFormedSequencesAreEachReplacedByOneReplacementCharacter) {
       {"\xC0\xAF", fffd + fffd},
       {"\xED\xA0\x80", fffd + fffd + fffd},
       {"\xF4\x90\x80\x80", fffd + fffd + fffd + fffd},
-      {"\x80" "a", fffd + "a"},
+      {"\x80"
+       "a",
+       fffd + "a"},
   };
   for (const auto& [in, out] : cases) {
     EXPECT_FALSE(is_utf8(in)) << quoted_for_message(in);
@@ -89,8 +92,10 @@ TEST(Utf8, ValidUtf8OfAnyBytesIsWellFormedAndKeepsItsAsciiBytes) {
     const std::string v = valid_utf8(s);
     EXPECT_TRUE(is_utf8(v)) << quoted_for_message(s);
     std::string ascii_in, ascii_out;
-    for (char c : s) if (static_cast<unsigned char>(c) < 0x80) ascii_in += c;
-    for (char c : v) if (static_cast<unsigned char>(c) < 0x80) ascii_out += c;
+    for (char c : s)
+      if (static_cast<unsigned char>(c) < 0x80) ascii_in += c;
+    for (char c : v)
+      if (static_cast<unsigned char>(c) < 0x80) ascii_out += c;
     EXPECT_EQ(ascii_in, ascii_out);
   }
 }
@@ -119,7 +124,8 @@ TEST_F(FileInFolderTest, AFileNameGivesAPathDirectlyInTheFolder) {
 }
 
 TEST_F(FileInFolderTest, NamesWithFoldersOrFolderReferencesAreRefused) {
-  for (const std::string& name : std::vector<std::string>{"", ".", "..", "../x.exr", "a/b.exr", "/etc/x", std::string("a\0b", 3)})
+  for (const std::string& name :
+       std::vector<std::string>{"", ".", "..", "../x.exr", "a/b.exr", "/etc/x", std::string("a\0b", 3)})
     EXPECT_NE(error_of([&] { file_in_folder(dir_ / "out", name); }), "") << quoted_for_message(name);
 }
 

@@ -137,8 +137,8 @@ std::array<double, 3> paper_weights(const Vec3& p, const Vec3& a, const Vec3& b,
 // Solid angle of the spherical triangle that is the central projection of the planar triangle
 // (P, Q, R) lying in the plane of (a, b, c), by midpoint quadrature of dOmega = det(a,b,c)/|x|^3
 // du dv over a fine subdivision (x = a + u (b - a) + v (c - a)). Independent of the atan2 formula.
-double numerical_solid_angle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec2& P, const Vec2& Q,
-                             const Vec2& R, int n) {
+double numerical_solid_angle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec2& P, const Vec2& Q, const Vec2& R,
+                             int n) {
   const double D = det3(a, b, c);
   const Vec3 eu = b - a, ev = c - a;
   const double jac = std::abs((Q - P).x() * (R - P).y() - (Q - P).y() * (R - P).x()) / 2.0;
@@ -259,8 +259,7 @@ TEST(ViewSet, ConstructorRejectsBadViews) {
   EXPECT_THROW(ViewSet(std::vector<Vec3>{}), std::invalid_argument);
   EXPECT_THROW(ViewSet({Vec3(1, 0, 0), Vec3(0, 0, 0)}), std::invalid_argument);
   EXPECT_THROW(ViewSet({Vec3(1, 0, 0), Vec3(0, std::nan(""), 1)}), std::invalid_argument);
-  EXPECT_THROW(ViewSet({Vec3(1, 0, 0), Vec3(0, std::numeric_limits<double>::infinity(), 1)}),
-               std::invalid_argument);
+  EXPECT_THROW(ViewSet({Vec3(1, 0, 0), Vec3(0, std::numeric_limits<double>::infinity(), 1)}), std::invalid_argument);
   try {
     ViewSet({Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(2, 1e-12, 0)});
     ADD_FAILURE() << "coincident views accepted";
@@ -503,8 +502,15 @@ TEST(Barycentric, WeightsAreFiniteAtVerticesEdgesAndInTinyTriangles) {
       }
       const Vec3 &a = v[0], &b = v[1], &c = v[2];
       ASSERT_GT(det3(a, b, c), 0.0);
-      std::vector<Vec3> probes = {a, b, c, (a + b).normalized(), (b + c).normalized(), (c + a).normalized(),
-                                  (a + b + c).normalized(), (0.25 * a + 0.75 * c).normalized(), centre};
+      std::vector<Vec3> probes = {a,
+                                  b,
+                                  c,
+                                  (a + b).normalized(),
+                                  (b + c).normalized(),
+                                  (c + a).normalized(),
+                                  (a + b + c).normalized(),
+                                  (0.25 * a + 0.75 * c).normalized(),
+                                  centre};
       for (int i = 0; i < 20; ++i) {
         const double x = u01(rng), y = u01(rng), z = u01(rng);
         probes.push_back((x * a + y * b + z * c).normalized());
@@ -585,8 +591,8 @@ TEST(Barycentric, SolidAngleWeightsJumpAcrossEdgesOfUnequalTriangles) {
   const auto g1 = triangle_weights(q, a, b, c, Barycentric::Gnomonic);
   const auto g2 = triangle_weights(q, c, b, d, Barycentric::Gnomonic);
   const double gnomonic_jump = std::max(std::abs(g1[1] - g2[1]), std::abs(g1[2] - g2[0]));
-  std::cout << "[ measured ] SolidAngle jump on the constructed pair: " << solid_jump
-            << ", Gnomonic: " << gnomonic_jump << "\n";
+  std::cout << "[ measured ] SolidAngle jump on the constructed pair: " << solid_jump << ", Gnomonic: " << gnomonic_jump
+            << "\n";
   EXPECT_GT(solid_jump, 1e-3) << "SolidAngle weights of unequal neighbours should disagree on the edge";
   EXPECT_LT(gnomonic_jump, 1e-14);
   EXPECT_NEAR(s1[0], 0.0, 1e-15);
@@ -654,9 +660,12 @@ TEST(Barycentric, SolidAngleWeightsMatchNumericalSolidAngles) {
     for (int i = 0; i < 400000; ++i) {
       const Vec3 d = random_dir(r2);
       if (!(d.x() > 0 && d.y() > 0 && d.z() > 0)) continue;
-      if (det3(d, b, c) >= 0 && det3(p, d, c) >= 0 && det3(p, b, d) >= 0) ++counts[0];        // (p,b,c)
-      else if (det3(d, p, c) >= 0 && det3(a, d, c) >= 0 && det3(a, p, d) >= 0) ++counts[1];   // (a,p,c)
-      else ++counts[2];                                                                       // (a,b,p)
+      if (det3(d, b, c) >= 0 && det3(p, d, c) >= 0 && det3(p, b, d) >= 0)
+        ++counts[0];  // (p,b,c)
+      else if (det3(d, p, c) >= 0 && det3(a, d, c) >= 0 && det3(a, p, d) >= 0)
+        ++counts[1];  // (a,p,c)
+      else
+        ++counts[2];  // (a,b,p)
     }
     const double n = counts[0] + counts[1] + counts[2];
     const auto w = triangle_weights(p, a, b, c, Barycentric::SolidAngle);
@@ -706,7 +715,8 @@ TEST(Barycentric, PaperAcosFormulaFailsWhereOursDoesNot) {
       ours_rel = std::max(ours_rel, std::abs(ours - exact) / exact);
       // triangle_weights (Gnomonic) at p = normalise(a + 2b + 3c): exactly (1, 2, 3)/6 in exact arithmetic.
       const auto w = triangle_weights((v[0] + 2 * v[1] + 3 * v[2]).normalized(), v[0], v[1], v[2]);
-      gnomonic_err = std::max({gnomonic_err, std::abs(w[0] - 1.0 / 6), std::abs(w[1] - 2.0 / 6), std::abs(w[2] - 3.0 / 6)});
+      gnomonic_err =
+          std::max({gnomonic_err, std::abs(w[0] - 1.0 / 6), std::abs(w[1] - 2.0 / 6), std::abs(w[2] - 3.0 / 6)});
       for (const Barycentric kind : {Barycentric::Gnomonic, Barycentric::SolidAngle})
         for (double wi : triangle_weights(v[0], v[0], v[1], v[2], kind)) EXPECT_TRUE(std::isfinite(wi));
       for (double wi : triangle_weights((v[0] + v[1]).normalized(), v[0], v[1], v[2], Barycentric::SolidAngle))
@@ -754,7 +764,10 @@ Vec3 nearest_boundary_point(const ViewSet& set, const Vec3& p) {
     double lo = std::max(0.0, (bi - 1.0) / N), hi = std::min(1.0, (bi + 1.0) / N);
     for (int it = 0; it < 100; ++it) {
       const double m1 = lo + (hi - lo) * 0.382, m2 = lo + (hi - lo) * 0.618;
-      if (dist(m1) < dist(m2)) hi = m2; else lo = m1;
+      if (dist(m1) < dist(m2))
+        hi = m2;
+      else
+        lo = m1;
     }
     const double s = 0.5 * (lo + hi);
     if (dist(s) < best_d) {
@@ -799,8 +812,9 @@ TEST(ViewSet, HemisphereSetDoesNotSurroundAndOutsideIsProjected) {
   const Vec3 p = from_elev_azim(-10, 20);
   const ViewWeights ws = set.locate(p, Barycentric::SolidAngle);
   EXPECT_FALSE(ws.inside);
-  EXPECT_LT(max_abs_diff(scatter(ws, n), scatter(set.locate(nearest_boundary_point(set, p), Barycentric::SolidAngle), n)),
-            1e-6);
+  EXPECT_LT(
+      max_abs_diff(scatter(ws, n), scatter(set.locate(nearest_boundary_point(set, p), Barycentric::SolidAngle), n)),
+      1e-6);
 }
 
 TEST(ViewSet, OutsideWeightsAreContinuousAtTheBoundary) {
@@ -1002,8 +1016,9 @@ TEST(ViewSet, NoNaNAnywhere) {
       {"small circle", small_circle_views()},
       {"hemisphere", hemisphere_views()},
       {"random 20", random_dirs(20, 5)},
-      {"clustered", {from_elev_azim(0, 0), from_elev_azim(0.01, 0), from_elev_azim(0, 0.01), from_elev_azim(0.01, 0.01),
-                     from_elev_azim(0.005, 0.004)}},
+      {"clustered",
+       {from_elev_azim(0, 0), from_elev_azim(0.01, 0), from_elev_azim(0, 0.01), from_elev_azim(0.01, 0.01),
+        from_elev_azim(0.005, 0.004)}},
       {"geodesic 1", ViewSet::geodesic(1).views()},
   };
   const std::vector<Vec3> probes = random_dirs(5000, 6);

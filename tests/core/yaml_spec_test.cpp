@@ -37,8 +37,11 @@ TEST(ParseYaml, AliasesThatExpandToBillionsOfNodesAreRefused) {
 }
 
 TEST(ParseYaml, NestingDeeperThanTheLimitIsRefusedAndShallowerIsKept) {
-  const auto nested = [](int depth) { return std::string(std::size_t(depth), '[') + std::string(std::size_t(depth), ']'); };
-  EXPECT_NE(error_of([&] { parse_yaml(nested(kMaxYamlDepth + 1), "deep.yaml"); }).find("nested deeper than"), std::string::npos);
+  const auto nested = [](int depth) {
+    return std::string(std::size_t(depth), '[') + std::string(std::size_t(depth), ']');
+  };
+  EXPECT_NE(error_of([&] { parse_yaml(nested(kMaxYamlDepth + 1), "deep.yaml"); }).find("nested deeper than"),
+            std::string::npos);
   EXPECT_EQ(error_of([&] { parse_yaml(nested(kMaxYamlDepth - 1), "deep.yaml"); }), "");
 }
 

@@ -70,7 +70,7 @@ TEST(ExposureMetadata, MissingExposureIsAnErrorNamingTheFile) {
 
 TEST(BracketSet, LoadsAViewSortedByExposureInRgbOrder) {
   testing::TempDir dir;
-  cv::imwrite(dir.file("long.png"), cv::Mat(6, 5, CV_8UC3, cv::Scalar(30, 20, 10)));   // BGR on disk
+  cv::imwrite(dir.file("long.png"), cv::Mat(6, 5, CV_8UC3, cv::Scalar(30, 20, 10)));  // BGR on disk
   cv::imwrite(dir.file("short.png"), cv::Mat(6, 5, CV_8UC3, cv::Scalar(3, 2, 1)));
   std::ofstream(dir.file("photoset.yaml")) << "rsibr_photoset: 1\nviews:\n  - name: v\n    brackets:\n"
                                               "      - {file: long.png, exposure_s: 0.1}\n"

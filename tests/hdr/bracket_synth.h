@@ -17,8 +17,8 @@ namespace rsibr::testing {
 
 struct BracketCamera {
   std::function<double(int channel, double X)> response = [](int, double X) { return X; };  // [0,1] -> [0,1]
-  double gain = 1.0;        // k
-  double full_well = 2e4;   // electrons at X = 1 (0: no shot noise)
+  double gain = 1.0;                                                                        // k
+  double full_well = 2e4;  // electrons at X = 1 (0: no shot noise)
   double read_sigma = 1.5e-4;
   int max_code = 65535;
   double shot() const { return full_well > 0 ? 1.0 / full_well : 0.0; }
@@ -43,15 +43,19 @@ inline std::vector<cv::Mat> synthesize(const cv::Mat& radiance, const std::vecto
           if (cam.full_well > 0) {
             const double mean = X * cam.full_well;
             double electrons;
-            if (mean > 1e5) electrons = mean + std::sqrt(mean) * gauss(rng);  // Poisson ~ normal; past saturation anyway
-            else electrons = double(std::poisson_distribution<long>(mean)(rng));
+            if (mean > 1e5)
+              electrons = mean + std::sqrt(mean) * gauss(rng);  // Poisson ~ normal; past saturation anyway
+            else
+              electrons = double(std::poisson_distribution<long>(mean)(rng));
             Xn = electrons / cam.full_well;
           }
           Xn += cam.read_sigma * gauss(rng);
           Xn = std::clamp(Xn, 0.0, 1.0);
           const double code = std::round(std::clamp(cam.response(c, Xn), 0.0, 1.0) * cam.max_code);
-          if (cam.max_code == 255) codes.at<cv::Vec3b>(r, x)[c] = static_cast<unsigned char>(code);
-          else codes.at<cv::Vec3w>(r, x)[c] = static_cast<std::uint16_t>(code);
+          if (cam.max_code == 255)
+            codes.at<cv::Vec3b>(r, x)[c] = static_cast<unsigned char>(code);
+          else
+            codes.at<cv::Vec3w>(r, x)[c] = static_cast<std::uint16_t>(code);
         }
     out.push_back(codes);
   }

@@ -32,11 +32,11 @@
 namespace rsibr::testing {
 
 struct ShootSpec {
-  std::string env;              // an environment file (lat-long EXR)
+  std::string env;  // an environment file (lat-long EXR)
   int width = 320, height = 160, views = 3;
   int brackets = 7;
-  double step_ev = 2.0;         // between brackets
-  int jpeg_quality = 0;         // 0: PNG (lossless 8-bit codes), else JPEG at this quality
+  double step_ev = 2.0;  // between brackets
+  int jpeg_quality = 0;  // 0: PNG (lossless 8-bit codes), else JPEG at this quality
   std::uint64_t seed = 1;
   std::string response = "filmic";
   CameraProcessing processing = realistic_processing();
@@ -53,11 +53,11 @@ struct ShootSpec {
 
 struct Shoot {
   std::vector<BracketSet> views;
-  std::vector<cv::Mat> truth;     // per view, CV_32FC3: the merge's X / e for a perfect curve
-  std::vector<cv::Mat> clipped;   // per view, CV_8UC1: bit c set where channel c clips in the shortest bracket
-  cv::Rect patch;                 // the neutral patch (view 0)
+  std::vector<cv::Mat> truth;    // per view, CV_32FC3: the merge's X / e for a perfect curve
+  std::vector<cv::Mat> clipped;  // per view, CV_8UC1: bit c set where channel c clips in the shortest bracket
+  cv::Rect patch;                // the neutral patch (view 0)
   std::vector<double> exposures;
-  double k = 1;                   // electrons per unit L e
+  double k = 1;  // electrons per unit L e
 };
 
 inline Shoot shoot(const ShootSpec& s) {
@@ -108,11 +108,10 @@ inline Shoot shoot(const ShootSpec& s) {
   for (int j = 0; j < s.brackets; ++j) out.exposures.push_back(std::pow(2.0, s.step_ev * (j - (s.brackets - 1) / 2.0)));
   for (int v = 0; v < s.views; ++v) {
     std::vector<cv::Mat> codes;
-    for (int j = 0; j < s.brackets; ++j)
-    {
+    for (int j = 0; j < s.brackets; ++j) {
       cv::Mat eight;  // 8-bit images: make_brackets takes the code range from the depth
-      camera_bracket(L[std::size_t(v)], out.exposures[std::size_t(j)], noise, s.processing, response, 255, s.jpeg_quality,
-                     s.seed, std::uint64_t(1 + 64 * v + j))
+      camera_bracket(L[std::size_t(v)], out.exposures[std::size_t(j)], noise, s.processing, response, 255,
+                     s.jpeg_quality, s.seed, std::uint64_t(1 + 64 * v + j))
           .convertTo(eight, CV_8UC3);
       codes.push_back(eight);
     }
@@ -129,7 +128,8 @@ inline Shoot shoot(const ShootSpec& s) {
         const cv::Vec3f l = L[std::size_t(v)].at<cv::Vec3f>(y, x), o = t.at<cv::Vec3f>(y, x);
         unsigned char bits = 0;
         for (int ch = 0; ch < 3; ++ch)
-          if (g[ch] * s.processing.sensitivity[ch] * l[ch] * out.k * e0 / s.full_well >= 1 || o[ch] * e0 >= 1) bits |= 1 << ch;
+          if (g[ch] * s.processing.sensitivity[ch] * l[ch] * out.k * e0 / s.full_well >= 1 || o[ch] * e0 >= 1)
+            bits |= 1 << ch;
         clip.at<unsigned char>(y, x) = bits;
       }
     out.clipped.push_back(clip);
@@ -182,10 +182,13 @@ inline std::vector<cv::Mat> pixel_classes(const Shoot& sh) {
       for (int x = 0; x < k.cols; ++x) {
         const cv::Vec3f t = sh.truth[v].at<cv::Vec3f>(y, x);
         const double l = luminance(t);
-        if (sh.clipped[v].at<unsigned char>(y, x)) k.at<unsigned char>(y, x) = kClippedClass;
+        if (sh.clipped[v].at<unsigned char>(y, x))
+          k.at<unsigned char>(y, x) = kClippedClass;
         else if (!(t[0] > kGamutFloor * l && t[1] > kGamutFloor * l && t[2] > kGamutFloor * l))
-          k.at<unsigned char>(y, x) = kExcluded;  // (nearly) outside the output gamut: the camera clipped a channel at 0
-        else k.at<unsigned char>(y, x) = l < p10 ? kDark : l > p90 ? kBright : kMid;
+          k.at<unsigned char>(y, x) =
+              kExcluded;  // (nearly) outside the output gamut: the camera clipped a channel at 0
+        else
+          k.at<unsigned char>(y, x) = l < p10 ? kDark : l > p90 ? kBright : kMid;
       }
     out.push_back(k);
   }
@@ -230,7 +233,10 @@ inline ShootErrors shoot_errors(const std::vector<cv::Mat>& est, const Shoot& sh
         const int k = cls[v].at<unsigned char>(y, x);
         bool finite = true;
         for (int c = 0; c < 3; ++c) finite = finite && std::isfinite(a[c]);
-        if (!finite) { ++e.non_finite; continue; }
+        if (!finite) {
+          ++e.non_finite;
+          continue;
+        }
         if (k == kClippedClass) {
           // The lower bound is for the channels that saturated (the others are estimates).
           const int bits = sh.clipped[v].at<unsigned char>(y, x);

@@ -28,15 +28,15 @@ bool all_finite(const cv::Mat& m) { return cv::checkRange(m, true, nullptr, -FLT
 cv::Mat level_scene(const std::vector<double>& levels, int per_level) {
   cv::Mat L(per_level, int(levels.size()), CV_64FC3);
   for (int x = 0; x < L.cols; ++x)
-    for (int r = 0; r < L.rows; ++r)
-      L.at<cv::Vec3d>(r, x) = cv::Vec3d(0.9, 1.0, 1.1) * levels[std::size_t(x)];
+    for (int r = 0; r < L.rows; ++r) L.at<cv::Vec3d>(r, x) = cv::Vec3d(0.9, 1.0, 1.1) * levels[std::size_t(x)];
   return L;
 }
 
 // The noise-optimal variance of an unbiased combination: 1 / sum_j e_j^2 / var(X_j), over the
 // brackets that do not saturate (X = L e k; the merge's unit is X / e, so its truth is L k).
 // A bracket counts when its brightest channel (Lk_max) does not saturate: the merge's rule.
-double optimal_variance(double Lk, double Lk_max, const std::vector<double>& e, const BracketCamera& cam, double sat_X) {
+double optimal_variance(double Lk, double Lk_max, const std::vector<double>& e, const BracketCamera& cam,
+                        double sat_X) {
   double info = 0;
   for (double ej : e) {
     const double X = Lk * ej;
@@ -57,8 +57,8 @@ bool near_saturation(double Lk, const std::vector<double>& e, const BracketCamer
 }
 
 struct LevelStats {
-  double max_bias_sigmas = 0;   // worst |mean error| / standard error of the mean
-  double mse_over_bound = 0;    // mean over levels and channels of MSE / optimal variance
+  double max_bias_sigmas = 0;  // worst |mean error| / standard error of the mean
+  double mse_over_bound = 0;   // mean over levels and channels of MSE / optimal variance
   int levels_used = 0;
 };
 
@@ -123,8 +123,10 @@ TEST(Merge, WeightsFromTheMeasuredSignalAreBiasedLowAndThePilotPassRemovesIt) {
   const double sat_X = double(default_saturation_code(65535)) / 65535.0;
   MergeOptions naive;
   naive.pilot_pass = false;
-  const LevelStats with_pilot = level_stats(merge_brackets(b, ResponseCurve::identity(65535), true_noise(cam)), levels, e, cam, sat_X);
-  const LevelStats without = level_stats(merge_brackets(b, ResponseCurve::identity(65535), true_noise(cam), naive), levels, e, cam, sat_X);
+  const LevelStats with_pilot =
+      level_stats(merge_brackets(b, ResponseCurve::identity(65535), true_noise(cam)), levels, e, cam, sat_X);
+  const LevelStats without =
+      level_stats(merge_brackets(b, ResponseCurve::identity(65535), true_noise(cam), naive), levels, e, cam, sat_X);
   EXPECT_LT(with_pilot.max_bias_sigmas, 4.5);
   EXPECT_GT(without.max_bias_sigmas, 6.0);
 }
@@ -145,7 +147,7 @@ TEST(Merge, PixelsClippedInEveryBracketAreFlaggedAndNeverExceedTheTruth) {
       if (!sun) continue;
       for (int c = 0; c < 3; ++c) {
         const float v = m.radiance.at<cv::Vec3f>(r, x)[c];
-        EXPECT_LE(v, L.at<cv::Vec3d>(r, x)[c]);  // a lower bound, never invented
+        EXPECT_LE(v, L.at<cv::Vec3d>(r, x)[c]);   // a lower bound, never invented
         EXPECT_NEAR(v, 1.0 / e[0], 1e-3 / e[0]);  // exactly what the shortest bracket saw
       }
     }
@@ -226,8 +228,10 @@ TEST(Merge, SameInputsGiveTheSameBytes) {
   const cv::Mat L = testing::ramp_scene(40, 60, -2, 2);
   const BracketSet b = make_brackets(testing::synthesize(L, e, cam, 16), e);
   const BracketSet b2 = make_brackets(testing::synthesize(L, e, cam, 16), e);
-  const MergedImage m1 = merge_brackets(b, ResponseCurve::identity(65535), estimate_noise(b, ResponseCurve::identity(65535), 65209));
-  const MergedImage m2 = merge_brackets(b2, ResponseCurve::identity(65535), estimate_noise(b2, ResponseCurve::identity(65535), 65209));
+  const MergedImage m1 =
+      merge_brackets(b, ResponseCurve::identity(65535), estimate_noise(b, ResponseCurve::identity(65535), 65209));
+  const MergedImage m2 =
+      merge_brackets(b2, ResponseCurve::identity(65535), estimate_noise(b2, ResponseCurve::identity(65535), 65209));
   ASSERT_EQ(m1.radiance.total(), m2.radiance.total());
   EXPECT_EQ(std::memcmp(m1.radiance.data, m2.radiance.data, m1.radiance.total() * 12), 0);
   EXPECT_EQ(std::memcmp(m1.variance.data, m2.variance.data, m1.variance.total() * 12), 0);
@@ -301,7 +305,8 @@ TEST(Merge, GhostsAreFlaggedWhereTheSceneMovedAndRarelyElsewhere) {
     for (int x = 24; x < 40; ++x) {
       if (!(d.flags.at<unsigned char>(r, x) & kGhost)) continue;
       ++checked;
-      const double v = d.radiance.at<cv::Vec3f>(r, x)[1], a = L.at<cv::Vec3d>(r, x)[1], b = moved.at<cv::Vec3d>(r, x)[1];
+      const double v = d.radiance.at<cv::Vec3f>(r, x)[1], a = L.at<cv::Vec3d>(r, x)[1],
+                   b = moved.at<cv::Vec3d>(r, x)[1];
       const double sigma = std::sqrt(d.variance.at<cv::Vec3f>(r, x)[1]);
       if (std::abs(v - a) > 4.5 * sigma && std::abs(v - b) > 4.5 * sigma) ++blended;
       const double p = m.radiance.at<cv::Vec3f>(r, x)[1];  // the plain merge, same tolerance

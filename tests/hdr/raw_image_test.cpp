@@ -54,7 +54,8 @@ cv::Mat raw_codes(const cv::Mat& L, const Mat3& C, double e) {
       const cv::Vec3f p = L.at<cv::Vec3f>(y, x);
       const Vec3 cam = C * Vec3(p[0], p[1], p[2]) * e;
       for (int c = 0; c < 3; ++c)
-        codes.at<cv::Vec3w>(y, x)[c] = std::uint16_t(kBlackLevel + std::lround(std::clamp(cam[c], 0.0, 1.0) * (kWhiteLevel - kBlackLevel)));
+        codes.at<cv::Vec3w>(y, x)[c] =
+            std::uint16_t(kBlackLevel + std::lround(std::clamp(cam[c], 0.0, 1.0) * (kWhiteLevel - kBlackLevel)));
     }
   return codes;
 }
@@ -108,7 +109,9 @@ TEST(RawFiles, ADngOfKnownRadianceDevelopsToThatRadianceInLinearRec709) {
       const cv::Vec3f l = L.at<cv::Vec3f>(y, x);
       if (x >= 10 && x < 14) continue;  // the neutral strip's edge: a colour step the demosaic blurs
       for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(o[c] / 65535.0 / (k * l[c]) - 1));
-      if (x < 10) worst_neutral = std::max(worst_neutral, (std::max({o[0], o[1], o[2]}) - std::min({o[0], o[1], o[2]})) / double(o[1]));
+      if (x < 10)
+        worst_neutral =
+            std::max(worst_neutral, (std::max({o[0], o[1], o[2]}) - std::min({o[0], o[1], o[2]})) / double(o[1]));
     }
   EXPECT_LT(worst, 0.01);
   EXPECT_LT(worst_neutral, 0.005);
@@ -183,8 +186,8 @@ TEST(RawFiles, TheDevelopingStepMasksExactlyTheClippedNeighbourhood) {
   cv::Mat mask;
   const cv::Mat out = camera_to_output_codes(cam, Mat3::Identity(), mask);
   EXPECT_EQ(cv::countNonZero(mask), 25);
-  EXPECT_TRUE(mask.at<unsigned char>(8, 12));   // 2 px away: masked
-  EXPECT_FALSE(mask.at<unsigned char>(7, 10));  // 3 px away: not
+  EXPECT_TRUE(mask.at<unsigned char>(8, 12));                          // 2 px away: masked
+  EXPECT_FALSE(mask.at<unsigned char>(7, 10));                         // 3 px away: not
   EXPECT_EQ(out.at<cv::Vec3w>(10, 10), cv::Vec3w(65535, 2000, 3000));  // its clipped channel only
   EXPECT_EQ(out.at<cv::Vec3w>(8, 12), cv::Vec3w(1000, 2000, 3000));    // the ring keeps its values
   // The matrix: out of range is clamped (negative to 0, above the top to the top); a clipped
@@ -275,7 +278,8 @@ TEST(RawFiles, SynthesizedDngBracketsMergeToTheTrueRadianceWithTheIdentityRespon
   const std::string camera = ", format: dng, processing: {sensitivity: [0.5, 1, 0.7]}";
   // Metered, then exposed three stops brighter, so that the sun clips in every bracket.
   write_synth_capture(testing::small_scene(camera), dir.path() / "metered");
-  const double metered = YAML::LoadFile((dir.path() / "metered" / "truth" / "truth.yaml").string())["camera"]["gain"].as<double>();
+  const double metered =
+      YAML::LoadFile((dir.path() / "metered" / "truth" / "truth.yaml").string())["camera"]["gain"].as<double>();
   const SynthScene scene = testing::small_scene(camera + ", gain: " + std::to_string(8 * metered));
   write_synth_capture(scene, dir.path() / "out");
   const PhotoSet set = load_photo_set(dir.path() / "out" / "photos");

@@ -64,7 +64,8 @@ TEST(RealEnvironment, SunIsFlaggedAsALowerBoundAndMidTonesAreWithinFivePercent) 
   const ResponseCurve untied = true_curve;
   tie_channels(true_curve);
   cv::Vec3d balance;
-  for (int c = 0; c < 3; ++c) balance[c] = true_curve.knots[std::size_t(c)].back() / untied.knots[std::size_t(c)].back();
+  for (int c = 0; c < 3; ++c)
+    balance[c] = true_curve.knots[std::size_t(c)].back() / untied.knots[std::size_t(c)].back();
   truth.forEach<cv::Vec3d>([&](cv::Vec3d& p, const int*) {
     for (int c = 0; c < 3; ++c) p[c] *= balance[c];
   });
@@ -75,7 +76,8 @@ TEST(RealEnvironment, SunIsFlaggedAsALowerBoundAndMidTonesAreWithinFivePercent) 
   for (int r = 0; r < truth.rows; ++r)
     for (int x = 0; x < truth.cols; ++x) {
       const double l = luminance(truth.at<cv::Vec3d>(r, x));
-      if (l > 0.3 * median && l < 3 * median) ratios.push_back(l / luminance(cv::Vec3d(m.radiance.at<cv::Vec3f>(r, x))));
+      if (l > 0.3 * median && l < 3 * median)
+        ratios.push_back(l / luminance(cv::Vec3d(m.radiance.at<cv::Vec3f>(r, x))));
     }
   std::nth_element(ratios.begin(), ratios.begin() + long(ratios.size() / 2), ratios.end());
   const double scale = ratios[ratios.size() / 2];
@@ -89,7 +91,8 @@ TEST(RealEnvironment, SunIsFlaggedAsALowerBoundAndMidTonesAreWithinFivePercent) 
       const cv::Vec3f v = m.radiance.at<cv::Vec3f>(r, x);
       if (m.flags.at<unsigned char>(r, x) & kClipped) {
         ++clipped;
-        for (int c = 0; c < 3; ++c) EXPECT_LE(v[c] * scale, t[c] * 1.05) << "clipped pixel exceeds the truth at " << x << "," << r;
+        for (int c = 0; c < 3; ++c)
+          EXPECT_LE(v[c] * scale, t[c] * 1.05) << "clipped pixel exceeds the truth at " << x << "," << r;
         continue;
       }
       const double l = luminance(t);

@@ -83,7 +83,9 @@ class RealisticCamera : public ::testing::Test {
     if (!std::filesystem::exists(testing::assets_dir() / "hdri" / "park.exr")) GTEST_SKIP() << testing::kNoAssets;
   }
   // The two environments (a sunlit park, an interior) as PNG and as JPEG at quality 90.
-  static std::vector<std::tuple<std::string, int>> shoots() { return {{"park", 0}, {"park", 90}, {"lab", 0}, {"lab", 90}}; }
+  static std::vector<std::tuple<std::string, int>> shoots() {
+    return {{"park", 0}, {"park", 90}, {"lab", 0}, {"lab", 90}};
+  }
   static std::string name(const std::string& env, int q) { return env + (q ? " JPEG" : " PNG"); }
 };
 
@@ -91,8 +93,8 @@ TEST_F(RealisticCamera, ANeutralPatchStaysNeutralWithinTwoPercent) {
   for (const auto& [env, q] : shoots()) {
     const ShootRun& r = cached(env, q, 1);
     std::printf("%s: neutral patch R/G %.4f B/G %.4f, clipped at or below truth %.4f, ghosts %.5f, spread %.3f, %s\n",
-                name(env, q).c_str(), r.errors.patch_rg, r.errors.patch_bg, r.errors.clipped_at_or_below, r.ghost_fraction,
-                r.spread, r.recovery.chosen.c_str());
+                name(env, q).c_str(), r.errors.patch_rg, r.errors.patch_bg, r.errors.clipped_at_or_below,
+                r.ghost_fraction, r.spread, r.recovery.chosen.c_str());
     EXPECT_NEAR(r.errors.patch_rg, 1.0, 0.02) << name(env, q);
     EXPECT_NEAR(r.errors.patch_bg, 1.0, 0.02) << name(env, q);
   }
@@ -117,8 +119,10 @@ TEST_F(RealisticCamera, SaturationIsMeasuredBelowTheTopCodeForJpegAndAtItForPng)
     const SaturationLevel& s = cached(env, q, 1).recovery.saturation;
     EXPECT_EQ(s.source, "detected") << name(env, q);
     for (int c = 0; c < 3; ++c) {
-      if (q == 0) EXPECT_EQ(s.code[std::size_t(c)], default_saturation_code(255)) << name(env, q);
-      else EXPECT_LT(s.code[std::size_t(c)], default_saturation_code(255)) << name(env, q) << " channel " << c;
+      if (q == 0)
+        EXPECT_EQ(s.code[std::size_t(c)], default_saturation_code(255)) << name(env, q);
+      else
+        EXPECT_LT(s.code[std::size_t(c)], default_saturation_code(255)) << name(env, q) << " channel " << c;
       EXPECT_GT(s.code[std::size_t(c)], 200) << name(env, q);
     }
   }
@@ -163,7 +167,8 @@ TEST_F(RealisticCamera, TheCurveHasNoRippleAtTheExposureSteps) {
     for (int c = 0; c < 3; ++c) {
       const double mid = curve.linear(c, 127.5) / filmic.relative(0.5, c);
       double worst = 0;
-      for (int z = 16; z <= 240; ++z) worst = std::max(worst, std::abs(curve.linear(c, z) / filmic.relative(z / 255.0, c) / mid - 1));
+      for (int z = 16; z <= 240; ++z)
+        worst = std::max(worst, std::abs(curve.linear(c, z) / filmic.relative(z / 255.0, c) / mid - 1));
       EXPECT_LT(worst, 0.015) << name(env, q) << " channel " << c;
     }
   }
@@ -196,7 +201,8 @@ TEST_F(RealisticCamera, MidToneAndColourErrorsAreAtOrBelowOpenCVsInTheSameRun) {
       const testing::ShootErrors cv_errors = testing::shoot_errors(opencv_merge(r.shoot, robertson), r.shoot);
       const std::string who = name(env, q) + (robertson ? " vs OpenCV Robertson" : " vs OpenCV Debevec");
       std::printf("%s: mid-tone %.4f vs %.4f stops, colour ratio %.4f vs %.4f stops\n", who.c_str(),
-                  r.errors.stops[testing::kMid], cv_errors.stops[testing::kMid], r.errors.colour_stops, cv_errors.colour_stops);
+                  r.errors.stops[testing::kMid], cv_errors.stops[testing::kMid], r.errors.colour_stops,
+                  cv_errors.colour_stops);
       EXPECT_LE(r.errors.stops[testing::kMid], cv_errors.stops[testing::kMid]) << who;
       EXPECT_LE(r.errors.colour_stops, cv_errors.colour_stops) << who;
     }

@@ -19,8 +19,9 @@ using testing::BracketCamera;
 // Seven brackets two stops apart (the usual bracketing), or in irregular steps.
 BracketSet synth_set(const BracketCamera& cam, unsigned seed, bool irregular = false) {
   const cv::Mat L = testing::ramp_scene(96, 192, -3.5, 1.0);
-  const auto e = irregular ? std::vector<double>{1.0 / 64, 3.0 / 64, 10.0 / 64, 40.0 / 64, 110.0 / 64, 500.0 / 64, 1600.0 / 64}
-                           : testing::exposure_series(1.0 / 64, 4.0, 7);
+  const auto e =
+      irregular ? std::vector<double>{1.0 / 64, 3.0 / 64, 10.0 / 64, 40.0 / 64, 110.0 / 64, 500.0 / 64, 1600.0 / 64}
+                : testing::exposure_series(1.0 / 64, 4.0, 7);
   return make_brackets(testing::synthesize(L, e, cam, seed), e);
 }
 
@@ -109,7 +110,8 @@ TEST(ResponseRecovery, HeldOutErrorChoosesGammaForAPowerLaw) {
   const BracketCamera cam = eight_bit([](int c, double X) { return std::pow(X, 1.0 / (2.0 + 0.2 * c)); });
   const ResponseRecovery r = recover_response(synth_set(cam, 5));
   EXPECT_EQ(r.curve.model, "gamma");
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.curve.parameters["gamma"][std::size_t(c)].get<double>(), 2.0 + 0.2 * c, 0.05);
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(r.curve.parameters["gamma"][std::size_t(c)].get<double>(), 2.0 + 0.2 * c, 0.05);
 }
 
 TEST(ResponseRecovery, HeldOutErrorRejectsAPowerLawForAnSCurve) {
@@ -179,8 +181,10 @@ TEST(Nnls, MatchesTheActiveSetSolutionOfASmallProblem) {
   const Eigen::VectorXd grad = A.transpose() * (A * y - b);
   for (int i = 0; i < 3; ++i) {
     EXPECT_GE(y(i), 0);
-    if (y(i) > 0) EXPECT_NEAR(grad(i), 0, 1e-9);
-    else EXPECT_GE(grad(i), -1e-9);
+    if (y(i) > 0)
+      EXPECT_NEAR(grad(i), 0, 1e-9);
+    else
+      EXPECT_GE(grad(i), -1e-9);
   }
 }
 

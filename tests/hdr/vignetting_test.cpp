@@ -53,8 +53,8 @@ Vignetting truth_model(double k1, double k2, double k3) {
 TEST(Vignetting, ALensFallOffIsRecoveredToAPercentWhereTheBoardsReachAndATwelfthOfAStopAtTheCorner) {
   for (const auto& k : {std::array<double, 3>{-0.3, 0, 0}, std::array<double, 3>{-0.45, -0.15, 0.05}}) {
     const Vignetting truth = truth_model(k[0], k[1], k[2]);
-    const VignettingEstimate e = estimate_vignetting(boards(truth, 8, 0, 3), ResponseCurve::identity(65535),
-                                                     truth.centre, 480, 360);
+    const VignettingEstimate e =
+        estimate_vignetting(boards(truth, 8, 0, 3), ResponseCurve::identity(65535), truth.centre, 480, 360);
     ASSERT_GT(e.degree, 0) << e.note;
     EXPECT_EQ(e.boards, 8);
     EXPECT_GT(e.squares, 200);
@@ -73,8 +73,8 @@ TEST(Vignetting, ALensFallOffIsRecoveredToAPercentWhereTheBoardsReachAndATwelfth
 // vignetting.
 TEST(Vignetting, UnevenlyLitBoardsDoNotBiasTheEstimate) {
   const Vignetting truth = truth_model(-0.3, 0, 0);
-  const VignettingEstimate e = estimate_vignetting(boards(truth, 8, 0.1, 5), ResponseCurve::identity(65535),
-                                                   truth.centre, 480, 360);
+  const VignettingEstimate e =
+      estimate_vignetting(boards(truth, 8, 0.1, 5), ResponseCurve::identity(65535), truth.centre, 480, 360);
   ASSERT_GT(e.degree, 0);
   for (double r : {0.2, 0.4, e.max_r}) {
     const double x = truth.centre.x() + r * truth.r_corner;
@@ -85,8 +85,8 @@ TEST(Vignetting, UnevenlyLitBoardsDoNotBiasTheEstimate) {
 
 TEST(Vignetting, AFlatLensGivesNoneWithinAHundredthOfAStop) {
   const Vignetting truth = truth_model(0, 0, 0);
-  const VignettingEstimate e = estimate_vignetting(boards(truth, 6, 0, 7), ResponseCurve::identity(65535),
-                                                   truth.centre, 480, 360);
+  const VignettingEstimate e =
+      estimate_vignetting(boards(truth, 6, 0, 7), ResponseCurve::identity(65535), truth.centre, 480, 360);
   ASSERT_GT(e.degree, 0);
   EXPECT_LT(std::abs(e.model.corner_stops()), 0.01 + 2 * e.corner_sigma_stops);
   EXPECT_LT(std::abs(e.model.corner_stops()), 0.03);
@@ -94,8 +94,8 @@ TEST(Vignetting, AFlatLensGivesNoneWithinAHundredthOfAStop) {
 
 TEST(Vignetting, FewerThanThreeBoardsGiveNoEstimateAndSaySo) {
   const Vignetting truth = truth_model(-0.3, 0, 0);
-  const VignettingEstimate e = estimate_vignetting(boards(truth, 2, 0, 3), ResponseCurve::identity(65535),
-                                                   truth.centre, 480, 360);
+  const VignettingEstimate e =
+      estimate_vignetting(boards(truth, 2, 0, 3), ResponseCurve::identity(65535), truth.centre, 480, 360);
   EXPECT_EQ(e.degree, 0);
   EXPECT_TRUE(e.model.is_identity());
   EXPECT_NE(e.note.find("need at least 3"), std::string::npos);

@@ -40,7 +40,8 @@ struct Disc {
 // `base` (any layout, resampled bilinearly) plus the discs, in a lat-long map `width` wide
 // (each texel the mean over 4 x 4 points of its cell: a disc smaller than a texel keeps its energy).
 inline EnvMap environment_with(const std::optional<EnvMap>& base, const std::vector<Disc>& discs, int width = 256,
-                               const Vec3& zenith = Vec3(0.25, 0.45, 1.0), const Vec3& horizon = Vec3(1.0, 0.95, 0.85)) {
+                               const Vec3& zenith = Vec3(0.25, 0.45, 1.0),
+                               const Vec3& horizon = Vec3(1.0, 0.95, 0.85)) {
   std::vector<double> cos_radius;
   for (const Disc& s : discs) cos_radius.push_back(std::cos(s.radius_deg * kPi / 180));
   return render_pattern(
@@ -72,7 +73,8 @@ struct ClippedShoot {
 };
 
 inline double rim_fade(double cos_nv) {
-  const double t = std::clamp((cos_nv - std::cos(82 * kPi / 180)) / (std::cos(70 * kPi / 180) - std::cos(82 * kPi / 180)), 0.0, 1.0);
+  const double t =
+      std::clamp((cos_nv - std::cos(82 * kPi / 180)) / (std::cos(70 * kPi / 180) - std::cos(82 * kPi / 180)), 0.0, 1.0);
   return t * t * (3 - 2 * t);
 }
 
@@ -111,7 +113,8 @@ inline ClippedShoot clipped_shoot(const EnvMap& env, double clip, int views = 6,
         int n = 0;
         for (int a = 0; a < 4; ++a)
           for (int b = 0; b < 4; ++b) {
-            const Vec2 q = sphere_map::disc_from_pixel(Vec2(col - 0.5 + (b + 0.5) / 4, r - 0.5 + (a + 0.5) / 4), size, size);
+            const Vec2 q =
+                sphere_map::disc_from_pixel(Vec2(col - 0.5 + (b + 0.5) / 4, r - 0.5 + (a + 0.5) / 4), size, size);
             if (q.squaredNorm() >= 1) continue;
             const Vec3 nrm = c.world_from_view * sphere_map::g_normal(q);
             const double cosine = std::max(0.0, nrm.dot(view));
@@ -126,8 +129,10 @@ inline ClippedShoot clipped_shoot(const EnvMap& env, double clip, int views = 6,
         const double conf = rim_fade(centre_n.dot(view));
         const Vec3 value = clipped ? Vec3::Constant(clip) : Vec3(sum / std::max(n, 1));
         c.rgb.at<cv::Vec3f>(r, col) = cv::Vec3f(float(value[0]), float(value[1]), float(value[2]));
-        if (clipped) c.clipped.at<float>(r, col) = float(conf);
-        else c.confidence.at<float>(r, col) = float(conf);
+        if (clipped)
+          c.clipped.at<float>(r, col) = float(conf);
+        else
+          c.confidence.at<float>(r, col) = float(conf);
       }
     shoot.chrome.views.push_back(std::move(c));
 
@@ -170,7 +175,9 @@ inline ProbeOptions probe_options(int width = 256) {
   po.fresnel = fresnel.get();
   return po;
 }
-inline Probe shoot_probe(const ClippedShoot& shoot, int width = 256) { return assemble_probe(shoot.chrome, probe_options(width)); }
+inline Probe shoot_probe(const ClippedShoot& shoot, int width = 256) {
+  return assemble_probe(shoot.chrome, probe_options(width));
+}
 
 // What a recovered source had to supply (its truth): inside a cap around a clipped region (its
 // radius + 2 degrees), the environment's power minus the measured probe's (the probe holds what

@@ -41,13 +41,14 @@ Vec3 integral3(const EnvMap& e) {
 // Checks one recovered source against the truth of its region; prints what it measured.
 void expect_recovered(const LightSource& s, const std::pair<Vec3, Vec3>& truth, const std::string& what) {
   const double angle = angle_between(s.direction, truth.second) * 180 / kPi;
-  std::printf("  %s: power %.4g %.4g %.4g of %.4g %.4g %.4g (sigma %.3g %.3g %.3g), %.3f deg off (sigma %.3f)\n", what.c_str(),
-              s.power[0], s.power[1], s.power[2], truth.first[0], truth.first[1], truth.first[2], s.power_sigma[0],
-              s.power_sigma[1], s.power_sigma[2], angle, s.direction_sigma * 180 / kPi);
+  std::printf("  %s: power %.4g %.4g %.4g of %.4g %.4g %.4g (sigma %.3g %.3g %.3g), %.3f deg off (sigma %.3f)\n",
+              what.c_str(), s.power[0], s.power[1], s.power[2], truth.first[0], truth.first[1], truth.first[2],
+              s.power_sigma[0], s.power_sigma[1], s.power_sigma[2], angle, s.direction_sigma * 180 / kPi);
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(s.power[k] / truth.first[k], 1.0, 0.10) << what << " channel " << k;
     // Sigma consistent with the error: the error within 3 sigma, and sigma not so wide as to say nothing.
-    EXPECT_LT(std::abs(s.power[k] - truth.first[k]), 3 * s.power_sigma[k] + 0.01 * truth.first[k]) << what << " channel " << k;
+    EXPECT_LT(std::abs(s.power[k] - truth.first[k]), 3 * s.power_sigma[k] + 0.01 * truth.first[k])
+        << what << " channel " << k;
     EXPECT_LT(s.power_sigma[k], 0.15 * truth.first[k]) << what << " channel " << k;
   }
   EXPECT_LT(angle, 1.0) << what;
@@ -66,7 +67,8 @@ TEST_P(SunElevation, ASunClippedEverywhereIsRecoveredFromTheGreyBall) {
   const Outcome o = run(env, 50);
   ASSERT_EQ(o.recovered.regions.size(), 1u);
   ASSERT_EQ(o.recovered.recovery.sources.size(), 1u) << o.recovered.recovery.notes.front();
-  expect_recovered(o.recovered.recovery.sources[0], o.truth[0], "sun at " + std::to_string(int(elevation)) + " degrees");
+  expect_recovered(o.recovered.recovery.sources[0], o.truth[0],
+                   "sun at " + std::to_string(int(elevation)) + " degrees");
   const Vec3 truth = integral3(env), before = integral3(o.measured.env), after = integral3(o.recovered.env);
   for (int k = 0; k < 3; ++k) {
     EXPECT_LT(before[k] / truth[k], 0.6) << k;  // the clipped sun held most of the light
@@ -101,12 +103,14 @@ INSTANTIATE_TEST_SUITE_P(Skies, RealSky, ::testing::Values("forest.exr", "city.e
 // regions, two sources, each within 10% and 1 degree.
 TEST(SourceRecovery, TwoClippedStudioLightsAreRecoveredSeparately) {
   const Vec3 a = direction_at(30, 40), b = direction_at(-40, 25);
-  const EnvMap env = testing::environment_with(std::nullopt, {{a, 1.0, Vec3(3000, 3000, 3000)}, {b, 2.0, Vec3(800, 700, 600)}},
-                                               256, Vec3(0.3, 0.3, 0.3), Vec3(0.2, 0.2, 0.2));
+  const EnvMap env =
+      testing::environment_with(std::nullopt, {{a, 1.0, Vec3(3000, 3000, 3000)}, {b, 2.0, Vec3(800, 700, 600)}}, 256,
+                                Vec3(0.3, 0.3, 0.3), Vec3(0.2, 0.2, 0.2));
   const Outcome o = run(env, 50);
   ASSERT_EQ(o.recovered.regions.size(), 2u);
   ASSERT_EQ(o.recovered.recovery.sources.size(), 2u);
-  for (std::size_t i = 0; i < 2; ++i) expect_recovered(o.recovered.recovery.sources[i], o.truth[i], "light " + std::to_string(i));
+  for (std::size_t i = 0; i < 2; ++i)
+    expect_recovered(o.recovered.recovery.sources[i], o.truth[i], "light " + std::to_string(i));
 }
 
 // A glossy ball (GGX 0.05) beside the grey one: its highlight fits the light's size as well (a
@@ -126,8 +130,8 @@ TEST(SourceRecovery, AGlossyBallFitsTheSizeOfAClippedLight) {
   ASSERT_EQ(r.recovery.sources.size(), 1u);
   const LightSource& s = r.recovery.sources[0];
   expect_recovered(s, testing::truth_needed(env, r.measured.env, r.regions[std::size_t(s.region)]), "disc light");
-  std::printf("  radius %.2f degrees (sigma %.2f; truth 4), from %zu balls\n", s.radius * 180 / kPi, s.radius_sigma * 180 / kPi,
-              s.balls.size());
+  std::printf("  radius %.2f degrees (sigma %.2f; truth 4), from %zu balls\n", s.radius * 180 / kPi,
+              s.radius_sigma * 180 / kPi, s.balls.size());
   EXPECT_TRUE(s.radius_fitted);
   EXPECT_NEAR(s.radius * 180 / kPi, 4.0, 1.0);
   EXPECT_EQ(s.balls.size(), 2u);
@@ -173,7 +177,9 @@ TEST(SourceRecovery, WithoutAUsableGreyBallTheProbeStaysAsMeasuredWithANote) {
           mv.confidence.at<float>(r, c) = 0;
           if (std::string(what) == "clipped") mv.rgb.at<cv::Vec3f>(r, c) = cv::Vec3f(1e30f, 1e30f, 1e30f);
         }
-    check(recover_probe_sources(shoot.chrome, testing::probe_options(), {{"grey", &grey, Vec3::Constant(0.18)}}, {}, {}), what);
+    check(
+        recover_probe_sources(shoot.chrome, testing::probe_options(), {{"grey", &grey, Vec3::Constant(0.18)}}, {}, {}),
+        what);
   }
 }
 

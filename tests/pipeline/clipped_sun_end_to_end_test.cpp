@@ -38,9 +38,9 @@ struct Shoot {
 std::string spec(const Shoot& s) {
   std::ostringstream y;
   y << "rsibr_synth: 1\nseed: " << s.seed << "\n"
-    << "environment: {pattern: sun_and_sky, size: 512, sun_direction: [" << s.sun[0] << ", " << s.sun[1] << ", " << s.sun[2]
-    << "], sun_radius_deg: 0.6, sun_rgb: [5.0e5, 4.75e5, 4.25e5], zenith_rgb: [" << s.zenith[0] << ", " << s.zenith[1] << ", "
-    << s.zenith[2] << "], horizon_rgb: [1.0, 0.95, 0.85]}\n"
+    << "environment: {pattern: sun_and_sky, size: 512, sun_direction: [" << s.sun[0] << ", " << s.sun[1] << ", "
+    << s.sun[2] << "], sun_radius_deg: 0.6, sun_rgb: [5.0e5, 4.75e5, 4.25e5], zenith_rgb: [" << s.zenith[0] << ", "
+    << s.zenith[1] << ", " << s.zenith[2] << "], horizon_rgb: [1.0, 0.95, 0.85]}\n"
     << "balls:\n  - {name: chrome, kind: chrome, diameter_m: 0.1, centre: [-0.15, 1.3, 0]}\n"
     << "  - {name: grey, kind: grey, diameter_m: 0.1, centre: [0.15, 1.3, 0], albedo: [0.18, 0.18, 0.18]}\n"
     << "camera: {width: 320, height: 240, lens: {model: LENSMODEL_PINHOLE, focal_px: 700}, response: srgb, format: png, supersampling: 3}\n"
@@ -66,7 +66,8 @@ class ClippedSun : public ::testing::TestWithParam<Shoot> {};
 
 TEST_P(ClippedSun, TheProbeGetsTheSunBackAndCapturedMatchesComputed) {
   const Shoot& shoot = GetParam();
-  const fs::path root = fs::temp_directory_path() / ("rsibr-clipped-" + std::string(shoot.name) + "-" + std::to_string(::getpid()));
+  const fs::path root =
+      fs::temp_directory_path() / ("rsibr-clipped-" + std::string(shoot.name) + "-" + std::to_string(::getpid()));
   fs::remove_all(root);
   fs::create_directories(root);
   const SynthScene scene = parse_synth_scene(spec(shoot), "clipped.yaml", root);
@@ -96,13 +97,14 @@ TEST_P(ClippedSun, TheProbeGetsTheSunBackAndCapturedMatchesComputed) {
   EXPECT_EQ(src["views"].size(), 3u);
 
   // The probe's integral per channel against the truth's (in the merge's unit: gain_normalised).
-  const double unit = YAML::LoadFile((root / "syn" / "truth" / "truth.yaml").string())["camera"]["gain_normalised"].as<double>();
+  const double unit =
+      YAML::LoadFile((root / "syn" / "truth" / "truth.yaml").string())["camera"]["gain_normalised"].as<double>();
   const Vec3 truth = integral3(synth_environment(scene)) * unit;
   const Vec3 after = integral3(read_environment((o.out / "probe.exr").string()));
   const Vec3 before = integral3(read_environment((o.out / "probe-measured.exr").string()));
-  std::printf("  %s: sun %.2f degrees off; probe integral %.3f %.3f %.3f of the truth (measured %.3f %.3f %.3f)\n", shoot.name,
-              angle, after[0] / truth[0], after[1] / truth[1], after[2] / truth[2], before[0] / truth[0], before[1] / truth[1],
-              before[2] / truth[2]);
+  std::printf("  %s: sun %.2f degrees off; probe integral %.3f %.3f %.3f of the truth (measured %.3f %.3f %.3f)\n",
+              shoot.name, angle, after[0] / truth[0], after[1] / truth[1], after[2] / truth[2], before[0] / truth[0],
+              before[1] / truth[1], before[2] / truth[2]);
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(after[k] / truth[k], 1.0, 0.10) << k;
     EXPECT_LT(before[k] / truth[k], 0.6) << k;

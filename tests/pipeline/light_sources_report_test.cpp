@@ -57,27 +57,30 @@ TEST(LightSourcesStep, AClippedSunIsWrittenIntoTheProbeAndTheReportNamesIt) {
   const std::vector<double> before = integral(read_environment((r.dir / "probe-measured.exr").string()));
   const std::vector<double> after = integral(probe);
   for (int k = 0; k < 3; ++k)
-    EXPECT_NEAR(after[std::size_t(k)] - before[std::size_t(k)], r.summary["recovered_power"][std::size_t(k)].get<double>(),
-                1e-4 * after[std::size_t(k)]);
+    EXPECT_NEAR(after[std::size_t(k)] - before[std::size_t(k)],
+                r.summary["recovered_power"][std::size_t(k)].get<double>(), 1e-4 * after[std::size_t(k)]);
   const std::string warning = light_sources_warning(r.summary);
   EXPECT_NE(warning.find("the source at azimuth"), std::string::npos) << warning;
   EXPECT_NE(warning.find("of the light"), std::string::npos) << warning;
   EXPECT_NE(warning.find("grey"), std::string::npos) << warning;
   const std::string section = light_sources_section(r.dir, r.summary);
   EXPECT_NE(section.find("Clipped light sources"), std::string::npos);
-  EXPECT_NE(section.find("data:image/png;base64,"), std::string::npos);  // the probe around the source, before and after
+  EXPECT_NE(section.find("data:image/png;base64,"),
+            std::string::npos);  // the probe around the source, before and after
   EXPECT_EQ(section.find("nan"), std::string::npos);
   fs::remove_all(r.dir);
 }
 
 TEST(LightSourcesStep, NothingClippedGivesNoWarningAndTheMeasuredProbe) {
-  const EnvMap env = testing::environment_with(std::nullopt, {{testing::direction_at(30, 40), 0.5, Vec3(2e4, 2e4, 1.8e4)}}, 128);
+  const EnvMap env =
+      testing::environment_with(std::nullopt, {{testing::direction_at(30, 40), 0.5, Vec3(2e4, 2e4, 1.8e4)}}, 128);
   const StepRun r = run_step_on(env, 1e12, "none");
   EXPECT_TRUE(r.summary["regions"].empty());
   EXPECT_EQ(light_sources_warning(r.summary), "");
   EXPECT_EQ(light_sources_section(r.dir, r.summary), "");
   // The step's probe is the chrome maps' blend as read back (frames stored as float), unchanged.
-  const EnvMap a = read_environment((r.dir / "probe.exr").string()), b = read_environment((r.dir / "probe-measured.exr").string());
+  const EnvMap a = read_environment((r.dir / "probe.exr").string()),
+               b = read_environment((r.dir / "probe-measured.exr").string());
   EXPECT_LT(cv::norm(a.pixels, b.pixels, cv::NORM_INF), 1e-6 * cv::norm(b.pixels, cv::NORM_INF));
   for (int k = 0; k < 3; ++k) EXPECT_EQ(r.summary["recovered_power"][std::size_t(k)].get<double>(), 0.0);
   EXPECT_FALSE(a.attributes.count("lightSources"));
@@ -85,7 +88,8 @@ TEST(LightSourcesStep, NothingClippedGivesNoWarningAndTheMeasuredProbe) {
 }
 
 TEST(LightSourcesStep, WithRecoveryOffTheReportSaysWhatIsMissing) {
-  const EnvMap env = testing::environment_with(std::nullopt, {{testing::direction_at(30, 40), 0.5, Vec3(2e4, 2e4, 1.8e4)}}, 128);
+  const EnvMap env =
+      testing::environment_with(std::nullopt, {{testing::direction_at(30, 40), 0.5, Vec3(2e4, 2e4, 1.8e4)}}, 128);
   const StepRun r = run_step_on(env, 50, "off", false);
   ASSERT_EQ(r.summary["regions"].size(), 1u);
   EXPECT_TRUE(r.summary["sources"].empty());

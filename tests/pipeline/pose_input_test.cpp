@@ -27,7 +27,7 @@ TEST(GivenPoses, PosesFileRowsAreRowMajor) {
   const PoseSet g = read_given_poses(p.string());
   ASSERT_EQ(g.views.size(), 1u);
   const Mat3& m = g.find("north")->world_from_cam;
-  EXPECT_NEAR(m(0, 2), 1, 1e-12);   // row 0, column 2
+  EXPECT_NEAR(m(0, 2), 1, 1e-12);  // row 0, column 2
   EXPECT_NEAR(m(2, 0), -1, 1e-12);
   EXPECT_DOUBLE_EQ(g.find("north")->sigma_deg, 0.03);
   EXPECT_EQ(g.gauge, "up");
@@ -47,13 +47,16 @@ TEST(GivenPoses, SynthTruthRowsAreRead) {
 
 TEST(GivenPoses, NonRotationsDuplicatesAndUnknownFormatsAreErrorsNamingTheFile) {
   const std::string head = "rsibr_poses: 1\ngauge: up\nviews:\n";
-  for (const std::string& bad :
-       {head + "  - {name: a, world_from_cam: [2, 0, 0, 0, 1, 0, 0, 0, 1]}\n",
-        head + "  - {name: a, world_from_cam: [-1, 0, 0, 0, 1, 0, 0, 0, 1]}\n",  // a reflection
-        head + "  - {name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0]}\n",
-        head + "  - {name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, 1]}\n  - {name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, 1]}\n",
-        std::string("views: []\n"), std::string("rsibr_poses: 1\ngauge: sideways\nviews: []\n"),
-        std::string("rsibr_synth_truth: 1\nviews:\n  - {name: a, world_from_cam: [[1, 0, 0], [0, 1, 0], [0, 0, 2]]}\n")}) {
+  for (
+      const std::string& bad :
+      {head + "  - {name: a, world_from_cam: [2, 0, 0, 0, 1, 0, 0, 0, 1]}\n",
+       head + "  - {name: a, world_from_cam: [-1, 0, 0, 0, 1, 0, 0, 0, 1]}\n",  // a reflection
+       head + "  - {name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0]}\n",
+       head +
+           "  - {name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, 1]}\n  - {name: a, world_from_cam: [1, 0, 0, 0, 1, 0, 0, 0, 1]}\n",
+       std::string("views: []\n"), std::string("rsibr_poses: 1\ngauge: sideways\nviews: []\n"),
+       std::string(
+           "rsibr_synth_truth: 1\nviews:\n  - {name: a, world_from_cam: [[1, 0, 0], [0, 1, 0], [0, 0, 2]]}\n")}) {
     const fs::path p = write_temp("bad.yaml", bad);
     try {
       read_given_poses(p.string());

@@ -162,7 +162,8 @@ TEST_F(ProcessEndToEnd, ACopiedRunFolderResumesWithoutRedoingAStep) {
   ASSERT_EQ(grey["name"].as<std::string>(), "grey");
   const double x = grey["centre_px"][0].as<double>(), y = grey["centre_px"][1].as<double>();
   const double r = 700 * 0.05 / grey["distance_m"].as<double>();
-  o.ball_overrides = {"view01:grey=" + std::to_string(x + 3) + "," + std::to_string(y - 2) + "," + std::to_string(1.1 * r)};
+  o.ball_overrides = {"view01:grey=" + std::to_string(x + 3) + "," + std::to_string(y - 2) + "," +
+                      std::to_string(1.1 * r)};
   const ProcessResult given = run_process(o);
   const auto& balls = given.summary["extract"]["views"][1]["balls"];
   EXPECT_EQ(balls[1]["status"], "given");
@@ -235,7 +236,8 @@ TEST_F(ProcessEndToEnd, ReportIsSelfContained) {
   EXPECT_EQ(html.find("src=\"file"), std::string::npos);
   EXPECT_EQ(html.find("<link"), std::string::npos);
   EXPECT_EQ(html.find("<script"), std::string::npos);
-  for (const char* section : {"Camera response", "Orientations", "Light probe", "Captured vs computed", "Turntable", "Lens"})
+  for (const char* section :
+       {"Camera response", "Orientations", "Light probe", "Captured vs computed", "Turntable", "Lens"})
     EXPECT_NE(html.find(section), std::string::npos) << section;
 }
 

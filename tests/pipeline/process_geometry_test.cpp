@@ -36,7 +36,8 @@ SynthScene shoot() {
   const std::string text = R"(
 rsibr_synth: 1
 seed: 21
-environment: {file: )" + kLobby.string() + R"(, sanitize: true}
+environment: {file: )" + kLobby.string() +
+                           R"(, sanitize: true}
 balls:
   - {name: chrome, kind: chrome, diameter_m: 0.1, centre: [-0.07, 1.3, 0]}
   - {name: grey, kind: grey, diameter_m: 0.1, centre: [0.07, 1.3, 0]}
@@ -155,7 +156,8 @@ TEST_F(ProcessGeometry, TheProbeIsLevelWithinADegree) {
   const PoseSet est = read_pose_file((root_ / "out" / "poses.yaml").string());
   EXPECT_EQ(est.gauge, "estimated-up");
   Vec3 up = Vec3::Zero();
-  for (const ViewPose& v : est.views) up += truth_->find(v.name)->world_from_cam * v.world_from_cam.transpose() * Vec3(0, 1, 0);
+  for (const ViewPose& v : est.views)
+    up += truth_->find(v.name)->world_from_cam * v.world_from_cam.transpose() * Vec3(0, 1, 0);
   const double tilt = angle_between(up, Vec3(0, 1, 0)) * 180 / kPi;
   const double sigma = result_->summary["orient"]["world_up"]["sigma_deg"].get<double>();
   std::printf("  probe tilt %.3f degrees (sigma %.3f), the first camera's %.1f\n", tilt, sigma,
@@ -184,12 +186,14 @@ TEST_F(ProcessGeometry, GreyMapsAreWithinATenthOfAStopOfTheTruthInEveryView) {
   MapSet grey = read_map_set((root_ / "out" / "maps" / "captured-grey.exr").string());
   for (MapView& v : grey.views) {
     const std::string img = v.attributes.at("image");
-    v.world_from_view = truth_->find(img)->world_from_cam * est.find(img)->world_from_cam.transpose() * v.world_from_view;
+    v.world_from_view =
+        truth_->find(img)->world_from_cam * est.find(img)->world_from_cam.transpose() * v.world_from_view;
     v.view = v.world_from_view.col(2);
   }
   CompareOptions co;
   co.view_tolerance_deg = 2;
-  const Comparison c = compare_map_sets(grey, read_map_set((root_ / "syn" / "truth" / "maps" / "grey.exr").string()), co);
+  const Comparison c =
+      compare_map_sets(grey, read_map_set((root_ / "syn" / "truth" / "maps" / "grey.exr").string()), co);
   ASSERT_GE(c.pairs.size(), 7u);
   for (const PairComparison& p : c.pairs) {
     std::printf("  %s: %.3f stops\n", grey.views[p.index_a].attributes.at("image").c_str(), p.after.log_rms_stops);

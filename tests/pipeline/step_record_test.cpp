@@ -61,7 +61,8 @@ TEST_F(StepRecordTest, MissingRecordChangedSettingsTouchedInputOrDeletedOutputAr
   // An input rewritten (same size, later time) is a change.
   write(dir / "in.txt", "c");
   touch_later(dir / "in.txt", dir / "out.txt");
-  EXPECT_NE(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}).find("in.txt changed"), std::string::npos);
+  EXPECT_NE(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}).find("in.txt changed"),
+            std::string::npos);
   write_step_record(dir, record({{"samples", 64}}));
   // A touched input with the same contents (a later mtime, the same bytes) is no change.
   touch_later(dir / "in.txt", dir / "out.txt");
@@ -69,7 +70,8 @@ TEST_F(StepRecordTest, MissingRecordChangedSettingsTouchedInputOrDeletedOutputAr
   // An output replaced by other bytes of the same size (restored from a backup, say) is stale.
   write(dir / "out.txt", "x");
   touch_later(dir / "out.txt", dir / "in.txt");
-  EXPECT_NE(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}).find("out.txt changed"), std::string::npos);
+  EXPECT_NE(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}).find("out.txt changed"),
+            std::string::npos);
   write(dir / "out.txt", "b");
   EXPECT_EQ(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}), "");
   fs::remove(dir / "out.txt");
@@ -123,11 +125,13 @@ TEST_F(StepRecordTest, ACopiedRunFolderWithMovedPhotosIsUpToDate) {
   EXPECT_EQ(back.inputs[0], fs::absolute(photos2 / "v0" / "b0.png").lexically_normal());
   // The copy is independent: an edited input in it is a change there only.
   write(photos2 / "v0" / "b0.png", "other bytes");
-  EXPECT_NE(step_stale_reason(run2, "extract", nlohmann::json::object(), inputs2, roots2).find("b0.png changed"), std::string::npos);
+  EXPECT_NE(step_stale_reason(run2, "extract", nlohmann::json::object(), inputs2, roots2).find("b0.png changed"),
+            std::string::npos);
   // Another file in the input's place (another name) is a change even with the same contents.
   write(run2 / "lens2.cameramodel", "lens");
   write(photos2 / "v0" / "b0.png", "photo bytes");
-  EXPECT_EQ(step_stale_reason(run2, "extract", nlohmann::json::object(), {photos2 / "v0" / "b0.png", run2 / "lens2.cameramodel"}, roots2),
+  EXPECT_EQ(step_stale_reason(run2, "extract", nlohmann::json::object(),
+                              {photos2 / "v0" / "b0.png", run2 / "lens2.cameramodel"}, roots2),
             (run2 / "lens2.cameramodel").string() + " changed");
 }
 

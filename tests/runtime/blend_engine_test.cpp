@@ -16,11 +16,11 @@ using namespace rsibr::testing;
 TEST(BlendEngine, LookupEqualsBlendAtTheDestinationView) {
   const ViewSet views = ViewSet::icosahedron();
   std::vector<Vec3> dests = random_directions(4, 11);
-  dests.push_back(views.views()[3]);                                          // at a source
+  dests.push_back(views.views()[3]);  // at a source
   const auto& t0 = views.triangles()[0];
   dests.push_back((views.views()[std::size_t(t0[0])] + views.views()[std::size_t(t0[1])]).normalized());  // on an edge
-  for (const auto& [warp, f] : {std::pair{"mirror", TexelFunction(fresnel_mirror_texel)},
-                                std::pair{"normal", TexelFunction(lambert_texel)}}) {
+  for (const auto& [warp, f] :
+       {std::pair{"mirror", TexelFunction(fresnel_mirror_texel)}, std::pair{"normal", TexelFunction(lambert_texel)}}) {
     const MapSet set = analytic_map_set(views, 32, 32, warp, f);
     const BlendEngine lookup(set, views);
     for (const Vec3& d : dests) {
@@ -78,7 +78,8 @@ TEST(BlendEngine, LookupEqualsBlendWithConfidence) {
   for (std::size_t i = 0; i < set.views.size(); ++i) {
     set.views[i].confidence = cv::Mat(24, 24, CV_32FC1);
     for (int r = 0; r < 24; ++r)
-      for (int c = 0; c < 24; ++c) set.views[i].confidence.at<float>(r, c) = float(0.2 + 0.8 * ((r * 7 + c * 3 + int(i)) % 5) / 4.0);
+      for (int c = 0; c < 24; ++c)
+        set.views[i].confidence.at<float>(r, c) = float(0.2 + 0.8 * ((r * 7 + c * 3 + int(i)) % 5) / 4.0);
   }
   const BlendEngine lookup(set, views);
   const Vec3 d = Vec3(0.2, -0.4, 0.7).normalized();
@@ -100,7 +101,8 @@ TEST(BlendEngine, HintedLocateEqualsViewSetLocate) {
     int hint = -1;
     // A slowly turning direction (the hint is reused) and random jumps, plus the views themselves.
     std::vector<Vec3> dirs;
-    for (int i = 0; i < 400; ++i) dirs.push_back(Vec3(std::cos(0.01 * i), 0.3 * std::sin(0.013 * i), std::sin(0.01 * i)));
+    for (int i = 0; i < 400; ++i)
+      dirs.push_back(Vec3(std::cos(0.01 * i), 0.3 * std::sin(0.013 * i), std::sin(0.01 * i)));
     for (const Vec3& v : random_directions(200, 5)) dirs.push_back(v);
     for (const Vec3& v : views.views()) dirs.push_back(v);
     for (const Vec3& v : dirs) {
@@ -119,8 +121,9 @@ TEST(BlendEngine, HintedLocateEqualsViewSetLocate) {
 TEST(BlendEngine, NormalsFacingAwayTakeTheNearestRimNormal) {
   const ViewSet views = ViewSet::icosahedron();
   for (const char* warp : {"mirror", "normal"}) {
-    const MapSet set = analytic_map_set(views, 32, 32, warp, std::string(warp) == "mirror" ? TexelFunction(mirror_texel)
-                                                                                              : TexelFunction(lambert_texel));
+    const MapSet set =
+        analytic_map_set(views, 32, 32, warp,
+                         std::string(warp) == "mirror" ? TexelFunction(mirror_texel) : TexelFunction(lambert_texel));
     const BlendEngine lookup(set, views);
     const Vec3 v = Vec3(0.3, 0.5, 0.8).normalized();
     for (const Vec3& n : random_directions(50, 3)) {

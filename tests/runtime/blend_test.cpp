@@ -54,8 +54,10 @@ void expect_sane(const BlendResult& b, const MapSet& set, const std::string& wha
       bool ok = std::isfinite(w) && w >= 0.f && w <= 1.f + 1e-6f;
       for (int k = 0; k < 3; ++k) {
         ok = ok && std::isfinite(o[k]);
-        if (inside) ok = ok && o[k] >= lo - 1e-6 && o[k] <= hi + 1e-6;
-        else ok = ok && o[k] == 0.f && w == 0.f;
+        if (inside)
+          ok = ok && o[k] >= lo - 1e-6 && o[k] <= hi + 1e-6;
+        else
+          ok = ok && o[k] == 0.f && w == 0.f;
       }
       if (!ok && bad++ < 3)
         ADD_FAILURE() << what << ": texel " << c << "," << r << " = (" << o[0] << "," << o[1] << "," << o[2]
@@ -66,8 +68,8 @@ void expect_sane(const BlendResult& b, const MapSet& set, const std::string& wha
 
 TEST(Blend, BlendingAtASourceViewReproducesThatSource) {
   const ViewSet views = ViewSet::icosahedron();
-  for (const auto& [warp, f] : {std::pair{"mirror", TexelFunction(fresnel_mirror_texel)},
-                                std::pair{"normal", TexelFunction(lambert_texel)}}) {
+  for (const auto& [warp, f] :
+       {std::pair{"mirror", TexelFunction(fresnel_mirror_texel)}, std::pair{"normal", TexelFunction(lambert_texel)}}) {
     const MapSet set = analytic_map_set(views, 64, 64, warp, f);
     for (std::size_t i = 0; i < set.views.size(); ++i) {
       const MapView& src = set.views[i];
@@ -96,8 +98,8 @@ TEST(Blend, BlendingAtASourceViewReproducesThatSource) {
 struct NovelViewErrors {
   MapError all, interior;
 };
-NovelViewErrors novel_view_errors(const ViewSet& views, int size, const char* warp, const TexelFunction& f,
-                                  int count, unsigned seed, const BlendOptions& options = {}) {
+NovelViewErrors novel_view_errors(const ViewSet& views, int size, const char* warp, const TexelFunction& f, int count,
+                                  unsigned seed, const BlendOptions& options = {}) {
   const MapSet set = analytic_map_set(views, size, size, warp, f);
   NovelViewErrors worst;
   double sum_all = 0, sum_in = 0;
@@ -171,8 +173,10 @@ TEST(Blend, DISABLED_FadeWidthSweep) {
       const NovelViewErrors m = novel_view_errors(views, 128, "mirror", mirror_texel, 8, 3, o);
       const NovelViewErrors n = novel_view_errors(views, 128, "normal", lambert_texel, 8, 4, o);
       const NovelViewErrors f = novel_view_errors(views, 128, "mirror", fresnel_mirror_texel, 8, 5, o);
-      std::printf("[ fade %.2f %zu ] mirror max %.2e rms %.2e | normal max %.2e rms %.2e | fresnel max %.2e rms %.2e in %.2e %.2e\n", fade,
-                  views.views().size(), m.all.max_abs, m.all.rms, n.all.max_abs, n.all.rms, f.all.max_abs, f.all.rms, f.interior.max_abs, f.interior.rms);
+      std::printf(
+          "[ fade %.2f %zu ] mirror max %.2e rms %.2e | normal max %.2e rms %.2e | fresnel max %.2e rms %.2e in %.2e %.2e\n",
+          fade, views.views().size(), m.all.max_abs, m.all.rms, n.all.max_abs, n.all.rms, f.all.max_abs, f.all.rms,
+          f.interior.max_abs, f.interior.rms);
     }
   }
 }
@@ -204,15 +208,18 @@ double max_change_along(const MapSet& set, const ViewSet& views, const std::vect
 TEST(Blend, WeightsAndOutputAreContinuousAcrossEdgesAndVertices) {
   const double step = 1e-6;
   const ViewSet views = ViewSet::icosahedron();
-  for (const auto& [warp, f] : {std::pair{"mirror", TexelFunction(fresnel_mirror_texel)},
-                                std::pair{"normal", TexelFunction(lambert_texel)}}) {
+  for (const auto& [warp, f] :
+       {std::pair{"mirror", TexelFunction(fresnel_mirror_texel)}, std::pair{"normal", TexelFunction(lambert_texel)}}) {
     const MapSet set = analytic_map_set(views, 64, 64, warp, f);
     // Pick a triangle with no vertex near +-Y (the up vector) so that the frame is smooth along the paths.
     std::array<int, 3> tri{};
     for (const auto& t : views.triangles()) {
       bool ok = true;
       for (int i : t) ok = ok && std::abs(views.views()[std::size_t(i)].y()) < 0.9;
-      if (ok) { tri = t; break; }
+      if (ok) {
+        tri = t;
+        break;
+      }
     }
     const Vec3 a = views.views()[std::size_t(tri[0])], b = views.views()[std::size_t(tri[1])],
                c = views.views()[std::size_t(tri[2])];
@@ -229,12 +236,14 @@ TEST(Blend, WeightsAndOutputAreContinuousAcrossEdgesAndVertices) {
     // The path really crosses: its ends lie in different triangles, the middle of vertex_path is the vertex.
     EXPECT_NE(views.locate(edge_path.front()).triangle, views.locate(edge_path.back()).triangle);
     EXPECT_EQ(views.locate(vertex_path[4]).weights[0] + views.locate(vertex_path[4]).weights[1] +
-                  views.locate(vertex_path[4]).weights[2], 1.0);
+                  views.locate(vertex_path[4]).weights[2],
+              1.0);
     const double interior = max_change_along(set, views, interior_path);
     const double edge = max_change_along(set, views, edge_path);
     const double vertex = max_change_along(set, views, vertex_path);
-    std::printf("[ %s ] largest change per %.0e rad step: inside a triangle %.2e, across an edge %.2e, through a vertex %.2e\n",
-                warp, step, interior, edge, vertex);
+    std::printf(
+        "[ %s ] largest change per %.0e rad step: inside a triangle %.2e, across an edge %.2e, through a vertex %.2e\n",
+        warp, step, interior, edge, vertex);
     // Across an edge the weights are continuous (Gnomonic) and the change is of the order of a step
     // inside a triangle. Through a vertex v_a the per-texel normalisation amplifies a weight change eps by
     // 1/fade_a at texels near -v_a (out = (w_a f_a L_a + eps L_b)/(w_a f_a + eps)), and the smallest fade
@@ -297,8 +306,8 @@ TEST(Blend, NoNaNOrInfAnywhere) {
       }
       // A set that does not surround the sphere, seen from far outside it.
       const MapSet capped = analytic_map_set(cap, size, size, warp, f);
-      for (const Vec3& d : {Vec3(0, -1, 0), Vec3(1, 0, 0), Vec3(1, -1, 0.3), Vec3(0, 0.2, -1), Vec3(0, 1, 0),
-                            ring[0], Vec3(-ring[3])}) {
+      for (const Vec3& d : {Vec3(0, -1, 0), Vec3(1, 0, 0), Vec3(1, -1, 0.3), Vec3(0, 0.2, -1), Vec3(0, 1, 0), ring[0],
+                            Vec3(-ring[3])}) {
         const BlendResult b = blend(capped, cap, d, Vec3(0, 0, 1));
         expect_sane(b, capped, std::string(warp) + " cap set, size " + std::to_string(size));
       }
@@ -325,7 +334,8 @@ TEST(Blend, OutsideANonSurroundingSetTheUncoveredTexelsHaveZeroWeightAndAFiniteV
       if (sphere_map::disc_from_pixel(Vec2(c, r), 48, 48).squaredNorm() > 1.0) continue;
       (b.weight.at<float>(r, c) > 0 ? positive : zero)++;
     }
-  std::printf("[ nadir view of a 30-degree ring + zenith ] %d texels covered, %d with weight 0 (fallback)\n", positive, zero);
+  std::printf("[ nadir view of a 30-degree ring + zenith ] %d texels covered, %d with weight 0 (fallback)\n", positive,
+              zero);
   EXPECT_GT(zero, 0);
   EXPECT_GT(positive, 0);
   expect_sane(b, set, "nadir");
@@ -337,7 +347,8 @@ TEST(Blend, SingularityFadeRemovesTheStretchedRim) {
   const MapSet set = analytic_map_set(views, size, size, "mirror", mirror_texel);
   const auto& t = views.triangles()[0];
   const Vec3 centre =
-      (views.views()[std::size_t(t[0])] + views.views()[std::size_t(t[1])] + views.views()[std::size_t(t[2])]).normalized();
+      (views.views()[std::size_t(t[0])] + views.views()[std::size_t(t[1])] + views.views()[std::size_t(t[2])])
+          .normalized();
   BlendOptions with;
   with.source_weights = true;
   BlendOptions without = with;
@@ -369,8 +380,10 @@ TEST(Blend, SingularityFadeRemovesTheStretchedRim) {
         }
       }
     }
-  std::printf("[ singularity ] %d texels within 5 deg of some -v_s: that source's largest share %.2e; max error "
-              "within 20 deg: %.2e with the fade, %.2e without\n", near, worst_share, err_faded, err_unfaded);
+  std::printf(
+      "[ singularity ] %d texels within 5 deg of some -v_s: that source's largest share %.2e; max error "
+      "within 20 deg: %.2e with the fade, %.2e without\n",
+      near, worst_share, err_faded, err_unfaded);
   EXPECT_GT(near, 0);
   EXPECT_LT(worst_share, 0.02);
   EXPECT_LT(err_faded, 0.5 * err_unfaded);
@@ -378,7 +391,8 @@ TEST(Blend, SingularityFadeRemovesTheStretchedRim) {
   // A texel centre exactly on a source's singular direction takes nothing from that source.
   const Vec3 v0 = views.views()[std::size_t(t[0])];
   // The texel nearest to where -v0 lands at the centre view, then a rotation by less than a texel.
-  const Vec2 p = sphere_map::pixel_from_disc(sphere_map::g_mirror_inv(faded.world_from_view.transpose() * -v0), size, size);
+  const Vec2 p =
+      sphere_map::pixel_from_disc(sphere_map::g_mirror_inv(faded.world_from_view.transpose() * -v0), size, size);
   const int hc = int(std::lround(p.x())), hr = int(std::lround(p.y()));
   const auto [d, up] = view_with_singularity_at_texel(centre, v0, hc, hr, size);
   const BlendResult hit = blend(set, views, d, up, with);
@@ -386,7 +400,9 @@ TEST(Blend, SingularityFadeRemovesTheStretchedRim) {
   for (int k = 0; k < 3; ++k)
     if (hit.located.views[std::size_t(k)] == t[0]) k0 = k;
   ASSERT_GE(k0, 0);
-  EXPECT_LT(angle_between(hit.world_from_view * sphere_map::g_mirror(sphere_map::disc_from_pixel(Vec2(hc, hr), size, size)), -v0), 1e-7);
+  EXPECT_LT(angle_between(
+                hit.world_from_view * sphere_map::g_mirror(sphere_map::disc_from_pixel(Vec2(hc, hr), size, size)), -v0),
+            1e-7);
   EXPECT_LT(hit.source_weight[std::size_t(k0)].at<float>(hr, hc), 1e-9);
   EXPECT_GT(hit.weight.at<float>(hr, hc), 0.1f);
 }
@@ -410,8 +426,8 @@ TEST(Blend, WeightIsTheSumOfBarycentricWeightsAwayFromSingularities) {
 
 TEST(Blend, PrecomputedWarpMatchesExactWarp) {
   const ViewSet views = ViewSet::geodesic(1);
-  for (const auto& [warp, f] : {std::pair{"mirror", TexelFunction(fresnel_mirror_texel)},
-                                std::pair{"normal", TexelFunction(lambert_texel)}}) {
+  for (const auto& [warp, f] :
+       {std::pair{"mirror", TexelFunction(fresnel_mirror_texel)}, std::pair{"normal", TexelFunction(lambert_texel)}}) {
     const MapSet set = analytic_map_set(views, 64, 64, warp, f);
     const PrecomputedWarp pre(64, 64);
     BlendOptions o;
@@ -504,8 +520,7 @@ struct PathDifference {
   double colour = 0, weight = 0, source_weight = 0;
   int worst_r = -1, worst_c = -1;
 };
-PathDifference path_difference(const MapSet& set, const ViewSet& views, const Vec3& d, const Vec3& up,
-                               BlendOptions o) {
+PathDifference path_difference(const MapSet& set, const ViewSet& views, const Vec3& d, const Vec3& up, BlendOptions o) {
   o.source_weights = true;
   const BlendResult fast = blend(set, views, d, up, o);
   const BlendResult ref = blend_oracle(set, views, d, up, o);
@@ -520,8 +535,9 @@ PathDifference path_difference(const MapSet& set, const ViewSet& views, const Ve
           p.worst_r = r;
           p.worst_c = c;
         }
-        p.source_weight = std::max(p.source_weight, double(std::abs(fast.source_weight[std::size_t(k)].at<float>(r, c) -
-                                                                    ref.source_weight[std::size_t(k)].at<float>(r, c))));
+        p.source_weight =
+            std::max(p.source_weight, double(std::abs(fast.source_weight[std::size_t(k)].at<float>(r, c) -
+                                                      ref.source_weight[std::size_t(k)].at<float>(r, c))));
       }
       p.weight = std::max(p.weight, double(std::abs(fast.weight.at<float>(r, c) - ref.weight.at<float>(r, c))));
     }
@@ -546,8 +562,8 @@ TEST(Blend, TinySourcesTakeTheRimPathAndMatchTheDefinition) {
   double worst = 0;
   for (const auto& [w, h] : {std::pair{2, 2}, std::pair{3, 3}, std::pair{5, 4}})
     for (const char* warp : {"mirror", "normal"}) {
-      const MapSet set = analytic_map_set(views, w, h, warp, warp[0] == 'm' ? TexelFunction(fresnel_mirror_texel)
-                                                                          : TexelFunction(lambert_texel));
+      const MapSet set = analytic_map_set(
+          views, w, h, warp, warp[0] == 'm' ? TexelFunction(fresnel_mirror_texel) : TexelFunction(lambert_texel));
       for (const Vec3& d : random_directions(4, 17)) {
         BlendOptions o;
         o.width = 17;
@@ -568,8 +584,8 @@ TEST(Blend, TinySourcesTakeTheRimPathAndMatchTheDefinition) {
 TEST(Blend, EngineMatchesTheDefinitionEvaluatedInDouble) {
   const ViewSet views = ViewSet::geodesic(1);
   PathDifference smooth, noisy;
-  for (const auto& [warp, f] : {std::pair{"mirror", TexelFunction(fresnel_mirror_texel)},
-                                std::pair{"normal", TexelFunction(lambert_texel)}})
+  for (const auto& [warp, f] :
+       {std::pair{"mirror", TexelFunction(fresnel_mirror_texel)}, std::pair{"normal", TexelFunction(lambert_texel)}})
     for (const int size : {64, 129}) {
       MapSet set = analytic_map_set(views, size, size, warp, f);
       std::vector<std::pair<Vec3, Vec3>> cases;
@@ -578,7 +594,8 @@ TEST(Blend, EngineMatchesTheDefinitionEvaluatedInDouble) {
       // Every warp: exact and precomputed (their own float forms), tessellated (through warp_row).
       const PrecomputedWarp pre(size, size);
       const TessellatedWarp mesh(size, size);
-      for (const Warp* w : {static_cast<const Warp*>(nullptr), static_cast<const Warp*>(&pre), static_cast<const Warp*>(&mesh)})
+      for (const Warp* w :
+           {static_cast<const Warp*>(nullptr), static_cast<const Warp*>(&pre), static_cast<const Warp*>(&mesh)})
         for (const auto& [d, up] : cases) {
           BlendOptions o;
           o.warp = w;

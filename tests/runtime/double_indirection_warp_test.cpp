@@ -17,7 +17,6 @@
 namespace rsibr {
 namespace {
 
-
 // A ring of views around world up (0, 1, 0) at elevation `elev_deg`, `count` views.
 std::vector<Mat3> ring_frames(int count, double elev_deg, double phase_deg = 0) {
   std::vector<Mat3> out;
@@ -49,7 +48,8 @@ TEST(DoubleIndirectionWarp, AtTableNodesItIsTheExactWarpOfTheNodeDirection) {
   o.latitudes = 25;
   const DoubleIndirectionWarp warp(64, 64, o);
   std::vector<Mat3> ms;
-  for (double deg : {0.0, 7.5, 90.0, 180.0, -133.0}) ms.push_back(Eigen::AngleAxisd(deg * kPi / 180, o.axis.normalized()).toRotationMatrix());
+  for (double deg : {0.0, 7.5, 90.0, 180.0, -133.0})
+    ms.push_back(Eigen::AngleAxisd(deg * kPi / 180, o.axis.normalized()).toRotationMatrix());
   for (const Mat3& m : general_rotations(3)) ms.push_back(m);
   for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal})
     for (const Mat3& m : ms) {
@@ -218,7 +218,8 @@ TEST(DoubleIndirectionWarp, BadSettingsAndAnotherSizeAreRefused) {
   const DoubleIndirectionWarp warp(8, 8);
   EXPECT_FALSE(warp.supports(16, 16));
   std::vector<WarpSample> out(16);
-  EXPECT_THROW(warp.warp_row(CentralDirection::Mirror, Mat3::Identity(), 16, 16, 8, 0, 16, out.data()), std::invalid_argument);
+  EXPECT_THROW(warp.warp_row(CentralDirection::Mirror, Mat3::Identity(), 16, 16, 8, 0, 16, out.data()),
+               std::invalid_argument);
 }
 
 TEST(MakeWarp, EveryNameGivesThatWarpAndAnUnknownOneListsThem) {

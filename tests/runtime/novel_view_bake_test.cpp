@@ -79,7 +79,8 @@ double novel_view_error(const Integrator& integrator, const Brdf& brdf, const Vi
   return std::sqrt(num / den);
 }
 
-const char* kGold = "{type: ggx, roughness: 0.2, fresnel: {type: conductor, eta: [0.2, 0.92, 1.1], k: [3.9, 2.45, 2.14]}}";
+const char* kGold =
+    "{type: ggx, roughness: 0.2, fresnel: {type: conductor, eta: [0.2, 0.92, 1.1], k: [3.9, 2.45, 2.14]}}";
 
 TEST(NovelViewAgainstBake, BlendAtASourceViewEqualsTheDirectBake) {
   const EnvMap env = sun_and_sky();

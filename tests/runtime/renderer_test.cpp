@@ -32,7 +32,8 @@ Mesh sphere_mesh(int rings = 48, int segments = 96, double radius = 1.0, const V
   const uint32_t south = add(Vec3(0, -1, 0));
   auto at = [&](int i, int j) { return uint32_t(1 + (i - 1) * segments + (j % segments)); };
   auto tri = [&](uint32_t a, uint32_t b, uint32_t c) {
-    const Vec3 pa = m.positions[a].cast<double>(), pb = m.positions[b].cast<double>(), pc = m.positions[c].cast<double>();
+    const Vec3 pa = m.positions[a].cast<double>(), pb = m.positions[b].cast<double>(),
+               pc = m.positions[c].cast<double>();
     if ((pb - pa).cross(pc - pa).dot(pa + pb + pc - 3 * centre) < 0) std::swap(b, c);
     m.triangles.push_back({a, b, c});
   };
@@ -148,7 +149,8 @@ TEST(Renderer, MirrorSetGivesTheAnalyticReflectionPerPixelAndTheCentralOneInPape
         ++s.n;
       }
     ASSERT_GT(s.n, 1000);
-    std::printf("mirror %s: max %.3g mean %.3g, other mode mean %.3g\n", to_string(mode), s.max_abs, s.mean_abs / s.n, wrong.mean_abs / s.n);
+    std::printf("mirror %s: max %.3g mean %.3g, other mode mean %.3g\n", to_string(mode), s.max_abs, s.mean_abs / s.n,
+                wrong.mean_abs / s.n);
     // Measured (128^2 maps): per-pixel max 7.2e-3, paper 1.3e-3, both mean 2.3e-4; against the other
     // mode's answer the mean error is 6.2e-2 (35 degree field of view).
     EXPECT_LT(s.max_abs, 2e-2) << to_string(mode);
@@ -246,8 +248,10 @@ TEST(Renderer, NoNanOrInfAtSilhouettesAndOutsideANonSurroundingSet) {
           ASSERT_LE(p[3], 1.f);
           fractional += p[3] > 0 && p[3] < 1;
         }
-      if (spp == 4) EXPECT_GT(fractional, 10) << "supersampling gives partial coverage at silhouettes";
-      else EXPECT_EQ(fractional, 0);
+      if (spp == 4)
+        EXPECT_GT(fractional, 10) << "supersampling gives partial coverage at silhouettes";
+      else
+        EXPECT_EQ(fractional, 0);
     }
   }
 }
@@ -265,7 +269,8 @@ TEST(Renderer, SummingTwoMapSetsEqualsTheSumOfSeparateRenders) {
     for (int r = 0; r < cam.height; ++r)
       for (int c = 0; c < cam.width; ++c) {
         const cv::Vec4f pa = ra.at<cv::Vec4f>(r, c), pb = rb.at<cv::Vec4f>(r, c), pab = rab.at<cv::Vec4f>(r, c);
-        for (int k = 0; k < 3; ++k) ASSERT_NEAR(pab[k], pa[k] + pb[k], 1e-6 * (1 + std::abs(pab[k]))) << to_string(mode);
+        for (int k = 0; k < 3; ++k)
+          ASSERT_NEAR(pab[k], pa[k] + pb[k], 1e-6 * (1 + std::abs(pab[k]))) << to_string(mode);
         ASSERT_EQ(pab[3], pa[3]);
       }
   }

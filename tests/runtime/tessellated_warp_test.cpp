@@ -13,12 +13,12 @@
 namespace rsibr {
 namespace {
 
-
 std::vector<Mat3> rotations(int count) {
   std::vector<Mat3> out;
   for (const Vec3& v : testing::random_directions(count, 17)) {
     const Mat3 Td = world_from_view_for(v);
-    const Mat3 Ts = world_from_view_for((v + 0.6 * testing::random_directions(1, unsigned(out.size()) + 3)[0]).normalized());
+    const Mat3 Ts =
+        world_from_view_for((v + 0.6 * testing::random_directions(1, unsigned(out.size()) + 3)[0]).normalized());
     out.push_back(Ts.transpose() * Td);  // a source about 35 degrees from the destination
   }
   return out;
@@ -106,7 +106,8 @@ TEST(TessellatedWarp, RejectsOtherSizesAndBadMeshes) {
   const TessellatedWarp warp(32, 32);
   EXPECT_FALSE(warp.supports(64, 64));
   std::vector<WarpSample> out(8);
-  EXPECT_THROW(warp.warp_row(CentralDirection::Mirror, Mat3::Identity(), 64, 64, 0, 0, 8, out.data()), std::invalid_argument);
+  EXPECT_THROW(warp.warp_row(CentralDirection::Mirror, Mat3::Identity(), 64, 64, 0, 0, 8, out.data()),
+               std::invalid_argument);
   EXPECT_THROW(TessellatedWarp(32, 32, {0, 8}), std::invalid_argument);
   EXPECT_THROW(TessellatedWarp(32, 32, {4, 2}), std::invalid_argument);
 }

@@ -122,7 +122,8 @@ TEST(Warp, PrecomputedWarpMatchesExactWarp) {
     }
     EXPECT_LE(worst, 1e-12) << W << "x" << H;  // same arithmetic: bitwise in practice
     std::vector<WarpSample> out(4);
-    EXPECT_THROW(pre.warp_row(CentralDirection::Mirror, Mat3::Identity(), W + 2, H, 0, 0, 1, out.data()), std::invalid_argument);
+    EXPECT_THROW(pre.warp_row(CentralDirection::Mirror, Mat3::Identity(), W + 2, H, 0, 0, 1, out.data()),
+                 std::invalid_argument);
   }
 }
 
@@ -162,11 +163,13 @@ TEST(Warp, RowWarpAgreesWithWarpDirectionToFloatRounding) {
           warp_directions(kind, m, n, x.data(), y.data(), z.data(), dx.data(), dy.data(), rim.data());
           for (int i = 0; i < n; ++i) {
             const Vec3 dir = central_direction(kind, sphere_map::disc_from_pixel(Vec2(c0 + i, r), W, H));
-            worst_dir = std::max(worst_dir, (dir - Vec3(x[std::size_t(i)], y[std::size_t(i)], z[std::size_t(i)])).norm());
+            worst_dir =
+                std::max(worst_dir, (dir - Vec3(x[std::size_t(i)], y[std::size_t(i)], z[std::size_t(i)])).norm());
             const WarpSample s = warp_direction(kind, M * dir);
             worst_rim = std::max(worst_rim, std::abs(s.rim - rim[std::size_t(i)]));
             // Conditioning: d disc / d direction ~ 1 / (2 rim) (mirror), 1 / |n_xy| (normal behind).
-            const double cond = std::max(kind == CentralDirection::Normal && s.rim < 0 ? (M * dir).head<2>().norm() : std::abs(s.rim), 1e-3);
+            const double cond = std::max(
+                kind == CentralDirection::Normal && s.rim < 0 ? (M * dir).head<2>().norm() : std::abs(s.rim), 1e-3);
             worst_disc = std::max(worst_disc, cond * (s.disc - Vec2(dx[std::size_t(i)], dy[std::size_t(i)])).norm());
           }
           std::vector<float> ex(count), ey(count), er(count), px(count), py(count), pr(count);
@@ -175,7 +178,8 @@ TEST(Warp, RowWarpAgreesWithWarpDirectionToFloatRounding) {
           differing_blocks += ex != px || ey != py || er != pr;
         }
     }
-    std::printf("[ row warp %dx%d ] direction %.2e, rim %.2e, disc x rim %.2e\n", W, H, worst_dir, worst_rim, worst_disc);
+    std::printf("[ row warp %dx%d ] direction %.2e, rim %.2e, disc x rim %.2e\n", W, H, worst_dir, worst_rim,
+                worst_disc);
     // float: 2^-24 = 6e-8 per rounding; a handful of roundings per result.
     EXPECT_LE(worst_dir, 1e-6);
     EXPECT_LE(worst_rim, 1e-6);

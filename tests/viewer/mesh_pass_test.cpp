@@ -68,9 +68,8 @@ Agreement compare(const cv::Mat& gpu, const cv::Mat& cpu) {
 }
 
 void expect_agreement(const Agreement& a, int pixels, const char* what) {
-  std::printf("%s: %ld covered by both, %ld coverage mismatches, %.4f%% within 1e-3, max relative %.3g\n", what,
-              a.both, a.coverage_mismatch, 100.0 * double(a.within_tight) / double(std::max(a.both, 1L)),
-              a.max_relative);
+  std::printf("%s: %ld covered by both, %ld coverage mismatches, %.4f%% within 1e-3, max relative %.3g\n", what, a.both,
+              a.coverage_mismatch, 100.0 * double(a.within_tight) / double(std::max(a.both, 1L)), a.max_relative);
   EXPECT_EQ(a.non_finite, 0) << what;
   EXPECT_GT(a.both, pixels / 20) << what << ": the mesh must cover a good part of the frame";
   EXPECT_LE(a.coverage_mismatch, pixels / 200) << what;
@@ -168,7 +167,8 @@ TEST(MeshPass, PerPixelShaderMatchesOutsideANonSurroundingSet) {
 // hide it (a shader that ignored v_px would match paper mode instead).
 TEST(MeshPass, PerPixelShaderUsesEachPixelsViewDirection) {
   const Mesh mesh = scene_mesh();
-  const MapSet maps = testing::analytic_map_set(ViewSet::icosahedron(), 64, 64, "mirror", testing::fresnel_mirror_texel);
+  const MapSet maps =
+      testing::analytic_map_set(ViewSet::icosahedron(), 64, 64, "mirror", testing::fresnel_mirror_texel);
   const Camera cam = look_at(Vec3(0.3, 1.2, 3.0), Vec3(0, 0, 0), Vec3(0, 1, 0), 70, 256, 192);
   RenderOptions ro;
   ro.map_size = 64;
@@ -210,8 +210,10 @@ TEST(MeshPass, WeightViewIsTheSumOfFadedWeights) {
         worst = std::max(worst, std::abs(cpu_weight - g[0]));
       }
     EXPECT_GT(covered, 1000);
-    if (fade == 0.0) EXPECT_EQ(faded, 0);
-    else EXPECT_GT(faded, 0) << "some normals reflect near a source's singular direction";
+    if (fade == 0.0)
+      EXPECT_EQ(faded, 0);
+    else
+      EXPECT_GT(faded, 0) << "some normals reflect near a source's singular direction";
     // The icosphere's interpolated normals differ from the exact sphere's by up to ~1e-2 rad at
     // level 4, so the weights agree loosely here (the exact comparison is the frame tests' job).
     EXPECT_LT(worst, 0.1) << "fade " << fade;
@@ -224,7 +226,8 @@ TEST(MeshPass, BunnyPerPixelMatchesTheCpuRenderer) {
   const auto path = testing::assets_dir() / "models" / "bunny.glb";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not fetched (scripts/fetch-assets.sh)";
   const Mesh mesh = load_mesh(path.string());
-  const MapSet maps = testing::analytic_map_set(ViewSet::icosahedron(), 64, 64, "mirror", testing::fresnel_mirror_texel);
+  const MapSet maps =
+      testing::analytic_map_set(ViewSet::icosahedron(), 64, 64, "mirror", testing::fresnel_mirror_texel);
   const Camera cam = frame_bounds(mesh.bounds(), Vec3(0.3, -0.3, -1), Vec3(0, 1, 0), 40, 256, 192);
   RenderOptions ro;
   const cv::Mat cpu = Renderer(mesh, {&maps}, ro).render(cam);
