@@ -24,6 +24,7 @@ packages=(
   libglfw3-dev libimgui-dev libepoxy-dev xvfb xauth libgl1-mesa-dri
   # tests and benchmarks; clang's libFuzzer for the fuzz targets (fuzz/)
   libgtest-dev libgmock-dev libbenchmark-dev clang-14 libclang-rt-14-dev
+  clang-format-14  # tests/style: the tree stays formatted with .clang-format
   # real-data fetch (npm registry) and docs plots
   python3 python3-numpy python3-matplotlib python3-yaml
   # the Python module (python/) and its tests (tests/python)
