@@ -33,12 +33,28 @@ struct MapSetBakeOptions {
 MapSet bake_map_set(const Brdf& brdf, const Integrator& integrator, const ViewSet& views,
                     const MapSetBakeOptions& options, const std::function<void(double)>& progress = {});
 
+// One map's view and frame: the view v (world, unit, toward the viewer) and world_from_view.
+struct BakeFrame {
+  Vec3 view;
+  Mat3 world_from_view;
+};
+// The frames bake_map_set(views) uses: world_from_view_for(v) for each view, in order.
+std::vector<BakeFrame> frames_of(const ViewSet& views);
+
+// The same bake at given frames (e.g. the captured maps' frames, to compare texel for texel): one
+// map per frame, in order, with the same headers. Throws what bake_map_set throws, and
+// std::invalid_argument for no frame.
+MapSet bake_map_set(const Brdf& brdf, const Integrator& integrator, const std::vector<BakeFrame>& frames,
+                    const MapSetBakeOptions& options, const std::function<void(double)>& progress = {});
+
 // The set bake_map_set makes from maps already integrated: radiance[i] is the CV_32FC3 res x res
 // map of views.views()[i] that integrator.radiance_map gives (with options.integrator); this adds
 // the headers and the albedo normalisation. For bakes split over processes (cluster/), whose
 // texels are integrated apart and gathered: the same texels give the same set.
 // Throws std::invalid_argument when the counts or sizes do not match.
 MapSet computed_map_set(const Brdf& brdf, const Integrator& integrator, const ViewSet& views,
+                        const MapSetBakeOptions& options, std::vector<cv::Mat> radiance);
+MapSet computed_map_set(const Brdf& brdf, const Integrator& integrator, const std::vector<BakeFrame>& frames,
                         const MapSetBakeOptions& options, std::vector<cv::Mat> radiance);
 
 }  // namespace rsibr
