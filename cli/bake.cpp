@@ -1,5 +1,6 @@
 // rsibr bake: a computed map set, the lighting integral of a BRDF against an environment, one
 // sphere map per view (bake/integrator.h for what a texel holds).
+#include "cli/bake_planning.h"
 #include "cli/option_checks.h"
 #include "cli/render_image.h"
 #include "cli/summary.h"
@@ -32,6 +33,7 @@ namespace {
 
 struct BakeArgs {
   std::string env, brdf, views = "icosa", method = "mis", layout, json, output, lobe = "all", normalise = "none";
+  std::string max_error;  // empty: the settings as given; else plan them (plan/bake_plan.h)
   int res = 128;
   int samples = 64;
   int reference_width = 0;
@@ -59,11 +61,14 @@ BakeInputs read_bake_inputs(const BakeArgs& a) {
   return in;
 }
 
-int run_bake(const BakeArgs& a) {
+int run_bake(const BakeArgs& given, const CLI::App& command) {
+  BakeArgs a = given;  // --max-error replaces the knobs it plans
   if (std::filesystem::path(a.output).extension() != ".exr")
     throw std::invalid_argument(a.output + ": the output must be an .exr file");
   // Under mpirun the ranks split the texels (cluster/distributed_bake.h); the root writes.
   const cluster::Session& session = cluster::Session::current();
+  if (!a.max_error.empty() && session.size() > 1)
+    throw std::invalid_argument("--max-error plans in one process; run rsibr plan, then mpirun the bake it prints");
   OutputPlan outputs({a.env, a.brdf, a.views});
   const std::string exr = outputs.file(a.output), json = outputs.file(a.json);
   const auto t0 = std::chrono::steady_clock::now();
@@ -81,8 +86,36 @@ int run_bake(const BakeArgs& a) {
     if (failed) std::rethrow_exception(failed);
     throw std::runtime_error("another rank could not read the inputs");
   }
-  const BakeInputs& in = *read;
+  BakeInputs& in = *read;
   const EnvMap& env = in.env;
+
+  // --max-error: the knobs the user did not fix are planned from pilot measurements, then the bake
+  // runs with the chosen setting and is checked at fresh novel views.
+  std::optional<BakePlan> plan;
+  if (!a.max_error.empty()) {
+    BakeKnobs knobs;
+    if (command.count("--views")) knobs.views = a.views;
+    if (command.count("--res")) knobs.res = a.res;
+    if (command.count("--method")) knobs.method = a.method;
+    if (command.count("--samples")) knobs.samples = a.samples;
+    if (command.count("--reference-width")) knobs.reference_width = a.reference_width;
+    knobs.normalise_albedo = a.normalise == "albedo";
+    plan = plan_bake(env, *in.brdf, bake_plan_options(parse_error_budget(a.max_error), knobs, a.seed));
+    if (!plan->chosen) {
+      std::cerr << "rsibr bake: error: " << a.brdf << ": no setting is predicted to meet --max-error " << a.max_error
+                << " under " << a.env << " (rsibr plan shows the candidates); nothing written\n";
+      return 3;
+    }
+    const BakeSetting& s = plan->chosen->setting;
+    a.views = s.views;
+    a.res = s.res;
+    a.method = s.integrator.method;
+    if (a.method == "mis" || a.method == "fis") a.samples = s.integrator.samples;
+    if (a.method == "reference") a.reference_width = s.integrator.reference_width;
+    in.views = ViewSet::named(a.views);
+    in.integrator = make_integrator(a.method, env);
+    if (!a.quiet) std::cerr << "rsibr bake: planned: " << plan->why;
+  }
   const Brdf* brdf = in.brdf.get();
   IntegratorOptions options;
   options.samples = a.samples;
@@ -107,6 +140,17 @@ int run_bake(const BakeArgs& a) {
   const auto t2 = std::chrono::steady_clock::now();
   write_map_set(exr, set);
   const auto t3 = std::chrono::steady_clock::now();
+  std::optional<BakeCheck> check;
+  if (plan) {
+    check = check_bake(set, in.views, env, *brdf, a.seed + 1);
+    if (!a.quiet)
+      std::cerr << "rsibr bake: checked at " << check->views << " fresh novel views: " << 100 * check->error
+                << "% against the reference (predicted " << 100 * plan->chosen->error << "%, budget "
+                << 100 * plan->options.max_error << "%)\n";
+    if (check->error > plan->options.max_error)
+      std::cerr << "rsibr bake: warning: the checked error " << 100 * check->error << "% exceeds --max-error "
+                << a.max_error << "\n";
+  }
 
   auto secs = [](auto d) { return std::chrono::duration<double>(d).count(); };
   if (!a.quiet)
@@ -135,6 +179,18 @@ int run_bake(const BakeArgs& a) {
                   {"write", secs(t3 - t2)}, {"per_map", secs(t2 - t1) / double(set.views.size())},
                   {"gather", times.gather}, {"root_integrate", times.integrate}};
   j["root_rows"] = times.rows;
+  if (plan) {
+    j["plan"] = plan->to_json();
+    j["check"] = {{"error", check->error},
+                  {"predicted_error", plan->chosen->error},
+                  {"max_error", plan->options.max_error},
+                  {"meets", check->error <= plan->options.max_error},
+                  {"predicted_seconds", plan->chosen->seconds},
+                  {"seconds", secs(t2 - t1)},
+                  {"views", check->views},
+                  {"texels", check->texels},
+                  {"check_seconds", check->seconds}};
+  }
   write_summary(json, j);
   outputs.commit();
   return 0;
@@ -179,7 +235,11 @@ Runner add_bake(CLI::App& app) {
   c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and negative environment values instead of failing");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or summary line");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
-  return [a] { return run_bake(*a); };
+  c->add_option("--max-error", a->max_error,
+                "Plan the knobs not given (views, res, method, samples) for this error budget at novel views, "
+                "e.g. 2% (see rsibr plan --help); the result is checked and the check is in --json")
+      ->check(error_budget_check());
+  return [a, c] { return run_bake(*a, *c); };
 }
 
 }  // namespace rsibr::cli

@@ -1,5 +1,6 @@
 // rsibr blend: the radiance map for any view from a map set (the runtime's warp and blend), written
 // as a one-view map set whose confidence channel is the blend's total weight.
+#include "cli/bake_planning.h"
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
@@ -10,10 +11,12 @@
 #include "core/preview_exposure.h"
 #include "runtime/blend.h"
 #include "runtime/make_warp.h"
+#include "plan/warp_plan.h"
 
 #include <opencv2/imgcodecs.hpp>
 
 #include <chrono>
+#include <iostream>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -23,6 +26,7 @@ namespace {
 
 struct BlendArgs {
   std::string maps, output, warp = "precomputed", preview, json;
+  std::string max_error;  // empty: --warp as given; else the fastest warp within this error (plan/warp_plan.h)
   std::vector<double> view{0, 0, 1}, up{0, 1, 0};
   int size = 0;
   int rings = 16;
@@ -45,7 +49,22 @@ int run_blend(const BlendArgs& a) {
   options.width = w;
   options.height = h;
   options.rim_fade = a.rim_fade;
-  const std::unique_ptr<Warp> warp = make_warp({a.warp, a.rings, axis_in_views(set, up), a.table}, w, h);
+  WarpSettings warp_settings{a.warp, a.rings, axis_in_views(set, up), a.table};
+  std::optional<WarpPlan> warp_plan;
+  if (!a.max_error.empty()) {
+    try {
+      warp_plan = plan_warp(set, views, view, up, w, h, parse_error_budget(a.max_error),
+                            default_warp_candidates(warp_settings.axis), options);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(a.maps + ": " + e.what());
+    }
+    warp_settings = warp_plan->chosen.warp;
+    std::cerr << "rsibr blend: --max-error " << a.max_error << ": the " << warp_settings.name << " warp"
+              << (warp_settings.name == "tessellated" ? " (" + std::to_string(warp_settings.rings) + " rings)" : "")
+              << ", " << 100 * warp_plan->chosen.error << "% from the exact warp, " << 1e3 * warp_plan->chosen.seconds
+              << " ms\n";
+  }
+  const std::unique_ptr<Warp> warp = make_warp(warp_settings, w, h);
   options.warp = warp.get();
   const auto t0 = std::chrono::steady_clock::now();
   BlendResult r;
@@ -87,7 +106,8 @@ int run_blend(const BlendArgs& a) {
   j["sources"] = nlohmann::json::array();
   for (int i = 0; i < r.located.count; ++i)
     j["sources"].push_back({{"view", r.located.views[std::size_t(i)]}, {"weight", r.located.weights[std::size_t(i)]}});
-  j["warp"] = a.warp;
+  j["warp"] = warp_settings.name;
+  if (warp_plan) j["warp_plan"] = warp_plan->to_json();
   j["seconds"] = secs;
   j["values_sanitized"] = sanitized;
   write_summary(json, j);
@@ -121,6 +141,13 @@ Runner add_blend(CLI::App& app) {
                 "double-indirection: columns of the parametric table (half as many rows; "
                 "default: the map width)")
       ->check(CLI::Range(3, 4096));
+  c->add_option("--max-error", a->max_error,
+                "Choose the fastest warp whose map is within this relative RMS (e.g. 1%) of the exact warp's, "
+                "measured at this view (instead of --warp); the measurements go in --json")
+      ->check(error_budget_check())
+      ->excludes("--warp")
+      ->excludes("--rings")
+      ->excludes("--table");
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--preview", a->preview, "Also write a display-encoded PNG");
   c->add_option("--preview-exposure", a->preview_exposure,

@@ -1,5 +1,6 @@
 // rsibr process: the whole job, a photo set to probe, captured and computed maps, their comparison,
 // a turntable and an HTML report (pipeline/process_pipeline.h), resumable step by step.
+#include "cli/bake_planning.h"
 #include "cli/option_checks.h"
 #include "cli/summary.h"
 #include "cli/verbs.h"
@@ -20,11 +21,12 @@ namespace {
 
 struct ProcessArgs {
   ProcessOptions o;
-  std::string size = "320x240", json, up = "auto";
+  std::string size = "320x240", json, up = "auto", max_error;
   bool quiet = false, no_sources = false, no_self_calibration = false;
 };
 
 int run_process_verb(ProcessArgs a) {
+  if (!a.max_error.empty()) a.o.bake_max_error = parse_error_budget(a.max_error);
   int w = 0, h = 0;
   char x = 0;
   std::istringstream in(a.size);
@@ -127,6 +129,12 @@ Runner add_process(CLI::App& app) {
   c->add_option("--grey-albedo", a->o.grey_albedo, "The grey ball's albedo")->check(CLI::Range(0.001, 1.0));
   c->add_option("--bake-method", a->o.bake_method, "Integrator of the computed maps: mis, fis, sh, reference");
   c->add_option("--bake-samples", a->o.bake_samples, "Samples per texel (mis, fis)")->check(CLI::Range(1, 1 << 20));
+  c->add_option("--max-error", a->max_error,
+                "Plan the computed maps' integrator and samples instead: the cheapest whose error against the "
+                "probe's exact integral is within this relative RMS (e.g. 1%); the plan is in the bake step's record")
+      ->check(error_budget_check())
+      ->excludes("--bake-method")
+      ->excludes("--bake-samples");
   c->add_option("--seed", a->o.seed, "Seed of every stochastic step")->check(seed_check());
   c->add_option("--render-brdf", a->o.render_brdf, "BRDF spec (YAML text) of the turntable's material");
   c->add_option("--turntable", a->o.turntable, "Turntable frames")->check(CLI::Range(1, 360));

@@ -26,5 +26,6 @@ Runner add_calibrate(CLI::App& app);
 Runner add_probe(CLI::App& app);
 Runner add_orient(CLI::App& app);
 Runner add_process(CLI::App& app);
+Runner add_plan(CLI::App& app);
 
 }  // namespace rsibr::cli

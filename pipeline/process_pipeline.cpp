@@ -2,6 +2,8 @@
 
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
+#include "bake/map_set_bake.h"
+#include "plan/bake_plan.h"
 #include "calib/ball_identification.h"
 #include "calib/ball_locator.h"
 #include "calib/intrinsics.h"
@@ -904,44 +906,56 @@ void step_bake(Context& c) {
   std::vector<fs::path> inputs = {c.dir / "probe.exr"};
   const auto greys = balls_of(c, BallKind::grey);
   for (const BallSpec* b : greys) inputs.push_back(captured_path(c, *b));
-  const nlohmann::json settings = {
+  nlohmann::json settings = {
       {"albedo", c.o.grey_albedo}, {"method", c.o.bake_method}, {"samples", c.o.bake_samples}, {"seed", c.o.seed}};
+  if (c.o.bake_max_error > 0)
+    settings = {{"albedo", c.o.grey_albedo}, {"max_error", c.o.bake_max_error}, {"seed", c.o.seed}};
   run_step(c, "bake", settings, inputs, [&](StepRecord& r) {
     const EnvMap probe = read_environment((c.dir / "probe.exr").string());
-    const auto integrator = make_integrator(c.o.bake_method, probe);
     std::ostringstream spec;
     spec << std::setprecision(9) << "{type: lambert, albedo: [" << c.o.grey_albedo << ", " << c.o.grey_albedo << ", "
          << c.o.grey_albedo << "]}";
     const auto brdf = parse_brdf(spec.str());
-    IntegratorOptions io;
-    io.samples = c.o.bake_samples;
-    io.seed = c.o.seed;
+    std::string method = c.o.bake_method;
+    MapSetBakeOptions bo;
+    bo.integrator.samples = c.o.bake_samples;
+    nlohmann::json planned;
+    if (c.o.bake_max_error > 0) {
+      const IntegratorPlan plan =
+          plan_integrator(probe, *brdf, c.o.bake_max_error, default_integrator_settings(), c.o.seed + 1);
+      if (!plan.chosen)
+        throw std::runtime_error("no integrator is predicted to reach --max-error " +
+                                 std::to_string(c.o.bake_max_error) + " on probe.exr");
+      method = plan.chosen->setting.method;
+      bo.integrator.samples = std::max(1, plan.chosen->setting.samples);
+      bo.integrator.reference_width = plan.chosen->setting.reference_width;
+      planned = plan.to_json();
+      if (c.o.log)
+        c.o.log("bake: planned " + plan.chosen->setting.label() + " (" + std::to_string(100 * plan.chosen->error) +
+                "% at the pilot texels)");
+    }
+    const auto integrator = make_integrator(method, probe);
+    bo.integrator.seed = c.o.seed;
+    bo.environment_name = "probe.exr";
     nlohmann::json balls = nlohmann::json::array();
     for (const BallSpec* b : greys) {
       const MapSet captured = read_map_set(captured_path(c, *b).string());
-      MapSet computed;
-      for (const MapView& cv : captured.views) {
-        MapView mv;
-        mv.view = cv.view;
-        mv.world_from_view = cv.world_from_view;
-        mv.warp = CentralDirection::Normal;
-        mv.source = MapSource::Computed;
-        mv.material = brdf->spec();
-        mv.attributes = {{"version", RSIBR_VERSION},
-                         {"environment", "probe.exr"},
-                         {"method", c.o.bake_method},
-                         {"samples", std::to_string(c.o.bake_samples)},
-                         {"seed", std::to_string(c.o.seed)},
-                         {"image", cv.attributes.count("image") ? cv.attributes.at("image") : ""}};
-        mv.rgb = integrator->radiance_map(*brdf, mv.view, mv.world_from_view, cv.rgb.cols, io);
-        computed.views.push_back(std::move(mv));
+      // At the captured maps' own frames and size, so the comparison is texel for texel.
+      std::vector<BakeFrame> frames;
+      for (const MapView& cv : captured.views) frames.push_back({cv.view, cv.world_from_view});
+      bo.res = captured.width();
+      MapSet computed = bake_map_set(*brdf, *integrator, frames, bo);
+      for (std::size_t i = 0; i < computed.views.size(); ++i) {
+        const auto image = captured.views[i].attributes.find("image");
+        computed.views[i].attributes["image"] = image == captured.views[i].attributes.end() ? "" : image->second;
       }
       const fs::path out = computed_path(c, *b);
       write_map_set(out.string(), computed);
       r.outputs.push_back(out);
       balls.push_back({{"ball", b->name}, {"views", computed.views.size()}});
     }
-    r.summary = {{"material", brdf->spec()}, {"balls", balls}, {"method", c.o.bake_method}};
+    r.summary = {{"material", brdf->spec()}, {"balls", balls}, {"method", method}};
+    if (!planned.is_null()) r.summary["plan"] = planned;
   });
 }
 
@@ -1047,26 +1061,12 @@ void step_render(Context& c) {
     const EnvMap probe = read_environment((c.dir / "probe.exr").string());
     const auto brdf = parse_brdf(c.o.render_brdf);
     const auto integrator = make_integrator("fis", probe);
-    IntegratorOptions io;
-    io.samples = 32;
-    io.seed = c.o.seed;
-    MapSet maps;
-    const ViewSet views = ViewSet::named("icosa");
-    for (const Vec3& v : views.views()) {
-      MapView mv;
-      mv.view = v;
-      mv.world_from_view = world_from_view_for(v);
-      mv.warp = brdf->central_direction();
-      mv.source = MapSource::Computed;
-      mv.material = brdf->spec();
-      mv.attributes = {{"version", RSIBR_VERSION},
-                       {"environment", "probe.exr"},
-                       {"method", "fis"},
-                       {"samples", "32"},
-                       {"seed", std::to_string(c.o.seed)}};
-      mv.rgb = integrator->radiance_map(*brdf, v, mv.world_from_view, c.o.render_views_res, io);
-      maps.views.push_back(std::move(mv));
-    }
+    MapSetBakeOptions bo;
+    bo.res = c.o.render_views_res;
+    bo.integrator.samples = 32;
+    bo.integrator.seed = c.o.seed;
+    bo.environment_name = "probe.exr";
+    const MapSet maps = bake_map_set(*brdf, *integrator, ViewSet::named("icosa"), bo);
     const fs::path folder = c.dir / "render";
     fs::create_directories(folder);
     write_map_set((folder / "maps.exr").string(), maps);

@@ -72,6 +72,10 @@ struct ProcessOptions {
   double grey_albedo = 0.18;    // the grey ball's Lambert albedo (compare fits a gain anyway)
   std::string bake_method = "mis";
   int bake_samples = 128;
+  // > 0: the bake step plans its integrator and samples instead (plan/bake_plan.h, plan_integrator):
+  // the cheapest whose own error, against the full reference quadrature of the probe, is within
+  // this relative RMS. The computed maps are baked at the captured frames, so nothing is interpolated.
+  double bake_max_error = 0;
   std::uint64_t seed = 0;
   std::string render_brdf = "{type: ggx, roughness: 0.25, fresnel: {type: schlick, f0: [0.95, 0.64, 0.54]}}";
   int render_views_res = 64;  // map size of the render's computed map set (icosa views)

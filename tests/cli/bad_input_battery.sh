@@ -120,6 +120,7 @@ for f in env-truncated env-flipped empty text folder fifo; do
   refused "info: $f" "$f.exr" info "$in/$f.exr"
   refused "convert: $f" "$f.exr" convert "$in/$f.exr" "$out/c.exr" --to cube --size 8
   refused "bake: environment $f" "$f.exr" bake --env "$in/$f.exr" --brdf "$in/ggx.yaml" --res 8 "$out/b.exr"
+  refused "plan: environment $f" "$f.exr" plan --env "$in/$f.exr" --brdf "$in/ggx.yaml" --max-error 5%
 done
 for f in maps-truncated maps-flipped; do
   refused "info: $f" "$f.exr" info "$in/$f.exr"
@@ -211,6 +212,11 @@ refused "extract: --ball far larger than the image" "--ball" extract "$in/shoot-
 refused "blend: --view 0 0 0" "--view" blend "$in/maps-good.exr" "$out/bl.exr" --view 0 0 0
 refused "blend: --view nan" "--view" blend "$in/maps-good.exr" "$out/bl.exr" --view nan 0 1
 refused "pattern: --size 0" "--size" pattern white "$out/pt.exr" --to latlong --size 0
+refused "plan: --max-error 0" "--max-error" plan --env "$in/env-good.exr" --brdf "$in/ggx.yaml" --max-error 0
+refused "plan: --max-error 150%" "--max-error" plan --env "$in/env-good.exr" --brdf "$in/ggx.yaml" --max-error 150%
+refused "plan: --max-error two" "--max-error" plan --env "$in/env-good.exr" --brdf "$in/ggx.yaml" --max-error two
+refused "plan: --samples without --method" "--method" plan --env "$in/env-good.exr" --brdf "$in/ggx.yaml" --max-error 2% --samples 64
+refused "bake: --max-error under a fixed --samples alone" "--method" bake --env "$in/env-good.exr" --brdf "$in/ggx.yaml" --max-error 2% --samples 64 "$out/b.exr"
 
 # ---- outputs: checked together before any work, distinct from the inputs and each other
 # Each line: verb | one of its inputs | its arguments.
@@ -226,7 +232,8 @@ for spec in "convert|$in/env-good.exr|$in/env-good.exr $out/c2.exr --to cube --s
             "orient|$in/north-copy.exr|$in/shoot-hdr/north.exr $in/north-copy.exr --lens $in/lens.cameramodel --out $out/p2.yaml" \
             "probe|$in/maps-good.exr|$in/maps-good.exr --out $out/p2.exr" \
             "process|$in/shoot/photoset.yaml|$in/shoot --out $out/pr2 --lens $in/lens.cameramodel -q" \
-            "synth|$in/minimal.yaml|$in/minimal.yaml --out $out/s2 -q"; do
+            "synth|$in/minimal.yaml|$in/minimal.yaml --out $out/s2 -q" \
+            "plan|$in/lambert.yaml|--env $in/env-good.exr --brdf $in/lambert.yaml --max-error 5% --views icosa --res 8 --method sh"; do
   verb=${spec%%|*}
   rest=${spec#*|}
   input=${rest%%|*}

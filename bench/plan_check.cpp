@@ -1,0 +1,165 @@
+// The planner against a full sweep (plan/bake_plan.h): for one environment and BRDF, the plan for a
+// budget, the chosen setting baked and checked at fresh novel views, and every candidate's error
+// measured for real (its own integrator, blended at the same fresh texels, against the full
+// reference) with its time from the measured cost per texel; the cheapest candidate that meets the
+// budget in the sweep is then baked and timed too. bench/plan_check.py runs it over held-out
+// environments and BRDFs and writes the docs/tradeoffs.md section "Planning for an error budget".
+// Output: one JSON object on stdout.
+#include "bake/brdf_spec.h"
+#include "bake/integrator.h"
+#include "bake/map_set_bake.h"
+#include "core/exr_io.h"
+#include "plan/bake_plan.h"
+#include "plan/error_sample.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <iostream>
+#include <map>
+
+using namespace rsibr;
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+IntegratorOptions options_of(const IntegratorSetting& s) {
+  IntegratorOptions o;
+  o.samples = std::max(1, s.samples);
+  o.reference_width = s.reference_width;
+  return o;
+}
+
+// Bakes the setting in full and returns the wall time (integrator construction included).
+double bake_seconds(const EnvMap& env, const Brdf& brdf, const BakeSetting& s, MapSet* out) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto integrator = make_integrator(s.integrator.method, env);
+  MapSetBakeOptions o;
+  o.res = s.res;
+  o.integrator = options_of(s.integrator);
+  *out = bake_map_set(brdf, *integrator, ViewSet::named(s.views), o);
+  return seconds_since(t0);
+}
+
+nlohmann::json setting_json(const BakeSetting& s) {
+  return {{"views", s.view_count}, {"res", s.res}, {"integrator", s.integrator.label()}};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string env_path, brdf_spec;
+  double budget = 0.02;
+  int check_views = 6, check_texels = 64;
+  bool skip_full_reference = true;
+  CLI::App app("The bake planner against a full sweep of its candidates");
+  app.add_option("--env", env_path)->required();
+  app.add_option("--brdf", brdf_spec, "BRDF spec (YAML text)")->required();
+  app.add_option("--max-error", budget);
+  app.add_option("--check-views", check_views);
+  app.add_option("--check-texels", check_texels);
+  CLI11_PARSE(app, argc, argv);
+  try {
+    EnvMap env = read_environment(env_path);
+    for (int r = 0; r < env.pixels.rows; ++r)  // lossy-compression ringing: negatives to 0
+      for (int c = 0; c < env.pixels.cols; ++c) {
+        cv::Vec3f& p = env.pixels.at<cv::Vec3f>(r, c);
+        for (int k = 0; k < 3; ++k) p[k] = std::max(0.f, p[k]);
+      }
+    const auto brdf = parse_brdf(brdf_spec);
+    nlohmann::json out;
+    out["env"] = env_path;
+    out["brdf"] = brdf->spec();
+    out["max_error"] = budget;
+
+    // The plan and its bake, checked at fresh novel views.
+    BakePlanOptions po;
+    po.max_error = budget;
+    auto t0 = std::chrono::steady_clock::now();
+    const BakePlan plan = plan_bake(env, *brdf, po);
+    const double plan_seconds = seconds_since(t0);
+    out["plan"] = plan.to_json();
+    out["plan_seconds"] = plan_seconds;
+    const std::uint64_t check_seed = 7777;
+    const ErrorSample sample(check_views, check_texels, 128, check_seed);
+    const auto reference = make_integrator("reference", env);
+    t0 = std::chrono::steady_clock::now();
+    const std::vector<Vec3> truth = direct_values(*reference, *brdf, IntegratorOptions{}, sample);
+    out["truth_seconds"] = seconds_since(t0);
+    if (plan.chosen) {
+      MapSet set;
+      const double seconds = bake_seconds(env, *brdf, plan.chosen->setting, &set);
+      const SampledBlend b = sampled_blend(set, ViewSet::named(plan.chosen->setting.views), sample);
+      out["chosen"] = setting_json(plan.chosen->setting);
+      out["chosen"]["predicted_error"] = plan.chosen->error;
+      out["chosen"]["predicted_seconds"] = plan.chosen->seconds;
+      out["chosen"]["error"] = relative_rms(b.values, truth, &b.weights);
+      out["chosen"]["seconds"] = seconds;
+    }
+
+    // The sweep: every candidate's real error at the check texels; its time from the cost per texel
+    // measured here (a whole 128^2 map per integrator setting).
+    std::map<std::string, std::unique_ptr<Integrator>> made;
+    std::map<std::string, double> setup;
+    auto integrator = [&](const std::string& m) -> const Integrator& {
+      if (!made.count(m)) {
+        const auto t = std::chrono::steady_clock::now();
+        made[m] = make_integrator(m, env);
+        setup[m] = seconds_since(t);
+      }
+      return *made[m];
+    };
+    std::map<std::string, double> per_texel;
+    std::vector<IntegratorSetting> settings;
+    for (const IntegratorSetting& s : po.integrators) {
+      if (skip_full_reference && s.method == "reference" && s.reference_width == 0) continue;
+      try {
+        const Integrator& in = integrator(s.method);
+        const auto t = std::chrono::steady_clock::now();
+        in.radiance_map(*brdf, sample.view(0), sample.frame(0), 128, options_of(s));
+        per_texel[s.label()] = seconds_since(t) / double(disc_texel_count(128));
+        settings.push_back(s);
+      } catch (const std::invalid_argument&) {
+      }
+    }
+    nlohmann::json rows = nlohmann::json::array();
+    std::optional<nlohmann::json> best;
+    BakeSetting best_setting;
+    for (const std::string& views : po.view_sets) {
+      const ViewSet vs = ViewSet::named(views);
+      for (int res : po.sizes)
+        for (const IntegratorSetting& s : settings) {
+          const auto t = std::chrono::steady_clock::now();
+          const SampledBlend b = sampled_blend(integrator(s.method), *brdf, options_of(s), vs, res, false, sample);
+          const double error = relative_rms(b.values, truth, &b.weights);
+          const double model =
+              setup[s.method] + double(vs.views().size()) * double(disc_texel_count(res)) * per_texel[s.label()];
+          BakeSetting bs{views, int(vs.views().size()), res, s};
+          nlohmann::json row = setting_json(bs);
+          row["error"] = error;
+          row["seconds_model"] = model;
+          row["sweep_seconds"] = seconds_since(t);
+          rows.push_back(row);
+          if (error <= budget && (!best || model < (*best)["seconds_model"].get<double>())) {
+            best = row;
+            best_setting = bs;
+          }
+        }
+    }
+    out["sweep"] = rows;
+    if (best) {
+      MapSet set;
+      (*best)["seconds"] = bake_seconds(env, *brdf, best_setting, &set);
+      out["sweep_best"] = *best;
+    }
+    std::cout << out.dump(1) << "\n";
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "rsibr_plan_check: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,332 @@
+#include "plan/bake_plan.h"
+
+#include "bake/integrator.h"
+#include "plan/error_sample.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+namespace rsibr {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+IntegratorOptions options_of(const IntegratorSetting& s, std::uint64_t seed) {
+  IntegratorOptions o;
+  o.samples = std::max(1, s.samples);
+  o.reference_width = s.reference_width;
+  o.seed = seed;
+  return o;
+}
+
+// The integrator that measures e_interp: deterministic (no noise to mistake for blend error) and
+// accurate enough that its smooth bias is common to the sources and the direct values.
+const IntegratorSetting kInterpolationIntegrator{"fis", 128, 0};
+
+std::string percent(double e) {
+  std::ostringstream s;
+  s.precision(e < 0.1 ? 2 : 3);
+  s << 100.0 * e << "%";
+  return s.str();
+}
+
+std::string setting_text(const BakeSetting& b) {
+  return std::to_string(b.view_count) + " views x " + std::to_string(b.res) + "^2, " + b.integrator.label();
+}
+
+// The integrator pilot: the truth (the full reference quadrature) at the sample's texels, then each
+// setting's error against it and its time per texel. Keeps the integrators it made.
+struct Pilots {
+  const EnvMap& env;
+  std::map<std::string, std::unique_ptr<Integrator>> made;
+  std::map<std::string, double> setup;
+  std::vector<IntegratorPilot> integrators;
+
+  const Integrator& integrator(const std::string& method) {
+    auto it = made.find(method);
+    if (it == made.end()) {
+      const auto t = std::chrono::steady_clock::now();
+      auto integrator = make_integrator(method, env);
+      setup[method] = seconds_since(t);
+      it = made.emplace(method, std::move(integrator)).first;
+    }
+    return *it->second;
+  }
+
+  Pilots(const EnvMap& environment, const Brdf& brdf, const ErrorSample& sample,
+         const std::vector<IntegratorSetting>& settings, std::uint64_t seed, int timing_size)
+      : env(environment) {
+    const Integrator& reference = integrator("reference");
+    double truth_seconds = 0;
+    const std::vector<Vec3> truth =
+        direct_values(reference, brdf, options_of({"reference", 0, 0}, seed), sample, &truth_seconds);
+    for (const IntegratorSetting& s : settings) {
+      const Integrator& chosen = integrator(s.method);
+      IntegratorPilot p;
+      p.setting = s;
+      p.setup_seconds = setup[s.method];
+      double seconds = 0;
+      std::vector<Vec3> values;
+      if (s.method == "reference" && s.reference_width == 0) {
+        values = truth;
+        seconds = truth_seconds;
+      } else {
+        try {
+          // Warm-up on one texel: an integrator may build what a setting needs on first use (the
+          // reference's MIP level), which is setup, not the time per texel.
+          IntegratorOptions one = options_of(s, seed);
+          one.texel_mask = cv::Mat::zeros(sample.size(), sample.size(), CV_8UC1);
+          one.texel_mask.at<unsigned char>(sample.texels(0)[0] / sample.size(), sample.texels(0)[0] % sample.size()) =
+              1;
+          chosen.radiance_map(brdf, sample.view(0), sample.frame(0), sample.size(), one);
+          values = direct_values(chosen, brdf, options_of(s, seed), sample, &seconds);
+        } catch (const std::invalid_argument&) {
+          continue;  // a setting this BRDF cannot use (sh for anything but Lambert)
+        }
+      }
+      p.error = relative_rms(values, truth);
+      p.seconds_per_texel = seconds / double(sample.count());
+      // Cheap integrators: the pilot's few texels time mostly the per-call overhead; one whole map
+      // times the integration itself.
+      if (seconds < 0.05) {
+        const auto t = std::chrono::steady_clock::now();
+        chosen.radiance_map(brdf, sample.view(0), sample.frame(0), timing_size, options_of(s, seed));
+        p.seconds_per_texel = seconds_since(t) / double(disc_texel_count(timing_size));
+      }
+      integrators.push_back(p);
+    }
+  }
+};
+
+}  // namespace
+
+std::string IntegratorSetting::label() const {
+  if (method == "reference")
+    return reference_width > 0 ? "reference width " + std::to_string(reference_width) : "reference (full)";
+  if (method == "sh") return "sh order 2";
+  return method + " " + std::to_string(samples) + " samples";
+}
+
+std::vector<IntegratorSetting> default_integrator_settings() {
+  std::vector<IntegratorSetting> s;
+  for (int w : {32, 64, 128, 256}) s.push_back({"reference", 0, w});
+  s.push_back({"reference", 0, 0});
+  for (int n : {16, 64, 256, 1024}) s.push_back({"mis", n, 0});
+  for (int n : {8, 32, 128, 512}) s.push_back({"fis", n, 0});
+  s.push_back({"sh", 0, 0});
+  return s;
+}
+
+BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& options) {
+  if (!(options.max_error > 0 && options.max_error < 1))
+    throw std::invalid_argument("plan: the error budget must lie in (0, 1) (a relative RMS, e.g. 0.02 for 2%), not " +
+                                std::to_string(options.max_error));
+  if (options.view_sets.empty() || options.sizes.empty() || options.integrators.empty())
+    throw std::invalid_argument("plan: no view set, map size or integrator to choose from");
+  if (!(options.margin > 0 && options.margin <= 1)) throw std::invalid_argument("plan: the margin must lie in (0, 1]");
+  for (int r : options.sizes)
+    if (r < 2) throw std::invalid_argument("plan: map sizes must be at least 2, not " + std::to_string(r));
+  std::vector<ViewSet> view_sets;
+  for (const std::string& name : options.view_sets) view_sets.push_back(ViewSet::named(name));
+
+  const auto t_start = std::chrono::steady_clock::now();
+  BakePlan plan;
+  plan.options = options;
+  const ErrorSample sample(options.pilot_views, options.pilot_texels, options.pilot_size, options.seed);
+  const double budget = options.margin * options.max_error;
+
+  // The truth at the pilot texels and every integrator setting's error and time per texel.
+  Pilots pilots(env, brdf, sample, options.integrators, options.seed, options.pilot_size);
+  plan.integrators = pilots.integrators;
+  plan.truth_texels = sample.count();
+  auto integrator_for = [&](const std::string& method) -> const Integrator& { return pilots.integrator(method); };
+  if (plan.integrators.empty()) throw std::invalid_argument("plan: no integrator setting can bake this BRDF");
+
+  // e_interp(N, r), measured when first needed.
+  std::vector<Vec3> interpolation_direct;
+  std::map<std::pair<std::size_t, int>, double> interpolation;
+  auto interpolation_error = [&](std::size_t set, int res) {
+    const auto key = std::make_pair(set, res);
+    if (auto it = interpolation.find(key); it != interpolation.end()) return it->second;
+    const Integrator& integrator = integrator_for(kInterpolationIntegrator.method);
+    const IntegratorOptions o = options_of(kInterpolationIntegrator, options.seed);
+    if (interpolation_direct.empty()) interpolation_direct = direct_values(integrator, brdf, o, sample);
+    const SampledBlend b = sampled_blend(integrator, brdf, o, view_sets[set], res, options.normalise_albedo, sample);
+    InterpolationPilot p;
+    p.views = options.view_sets[set];
+    p.view_count = int(view_sets[set].views().size());
+    p.res = res;
+    p.error = relative_rms(b.values, interpolation_direct, &b.weights);
+    p.texels = b.texels_baked;
+    p.seconds = b.seconds;
+    plan.interpolation.push_back(p);
+    interpolation[key] = p.error;
+    return p.error;
+  };
+
+  // Every candidate with its predicted time, cheapest first.
+  struct Candidate {
+    PlannedSetting planned;
+    std::size_t set;
+  };
+  std::vector<Candidate> candidates;
+  for (std::size_t v = 0; v < view_sets.size(); ++v)
+    for (int r : options.sizes)
+      for (const IntegratorPilot& p : plan.integrators) {
+        PlannedSetting s;
+        s.setting = {options.view_sets[v], int(view_sets[v].views().size()), r, p.setting};
+        s.integration_error = p.error;
+        s.error = p.error;
+        s.seconds = p.setup_seconds + double(s.setting.view_count) * double(disc_texel_count(r)) * p.seconds_per_texel;
+        candidates.push_back({s, v});
+      }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.planned.seconds < b.planned.seconds; });
+  for (Candidate& c : candidates) {
+    PlannedSetting& s = c.planned;
+    if (options.every_pair || (!plan.chosen && s.integration_error <= budget)) {
+      s.interpolation_error = interpolation_error(c.set, s.setting.res);
+    } else if (auto it = interpolation.find({c.set, s.setting.res}); it != interpolation.end()) {
+      s.interpolation_error = it->second;
+    }
+    if (s.interpolation_error) {
+      s.error = std::hypot(*s.interpolation_error, s.integration_error);
+      s.meets = s.error <= budget;
+    }
+    if (s.meets && !plan.chosen) plan.chosen = s;
+    plan.settings.push_back(s);
+  }
+  plan.pilot_seconds = seconds_since(t_start);
+
+  // Why, in a few lines.
+  std::ostringstream why;
+  if (plan.chosen) {
+    const PlannedSetting& c = *plan.chosen;
+    why << "chosen: " << setting_text(c.setting) << ": predicted " << percent(c.error) << " (interpolation "
+        << percent(*c.interpolation_error) << ", integration " << percent(c.integration_error) << "), " << c.seconds
+        << " s; the budget is " << percent(options.max_error) << ", planned to " << percent(budget) << ".\n";
+  } else {
+    why << "no setting is predicted to meet " << percent(options.max_error) << " (planned to " << percent(budget)
+        << "); the most accurate measured ones are listed in the table.\n";
+  }
+  int shown = 0;
+  for (const PlannedSetting& s : plan.settings) {
+    if (plan.chosen && s.seconds >= plan.chosen->seconds) break;
+    if (shown++ == 3) break;
+    why << "cheaper, predicted to miss: " << setting_text(s.setting) << ": ";
+    if (s.interpolation_error)
+      why << percent(s.error) << " (interpolation " << percent(*s.interpolation_error) << ", integration "
+          << percent(s.integration_error) << ")";
+    else
+      why << "integration alone " << percent(s.integration_error);
+    why << ", " << s.seconds << " s\n";
+  }
+  plan.why = why.str();
+  return plan;
+}
+
+nlohmann::json BakePlan::to_json() const {
+  auto setting_json = [](const BakeSetting& b) {
+    return nlohmann::json{{"views", b.views},
+                          {"view_count", b.view_count},
+                          {"res", b.res},
+                          {"method", b.integrator.method},
+                          {"samples", b.integrator.samples},
+                          {"reference_width", b.integrator.reference_width},
+                          {"integrator", b.integrator.label()}};
+  };
+  auto planned_json = [&](const PlannedSetting& s) {
+    nlohmann::json j = setting_json(s.setting);
+    j["predicted_error"] = s.error;
+    j["integration_error"] = s.integration_error;
+    j["interpolation_error"] = s.interpolation_error ? nlohmann::json(*s.interpolation_error) : nlohmann::json();
+    j["predicted_seconds"] = s.seconds;
+    j["meets"] = s.meets;
+    return j;
+  };
+  nlohmann::json j;
+  j["max_error"] = options.max_error;
+  j["margin"] = options.margin;
+  j["pilot"] = {{"views", options.pilot_views}, {"texels_per_view", options.pilot_texels},
+                {"size", options.pilot_size},   {"seed", options.seed},
+                {"seconds", pilot_seconds},     {"truth_texels", truth_texels}};
+  j["integrators"] = nlohmann::json::array();
+  for (const IntegratorPilot& p : integrators)
+    j["integrators"].push_back({{"integrator", p.setting.label()},
+                                {"error", p.error},
+                                {"seconds_per_texel", p.seconds_per_texel},
+                                {"setup_seconds", p.setup_seconds}});
+  j["interpolation"] = nlohmann::json::array();
+  for (const InterpolationPilot& p : interpolation)
+    j["interpolation"].push_back({{"views", p.views},
+                                  {"view_count", p.view_count},
+                                  {"res", p.res},
+                                  {"error", p.error},
+                                  {"texels", p.texels},
+                                  {"seconds", p.seconds}});
+  j["chosen"] = chosen ? planned_json(*chosen) : nlohmann::json();
+  j["settings"] = nlohmann::json::array();
+  for (const PlannedSetting& s : settings) j["settings"].push_back(planned_json(s));
+  j["why"] = why;
+  return j;
+}
+
+IntegratorPlan plan_integrator(const EnvMap& env, const Brdf& brdf, double max_error,
+                               const std::vector<IntegratorSetting>& settings, std::uint64_t seed, double margin) {
+  if (!(max_error > 0 && max_error < 1))
+    throw std::invalid_argument("plan: the error budget must lie in (0, 1), not " + std::to_string(max_error));
+  const auto t0 = std::chrono::steady_clock::now();
+  const ErrorSample sample(4, 96, 128, seed);
+  Pilots pilots(env, brdf, sample, settings, seed, 128);
+  if (pilots.integrators.empty()) throw std::invalid_argument("plan: no integrator setting can bake this BRDF");
+  IntegratorPlan plan;
+  plan.integrators = pilots.integrators;
+  plan.max_error = max_error;
+  plan.margin = margin;
+  for (const IntegratorPilot& p : plan.integrators)
+    if (p.error <= margin * max_error && (!plan.chosen || p.seconds_per_texel < plan.chosen->seconds_per_texel))
+      plan.chosen = p;
+  plan.seconds = seconds_since(t0);
+  return plan;
+}
+
+nlohmann::json IntegratorPlan::to_json() const {
+  auto one = [](const IntegratorPilot& p) {
+    return nlohmann::json{{"integrator", p.setting.label()},
+                          {"method", p.setting.method},
+                          {"samples", p.setting.samples},
+                          {"reference_width", p.setting.reference_width},
+                          {"error", p.error},
+                          {"seconds_per_texel", p.seconds_per_texel}};
+  };
+  nlohmann::json j = {{"max_error", max_error}, {"margin", margin}, {"seconds", seconds}};
+  j["chosen"] = chosen ? one(*chosen) : nlohmann::json();
+  j["integrators"] = nlohmann::json::array();
+  for (const IntegratorPilot& p : integrators) j["integrators"].push_back(one(p));
+  return j;
+}
+
+BakeCheck check_bake(const MapSet& set, const ViewSet& view_set, const EnvMap& env, const Brdf& brdf,
+                     std::uint64_t seed, int views, int texels, int size) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const ErrorSample sample(views, texels, size, seed);
+  const auto reference = make_integrator("reference", env);
+  IntegratorOptions o;
+  const std::vector<Vec3> truth = direct_values(*reference, brdf, o, sample);
+  const SampledBlend b = sampled_blend(set, view_set, sample);
+  BakeCheck c;
+  c.error = relative_rms(b.values, truth, &b.weights);
+  c.views = views;
+  c.texels = sample.count();
+  c.seconds = seconds_since(t0);
+  return c;
+}
+
+}  // namespace rsibr

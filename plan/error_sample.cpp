@@ -1,0 +1,211 @@
+#include "plan/error_sample.h"
+
+#include "bake/albedo_table.h"
+#include "core/albedo_normalisation.h"
+#include "core/sphere_map.h"
+#include "runtime/blend_engine.h"
+#include "runtime/warp.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace rsibr {
+namespace {
+
+// Counter-based uniform numbers in [0, 1) (SplitMix64 of the key): the same on every platform.
+double uniform(std::uint64_t seed, std::uint64_t index) {
+  return double(integrator_detail::mix64(seed * 0x9E3779B97F4A7C15ull + index) >> 11) * 0x1.0p-53;
+}
+
+Vec2 disc_point(int texel, int size) {
+  return sphere_map::disc_from_pixel(Vec2(texel % size, texel / size), size, size);
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Whether texel t of a size^2 map is in the disc with normal z >= min_cos (z^2 = 1 - |xy|^2).
+bool in_domain(int t, int size, double min_cos) {
+  const double r2 = disc_point(t, size).squaredNorm();
+  return r2 < 1.0 && 1.0 - r2 >= min_cos * min_cos;
+}
+
+}  // namespace
+
+long long disc_texel_count(int size, double min_cos) {
+  long long n = 0;
+  for (int t = 0; t < size * size; ++t) n += in_domain(t, size, min_cos);
+  return n;
+}
+
+ErrorSample::ErrorSample(int views, int texels, int size, std::uint64_t seed, double min_cos) : size_(size) {
+  if (views < 1 || texels < 1 || size < 1)
+    throw std::invalid_argument("error sample: needs at least one view, one texel and a size >= 1");
+  if (!(min_cos >= 0 && min_cos < 1)) throw std::invalid_argument("error sample: min_cos must lie in [0, 1)");
+  std::vector<int> disc;
+  for (int t = 0; t < size * size; ++t)
+    if (in_domain(t, size, min_cos)) disc.push_back(t);
+  if (int(disc.size()) < texels)
+    throw std::invalid_argument("error sample: a " + std::to_string(size) + "^2 disc has " +
+                                std::to_string(disc.size()) + " texels, fewer than " + std::to_string(texels));
+  std::uint64_t draw = 0;
+  for (int k = 0; k < views; ++k) {
+    // Uniform on the sphere: z uniform in [-1, 1], azimuth uniform.
+    const double z = 1.0 - 2.0 * uniform(seed, draw++), phi = 2.0 * kPi * uniform(seed, draw++);
+    const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const Vec3 v(s * std::cos(phi), s * std::sin(phi), z);
+    views_.push_back(v);
+    frames_.push_back(world_from_view_for(v));
+    // `texels` distinct disc texels: a partial Fisher-Yates shuffle.
+    std::vector<int> pool = disc;
+    std::vector<int> picked;
+    for (int i = 0; i < texels; ++i) {
+      const std::size_t j = std::size_t(i) + std::size_t(uniform(seed, draw++) * double(pool.size() - std::size_t(i)));
+      std::swap(pool[std::size_t(i)], pool[std::min(j, pool.size() - 1)]);
+      picked.push_back(pool[std::size_t(i)]);
+    }
+    std::sort(picked.begin(), picked.end());
+    texels_.push_back(std::move(picked));
+  }
+}
+
+Vec3 ErrorSample::normal(int k, int texel) const {
+  return (frame(k) * sphere_map::g_normal(disc_point(texel, size_))).normalized();
+}
+
+cv::Mat ErrorSample::mask(int k) const {
+  cv::Mat m(size_, size_, CV_8UC1, cv::Scalar(0));
+  for (int t : texels(k)) m.at<unsigned char>(t / size_, t % size_) = 255;
+  return m;
+}
+
+int ErrorSample::count() const {
+  int n = 0;
+  for (const auto& t : texels_) n += int(t.size());
+  return n;
+}
+
+std::vector<Vec3> direct_values(const Integrator& integrator, const Brdf& brdf, const IntegratorOptions& options,
+                                const ErrorSample& sample, double* seconds) {
+  std::vector<Vec3> out;
+  out.reserve(std::size_t(sample.count()));
+  double total = 0;
+  for (int k = 0; k < sample.view_count(); ++k) {
+    IntegratorOptions o = options;
+    o.texel_mask = sample.mask(k);
+    const auto t0 = std::chrono::steady_clock::now();
+    const cv::Mat map = integrator.radiance_map(brdf, sample.view(k), sample.frame(k), sample.size(), o);
+    total += seconds_since(t0);
+    for (int t : sample.texels(k)) {
+      const cv::Vec3f& p = map.at<cv::Vec3f>(t / sample.size(), t % sample.size());
+      out.emplace_back(p[0], p[1], p[2]);
+    }
+  }
+  if (seconds) *seconds = total;
+  return out;
+}
+
+namespace {
+
+SampledBlend blend_at_samples(const MapSet& set, const ViewSet& view_set, const ErrorSample& sample,
+                              const BlendRule& rule) {
+  const BlendEngine engine(set, view_set, rule);
+  SampledBlend out;
+  for (int k = 0; k < sample.view_count(); ++k) {
+    const ViewWeights located = engine.locate(sample.view(k));
+    for (int t : sample.texels(k)) {
+      double w = 0;
+      out.values.push_back(engine.radiance(located, sample.view(k), sample.normal(k, t), &w));
+      out.weights.push_back(w);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+SampledBlend sampled_blend(const Integrator& integrator, const Brdf& brdf, const IntegratorOptions& options,
+                           const ViewSet& views, int res, bool normalise_albedo, const ErrorSample& sample,
+                           const BlendRule& rule) {
+  if (res < 2) throw std::invalid_argument("sampled blend: the map size must be at least 2");
+  const std::vector<Vec3>& vs = views.views();
+  const CentralDirection kind = brdf.central_direction();
+  // The footprints: for every sampled texel and located source, the 2 x 2 bilinear taps around the
+  // warped point and a one-texel margin (4 x 4), so float rounding in the engine's warp cannot
+  // reach an unbaked texel.
+  std::vector<cv::Mat> masks(vs.size());
+  for (int k = 0; k < sample.view_count(); ++k) {
+    const Vec3& d = sample.view(k);
+    const ViewWeights located = views.locate(d, rule.barycentric);
+    for (int t : sample.texels(k)) {
+      const Vec3 n = sample.normal(k, t);
+      const Vec3 central = kind == CentralDirection::Mirror ? Vec3(2.0 * n.dot(d) * n - d) : n;
+      for (int j = 0; j < located.count; ++j) {
+        const int i = located.views[std::size_t(j)];
+        const Mat3 T = world_from_view_for(vs[std::size_t(i)]);
+        const WarpSample w = warp_direction(kind, T.transpose() * central);
+        const Vec2 px = sphere_map::pixel_from_disc(w.disc, res, res);
+        cv::Mat& m = masks[std::size_t(i)];
+        if (m.empty()) m = cv::Mat(res, res, CV_8UC1, cv::Scalar(0));
+        const int c0 = int(std::floor(px.x())), r0 = int(std::floor(px.y()));
+        for (int r = std::max(0, r0 - 1); r <= std::min(res - 1, r0 + 2); ++r)
+          for (int c = std::max(0, c0 - 1); c <= std::min(res - 1, c0 + 2); ++c) m.at<unsigned char>(r, c) = 255;
+      }
+    }
+  }
+  const std::vector<float> albedo = normalise_albedo ? albedo_table(brdf) : std::vector<float>{};
+  const cv::Mat unused(res, res, CV_32FC3, cv::Scalar::all(0));  // shared by the views no texel reads
+  MapSet set;
+  SampledBlend out;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (std::size_t i = 0; i < vs.size(); ++i) {
+    MapView mv;
+    mv.view = vs[i];
+    mv.world_from_view = world_from_view_for(vs[i]);
+    mv.warp = kind;
+    mv.source = MapSource::Computed;
+    if (masks[i].empty()) {
+      mv.rgb = unused;
+    } else {
+      IntegratorOptions o = options;
+      o.texel_mask = masks[i];
+      mv.rgb = integrator.radiance_map(brdf, mv.view, mv.world_from_view, res, o);
+      out.texels_baked += cv::countNonZero(masks[i]);
+    }
+    if (!albedo.empty()) {
+      if (!masks[i].empty()) normalise_by_albedo(mv.rgb, albedo);
+      mv.albedo = albedo;
+    }
+    set.views.push_back(std::move(mv));
+  }
+  out.seconds = seconds_since(t0);
+  SampledBlend b = blend_at_samples(set, views, sample, rule);
+  out.values = std::move(b.values);
+  out.weights = std::move(b.weights);
+  return out;
+}
+
+SampledBlend sampled_blend(const MapSet& set, const ViewSet& view_set, const ErrorSample& sample,
+                           const BlendRule& rule) {
+  return blend_at_samples(set, view_set, sample, rule);
+}
+
+double relative_rms(const std::vector<Vec3>& values, const std::vector<Vec3>& truth,
+                    const std::vector<double>* weights) {
+  if (values.size() != truth.size() || (weights && weights->size() != truth.size()))
+    throw std::invalid_argument("relative_rms: the vectors differ in size");
+  double num = 0, den = 0;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    if (weights && !((*weights)[i] > 0)) continue;
+    num += (values[i] - truth[i]).squaredNorm();
+    den += truth[i].squaredNorm();
+  }
+  if (den > 0) return std::sqrt(num / den);
+  return num > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+}
+
+}  // namespace rsibr

@@ -1,0 +1,122 @@
+#include "plan/bake_plan.h"
+
+#include "bake/brdf_spec.h"
+#include "bake/integrator.h"
+#include "bake/map_set_bake.h"
+#include "core/patterns.h"
+
+#include <gtest/gtest.h>
+
+namespace rsibr {
+namespace {
+
+EnvMap sky(const Vec3& sun, int width) {
+  return render_pattern(
+      patterns::sun_and_sky(sun.normalized(), 0.1, Vec3(200, 190, 150), Vec3(0.3, 0.5, 1.0), Vec3(0.9, 0.8, 0.6)),
+      Layout(LayoutKind::LatLong, width, width / 2), 2);
+}
+
+// A small plan: few candidates, a small pilot.
+BakePlanOptions small(double budget) {
+  BakePlanOptions o;
+  o.max_error = budget;
+  o.view_sets = {"icosa", "42", "162"};
+  o.sizes = {16, 32};
+  o.integrators = {{"reference", 0, 16}, {"reference", 0, 0}, {"mis", 16, 0}, {"fis", 32, 0}, {"sh", 0, 0}};
+  o.pilot_views = 3;
+  o.pilot_texels = 48;
+  o.pilot_size = 32;
+  return o;
+}
+
+MapSet bake(const EnvMap& env, const Brdf& brdf, const BakeSetting& s) {
+  const auto integrator = make_integrator(s.integrator.method, env);
+  MapSetBakeOptions o;
+  o.res = s.res;
+  o.integrator.samples = std::max(1, s.integrator.samples);
+  o.integrator.reference_width = s.integrator.reference_width;
+  return bake_map_set(brdf, *integrator, ViewSet::named(s.views), o);
+}
+
+// The property the planner is for: the setting it picks, baked in full, meets the budget at novel
+// views it never saw, on environments and BRDFs chosen here at random.
+TEST(BakePlan, ThePlannedSettingMeetsItsBudgetAtFreshNovelViews) {
+  const std::vector<std::pair<Vec3, std::string>> cases = {
+      {Vec3(0.3, 0.8, 0.2), "{type: lambert, albedo: [0.7, 0.6, 0.5]}"},
+      {Vec3(-0.6, 0.3, 0.5), "{type: ggx, roughness: 0.5, fresnel: {type: schlick, f0: [0.9, 0.7, 0.5]}}"},
+  };
+  for (const auto& [sun, spec] : cases) {
+    const EnvMap env = sky(sun, 64);
+    const auto brdf = parse_brdf(spec);
+    const BakePlan plan = plan_bake(env, *brdf, small(0.05));
+    ASSERT_TRUE(plan.chosen) << spec << "\n" << plan.why << plan.to_json().dump(1);
+    EXPECT_LE(plan.chosen->error, 0.8 * 0.05);
+    const MapSet set = bake(env, *brdf, plan.chosen->setting);
+    const BakeCheck check = check_bake(set, ViewSet::named(plan.chosen->setting.views), env, *brdf, 99, 4, 64, 32);
+    EXPECT_LE(check.error, 0.05) << spec << ": predicted " << plan.chosen->error << "\n" << plan.why;
+  }
+}
+
+TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
+  const EnvMap env = sky(Vec3(0.1, 0.9, -0.3), 64);
+  const auto brdf = parse_brdf("{type: ggx, roughness: 0.5, fresnel: {type: schlick, f0: [0.9, 0.8, 0.6]}}");
+  BakePlanOptions o = small(0.1);
+  o.every_pair = true;
+  const BakePlan plan = plan_bake(env, *brdf, o);
+  ASSERT_TRUE(plan.chosen) << plan.why;
+  ASSERT_EQ(plan.settings.size(), 3u * 2u * 4u);  // sh cannot bake GGX: left out
+  double previous = 0;
+  for (const PlannedSetting& s : plan.settings) {
+    EXPECT_GE(s.seconds, previous);  // sorted by predicted time
+    previous = s.seconds;
+    ASSERT_TRUE(s.interpolation_error);
+    if (s.seconds < plan.chosen->seconds) EXPECT_FALSE(s.meets) << s.setting.views << " " << s.setting.res;
+  }
+  // More views interpolate better at the same size.
+  auto interp = [&](const std::string& views, int res) {
+    for (const InterpolationPilot& p : plan.interpolation)
+      if (p.views == views && p.res == res) return p.error;
+    return -1.0;
+  };
+  EXPECT_LT(interp("42", 32), interp("icosa", 32));
+}
+
+TEST(BakePlan, AnUnreachableBudgetChoosesNothingAndSaysSo) {
+  const EnvMap env = sky(Vec3(0.2, 0.7, 0.4), 32);
+  const auto brdf = parse_brdf("{type: ggx, roughness: 0.1, fresnel: {type: schlick, f0: [0.9, 0.9, 0.9]}}");
+  const BakePlan plan = plan_bake(env, *brdf, small(1e-5));
+  EXPECT_FALSE(plan.chosen);
+  EXPECT_NE(plan.why.find("no setting"), std::string::npos);
+  EXPECT_TRUE(plan.to_json()["chosen"].is_null());
+}
+
+TEST(BakePlan, TheFullReferenceHasNoIntegrationErrorAndCoarserWidthsHaveMore) {
+  const EnvMap env = sky(Vec3(0.5, 0.5, 0.5), 64);
+  const auto brdf = parse_brdf("{type: lambert, albedo: [0.8, 0.8, 0.8]}");
+  const BakePlan plan = plan_bake(env, *brdf, small(0.05));
+  double full = -1, coarse = -1;
+  for (const IntegratorPilot& p : plan.integrators) {
+    if (p.setting.label() == "reference (full)") full = p.error;
+    if (p.setting.label() == "reference width 16") coarse = p.error;
+    EXPECT_GT(p.seconds_per_texel, 0.0) << p.setting.label();
+  }
+  EXPECT_EQ(full, 0.0);
+  EXPECT_GT(coarse, 0.0);
+}
+
+TEST(BakePlan, BadBudgetsAndEmptyChoicesAreRefused) {
+  const EnvMap env = sky(Vec3(0, 1, 0), 32);
+  const auto brdf = parse_brdf("{type: lambert, albedo: [0.8, 0.8, 0.8]}");
+  for (double bad : {0.0, -0.1, 1.0, std::nan("")})
+    EXPECT_THROW(plan_bake(env, *brdf, small(bad)), std::invalid_argument);
+  BakePlanOptions o = small(0.05);
+  o.sizes.clear();
+  EXPECT_THROW(plan_bake(env, *brdf, o), std::invalid_argument);
+  o = small(0.05);
+  o.integrators = {{"sh", 0, 0}};
+  const auto ggx = parse_brdf("{type: ggx, roughness: 0.3, fresnel: {type: none}}");
+  EXPECT_THROW(plan_bake(env, *ggx, o), std::invalid_argument);  // nothing can bake it
+}
+
+}  // namespace
+}  // namespace rsibr
