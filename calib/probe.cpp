@@ -3,6 +3,7 @@
 #include "core/parallel.h"
 #include "core/sphere_map.h"
 #include "core/luminance.h"
+#include "core/resolution_mask.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,6 +12,9 @@
 namespace rsibr {
 
 namespace {
+
+// Views one probe texel's lookups are held for (on the stack).
+constexpr std::size_t kMaxProbeViews = 256;
 
 // One view's bilinear lookup at mirror direction r (view frame): the trusted taps' value and
 // confidence, and the clipped taps' weight and value.
@@ -61,6 +65,9 @@ Lookup look_up(const MapView& mv, const Vec3& r) {
 
 Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
   if (set.views.empty()) throw std::invalid_argument("probe: no views");
+  if (set.views.size() > kMaxProbeViews)
+    throw std::invalid_argument("probe: " + std::to_string(set.views.size()) + " views; at most " +
+                                std::to_string(kMaxProbeViews) + " are assembled into one probe");
   for (std::size_t v = 0; v < set.views.size(); ++v) {
     const MapView& mv = set.views[v];
     if (mv.confidence.empty() || mv.rgb.type() != CV_32FC3)
@@ -83,6 +90,27 @@ Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
   for (const MapView& mv : set.views) map_size = std::max(map_size, std::min(mv.rgb.cols, mv.rgb.rows));
   const double map_texel = 4.0 / std::max(map_size, 1), probe_texel = kPi / (layout.height() - 1);
   const int k = std::clamp(int(std::ceil(probe_texel / map_texel - 1e-9)), 1, 4);
+  // Views measured at different resolutions (core/resolution_mask.h): each lookup's confidence is
+  // scaled by s_i = m_i + 1 - max_j m_j, the views' authored masks at the lookup's level of detail
+  // (the probe's subsample spacing in the view's map texels), so the sharpest views give the detail
+  // wherever they fully cover. Views of one resolution: s_i = 1.
+  std::vector<double> detail;
+  for (std::size_t v = 0; v < set.views.size(); ++v) {
+    try {
+      detail.push_back(native_detail_level(set.views[v]));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("probe: view." + std::to_string(v) + ": " + e.what());
+    }
+  }
+  const bool mixed = mixed_resolution(detail);
+  std::vector<std::unique_ptr<MaskPyramid>> masks(set.views.size());
+  std::vector<double> lod(set.views.size(), 0.0);
+  if (mixed)
+    for (std::size_t v = 0; v < set.views.size(); ++v) {
+      masks[v] = resolution_mask(set.views[v].confidence, detail[v]);
+      const double spacing = probe_texel / k, texel = 4.0 / std::max(1, set.views[v].rgb.cols);
+      lod[v] = spacing > texel ? std::log2(spacing / texel) : 0.0;
+    }
   std::vector<double> row_area(layout.height(), 0.0), row_covered(layout.height(), 0.0),
       row_clipped(layout.height(), 0.0);
   parallel_for_rows(layout.height(), [&](int row) {
@@ -97,9 +125,26 @@ Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
         for (int b = 0; b < k; ++b) {
           const auto w = k == 1 ? centre : layout.direction(Vec2(col - 0.5 + (b + 0.5) / k, row - 0.5 + (a + 0.5) / k));
           if (!w) continue;
-          for (const MapView& mv : set.views) {
+          Lookup looks[kMaxProbeViews];
+          float m[kMaxProbeViews];
+          float m_max = 0.0f;
+          const std::size_t nv = std::min(set.views.size(), kMaxProbeViews);
+          for (std::size_t v = 0; v < nv; ++v) {
+            const MapView& mv = set.views[v];
             const Vec3 r = mv.world_from_view.transpose() * *w;
-            const Lookup l = look_up(mv, r);
+            looks[v] = look_up(mv, r);
+            m[v] = 0.0f;
+            if (mixed && looks[v].confidence > 0) {
+              const Vec2 px = sphere_map::pixel_from_disc(sphere_map::g_mirror_inv(r), mv.rgb.cols, mv.rgb.rows);
+              m[v] = masks[v]->sample(px, lod[v]);
+              m_max = std::max(m_max, m[v]);
+            }
+          }
+          for (std::size_t v = 0; v < nv; ++v) {
+            const MapView& mv = set.views[v];
+            const Vec3 r = mv.world_from_view.transpose() * *w;
+            Lookup l = looks[v];
+            if (mixed) l.confidence *= m[v] + 1.0f - m_max;
             Vec3 f = Vec3::Ones();
             if (options.fresnel && (l.confidence > 0 || l.clipped > 0))
               f = options.fresnel->eval(std::sqrt(std::clamp(0.5 * (1 + r.normalized().z()), 0.0, 1.0)))

@@ -103,6 +103,10 @@ MapView extract_sphere_map(const cv::Mat& image, const cv::Mat& flags, const Len
   mv.source = MapSource::Captured;
   mv.material = options.material;
   mv.attributes["indexing"] = options.indexing == SphereIndexing::reflection ? "reflection" : "orthographic";
+  // The texels across the disc where they were measured: the ball's image diameter in pixels (its
+  // angular diameter times the pixels per radian at the outline). A map larger than this is an
+  // upsampling; the runtime's MIP-mask blend prefers sharper sources (runtime/blend_engine.h).
+  mv.attributes["nativeSize"] = std::to_string(2.0 * cone.half_angle * limb_scale);
   mv.rgb = cv::Mat(size, size, CV_32FC3, cv::Scalar::all(0));
   mv.confidence = cv::Mat(size, size, CV_32FC1, cv::Scalar(0));
   if (!flags.empty()) mv.clipped = cv::Mat(size, size, CV_32FC1, cv::Scalar(0));

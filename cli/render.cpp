@@ -36,6 +36,7 @@ struct RenderArgs {
   std::string mesh, output, mode = "per-pixel", warp = "precomputed", env, json;
   CameraArgs camera;
   int map_size = 0, rings = 16, spp = 1;
+  bool lod = false;
   double rim_fade = 0.4;
   std::optional<float> exposure;  // nullopt: metered on the first frame (core/preview_exposure.h)
   bool quiet = false, sanitize = false;
@@ -62,6 +63,7 @@ int run_render(const RenderArgs& a) {
   options.rings = a.rings;
   options.blend.rim_fade = a.rim_fade;
   options.spp = a.spp;
+  options.lod = a.lod;
   if (!is_warp_name(a.warp))
     throw std::invalid_argument(std::string("--warp must be ") + warp_names() + ", not '" + a.warp + "'");
 
@@ -111,6 +113,7 @@ int run_render(const RenderArgs& a) {
   provenance["maps"] = maps_names;
   provenance["mesh"] = file_name(a.mesh);
   provenance["spp"] = std::to_string(a.spp);
+  provenance["lod"] = a.lod ? "footprint" : "point";
   if (options.mode == RenderMode::Paper) {
     provenance["warp"] = a.warp;
     provenance["mapSize"] = std::to_string(a.map_size > 0 ? a.map_size : sets.front().width());
@@ -157,6 +160,7 @@ int run_render(const RenderArgs& a) {
     j["map_size"] = a.map_size > 0 ? a.map_size : sets.front().width();
   }
   j["spp"] = a.spp;
+  j["lod"] = a.lod;
   j["size"] = a.camera.size;
   j["frames"] = jframes;
   j["load_seconds"] = load_seconds;
@@ -199,6 +203,10 @@ Runner add_render(CLI::App& app) {
       ->check(CLI::Range(1, 1024));
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--spp", a->spp, "Samples per pixel: a perfect square (1, 4, 9, ...)")->check(CLI::Range(1, 1024));
+  c->add_flag(
+      "--lod", a->lod,
+      "per-pixel mode: read the maps at each pixel's level of detail (ray differentials, MIP levels of the "
+      "sources; for sets of mixed resolution the MIP-mask blend): no scintillation on small or distant objects");
   c->add_option("--env", a->env, "Environment map shown where rays miss (alpha 1)");
   c->add_option(
       "--exposure", a->exposure,

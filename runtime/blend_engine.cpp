@@ -2,6 +2,7 @@
 
 #include "core/albedo_normalisation.h"
 #include "core/avx2_clones.h"
+#include "core/resolution_mask.h"
 #include "core/sphere_map.h"
 #include "runtime/disc_sampler.h"
 
@@ -38,11 +39,22 @@ struct BlendEngine::Source {
     float interior2 = -1;
   } grid;
   int conf_stride = 0;  // floats per padded row of confidence (width + 2)
+  int width = 0, height = 0;
+  // Coarser levels for lookups at a footprint (blend_engine.h): coarser[l - 1] is level l, max(1,
+  // W >> l) x max(1, H >> l) texels in the same padded layout, each the mean of the finer texels it
+  // covers (RGBA and confidence), down to 1 x 1. Built on first use (source_pyramid).
+  struct Level {
+    std::vector<float> texels, confidence;
+    Grid grid;
+    int conf_stride = 0, width = 0, height = 0;
+  };
+  std::vector<Level> coarser;
+  std::unique_ptr<MaskPyramid> mask;  // mixed-resolution sets: the authored mask (blend_engine.h)
 };
 
 struct BlendEngine::Cache {
   std::vector<std::unique_ptr<Source>> sources;
-  std::unique_ptr<std::once_flag[]> once;
+  std::unique_ptr<std::once_flag[]> once, pyramid_once;
 };
 
 namespace {
@@ -94,7 +106,85 @@ Source make_source(const MapView& v, bool use_confidence) {
   // all four inside the disc.
   const double radius = 1.0 - std::sqrt(4.0 / (double(W) * W) + 4.0 / (double(H) * H)) - 1e-4;
   s.grid.interior2 = radius > 0 ? float(radius * radius) : -1.0f;
+  s.width = W;
+  s.height = H;
   return s;
+}
+
+// The grid of a w x h level in the kernel's padded layout (make_source's formulas); its footprints
+// always take the renormalising path (interior2 = -1).
+Source::Grid level_grid(int w, int h) {
+  Source::Grid g;
+  g.stride = 4 * (w + 2);
+  g.scale_x = float(0.5 * w);
+  g.offset_x = float(0.5 * (w + 1));
+  g.scale_y = float(0.5 * h);
+  g.offset_y = float(0.5 * (h + 1));
+  g.max_x = float(w) + 0.5f;
+  g.max_y = float(h) + 0.5f;
+  g.interior2 = -1.0f;
+  return g;
+}
+
+// The texels [begin, end) of a finer level that texel i of the next coarser level covers: two, and
+// the remainder for the last texel of an odd size.
+std::pair<int, int> children(int i, int coarse_size, int fine_size) {
+  const int begin = std::min(2 * i, fine_size - 1);
+  return {begin, i == coarse_size - 1 ? fine_size : std::min(2 * i + 2, fine_size)};
+}
+
+// Source s's coarser levels: each texel the mean of the finer level's texels it covers.
+void build_levels(Source& s) {
+  int w = s.width, h = s.height;
+  while (w > 1 || h > 1) {
+    const bool first = s.coarser.empty();
+    const float* fine = first ? s.texels.data() : s.coarser.back().texels.data();
+    const float* fine_conf = first
+                                 ? (s.confidence.empty() ? nullptr : s.confidence.data())
+                                 : (s.coarser.back().confidence.empty() ? nullptr : s.coarser.back().confidence.data());
+    const int fine_pw = w + 2;
+    Source::Level L;
+    L.width = std::max(1, w >> 1);
+    L.height = std::max(1, h >> 1);
+    const int pw = L.width + 2, ph = L.height + 2;
+    L.texels.assign(std::size_t(4) * pw * ph, 0.0f);
+    if (fine_conf) L.confidence.assign(std::size_t(pw) * ph, 0.0f);
+    for (int r = 0; r < L.height; ++r) {
+      const auto [r0, r1] = children(r, L.height, h);
+      for (int c = 0; c < L.width; ++c) {
+        const auto [c0, c1] = children(c, L.width, w);
+        float sum[4] = {0, 0, 0, 0}, conf = 0;
+        for (int fr = r0; fr < r1; ++fr)
+          for (int fc = c0; fc < c1; ++fc) {
+            const std::size_t at = std::size_t(fr + 1) * fine_pw + std::size_t(fc + 1);
+            for (int k = 0; k < 4; ++k) sum[k] += fine[4 * at + k];
+            if (fine_conf) conf += fine_conf[at];
+          }
+        const float inv = 1.0f / float((r1 - r0) * (c1 - c0));
+        const std::size_t at = std::size_t(r + 1) * pw + std::size_t(c + 1);
+        for (int k = 0; k < 4; ++k) L.texels[4 * at + k] = sum[k] * inv;
+        if (fine_conf) L.confidence[at] = conf * inv;
+      }
+    }
+    L.grid = level_grid(L.width, L.height);
+    L.conf_stride = pw;
+    w = L.width;
+    h = L.height;
+    s.coarser.push_back(std::move(L));
+  }
+}
+
+// The source's resolution mask (core/resolution_mask.h) from its coverage: the confidence where a
+// texel is valid (1 without a channel), 0 outside the disc.
+std::unique_ptr<MaskPyramid> make_mask(const Source& s, double detail_level) {
+  const int W = s.width, H = s.height, pw = W + 2;
+  cv::Mat coverage(H, W, CV_32FC1);
+  for (int r = 0; r < H; ++r)
+    for (int c = 0; c < W; ++c) {
+      const std::size_t at = std::size_t(r + 1) * pw + std::size_t(c + 1);
+      coverage.at<float>(r, c) = s.texels[4 * at + 3] > 0.0f ? (s.confidence.empty() ? 1.0f : s.confidence[at]) : 0.0f;
+    }
+  return resolution_mask(coverage, detail_level);
 }
 
 // Four floats (GCC/Clang vector extension): one texel's RGBA, or R, G, B and the weight sum.
@@ -293,6 +383,70 @@ RSIBR_AVX2_CLONES void gather_row(const Source& s, int n, const float* a, const 
   }
 }
 
+// --- Lookups at a footprint (radiance at a level of detail). ---
+
+// Level `level` of source s at disc point (x, y): the colour (bilinear, renormalised by the taps'
+// validity) and the confidence (the same weights); false where no tap holds a valid share.
+bool sample_level(const Source& s, int level, float x, float y, float rgb[3], float& conf) {
+  const float* texels = level == 0 ? s.texels.data() : s.coarser[std::size_t(level - 1)].texels.data();
+  const std::vector<float>& cv = level == 0 ? s.confidence : s.coarser[std::size_t(level - 1)].confidence;
+  const Source::Grid& g = level == 0 ? s.grid : s.coarser[std::size_t(level - 1)].grid;
+  const int conf_stride = level == 0 ? s.conf_stride : s.coarser[std::size_t(level - 1)].conf_stride;
+  int o;
+  float fx, fy;
+  footprint(g, x, y, o, fx, fy);
+  const float w00 = (1.0f - fx) * (1.0f - fy), w01 = fx * (1.0f - fy), w10 = (1.0f - fx) * fy, w11 = fx * fy;
+  const float* t0 = texels + o;
+  const float* t1 = t0 + g.stride;
+  const v4f S = w00 * load4(t0) + w01 * load4(t0 + 4) + w10 * load4(t1) + w11 * load4(t1 + 4);
+  if (!(S[3] > 1e-6f)) return false;
+  const float inv = 1.0f / S[3];
+  rgb[0] = S[0] * inv;
+  rgb[1] = S[1] * inv;
+  rgb[2] = S[2] * inv;
+  conf = 1.0f;
+  if (!cv.empty()) {
+    const float* k0 = cv.data() + o / 4;
+    const float* k1 = k0 + conf_stride;
+    const float c = (w00 * k0[0] + w01 * k0[1] + w10 * k1[0] + w11 * k1[1]) * inv;
+    conf = c > 0.0f ? c : 0.0f;
+  }
+  return true;
+}
+
+// Source s's contribution at weight a (> 0) and level of detail lod, trilinear between the two
+// nearest levels; lod <= 0 is contribute()'s tap exactly, and so is a lookup no level can serve.
+float contribute_lod(const Source& s, float a, float x, float y, double lod, v4f& acc) {
+  if (!(lod > 0) || s.coarser.empty()) return contribute(s, taps(s.grid, x, y, a), a, x, y, acc);
+  const double l = std::min(lod, double(s.coarser.size()));
+  const int l0 = int(l);
+  const float f = float(l - l0);
+  float c0[3], c1[3], k0 = 0, k1 = 0;
+  const bool ok0 = sample_level(s, l0, x, y, c0, k0);
+  const bool ok1 = f > 0.0f && l0 + 1 <= int(s.coarser.size()) && sample_level(s, l0 + 1, x, y, c1, k1);
+  float rgb[3], conf;
+  if (ok0 && ok1) {
+    for (int k = 0; k < 3; ++k) rgb[k] = (1.0f - f) * c0[k] + f * c1[k];
+    conf = (1.0f - f) * k0 + f * k1;
+  } else if (ok0 || ok1) {
+    for (int k = 0; k < 3; ++k) rgb[k] = ok0 ? c0[k] : c1[k];
+    conf = ok0 ? k0 : k1;
+  } else {
+    return contribute(s, taps(s.grid, x, y, a), a, x, y, acc);
+  }
+  const float ac = a * conf;
+  if (!(ac > 0.0f)) return 0.0f;
+  acc += v4f{ac * rgb[0], ac * rgb[1], ac * rgb[2], ac};
+  return ac;
+}
+
+// The level of detail of a lookup at disc point p whose footprint's corners land at q1 and q2 (disc
+// coordinates): log2 of the larger extent in texels of a width-W map, at least 0.
+double lod_of(const Vec2& p, const Vec2& q1, const Vec2& q2, int W) {
+  const double extent = std::max((q1 - p).norm(), (q2 - p).norm()) * 0.5 * W;
+  return extent > 1.0 ? std::log2(extent) : 0.0;
+}
+
 double det3(const Vec3& a, const Vec3& b, const Vec3& c) { return a.dot(b.cross(c)); }
 
 // v / |v|, as core/view_set.cpp's locate normalises (so the hinted weights are bitwise its weights).
@@ -309,6 +463,16 @@ BlendEngine::BlendEngine(const MapSet& maps, const ViewSet& view_set, const Blen
   check_blend_inputs(maps, view_set);
   cache_->sources.resize(maps.views.size());
   cache_->once = std::make_unique<std::once_flag[]>(maps.views.size());
+  cache_->pyramid_once = std::make_unique<std::once_flag[]>(maps.views.size());
+  // Native sizes (core/resolution_mask.h): the level from which each map holds real detail.
+  for (std::size_t i = 0; i < maps.views.size(); ++i) {
+    try {
+      detail_levels_.push_back(native_detail_level(maps.views[i]));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("blend: view " + std::to_string(i) + ": " + e.what());
+    }
+  }
+  mixed_ = rsibr::mixed_resolution(detail_levels_);
   const auto& views = view_set.views();
   for (const auto& T : view_set.triangles()) {
     const Vec3 &a = views[std::size_t(T[0])], &b = views[std::size_t(T[1])], &c = views[std::size_t(T[2])];
@@ -325,6 +489,17 @@ const BlendEngine::Source& BlendEngine::source(int index) const {
     cache_->sources[i] = std::make_unique<Source>(make_source(maps_.views[i], rule_.use_confidence));
   });
   return *cache_->sources[i];
+}
+
+const BlendEngine::Source& BlendEngine::source_pyramid(int index) const {
+  const Source& s = source(index);
+  const std::size_t i = std::size_t(index);
+  std::call_once(cache_->pyramid_once[i], [&] {
+    Source& own = *cache_->sources[i];
+    build_levels(own);
+    if (mixed_) own.mask = make_mask(own, detail_levels_[i]);
+  });
+  return s;
 }
 
 void BlendEngine::prepare_all() const {
@@ -357,7 +532,110 @@ ViewWeights BlendEngine::locate(const Vec3& v, int* hint) const {
   return out;
 }
 
+Vec3 BlendEngine::radiance(const ViewWeights& located, const Vec3& v, const Vec3& n, const Footprint& footprint,
+                           double* weight) const {
+  if (!mixed_ && footprint.dn_dx.isZero(0) && footprint.dn_dy.isZero(0)) return radiance(located, v, n, weight);
+  return radiance_at(located, v, n, &footprint, weight);
+}
+
+Vec3 BlendEngine::radiance_at(const ViewWeights& located, const Vec3& v, const Vec3& n_in, const Footprint* fp,
+                              double* weight) const {
+  // 0. Clamp n to v's hemisphere, as radiance() does.
+  Vec3 n = n_in;
+  double nv = n.dot(v);
+  if (nv < 0) {
+    n -= nv * v;
+    const double len = n.norm();
+    n = len > 0 ? Vec3(n / len) : Vec3(-world_from_view_for(v).col(1));
+    nv = 0;
+  }
+  const Vec3 r = 2.0 * nv * n - v;
+  const std::vector<float>& albedo = maps_.views.front().albedo;
+  const Vec3 A = albedo.empty() ? Vec3(1, 1, 1) : albedo_at(albedo, float(nv));
+  // The footprint's corners: the central directions of n + dn_dx and n + dn_dy.
+  const bool has_footprint = fp && !(fp->dn_dx.isZero(0) && fp->dn_dy.isZero(0));
+  Vec3 corner_n[2], corner_r[2];
+  if (has_footprint)
+    for (int q = 0; q < 2; ++q) {
+      Vec3 m = (n + (q == 0 ? fp->dn_dx : fp->dn_dy));
+      m = m.norm() > 0 ? Vec3(m.normalized()) : n;
+      corner_n[q] = m;
+      corner_r[q] = 2.0 * std::max(0.0, m.dot(v)) * m - v;
+    }
+
+  const Source* sources[3];
+  WarpSample samples[3];
+  float a[3] = {0, 0, 0}, mask[3] = {0, 0, 0};
+  double lod[3] = {0, 0, 0};
+  const float inv_fade = rule_.rim_fade > 0 ? float(1.0 / rule_.rim_fade) : 0.0f;
+  float mask_max = 0.0f;
+  for (int k = 0; k < located.count; ++k) {
+    const int index = located.views[std::size_t(k)];
+    const Source& s = has_footprint || mixed_ ? source_pyramid(index) : source(index);
+    sources[k] = &s;
+    const bool mirror = s.kind == CentralDirection::Mirror;
+    samples[k] = warp_direction(s.kind, s.view_from_world * (mirror ? r : n));
+    if (has_footprint) {
+      const WarpSample q1 = warp_direction(s.kind, s.view_from_world * (mirror ? corner_r[0] : corner_n[0]));
+      const WarpSample q2 = warp_direction(s.kind, s.view_from_world * (mirror ? corner_r[1] : corner_n[1]));
+      lod[k] = lod_of(samples[k].disc, q1.disc, q2.disc, s.width);
+    }
+    const double w = located.weights[std::size_t(k)];
+    if (!(w > 0)) continue;
+    a[k] = faded(float(w), float(samples[k].rim), inv_fade);
+    if (mixed_ && a[k] > 0.0f) {
+      mask[k] = s.mask->sample(sphere_map::pixel_from_disc(samples[k].disc, s.width, s.height), lod[k]);
+      mask_max = std::max(mask_max, mask[k]);
+    }
+  }
+  v4f acc = {0.0f, 0.0f, 0.0f, 0.0f};
+  for (int k = 0; k < located.count; ++k) {
+    float ak = a[k];
+    if (mixed_) ak *= mask[k] + 1.0f - mask_max;  // the MIP-mask blend's s_k
+    if (!(ak > 0.0f)) continue;
+    contribute_lod(*sources[k], ak, float(samples[k].disc.x()), float(samples[k].disc.y()), lod[k], acc);
+  }
+  float out[3], total = 0;
+  if (!finish(acc, out, &total))
+    fallback(
+        sources, located.count, [&](int k) { return samples[k]; }, out);
+  if (weight) *weight = total;
+  return Vec3(out[0], out[1], out[2]).cwiseProduct(A);
+}
+
+BlendResult BlendEngine::mixed_map(const Vec3& view_dir, const Vec3& up, int W, int H) const {
+  BlendResult result;
+  result.world_from_view = world_from_view_for(view_dir, up);
+  result.located = locate(view_dir);
+  const Mat3& T = result.world_from_view;
+  const Vec3 d = view_dir.normalized();
+  result.rgb = cv::Mat::zeros(H, W, CV_32FC3);
+  result.weight = cv::Mat::zeros(H, W, CV_32FC1);
+  tbb::parallel_for(tbb::blocked_range<int>(0, H), [&](const tbb::blocked_range<int>& rows) {
+    for (int r = rows.begin(); r != rows.end(); ++r) {
+      const auto [c0, c1] = disc_span(r, W, H);
+      for (int c = c0; c < c1; ++c) {
+        // The destination texel's footprint: its neighbours' normals one texel right and down.
+        const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), W, H);
+        const Vec3 n = T * sphere_map::g_normal(xy);
+        Footprint fp;
+        fp.dn_dx = T * sphere_map::g_normal(xy + Vec2(2.0 / W, 0)) - n;
+        fp.dn_dy = T * sphere_map::g_normal(xy - Vec2(0, 2.0 / H)) - n;
+        double w = 0;
+        const Vec3 L = radiance_at(result.located, d, n, &fp, &w);
+        float* o = result.rgb.ptr<float>(r) + 3 * c;
+        o[0] = float(L.x());
+        o[1] = float(L.y());
+        o[2] = float(L.z());
+        result.weight.at<float>(r, c) = float(w);
+      }
+    }
+  });
+  return result;
+}
+
 Vec3 BlendEngine::radiance(const ViewWeights& located, const Vec3& v, const Vec3& n_in, double* weight) const {
+  if (mixed_) return radiance_at(located, v, n_in, nullptr, weight);
   // 0. Clamp n to v's hemisphere (the nearest rim normal).
   Vec3 n = n_in;
   double nv = n.dot(v);
@@ -408,6 +686,8 @@ BlendResult BlendEngine::map(const Vec3& view_dir, const Vec3& up, const MapRequ
   if (!warp.supports(W, H))
     throw std::invalid_argument(std::string("blend: the ") + warp.name() + " warp does not support " +
                                 std::to_string(W) + "x" + std::to_string(H));
+
+  if (mixed_) return mixed_map(view_dir, up, W, H);
 
   BlendResult result;
   result.world_from_view = world_from_view_for(view_dir, up);

@@ -23,6 +23,28 @@
 // layout (RGBA float with a one-texel border: colour and tap validity in one 16-byte load, built the
 // first time the source is used; about 16 bytes a texel, 20 with a confidence channel).
 //
+// At a footprint (radiance with a Footprint: the renderer's pixels, mixed-resolution sets): each
+// located source is read at the level of detail its footprint covers, lambda = log2 of the footprint's
+// extent in the source's texels (the disc points of the central directions of n, n + dn_dx and
+// n + dn_dy), trilinearly from the source's MIP pyramid (level l: the means of level l-1's texels it
+// covers, validity and confidence alike, so a texel outside the disc never bleeds in and a tap
+// renormalises by the valid share). lambda = 0 is the kernel's bilinear tap exactly.
+//
+// Mixed-resolution sets (the MIP-mask blend): a source's native size nu (MapView attribute
+// "nativeSize": texels across its disc where they were measured, e.g. a ball's image diameter in
+// pixels; absent: the map width W) says from which level of detail l_i = max(0, log2(W / nu)) its
+// map holds real detail. When the sources' l_i differ by more than 1/2, each gets an authored mask
+// pyramid (core/mask_pyramid.h):
+//   m_i(l)(texel) = min over the level-0 texels it covers of c_i (confidence, 1 without a channel,
+//                   0 outside the disc) * clamp(l - l_i + 1, 0, 1)
+// and at a lookup with levels of detail lambda_i and disc points p_i, a_i <- a_i s_i with
+//   s_i = m_i(lambda_i, p_i) + 1 - max_j m_j(lambda_j, p_j)   (over the located sources with a_j > 0):
+// the sharpest source wherever it fully covers the lookup at that level of detail; where no source
+// is sharp enough (max m = 0) every s_i is 1 and the blend is the plain one; in between it moves
+// smoothly with lambda and p. Sets whose sources share a resolution (every computed set) have
+// s_i = 1: their blends are unchanged. map() of a mixed set evaluates radiance() per texel with the
+// destination texel's footprint (exact warps; request.warp and source_weights are not used).
+//
 // Thread safety: every method is const and may be called from many threads at once.
 #pragma once
 
@@ -63,6 +85,21 @@ class BlendEngine {
   // The same with located = locate(v) done by the caller.
   Vec3 radiance(const ViewWeights& located, const Vec3& v, const Vec3& n, double* weight = nullptr) const;
 
+  // A lookup's footprint: how the normal changes across one pixel (world; the differences to the
+  // neighbouring pixels' normals). Zero: a point.
+  struct Footprint {
+    Vec3 dn_dx = Vec3::Zero(), dn_dy = Vec3::Zero();
+  };
+  // radiance() at a footprint (the header comment: MIP levels, and the MIP-mask blend of
+  // mixed-resolution sets). A zero footprint of a set that is not mixed gives radiance() exactly.
+  Vec3 radiance(const ViewWeights& located, const Vec3& v, const Vec3& n, const Footprint& footprint,
+                double* weight = nullptr) const;
+
+  // Whether the set's sources differ in resolution (native sizes more than a factor sqrt 2 apart).
+  bool mixed_resolution() const { return mixed_; }
+  // Source index's level of real detail l_i = max(0, log2(W / native size)).
+  double detail_level(int index) const { return detail_levels_.at(std::size_t(index)); }
+
   // The destination map for view_dir with frame world_from_view_for(view_dir, up) (runtime/blend.h).
   // Throws std::invalid_argument for a zero or non-finite view_dir, a bad size, or a warp that does
   // not support the destination size.
@@ -75,13 +112,19 @@ class BlendEngine {
   struct Source;  // one view in the kernel's layout (blend_engine.cpp)
 
  private:
-  const Source& source(int index) const;  // built on first use (thread-safe)
+  const Source& source(int index) const;          // built on first use (thread-safe)
+  const Source& source_pyramid(int index) const;  // with its coarser levels (and mask), on first use
+  Vec3 radiance_at(const ViewWeights& located, const Vec3& v, const Vec3& n, const Footprint* footprint,
+                   double* weight) const;
+  BlendResult mixed_map(const Vec3& view_dir, const Vec3& up, int width, int height) const;
   const MapSet& maps_;
   const ViewSet& view_set_;
   BlendRule rule_;
   struct Cache;
   std::unique_ptr<Cache> cache_;
   std::vector<std::array<double, 3>> edge_norms_;  // per triangle: |a x b|, |b x c|, |c x a|
+  std::vector<double> detail_levels_;              // per source: l_i
+  bool mixed_ = false;
 };
 
 }  // namespace rsibr

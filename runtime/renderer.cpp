@@ -55,6 +55,17 @@ struct TileGrid {
   }
 };
 
+// A sample's normal difference to a neighbouring pixel's hit: the smaller of the backward and the
+// forward one where both pixels hit (so a silhouette or a depth step on one side does not widen the
+// footprint), the one that exists otherwise, zero where neither does. a, b: sample indices or -1.
+Vec3 smaller_difference(int a, int b, const Vec3& n, const Vec3* normals) {
+  const bool ha = a >= 0, hb = b >= 0;
+  if (!ha && !hb) return Vec3::Zero();
+  const Vec3 da = ha ? Vec3(n - normals[a]) : Vec3::Zero(), db = hb ? Vec3(normals[b] - n) : Vec3::Zero();
+  if (ha && hb) return da.squaredNorm() <= db.squaredNorm() ? da : db;
+  return ha ? da : db;
+}
+
 int spp_side(int spp) {
   const int k = int(std::lround(std::sqrt(double(spp))));
   if (spp < 1 || k * k != spp)
@@ -215,6 +226,7 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
   const double inv_spp = 1.0 / (k * k);
   const EnvMap* env = options_.environment;
   const ImageRect rect = projected_bounds(camera, impl_->bounds);
+  const bool lod = options_.lod && !paper;
 
   struct Counts {
     long long hits = 0, covered = 0;
@@ -229,9 +241,14 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
         double acc[N][4];
         int hit_count[N];
         std::vector<int> hints(nsets, -1);  // per-set triangle of the last located view (speed only)
+        Vec3 normals[N];
+        int slot[kTile][kTile];  // lod: the sample index of the tile's pixel (x, y), -1 where it missed
         for (int t = range.begin(); t != range.end(); ++t) {
           if (!env && !grid.overlaps(t, rect)) continue;  // every sample misses: stays 0
           const int n = grid.pixels(t, xs, ys);
+          const int tile_x0 = (t % grid.cols) * kTile, tile_y0 = (t / grid.cols) * kTile;
+          if (lod)
+            for (auto& row : slot) std::fill(row, row + kTile, -1);
           for (int i = 0; i < n; ++i) {
             acc[i][0] = acc[i][1] = acc[i][2] = acc[i][3] = 0;
             hit_count[i] = 0;
@@ -240,6 +257,15 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
             for (int sx = 0; sx < k; ++sx) {
               const double ox = (sx + 0.5) / k - 0.5, oy = (sy + 0.5) / k - 0.5;
               trace_samples(scene, camera, rect, n, xs, ys, ox, oy, env != nullptr, dirs, rh);
+              // With lod: every hit's normal first, then each sample's footprint from its neighbours.
+              if (lod) {
+                for (int i = 0; i < n; ++i) {
+                  slot[ys[i] - tile_y0][xs[i] - tile_x0] = rh[i].hit ? i : -1;
+                  if (!rh[i].hit) continue;
+                  normals[i] = scene.shading_normal(rh[i]);
+                  if (scene.geometric_normal(rh[i]).dot(dirs[i]) > 0) normals[i] = -normals[i];
+                }
+              }
               for (int i = 0; i < n; ++i) {
                 const Vec3& d = dirs[i];
                 if (!rh[i].hit) {
@@ -259,6 +285,16 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
                 Vec3 nrm = scene.shading_normal(rh[i]);
                 if (scene.geometric_normal(rh[i]).dot(d) > 0) nrm = -nrm;  // back face: two-sided
                 const Vec3 v = -d;
+                BlendEngine::Footprint fp;
+                if (lod) {
+                  const int px = xs[i] - tile_x0, py = ys[i] - tile_y0;
+                  fp.dn_dx = smaller_difference(px > 0 ? slot[py][px - 1] : -1, px + 1 < kTile ? slot[py][px + 1] : -1,
+                                                nrm, normals) /
+                             double(k);
+                  fp.dn_dy = smaller_difference(py > 0 ? slot[py - 1][px] : -1, py + 1 < kTile ? slot[py + 1][px] : -1,
+                                                nrm, normals) /
+                             double(k);
+                }
                 double L[3] = {0, 0, 0};
                 for (std::size_t s = 0; s < nsets; ++s) {
                   if (paper) {
@@ -270,7 +306,8 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
                     L[2] += Ls[2];
                   } else {
                     const BlendEngine& engine = *impl_->sets[s].engine;
-                    const Vec3 Ls = engine.radiance(engine.locate(v, &hints[s]), v, nrm);
+                    const Vec3 Ls = lod ? engine.radiance(engine.locate(v, &hints[s]), v, nrm, fp)
+                                        : engine.radiance(engine.locate(v, &hints[s]), v, nrm);
                     L[0] += Ls.x();
                     L[1] += Ls.y();
                     L[2] += Ls.z();

@@ -67,6 +67,14 @@ struct RenderOptions {
   BlendOptions blend;
   // Samples per pixel: a perfect square (1, 4, 9, ...).
   int spp = 1;
+  // Per-pixel mode: read each source at the level of detail of the sample's footprint (ray
+  // differentials: the normal's change to the neighbouring pixels' hits, the smaller of the forward
+  // and backward differences so a silhouette or a depth step does not widen it, divided by the
+  // samples per pixel side) through BlendEngine::radiance with a Footprint: MIP levels of the
+  // sources and, for mixed-resolution sets, the MIP-mask blend (runtime/blend_engine.h). Off: one
+  // bilinear tap per source, however small the object is on screen (aliasing that scintillates
+  // when it moves; measured in docs/tradeoffs.md, "MIP-mask blending"). Paper mode ignores it.
+  bool lod = false;
   // Shown where rays miss (alpha 1); nullptr: black with alpha 0. Not owned.
   const EnvMap* environment = nullptr;
 };
