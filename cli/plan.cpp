@@ -70,7 +70,7 @@ Runner add_plan(CLI::App& app) {
       "integrator's own error and time per texel at a few hundred random texels of random novel views, and the "
       "warp and blend's error for each view set and map size from blends of maps baked only where the blend reads "
       "them; a setting's predicted error is the root sum of squares of the two. Candidates: view sets icosa, 42, "
-      "162, 642, fib2562; sizes 32 to 256; reference widths 32-256 and full, mis 16-1024, fis 8-512, sh (Lambert). "
+      "fib24, 42, fib84, 162, fib324, 642, fib1284, fib2562; sizes 32, 45, 64, 90, 128, 181, 256; reference widths 32-256 and full, mis 16-1024, fis 8-512, sh (Lambert). "
       "--views, --res, --method, --samples and --reference-width fix a knob. rsibr bake --max-error plans, bakes "
       "and checks the result.\n"
       "Exit status: 0 with a setting, 3 when no candidate is predicted to meet the budget.\n"

@@ -28,7 +28,7 @@ IntegratorOptions options_of(const IntegratorSetting& s, std::uint64_t seed) {
 
 // The integrator that measures e_interp: deterministic (no noise to mistake for blend error) and
 // accurate enough that its smooth bias is common to the sources and the direct values.
-const IntegratorSetting kInterpolationIntegrator{"fis", 128, 0};
+const IntegratorSetting kInterpolationIntegrator{"fis", 64, 0};
 
 std::string percent(double e) {
   std::ostringstream s;
@@ -189,9 +189,20 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
       }
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) { return a.planned.seconds < b.planned.seconds; });
+  // A pair (N, r) cannot meet an allowance that a measured pair with at least as many views and at
+  // least the size already misses (more views and texels do not interpolate worse): not measured.
+  auto dominated = [&](std::size_t set, int res, double allowance) {
+    for (const auto& [key, e] : interpolation)
+      if (view_sets[key.first].views().size() >= view_sets[set].views().size() && key.second >= res && e > allowance)
+        return true;
+    return false;
+  };
   for (Candidate& c : candidates) {
     PlannedSetting& s = c.planned;
-    if (options.every_pair || (!plan.chosen && s.integration_error <= budget)) {
+    const double allowance =
+        s.integration_error < budget ? std::sqrt(budget * budget - s.integration_error * s.integration_error) : 0.0;
+    if (options.every_pair ||
+        (!plan.chosen && s.integration_error <= budget && !dominated(c.set, s.setting.res, allowance))) {
       s.interpolation_error = interpolation_error(c.set, s.setting.res);
     } else if (auto it = interpolation.find({c.set, s.setting.res}); it != interpolation.end()) {
       s.interpolation_error = it->second;

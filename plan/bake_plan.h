@@ -12,7 +12,7 @@
 //     pilot's sampled texels (random novel views, uniform over their discs) against the reference.
 //   e_interp(N, r): the warp and blend's error with maps that carry no integration error: the
 //     sampled blend of the N-view set at size r against the direct values, both with one fixed
-//     deterministic integrator (filtered importance sampling, 128 samples, whose smooth bias is
+//     deterministic integrator (filtered importance sampling, 64 samples, whose smooth bias is
 //     common to both and cancels). Measured per (N, r) with only the blend's footprints baked.
 //
 // Integration noise is not reduced by the blend's averaging in the prediction (it is, a little, in
@@ -24,7 +24,8 @@
 // measured in the pilot on this machine with its threads.
 //
 // The choice: the settings sorted by predicted time; the first that meets the budget. The pilot
-// measures e_interp lazily, only for the (N, r) pairs it reaches, unless asked for every pair.
+// measures e_interp lazily, only for the (N, r) pairs it reaches and that no measured pair with at
+// least as many views and texels already rules out, unless asked for every pair.
 #pragma once
 
 #include "bake/brdf.h"
@@ -63,12 +64,14 @@ struct BakeSetting {
 
 struct BakePlanOptions {
   double max_error = 0.02;  // relative RMS of blends at novel views against direct bakes there
-  std::vector<std::string> view_sets = {"icosa", "42", "162", "642", "fib2562"};
-  std::vector<int> sizes = {32, 64, 128, 256};
+  // Steps of about 2x in cost: view counts about 2x apart (the geodesic sets and Fibonacci sets
+  // between them), sizes sqrt 2 apart, so the margin below costs at most about one step.
+  std::vector<std::string> view_sets = {"icosa", "fib24", "42", "fib84", "162", "fib324", "642", "fib1284", "fib2562"};
+  std::vector<int> sizes = {32, 45, 64, 90, 128, 181, 256};
   std::vector<IntegratorSetting> integrators = default_integrator_settings();
   bool normalise_albedo = false;  // plan albedo-normalised maps (core/albedo_normalisation.h)
   // The pilot: novel views, texels per view and the destination size they are drawn from.
-  int pilot_views = 4;
+  int pilot_views = 8;
   int pilot_texels = 96;
   int pilot_size = 128;
   std::uint64_t seed = 1;
