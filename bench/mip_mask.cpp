@@ -17,6 +17,7 @@
 #include "core/exr_io.h"
 #include "core/mesh.h"
 #include "core/resample.h"
+#include "core/stopwatch.h"
 #include "core/texel_audit.h"
 #include "runtime/blend_engine.h"
 #include "runtime/renderer.h"
@@ -32,10 +33,6 @@
 using namespace rsibr;
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // RMS over the pixels covered in `ref` (alpha > 0.5) of an RGB difference image, and of ref itself.
 double rms_rgb(const cv::Mat& diff, const cv::Mat& ref) {

@@ -1,6 +1,7 @@
 #include "cluster/distributed_bake.h"
 
 #include "cluster/bake_partition.h"
+#include "core/stopwatch.h"
 
 #include <chrono>
 #include <cstring>
@@ -8,10 +9,6 @@
 
 namespace rsibr::cluster {
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // A rank's message: one status byte (1 = rows follow, 0 = an error text follows), then the payload.
 std::vector<std::uint8_t> message(bool ok, const std::vector<std::uint8_t>& payload) {

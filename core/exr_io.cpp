@@ -20,13 +20,13 @@
 namespace rsibr {
 namespace {
 
-[[noreturn]] void fail(const std::string& path, const std::string& what) { throw FileError(path, what); }
+[[noreturn]] void refuse(const std::string& path, const std::string& what) { throw FileError(path, what); }
 
 LayoutKind layout_from_shape(const std::string& path, int w, int h) {
   if (w == 2 * h) return LayoutKind::LatLong;
   if (h == 6 * w) return LayoutKind::Cube;
-  fail(path, "cannot tell the layout of a " + std::to_string(w) + "x" + std::to_string(h) +
-                 " image (not 2:1 lat-long nor 1:6 cube, no envmap or rsibr.layout attribute); pass --layout");
+  refuse(path, "cannot tell the layout of a " + std::to_string(w) + "x" + std::to_string(h) +
+                   " image (not 2:1 lat-long nor 1:6 cube, no envmap or rsibr.layout attribute); pass --layout");
 }
 
 EnvMap read_exr(const std::string& path, std::optional<LayoutKind> hint, EnvReadReport& report) {
@@ -36,7 +36,7 @@ EnvMap read_exr(const std::string& path, std::optional<LayoutKind> hint, EnvRead
   report.compression = h.compression;
   report.channels = h.channel_types;
   const bool rgb = h.has_channel("R") && h.has_channel("G") && h.has_channel("B");
-  if (!rgb && !h.has_channel("Y")) fail(path, "no R, G, B (or Y) channels; it has: " + report.channels);
+  if (!rgb && !h.has_channel("Y")) refuse(path, "no R, G, B (or Y) channels; it has: " + report.channels);
 
   EnvMap map;
   if (rgb) {
@@ -54,7 +54,7 @@ EnvMap read_exr(const std::string& path, std::optional<LayoutKind> hint, EnvRead
     try {
       kind = parse_layout_kind(*a);
     } catch (const std::exception& e) {
-      fail(path, e.what());
+      refuse(path, e.what());
     }
     report.layout_source = "rsibr.layout attribute";
   } else if (hint) {
@@ -67,7 +67,7 @@ EnvMap read_exr(const std::string& path, std::optional<LayoutKind> hint, EnvRead
   try {
     map.layout = Layout(kind, h.width, h.height);
   } catch (const std::exception& e) {
-    fail(path, e.what());
+    refuse(path, e.what());
   }
 
   // Colour: from the file's primaries to the working space.
@@ -91,21 +91,21 @@ void check_hdr_size(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
   for (int lines = 0; std::getline(in, line) && !line.empty(); ++lines)
-    if (lines > 1000 || line.size() > 4096) fail(path, "a Radiance header without its end");
+    if (lines > 1000 || line.size() > 4096) refuse(path, "a Radiance header without its end");
   std::getline(in, line);
   std::istringstream res(line);
   std::string ay, ax;
   long long h = 0, w = 0;
   if (!(res >> ay >> h >> ax >> w) || ay.size() != 2 || ax.size() != 2 || (ay[1] != 'Y' && ay[1] != 'X'))
-    fail(path, "no Radiance resolution line (\"-Y H +X W\")");
+    refuse(path, "no Radiance resolution line (\"-Y H +X W\")");
   if (w < 1 || h < 1 || w > 65536 || h > 65536 || w * h > (1LL << 27))
-    fail(path, "a resolution of " + std::to_string(w) + "x" + std::to_string(h) + " (corrupt, or too large)");
+    refuse(path, "a resolution of " + std::to_string(w) + "x" + std::to_string(h) + " (corrupt, or too large)");
 }
 
 EnvMap read_hdr(const std::string& path, std::optional<LayoutKind> hint, EnvReadReport& report) {
   check_hdr_size(path);
   cv::Mat bgr = cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
-  if (bgr.empty()) fail(path, "not a readable Radiance .hdr file");
+  if (bgr.empty()) refuse(path, "not a readable Radiance .hdr file");
   if (bgr.type() != CV_32FC3) bgr.convertTo(bgr, CV_32FC3);
   EnvMap map;
   cv::cvtColor(bgr, map.pixels, cv::COLOR_BGR2RGB);
@@ -117,7 +117,7 @@ EnvMap read_hdr(const std::string& path, std::optional<LayoutKind> hint, EnvRead
   try {
     map.layout = Layout(kind, bgr.cols, bgr.rows);
   } catch (const std::exception& e) {
-    fail(path, e.what());
+    refuse(path, e.what());
   }
   return map;
 }
@@ -130,7 +130,7 @@ EnvMap read_environment(const std::string& path, std::optional<LayoutKind> hint,
   EnvMap map = with_file(path, [&] {
     if (looks_like_exr(path)) return read_exr(path, hint, report);
     if (lower_extension(path) == ".hdr" || lower_extension(path) == ".pic") return read_hdr(path, hint, report);
-    fail(path, "not an OpenEXR or Radiance .hdr file");
+    refuse(path, "not an OpenEXR or Radiance .hdr file");
   });
   report.texels = audit_texels(map.pixels);
   if (report_out) *report_out = report;
@@ -140,8 +140,8 @@ EnvMap read_environment(const std::string& path, std::optional<LayoutKind> hint,
 void write_environment(const std::string& path, const EnvMap& map, const ExrWriteOptions& options) {
   const int W = map.pixels.cols, H = map.pixels.rows, ch = map.pixels.channels();
   if (map.pixels.depth() != CV_32F || (ch != 1 && ch != 3 && ch != 4))
-    fail(path, "internal: pixels must be float with 1, 3 or 4 channels");
-  if (W != map.layout.width() || H != map.layout.height()) fail(path, "internal: pixels do not match the layout");
+    refuse(path, "internal: pixels must be float with 1, 3 or 4 channels");
+  if (W != map.layout.width() || H != map.layout.height()) refuse(path, "internal: pixels do not match the layout");
   ExrPartOut part;
   for (int k = 0; k < ch; ++k) part.channels.push_back({ch == 1 ? "Y" : std::string(1, "RGBA"[k]), map.pixels, k});
   part.half = options.half;

@@ -1,6 +1,7 @@
 #include "plan/bake_plan.h"
 
 #include "bake/integrator.h"
+#include "core/stopwatch.h"
 #include "plan/error_sample.h"
 
 #include <algorithm>
@@ -13,10 +14,6 @@
 
 namespace rsibr {
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 IntegratorOptions options_of(const IntegratorSetting& s, std::uint64_t seed) {
   IntegratorOptions o;

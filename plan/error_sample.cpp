@@ -3,6 +3,7 @@
 #include "bake/albedo_table.h"
 #include "core/albedo_normalisation.h"
 #include "core/sphere_map.h"
+#include "core/stopwatch.h"
 #include "runtime/blend_engine.h"
 #include "runtime/warp.h"
 
@@ -22,10 +23,6 @@ double uniform(std::uint64_t seed, std::uint64_t index) {
 
 Vec2 disc_point(int texel, int size) {
   return sphere_map::disc_from_pixel(Vec2(texel % size, texel / size), size, size);
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 // Whether texel t of a size^2 map is in the disc with normal z >= min_cos (z^2 = 1 - |xy|^2).
