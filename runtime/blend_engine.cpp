@@ -456,6 +456,18 @@ Vec3 unit(const Vec3& v) {
   return (v / v.cwiseAbs().maxCoeff()).normalized();
 }
 
+// n clamped to v's hemisphere: a normal facing away (n . v < 0, a shading normal past the
+// silhouette) becomes the nearest rim normal, *nv = max(n . v, 0).
+Vec3 normal_facing(const Vec3& n_in, const Vec3& v, double* nv) {
+  Vec3 n = n_in;
+  *nv = n.dot(v);
+  if (!(*nv < 0)) return n;
+  n -= *nv * v;
+  *nv = 0;
+  const double len = n.norm();
+  return len > 0 ? Vec3(n / len) : Vec3(-world_from_view_for(v).col(1));
+}
+
 }  // namespace
 
 BlendEngine::BlendEngine(const MapSet& maps, const ViewSet& view_set, const BlendRule& rule)
@@ -540,15 +552,8 @@ Vec3 BlendEngine::radiance(const ViewWeights& located, const Vec3& v, const Vec3
 
 Vec3 BlendEngine::radiance_at(const ViewWeights& located, const Vec3& v, const Vec3& n_in, const Footprint* fp,
                               double* weight) const {
-  // 0. Clamp n to v's hemisphere, as radiance() does.
-  Vec3 n = n_in;
-  double nv = n.dot(v);
-  if (nv < 0) {
-    n -= nv * v;
-    const double len = n.norm();
-    n = len > 0 ? Vec3(n / len) : Vec3(-world_from_view_for(v).col(1));
-    nv = 0;
-  }
+  double nv;
+  const Vec3 n = normal_facing(n_in, v, &nv);
   const Vec3 r = 2.0 * nv * n - v;
   const std::vector<float>& albedo = maps_.views.front().albedo;
   const Vec3 A = albedo.empty() ? Vec3(1, 1, 1) : albedo_at(albedo, float(nv));
@@ -636,15 +641,8 @@ BlendResult BlendEngine::mixed_map(const Vec3& view_dir, const Vec3& up, int W, 
 
 Vec3 BlendEngine::radiance(const ViewWeights& located, const Vec3& v, const Vec3& n_in, double* weight) const {
   if (mixed_) return radiance_at(located, v, n_in, nullptr, weight);
-  // 0. Clamp n to v's hemisphere (the nearest rim normal).
-  Vec3 n = n_in;
-  double nv = n.dot(v);
-  if (nv < 0) {
-    n -= nv * v;
-    const double len = n.norm();
-    n = len > 0 ? Vec3(n / len) : Vec3(-world_from_view_for(v).col(1));
-    nv = 0;
-  }
+  double nv;
+  const Vec3 n = normal_facing(n_in, v, &nv);
   const Vec3 r = 2.0 * nv * n - v;
   // Albedo-normalised sets: the blend of stored texels times A(n.v) (core/albedo_normalisation.h).
   const std::vector<float>& albedo = maps_.views.front().albedo;
