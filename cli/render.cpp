@@ -203,10 +203,10 @@ Runner add_render(CLI::App& app) {
       ->check(CLI::Range(1, 1024));
   c->add_option("--rim-fade", a->rim_fade, "Width of the singularity fade (0 disables)")->check(CLI::Range(0.0, 1.0));
   c->add_option("--spp", a->spp, "Samples per pixel: a perfect square (1, 4, 9, ...)")->check(CLI::Range(1, 1024));
-  c->add_flag(
-      "--lod", a->lod,
-      "per-pixel mode: read the maps at each pixel's level of detail (ray differentials, MIP levels of the "
-      "sources; for sets of mixed resolution the MIP-mask blend): no scintillation on small or distant objects");
+  c->add_flag("--lod", a->lod,
+              "read the maps at each pixel's level of detail (ray differentials, MIP levels of the sources in "
+              "per-pixel mode, of the destination map in paper mode; for sets of mixed resolution the MIP-mask "
+              "blend): no scintillation on small or distant objects");
   c->add_option("--env", a->env, "Environment map shown where rays miss (alpha 1)");
   c->add_option(
       "--exposure", a->exposure,

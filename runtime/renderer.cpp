@@ -201,10 +201,17 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
   const std::size_t nsets = impl_->sets.size();
 
   // Paper mode: one destination map per set for the camera's central direction.
+  // With lod, the destination map is also held as a one-source engine of its own (a normal-warped
+  // view along the camera's direction), so that a sample reads it at its footprint's level of detail
+  // from the map's MIP pyramid, as per-pixel mode reads the sources.
   struct Dest {
     cv::Mat rgb;
     DiscMap map;
     Mat3 view_from_world;
+    MapSet as_set;
+    std::unique_ptr<ViewSet> as_views;
+    std::unique_ptr<BlendEngine> engine;
+    ViewWeights located;
   };
   std::vector<Dest> dests(paper ? nsets : 0);
   if (paper) {
@@ -213,9 +220,27 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
     request.warp = impl_->warp.get();
     for (std::size_t s = 0; s < nsets; ++s) {
       BlendResult b = impl_->sets[s].engine->map(camera.view_direction(), camera.up(), request);
-      dests[s].rgb = b.rgb;
-      dests[s].map = DiscMap{&dests[s].rgb, nullptr, b.rgb.cols, b.rgb.rows};
-      dests[s].view_from_world = b.world_from_view.transpose();
+      Dest& d = dests[s];
+      d.rgb = b.rgb;
+      d.map = DiscMap{&d.rgb, nullptr, b.rgb.cols, b.rgb.rows};
+      d.view_from_world = b.world_from_view.transpose();
+      if (options_.lod) {
+        MapView mv;
+        mv.view = b.world_from_view.col(2);
+        mv.world_from_view = b.world_from_view;
+        mv.warp = CentralDirection::Normal;
+        mv.rgb = d.rgb;
+        d.as_set.views.push_back(std::move(mv));
+        d.as_views = std::make_unique<ViewSet>(std::vector<Vec3>{d.as_set.views.front().view});
+        BlendRule one;  // one source: no fade, no confidence; the tap's value, renormalised at the rim
+        one.rim_fade = 0;
+        one.use_confidence = false;
+        d.engine = std::make_unique<BlendEngine>(d.as_set, *d.as_views, one);
+        d.located.count = 1;
+        d.located.views = {0, -1, -1};
+        d.located.weights = {1.0, 0.0, 0.0};
+        d.located.inside = true;
+      }
     }
   }
   const auto t1 = std::chrono::steady_clock::now();
@@ -226,7 +251,7 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
   const double inv_spp = 1.0 / (k * k);
   const EnvMap* env = options_.environment;
   const ImageRect rect = projected_bounds(camera, impl_->bounds);
-  const bool lod = options_.lod && !paper;
+  const bool lod = options_.lod;
 
   struct Counts {
     long long hits = 0, covered = 0;
@@ -297,7 +322,12 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
                 }
                 double L[3] = {0, 0, 0};
                 for (std::size_t s = 0; s < nsets; ++s) {
-                  if (paper) {
+                  if (paper && lod) {
+                    const Vec3 Ls = dests[s].engine->radiance(dests[s].located, v, nrm, fp);
+                    L[0] += Ls.x();
+                    L[1] += Ls.y();
+                    L[2] += Ls.z();
+                  } else if (paper) {
                     const WarpSample ws = warp_direction(CentralDirection::Normal, dests[s].view_from_world * nrm);
                     double Ls[3], conf;
                     if (!sample_disc(dests[s].map, ws.disc, Ls, &conf)) continue;

@@ -73,7 +73,8 @@ struct RenderOptions {
   // samples per pixel side) through BlendEngine::radiance with a Footprint: MIP levels of the
   // sources and, for mixed-resolution sets, the MIP-mask blend (runtime/blend_engine.h). Off: one
   // bilinear tap per source, however small the object is on screen (aliasing that scintillates
-  // when it moves; measured in docs/tradeoffs.md, "MIP-mask blending"). Paper mode ignores it.
+  // when it moves; measured in docs/tradeoffs.md, "MIP-mask blending"). Paper mode reads its
+  // destination map the same way, at the footprint's level of its MIP pyramid.
   bool lod = false;
   // Shown where rays miss (alpha 1); nullptr: black with alpha 0. Not owned.
   const EnvMap* environment = nullptr;

@@ -149,7 +149,9 @@ TEST(MipMaskBlend, TheSharpSourceGivesTheDetailWhereItCoversAndTheBlendReturnsWh
   double previous = 0;
   for (double size = 0.001; size < 0.7; size *= std::pow(2.0, 0.2)) {
     const double blue = engine.radiance(located, v, n, footprint_of(n, size)).z();
-    if (size < 0.1) EXPECT_LT(blue, 1e-3) << size;  // lod below 2: the sharp source alone
+    if (size < 0.1) {
+      EXPECT_LT(blue, 1e-3) << size;  // lod below 2: the sharp source alone
+    }
     EXPECT_LE(std::abs(blue - previous), 0.25) << size;
     previous = blue;
   }

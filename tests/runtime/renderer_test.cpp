@@ -348,6 +348,59 @@ TEST(Renderer, LodBringsASmallObjectCloserToItsSupersampledSelf) {
                                   << std::sqrt(e_lod / (3 * n));
 }
 
+// Paper mode with --lod: the frame's one destination map is read at each sample's footprint level,
+// so a small object comes closer to its supersampled self there too; on a large object (footprints
+// under a texel) the lookup stays the plain tap's value.
+TEST(Renderer, PaperModeLodBringsASmallObjectCloserToItsSupersampledSelf) {
+  MapSet set = analytic_map_set(ViewSet::named("42"), 128, 128, "normal", lambert_texel);
+  for (MapView& v : set.views)
+    for (int r = 0; r < 128; ++r)
+      for (int c = 0; c < 128; ++c) v.rgb.at<cv::Vec3f>(r, c) *= ((r + c) % 2) ? 1.0f : 0.2f;
+  const Mesh mesh = sphere_mesh(24, 48);
+  auto rms = [](const cv::Mat& a, const cv::Mat& ref, int* count) {
+    double e = 0;
+    int n = 0;
+    for (int r = 0; r < ref.rows; ++r)
+      for (int c = 0; c < ref.cols; ++c) {
+        if (ref.at<cv::Vec4f>(r, c)[3] < 1.0f || a.at<cv::Vec4f>(r, c)[3] < 1.0f) continue;  // interior pixels
+        for (int k = 0; k < 3; ++k) {
+          EXPECT_TRUE(std::isfinite(a.at<cv::Vec4f>(r, c)[k]));
+          e += std::pow(a.at<cv::Vec4f>(r, c)[k] - ref.at<cv::Vec4f>(r, c)[k], 2);
+        }
+        ++n;
+      }
+    *count = n;
+    return std::sqrt(e / std::max(1, 3 * n));
+  };
+  RenderOptions o = with_mode(RenderMode::Paper);
+  {  // small: about 18 pixels across
+    const Camera cam = look_at(Vec3(2.0, 3.0, 30.0), Vec3::Zero(), Vec3(0, 1, 0), 12, 48, 48);
+    const cv::Mat point = Renderer(mesh, {&set}, o).render(cam);
+    o.lod = true;
+    const cv::Mat lod = Renderer(mesh, {&set}, o).render(cam);
+    o.lod = false;
+    o.spp = 64;
+    const cv::Mat reference = Renderer(mesh, {&set}, o).render(cam);
+    o.spp = 1;
+    int n = 0;
+    const double e_point = rms(point, reference, &n), e_lod = rms(lod, reference, &n);
+    ASSERT_GT(n, 100);
+    std::printf("paper: rms point %.4f lod %.4f\n", e_point, e_lod);
+    EXPECT_LT(e_lod, 0.7 * e_point) << "rms point " << e_point << ", lod " << e_lod;
+  }
+  {  // large: the sphere fills most of the frame, a pixel spans about half a texel
+    const Camera cam = look_at(Vec3(0.5, 0.8, 3.2), Vec3::Zero(), Vec3(0, 1, 0), 40, 256, 256);
+    const cv::Mat point = Renderer(mesh, {&set}, o).render(cam);
+    o.lod = true;
+    const cv::Mat lod = Renderer(mesh, {&set}, o).render(cam);
+    int n = 0;
+    const double e = rms(lod, point, &n);
+    std::printf("paper, large: rms lod against point %.2e\n", e);
+    EXPECT_LT(e, 0.01) << "a footprint under a texel should read about the plain tap";
+    ASSERT_GT(n, 1000);
+  }
+}
+
 TEST(Renderer, RejectsBadOptions) {
   const Mesh mesh = sphere_mesh(8, 16);
   const MapSet set = analytic_map_set(ViewSet::icosahedron(), 16, 16, "normal", lambert_texel);
