@@ -13,6 +13,7 @@
 
 #include <memory>
 #include <optional>
+#include <optional>
 #include <string>
 
 #include <tbb/parallel_for.h>
@@ -53,11 +54,19 @@ class PyBlendEngine {
     request.warp = warp_.get();
     return engine_->map(view, up, request);
   }
-  // Per row of v (N x 3) and n (N x 3), world, unit: the radiance (N x 3) and the weight (N).
-  py::tuple radiance(const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& v,
-                     const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& n) const {
+  // Per row of v (N x 3) and n (N x 3), world, unit: the radiance (N x 3) and the weight (N); with
+  // dn_dx and dn_dy (N x 3 each, world), at that footprint (BlendEngine::Footprint).
+  using Rows = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+  py::tuple radiance(const Rows& v, const Rows& n, const std::optional<Rows>& dn_dx,
+                     const std::optional<Rows>& dn_dy) const {
     if (v.rows() != n.rows()) throw py::value_error("radiance: v and n must have the same number of rows");
     if (!v.allFinite() || !n.allFinite()) throw py::value_error("radiance: v and n must be finite");
+    if (dn_dx.has_value() != dn_dy.has_value())
+      throw py::value_error("radiance: give both dn_dx and dn_dy, or neither");
+    if (dn_dx && (dn_dx->rows() != v.rows() || dn_dy->rows() != v.rows()))
+      throw py::value_error("radiance: dn_dx and dn_dy must have as many rows as v");
+    if (dn_dx && (!dn_dx->allFinite() || !dn_dy->allFinite()))
+      throw py::value_error("radiance: dn_dx and dn_dy must be finite");
     Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> L(v.rows(), 3);
     Eigen::VectorXd w(v.rows());
     {
@@ -68,7 +77,15 @@ class PyBlendEngine {
         for (Eigen::Index i = range.begin(); i != range.end(); ++i) {
           const Vec3 vi = v.row(i).transpose().normalized(), ni = n.row(i).transpose().normalized();
           double wi = 0;
-          L.row(i) = engine_->radiance(engine_->locate(vi, &hint), vi, ni, &wi).transpose();
+          const ViewWeights located = engine_->locate(vi, &hint);
+          if (dn_dx) {
+            BlendEngine::Footprint fp;
+            fp.dn_dx = dn_dx->row(i).transpose();
+            fp.dn_dy = dn_dy->row(i).transpose();
+            L.row(i) = engine_->radiance(located, vi, ni, fp, &wi).transpose();
+          } else {
+            L.row(i) = engine_->radiance(located, vi, ni, &wi).transpose();
+          }
           w[i] = wi;
         }
       });
@@ -149,10 +166,14 @@ void bind_blend(py::module_& m) {
       .def("map", &PyBlendEngine::map, py::arg("view"), py::arg("up") = Vec3(0, 1, 0), py::arg("size") = 0,
            py::arg("warp") = "precomputed", py::arg("rings") = 16, py::arg("source_weights") = false,
            "The destination map of `view` (as blend()). Releases the GIL.")
-      .def("radiance", &PyBlendEngine::radiance, py::arg("v"), py::arg("n"),
+      .def("radiance", &PyBlendEngine::radiance, py::arg("v"), py::arg("n"), py::arg("dn_dx") = py::none(),
+           py::arg("dn_dy") = py::none(),
            "Radiance toward viewer directions v (N x 3, world, from the surface to the viewer) from normals "
            "n (N x 3, world): the blend for each (v, n) pair without a destination map (the renderer's "
-           "per-pixel mode). Returns (radiance N x 3, weight N). Rows are normalised. Releases the GIL.")
+           "per-pixel mode). With dn_dx and dn_dy (N x 3, world: how the normal changes across one pixel), "
+           "each source is read at that footprint's level of detail (MIP levels; the MIP-mask blend for sets "
+           "of mixed resolution), as `rsibr render --lod` does. Returns (radiance N x 3, weight N). v and n "
+           "are normalised. Releases the GIL.")
       .def("locate", &PyBlendEngine::locate, py::arg("v"), "The view set's triangle and weights for direction v.");
 }
 

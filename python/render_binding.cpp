@@ -33,7 +33,7 @@ std::vector<MapSet> sets_of(const py::object& maps) {
 
 std::unique_ptr<OwningRenderer> make_renderer(const Mesh& mesh, const py::object& maps, const std::string& mode,
                                               int spp, const std::string& warp, int map_size, int rings,
-                                              double rim_fade, const std::optional<EnvMap>& environment) {
+                                              double rim_fade, const std::optional<EnvMap>& environment, bool lod) {
   auto r = std::make_unique<OwningRenderer>();
   r->mesh = mesh;
   r->sets = sets_of(maps);
@@ -45,6 +45,7 @@ std::unique_ptr<OwningRenderer> make_renderer(const Mesh& mesh, const py::object
   options.map_size = map_size;
   options.rings = rings;
   options.blend.rim_fade = rim_fade;
+  options.lod = lod;
   options.environment = r->environment ? &*r->environment : nullptr;
   std::vector<const MapSet*> pointers;
   for (const MapSet& s : r->sets) pointers.push_back(&s);
@@ -152,10 +153,12 @@ void bind_render(py::module_& m) {
       m, "Renderer", "Renders a mesh with one or more map sets (summed, each with its own warps) from any camera.")
       .def(py::init(&make_renderer), py::arg("mesh"), py::arg("maps"), py::arg("mode") = "per-pixel",
            py::arg("spp") = 1, py::arg("warp") = "precomputed", py::arg("map_size") = 0, py::arg("rings") = 16,
-           py::arg("rim_fade") = 0.4, py::arg("environment") = py::none(),
+           py::arg("rim_fade") = 0.4, py::arg("environment") = py::none(), py::arg("lod") = false,
            "Renderer(mesh, maps, mode='per-pixel', spp=1, warp='precomputed', map_size=0, rings=16, rim_fade=0.4, "
-           "environment=None): maps a MapSet or a list of them. mode 'per-pixel' (exact) or 'paper' (one destination "
-           "map per frame, map_size and warp). spp a perfect square. environment is shown where rays miss. Builds "
+           "environment=None, lod=False): maps a MapSet or a list of them. mode 'per-pixel' (exact) or 'paper' (one "
+           "destination map per frame, map_size and warp). spp a perfect square. environment is shown where rays "
+           "miss. lod: each pixel reads the maps at its level of detail (ray differentials; `rsibr render --lod`). "
+           "Builds "
            "the ray scene and lookups once; the mesh and the views are copied (pixels shared).")
       .def(
           "render", [](const OwningRenderer& r, const Camera& c) { return to_array(render_frame(r, c)); },
@@ -165,13 +168,14 @@ void bind_render(py::module_& m) {
   m.def(
       "render",
       [](const Mesh& mesh, const py::object& maps, const Camera& camera, const std::string& mode, int spp,
-         const std::string& warp, int map_size, int rings, double rim_fade, const std::optional<EnvMap>& environment) {
-        const auto r = make_renderer(mesh, maps, mode, spp, warp, map_size, rings, rim_fade, environment);
+         const std::string& warp, int map_size, int rings, double rim_fade, const std::optional<EnvMap>& environment,
+         bool lod) {
+        const auto r = make_renderer(mesh, maps, mode, spp, warp, map_size, rings, rim_fade, environment, lod);
         return to_array(render_frame(*r, camera));
       },
       py::arg("mesh"), py::arg("maps"), py::arg("camera"), py::arg("mode") = "per-pixel", py::arg("spp") = 1,
       py::arg("warp") = "precomputed", py::arg("map_size") = 0, py::arg("rings") = 16, py::arg("rim_fade") = 0.4,
-      py::arg("environment") = py::none(),
+      py::arg("environment") = py::none(), py::arg("lod") = false,
       "One frame of Renderer(mesh, maps, ...).render(camera), as `rsibr render` draws it: (H, W, 4) float32 RGBA.");
 }
 

@@ -72,3 +72,37 @@ def test_engine_radiance_rejects_mismatched_rows():
     engine = rsibr.BlendEngine(random_map_set(rng, "icosa", size=8))
     with pytest.raises(ValueError):
         engine.radiance(np.zeros((3, 3)) + [0, 0, 1], np.zeros((2, 3)) + [0, 0, 1])
+
+
+def test_engine_radiance_at_a_zero_footprint_is_the_point_lookup_and_a_wide_one_smooths():
+    rng = np.random.default_rng(10)
+    maps = random_map_set(rng, "icosa", size=32)  # noise per texel
+    engine = rsibr.BlendEngine(maps)
+    n = rng.normal(size=(400, 3))
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    v = n + 0.3 * rng.normal(size=(400, 3))
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    L, w = engine.radiance(v, n)
+    zero = np.zeros_like(n)
+    L0, w0 = engine.radiance(v, n, dn_dx=zero, dn_dy=zero)
+    assert np.array_equal(L0, L) and np.array_equal(w0, w)
+    # A footprint of about a quarter of the disc: the noise averages out towards each map's mean.
+    a = np.cross(n, [0.0, 1.0, 0.0]) + 1e-3
+    b = np.cross(n, a)
+    a *= 0.5 / np.linalg.norm(a, axis=1, keepdims=True)
+    b *= 0.5 / np.linalg.norm(b, axis=1, keepdims=True)
+    Lw, ww = engine.radiance(v, n, dn_dx=a, dn_dy=b)
+    assert np.all(np.isfinite(Lw)) and np.all((ww >= 0) & (ww <= 1))
+    assert Lw.var(axis=0).sum() < 0.5 * L.var(axis=0).sum()
+
+
+def test_engine_radiance_rejects_half_or_mismatched_footprints():
+    rng = np.random.default_rng(11)
+    engine = rsibr.BlendEngine(random_map_set(rng, "icosa", size=8))
+    v = np.zeros((3, 3)) + [0, 0, 1]
+    with pytest.raises(ValueError):
+        engine.radiance(v, v, dn_dx=np.zeros((3, 3)))
+    with pytest.raises(ValueError):
+        engine.radiance(v, v, dn_dx=np.zeros((2, 3)), dn_dy=np.zeros((2, 3)))
+    with pytest.raises(ValueError):
+        engine.radiance(v, v, dn_dx=np.full((3, 3), np.nan), dn_dy=np.zeros((3, 3)))

@@ -18,8 +18,8 @@ def test_a_white_furnace_render_shows_the_lambert_albedo_at_every_covered_pixel(
     env.pixels[...] = 1.0
     maps = rsibr.bake("{type: lambert, albedo: [0.7, 0.4, 0.1]}", env, "icosa", res=32, method="sh")
     camera = rsibr.frame_bounds(mesh, (0.3, -0.5, -1.0), width=64, height=48)
-    for mode in ["per-pixel", "paper"]:
-        image = rsibr.render(mesh, maps, camera, mode=mode)
+    for mode, lod in [("per-pixel", False), ("paper", False), ("per-pixel", True), ("paper", True)]:
+        image = rsibr.render(mesh, maps, camera, mode=mode, lod=lod)  # MIP levels of a constant: the constant
         assert image.shape == (48, 64, 4)
         covered = image[..., 3] == 1
         assert covered.sum() > 150 and np.all(image[~covered & (image[..., 3] == 0)][:, :3] == 0)
