@@ -24,6 +24,19 @@ struct PlanArgs {
   bool sanitize = false, every_pair = false;
 };
 
+// The default candidates, from the planner's own lists: "view sets icosa, fib24, ...; sizes ...; ...".
+std::string candidates_text() {
+  const BakePlanOptions defaults;
+  auto join = [](const auto& items, auto text) {
+    std::string out;
+    for (const auto& item : items) out += (out.empty() ? "" : ", ") + text(item);
+    return out;
+  };
+  return "view sets " + join(defaults.view_sets, [](const std::string& v) { return v; }) + "; sizes " +
+         join(defaults.sizes, [](int r) { return std::to_string(r); }) + "; integrators " +
+         join(defaults.integrators, [](const IntegratorSetting& i) { return i.label(); }) + " (sh for Lambert only)";
+}
+
 int run_plan(const PlanArgs& a) {
   OutputPlan outputs({a.env, a.brdf});
   const std::string json = outputs.file(a.json);
@@ -69,9 +82,9 @@ Runner add_plan(CLI::App& app) {
       "(the outermost 1% of its area, where every source is faded, is left out). The pilot measures each "
       "integrator's own error and time per texel at a few hundred random texels of random novel views, and the "
       "warp and blend's error for each view set and map size from blends of maps baked only where the blend reads "
-      "them; a setting's predicted error is the root sum of squares of the two. Candidates: view sets icosa, 42, "
-      "fib24, 42, fib84, 162, fib324, 642, fib1284, fib2562; sizes 32, 45, 64, 90, 128, 181, 256; reference widths 32-256 and full, mis 16-1024, fis 8-512, sh (Lambert). "
-      "--views, --res, --method, --samples and --reference-width fix a knob. rsibr bake --max-error plans, bakes "
+      "them; a setting's predicted error is the root sum of squares of the two. Candidates: " +
+      candidates_text() +
+      ". --views, --res, --method, --samples and --reference-width fix a knob. rsibr bake --max-error plans, bakes "
       "and checks the result.\n"
       "Exit status: 0 with a setting, 3 when no candidate is predicted to meet the budget.\n"
       "Example: rsibr plan --env sky.exr --brdf copper.yaml --max-error 2%");
