@@ -115,12 +115,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     EnvMap env = read_environment(env_path);
-    sanitize_texels(env.pixels);
-    for (int r = 0; r < env.pixels.rows; ++r)
-      for (int c = 0; c < env.pixels.cols; ++c) {
-        cv::Vec3f& p = env.pixels.at<cv::Vec3f>(r, c);
-        for (int k = 0; k < 3; ++k) p[k] = std::max(0.f, p[k]);
-      }
+    sanitize_texels(env.pixels);  // lossy-compression ringing: negatives to 0
     const auto brdf = parse_brdf(brdf_spec);
     const auto integrator = make_integrator("fis", env);
     MapSetBakeOptions bo;

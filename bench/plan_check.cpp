@@ -10,6 +10,7 @@
 #include "bake/map_set_bake.h"
 #include "core/exr_io.h"
 #include "core/stopwatch.h"
+#include "core/texel_audit.h"
 #include "plan/bake_plan.h"
 #include "plan/error_sample.h"
 
@@ -66,11 +67,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     EnvMap env = read_environment(env_path);
-    for (int r = 0; r < env.pixels.rows; ++r)  // lossy-compression ringing: negatives to 0
-      for (int c = 0; c < env.pixels.cols; ++c) {
-        cv::Vec3f& p = env.pixels.at<cv::Vec3f>(r, c);
-        for (int k = 0; k < 3; ++k) p[k] = std::max(0.f, p[k]);
-      }
+    sanitize_texels(env.pixels);  // lossy-compression ringing: negatives to 0
     const auto brdf = parse_brdf(brdf_spec);
     nlohmann::json out;
     out["env"] = env_path;
