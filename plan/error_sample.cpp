@@ -7,10 +7,14 @@
 #include "runtime/blend_engine.h"
 #include "runtime/warp.h"
 
+#include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 namespace rsibr {
@@ -39,34 +43,92 @@ long long disc_texel_count(int size, double min_cos) {
   return n;
 }
 
-ErrorSample::ErrorSample(int views, int texels, int size, std::uint64_t seed, double min_cos) : size_(size) {
+ErrorSample::ErrorSample(int views, int texels, int size, std::uint64_t seed, double min_cos)
+    : ErrorSample(views, texels, size, seed, nullptr, min_cos) {}
+
+ErrorSample::ErrorSample(int views, int texels, int size, std::uint64_t seed, const TexelGuide& guide, double min_cos)
+    : ErrorSample(views, texels, size, seed, &guide, min_cos) {}
+
+ErrorSample::ErrorSample(int views, int texels, int size, std::uint64_t seed, const TexelGuide* guide, double min_cos)
+    : size_(size), guided_(guide != nullptr) {
   if (views < 1 || texels < 1 || size < 1)
     throw std::invalid_argument("error sample: needs at least one view, one texel and a size >= 1");
   if (!(min_cos >= 0 && min_cos < 1)) throw std::invalid_argument("error sample: min_cos must lie in [0, 1)");
   std::vector<int> disc;
   for (int t = 0; t < size * size; ++t)
     if (in_domain(t, size, min_cos)) disc.push_back(t);
-  if (int(disc.size()) < texels)
+  if (!guide && int(disc.size()) < texels)
     throw std::invalid_argument("error sample: a " + std::to_string(size) + "^2 disc has " +
                                 std::to_string(disc.size()) + " texels, fewer than " + std::to_string(texels));
+  if (disc.empty()) throw std::invalid_argument("error sample: the disc holds no texel at this size");
   std::uint64_t draw = 0;
+  // The views: a Fibonacci lattice of `views` directions under one uniformly random rotation (from a
+  // uniform unit quaternion, Shoemake's method). Each view is uniform on the sphere, and together
+  // they are spread evenly, which takes out most of the between-view scatter of an error estimate.
+  const double u1 = uniform(seed, draw++), u2 = uniform(seed, draw++), u3 = uniform(seed, draw++);
+  const Eigen::Quaterniond q(std::sqrt(u1) * std::cos(2.0 * kPi * u3), std::sqrt(1.0 - u1) * std::sin(2.0 * kPi * u2),
+                             std::sqrt(1.0 - u1) * std::cos(2.0 * kPi * u2), std::sqrt(u1) * std::sin(2.0 * kPi * u3));
+  const Mat3 rotation = q.normalized().toRotationMatrix();
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
   for (int k = 0; k < views; ++k) {
-    // Uniform on the sphere: z uniform in [-1, 1], azimuth uniform.
-    const double z = 1.0 - 2.0 * uniform(seed, draw++), phi = 2.0 * kPi * uniform(seed, draw++);
+    const double z = 1.0 - (2.0 * k + 1.0) / views, phi = golden * k;
     const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const Vec3 v(s * std::cos(phi), s * std::sin(phi), z);
+    const Vec3 v = (rotation * Vec3(s * std::cos(phi), s * std::sin(phi), z)).normalized();
     views_.push_back(v);
     frames_.push_back(world_from_view_for(v));
-    // `texels` distinct disc texels: a partial Fisher-Yates shuffle.
-    std::vector<int> pool = disc;
     std::vector<int> picked;
-    for (int i = 0; i < texels; ++i) {
-      const std::size_t j = std::size_t(i) + std::size_t(uniform(seed, draw++) * double(pool.size() - std::size_t(i)));
-      std::swap(pool[std::size_t(i)], pool[std::min(j, pool.size() - 1)]);
-      picked.push_back(pool[std::size_t(i)]);
+    std::vector<double> weights;
+    if (!guide) {
+      // `texels` distinct disc texels: a partial Fisher-Yates shuffle.
+      std::vector<int> pool = disc;
+      for (int i = 0; i < texels; ++i) {
+        const std::size_t j =
+            std::size_t(i) + std::size_t(uniform(seed, draw++) * double(pool.size() - std::size_t(i)));
+        std::swap(pool[std::size_t(i)], pool[std::min(j, pool.size() - 1)]);
+        picked.push_back(pool[std::size_t(i)]);
+      }
+      std::sort(picked.begin(), picked.end());
+      weights.assign(picked.size(), 1.0);
+    } else {
+      const cv::Mat q = (*guide)(k, v, frames_.back());
+      if (q.empty() || q.type() != CV_32FC1 || q.rows != q.cols)
+        throw std::invalid_argument("error sample: a guide must be a square single-channel float map");
+      cv::Mat qs;
+      if (q.rows == size)
+        qs = q;
+      else
+        cv::resize(q, qs, cv::Size(size, size), 0, 0, cv::INTER_LINEAR);
+      std::vector<double> p(disc.size());
+      double total = 0;
+      for (std::size_t i = 0; i < disc.size(); ++i) {
+        const double qi = qs.at<float>(disc[i] / size, disc[i] % size);
+        if (!(qi >= 0) || !std::isfinite(qi))
+          throw std::invalid_argument("error sample: a guide holds a negative or non-finite importance");
+        p[i] = qi;
+        total += qi;
+      }
+      // The defensive mixture; a guide that is 0 everywhere leaves the uniform draw.
+      const double M = double(disc.size()), a = total > 0 ? kGuideShare : 0.0;
+      std::vector<double> cdf(disc.size());
+      double run = 0;
+      for (std::size_t i = 0; i < disc.size(); ++i) {
+        p[i] = (1.0 - a) / M + (total > 0 ? a * p[i] / total : 0.0);
+        run += p[i];
+        cdf[i] = run;
+      }
+      std::map<std::size_t, int> counts;
+      for (int i = 0; i < texels; ++i) {
+        const double u = uniform(seed, draw++) * run;
+        const std::size_t j = std::size_t(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin());
+        ++counts[std::min(j, disc.size() - 1)];
+      }
+      for (const auto& [j, c] : counts) {  // ascending, since disc is
+        picked.push_back(disc[j]);
+        weights.push_back(double(c) / (p[j] * M));
+      }
     }
-    std::sort(picked.begin(), picked.end());
     texels_.push_back(std::move(picked));
+    weights_.push_back(std::move(weights));
   }
 }
 
@@ -203,6 +265,66 @@ double relative_rms(const std::vector<Vec3>& values, const std::vector<Vec3>& tr
   }
   if (den > 0) return std::sqrt(num / den);
   return num > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+}
+
+ErrorEstimate sample_error(const ErrorSample& sample, const std::vector<Vec3>& values, const std::vector<Vec3>& truth,
+                           const std::vector<double>* blend_weights) {
+  const std::size_t n = std::size_t(sample.count());
+  if (values.size() != n || truth.size() != n || (blend_weights && blend_weights->size() != n))
+    throw std::invalid_argument("sample_error: the vectors differ in size from the sample");
+  const int K = sample.view_count();
+  std::vector<double> num(std::size_t(K), 0.0), den(std::size_t(K), 0.0);
+  std::size_t i = 0;
+  for (int k = 0; k < K; ++k)
+    for (double w : sample.weights(k)) {
+      if (!blend_weights || (*blend_weights)[i] > 0) {
+        num[std::size_t(k)] += w * (values[i] - truth[i]).squaredNorm();
+        den[std::size_t(k)] += w * truth[i].squaredNorm();
+      }
+      ++i;
+    }
+  auto ratio = [](double a, double b) {
+    if (b > 0) return std::sqrt(a / b);
+    return a > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+  };
+  double N = 0, D = 0;
+  for (int k = 0; k < K; ++k) N += num[std::size_t(k)], D += den[std::size_t(k)];
+  ErrorEstimate e;
+  e.value = ratio(N, D);
+  if (K < 2 || !std::isfinite(e.value)) return e;
+  // Jackknife: sigma^2 = (K - 1) / K sum_k (R_(-k) - mean R_(-k))^2.
+  std::vector<double> loo(static_cast<std::size_t>(K));
+  double mean = 0;
+  for (int k = 0; k < K; ++k) {
+    loo[std::size_t(k)] = ratio(N - num[std::size_t(k)], D - den[std::size_t(k)]);
+    if (!std::isfinite(loo[std::size_t(k)])) {
+      e.sigma = std::numeric_limits<double>::infinity();
+      return e;
+    }
+    mean += loo[std::size_t(k)] / K;
+  }
+  double ss = 0;
+  for (double r : loo) ss += (r - mean) * (r - mean);
+  e.sigma = std::sqrt(double(K - 1) / K * ss);
+  return e;
+}
+
+TexelGuide squared_radiance_guide(const Integrator& integrator, const Brdf& brdf, const IntegratorOptions& options,
+                                  int guide_size) {
+  if (guide_size < 2) throw std::invalid_argument("error sample: a guide's size must be at least 2");
+  return [&integrator, &brdf, options, guide_size](int, const Vec3& view, const Mat3& frame) {
+    IntegratorOptions o = options;
+    o.texel_mask = cv::Mat();
+    const cv::Mat rgb = integrator.radiance_map(brdf, view, frame, guide_size, o);
+    cv::Mat q(guide_size, guide_size, CV_32FC1, cv::Scalar(0));
+    for (int r = 0; r < guide_size; ++r)
+      for (int c = 0; c < guide_size; ++c) {
+        const cv::Vec3f& p = rgb.at<cv::Vec3f>(r, c);
+        const float v = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+        q.at<float>(r, c) = std::isfinite(v) && v > 0 ? v : 0.0f;
+      }
+    return q;
+  };
 }
 
 }  // namespace rsibr

@@ -10,6 +10,21 @@
 // reference quadrature) and B_k the blend of the set (runtime/blend.h). S texels per view drawn
 // uniformly from the disc's texels give the ratio estimator of it.
 //
+// Guided sampling. Where a sun's glint dominates, a few texels carry most of the squared error and a
+// uniform sample of a few hundred texels misses or over-counts them: its estimate is heavy-tailed.
+// A guide (an importance q_t >= 0 per texel, e.g. |D|^2 from a cheap low-resolution bake) draws
+// texels with replacement from the defensive mixture
+//
+//   p_t = (1 - a) / M + a q_t / sum q      (M disc texels, a = kGuideShare)
+//
+// and weighs each drawn texel by w_t = c_t / (p_t M) (c_t: how often it was drawn; w = c_t for a
+// uniform draw), which makes sum w f an unbiased estimate of (S / M) sum over the disc of f for both
+// sums of the ratio. If relative errors were the same everywhere, q = |D|^2 would make the ratio
+// exact from any sample; the uniform half bounds every draw's weight by 1 / (1 - a).
+//
+// The estimate's standard error: a jackknife over the views (texels of one view share its glints, so
+// views, not texels, are the independent units).
+//
 // The outermost ring of the disc, where n . d < 0.1 (radius above 0.995, 1% of the disc's area), is
 // left out by default: there every source is faded (the mirror direction nears -d, the singular
 // direction of every map), the blend falls back to its least-faded source, and a grazing glint of a
@@ -34,25 +49,40 @@
 #include <opencv2/core.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace rsibr {
 
+// An importance map for view k (direction `view`, frame `frame`): CV_32FC1, any square size (resized
+// bilinearly to the sample's), values >= 0 and finite; read only inside the disc.
+using TexelGuide = std::function<cv::Mat(int k, const Vec3& view, const Mat3& frame)>;
+
 class ErrorSample {
  public:
-  // `views` novel views uniform on the sphere and `texels` distinct texels of each one's size x size
+  // `views` novel views (a Fibonacci lattice under a random rotation: each uniform on the sphere,
+  // together evenly spread) and `texels` distinct texels of each one's size x size
   // destination disc whose normal has n . d >= min_cos, uniform among those texels; all drawn from
   // `seed`. Throws std::invalid_argument for views < 1, texels < 1, min_cos outside [0, 1) or a size
   // with fewer such texels than `texels`.
   static constexpr double kDefaultMinCos = 0.1;
   ErrorSample(int views, int texels, int size, std::uint64_t seed, double min_cos = kDefaultMinCos);
+  // Guided: `texels` draws per view with replacement from the mixture above (so a view may hold
+  // fewer distinct texels, each weighted). Throws std::invalid_argument as above and for a guide map
+  // that is empty, not single-channel float, not square, or holds a negative or non-finite value.
+  static constexpr double kGuideShare = 0.5;
+  ErrorSample(int views, int texels, int size, std::uint64_t seed, const TexelGuide& guide,
+              double min_cos = kDefaultMinCos);
 
   int size() const { return size_; }
   int view_count() const { return int(views_.size()); }
   const Vec3& view(int k) const { return views_[std::size_t(k)]; }
   const Mat3& frame(int k) const { return frames_[std::size_t(k)]; }
-  // View k's texels as indices r * size + c, ascending.
+  // View k's texels as indices r * size + c, ascending and distinct, and their weights (all 1 for a
+  // uniform sample).
   const std::vector<int>& texels(int k) const { return texels_[std::size_t(k)]; }
+  const std::vector<double>& weights(int k) const { return weights_[std::size_t(k)]; }
+  bool guided() const { return guided_; }
   // The world normal of view k's texel index t: T_k g_normal(its disc point).
   Vec3 normal(int k, int texel) const;
   // A CV_8UC1 size x size mask of view k's texels (the integrators' texel mask).
@@ -61,11 +91,33 @@ class ErrorSample {
   int count() const;
 
  private:
+  ErrorSample(int views, int texels, int size, std::uint64_t seed, const TexelGuide* guide, double min_cos);
   int size_;
+  bool guided_ = false;
   std::vector<Vec3> views_;
   std::vector<Mat3> frames_;
   std::vector<std::vector<int>> texels_;
+  std::vector<std::vector<double>> weights_;
 };
+
+// A relative RMS with its standard error (the jackknife over views; 0 with one view).
+struct ErrorEstimate {
+  double value = 0;
+  double sigma = 0;
+  double upper(double k = 1.0) const { return value + k * sigma; }
+};
+
+// The sample's estimate of the relative RMS of `values` against `truth` (both view-major over the
+// sample, as direct_values and sampled_blend give them), over the texels whose blend weight is > 0
+// (all when blend_weights is null), each weighted by the sample's weight. Same conventions as
+// relative_rms for a zero truth. Throws std::invalid_argument when a size differs from the sample's.
+ErrorEstimate sample_error(const ErrorSample& sample, const std::vector<Vec3>& values, const std::vector<Vec3>& truth,
+                           const std::vector<double>* blend_weights = nullptr);
+
+// The guide of squared radiance: each view's direct bake at guide_size x guide_size (the integrator
+// with `options`, every texel), q = |rgb|^2.
+TexelGuide squared_radiance_guide(const Integrator& integrator, const Brdf& brdf, const IntegratorOptions& options,
+                                  int guide_size);
 
 // What the integrator bakes at every sampled texel (view-major): the direct bake there.
 // seconds (optional) gets the wall time of the integration alone.

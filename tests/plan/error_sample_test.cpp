@@ -8,6 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
 #include <set>
 
 namespace rsibr {
@@ -128,6 +132,165 @@ TEST(RelativeRms, IsZeroForEqualVectorsAndScalesWithTheError) {
   EXPECT_EQ(relative_rms({Vec3(0, 0, 0)}, {Vec3(0, 0, 0)}), 0.0);
   EXPECT_TRUE(std::isinf(relative_rms({Vec3(1, 0, 0)}, {Vec3(0, 0, 0)})));
   EXPECT_THROW(relative_rms(truth, {Vec3(1, 1, 1)}), std::invalid_argument);
+}
+
+// A synthetic glint for the sampling tests: the truth over the sphere of normals is a dim sky with a
+// bright narrow lobe; the values hold the lobe a little displaced, by an amount that depends on the
+// view (as a blend of glints errs), so a few texels on the lobe's flanks in some views hold all of
+// the error.
+const Vec3 kGlint = Vec3(0.3, 0.5, 0.8).normalized();
+Vec3 glint_truth(const Vec3& n) { return Vec3(1, 1, 1) * (1.0 + 200.0 * std::exp((n.dot(kGlint) - 1.0) / 0.01)); }
+Vec3 glint_value(const Vec3& n, const Vec3& view) {
+  return glint_truth((n + 0.04 * view.cross(kGlint)).normalized()).cwiseProduct(Vec3(1.0, 0.95, 0.9));
+}
+
+struct Evaluated {
+  std::vector<Vec3> values, truth;
+};
+Evaluated evaluate(const ErrorSample& s) {
+  Evaluated e;
+  for (int k = 0; k < s.view_count(); ++k)
+    for (int t : s.texels(k)) {
+      e.values.push_back(glint_value(s.normal(k, t), s.view(k)));
+      e.truth.push_back(glint_truth(s.normal(k, t)));
+    }
+  return e;
+}
+// The guide of the glint's squared truth, as squared_radiance_guide would give it from a bake.
+TexelGuide glint_guide(int size) {
+  return [size](int, const Vec3&, const Mat3& frame) {
+    cv::Mat q(size, size, CV_32FC1, cv::Scalar(0));
+    for (int r = 0; r < size; ++r)
+      for (int c = 0; c < size; ++c) {
+        const Vec2 d = sphere_map::disc_from_pixel(Vec2(c, r), size, size);
+        if (d.squaredNorm() >= 1) continue;
+        q.at<float>(r, c) = float(glint_truth(frame * sphere_map::g_normal(d)).squaredNorm());
+      }
+    return q;
+  };
+}
+// The exact relative RMS over the whole domain of the same views.
+double whole_disc_error(const ErrorSample& s) {
+  double num = 0, den = 0;
+  const ErrorSample all(s.view_count(), int(disc_texel_count(s.size(), ErrorSample::kDefaultMinCos)), s.size(), 0);
+  for (int k = 0; k < s.view_count(); ++k)
+    for (int t : all.texels(k)) {
+      const Vec3 n = (s.frame(k) * sphere_map::g_normal(sphere_map::disc_from_pixel(Vec2(t % s.size(), t / s.size()),
+                                                                                    s.size(), s.size())))
+                         .normalized();
+      num += (glint_value(n, s.view(k)) - glint_truth(n)).squaredNorm();
+      den += glint_truth(n).squaredNorm();
+    }
+  return std::sqrt(num / den);
+}
+
+TEST(GuidedSample, TexelsAreDistinctAscendingAndEachDrawWeighsAtMostTheUniformShare) {
+  const int S = 200;
+  const ErrorSample s(4, S, 32, 3, glint_guide(16));
+  EXPECT_TRUE(s.guided());
+  for (int k = 0; k < s.view_count(); ++k) {
+    ASSERT_EQ(s.texels(k).size(), s.weights(k).size());
+    EXPECT_TRUE(std::is_sorted(s.texels(k).begin(), s.texels(k).end()));
+    EXPECT_EQ(std::set<int>(s.texels(k).begin(), s.texels(k).end()).size(), s.texels(k).size());
+    EXPECT_LT(s.texels(k).size(), std::size_t(S));  // the glint's texels are drawn more than once
+    // w = c / (p M) with p >= (1 - a) / M; the counts c sum to S.
+    double bound = 0;
+    for (double w : s.weights(k)) {
+      EXPECT_GT(w, 0.0);
+      bound += w * (1.0 - ErrorSample::kGuideShare);
+    }
+    EXPECT_LE(bound, double(S) + 1e-9);
+  }
+  const ErrorSample uniform(2, 50, 32, 3);
+  EXPECT_FALSE(uniform.guided());
+  for (int k = 0; k < 2; ++k)
+    for (double w : uniform.weights(k)) EXPECT_EQ(w, 1.0);
+}
+
+TEST(GuidedSample, BadGuidesAreRefused) {
+  auto constant = [](float v, int size, int type = CV_32FC1) {
+    return TexelGuide([=](int, const Vec3&, const Mat3&) { return cv::Mat(size, size, type, cv::Scalar::all(v)); });
+  };
+  EXPECT_THROW(ErrorSample(1, 10, 16, 0, constant(-1.0f, 16)), std::invalid_argument);
+  EXPECT_THROW(ErrorSample(1, 10, 16, 0, constant(std::numeric_limits<float>::quiet_NaN(), 16)), std::invalid_argument);
+  EXPECT_THROW(ErrorSample(1, 10, 16, 0, constant(1.0f, 16, CV_8UC1)), std::invalid_argument);
+  EXPECT_THROW(ErrorSample(1, 10, 16, 0, TexelGuide([](int, const Vec3&, const Mat3&) { return cv::Mat(); })),
+               std::invalid_argument);
+  // A guide of zeros leaves the uniform draw, with replacement: every weight is the texel's count.
+  const ErrorSample zero(1, 30, 16, 0, constant(0.0f, 16));
+  double sum = 0;
+  for (double w : zero.weights(0)) {
+    EXPECT_NEAR(w, std::round(w), 1e-9);
+    sum += w;
+  }
+  EXPECT_NEAR(sum, 30.0, 1e-9);
+}
+
+// The weights make both sums of the ratio unbiased: over many draws the guided estimate of the
+// error converges to the whole-disc value, and with far less scatter than a uniform sample of the
+// same size, since the glint's few texels are drawn densely.
+TEST(GuidedSample, TheGuidedEstimateConvergesToTheWholeDiscAndScattersLessThanAUniformOne) {
+  const int draws = 300, views = 4, texels = 40, size = 48;
+  std::vector<double> guided, uniform;
+  double truth_mean = 0;
+  for (int d = 0; d < draws; ++d) {
+    const ErrorSample g(views, texels, size, 1000 + d, glint_guide(24));
+    const ErrorSample u(views, texels, size, 1000 + d);
+    const Evaluated eg = evaluate(g), eu = evaluate(u);
+    guided.push_back(std::pow(sample_error(g, eg.values, eg.truth).value, 2));
+    uniform.push_back(std::pow(sample_error(u, eu.values, eu.truth).value, 2));
+    if (d < 40) truth_mean += std::pow(whole_disc_error(g), 2) / 40.0;
+  }
+  auto mean = [](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / double(v.size()); };
+  auto sd = [&](const std::vector<double>& v) {
+    const double m = mean(v);
+    double ss = 0;
+    for (double x : v) ss += (x - m) * (x - m);
+    return std::sqrt(ss / double(v.size() - 1));
+  };
+  // The ratio of means is biased at O(1/n); within 10% of the whole disc's mean squared error here.
+  EXPECT_NEAR(mean(guided), truth_mean, 0.1 * truth_mean);
+  EXPECT_LT(sd(guided), 0.5 * sd(uniform));
+}
+
+// The jackknife over views is an honest standard error: its typical value covers the scatter of the
+// estimate over independent draws, and is not uselessly loose (the views are spread evenly, which
+// the jackknife, treating them as independent, does not credit: it errs high).
+TEST(GuidedSample, TheJackknifeSigmaCoversTheScatterOverDraws) {
+  const int draws = 200;
+  std::vector<double> values;
+  double sigma2 = 0;
+  for (int d = 0; d < draws; ++d) {
+    const ErrorSample g(12, 30, 32, 5000 + d, glint_guide(16));
+    const Evaluated e = evaluate(g);
+    const ErrorEstimate est = sample_error(g, e.values, e.truth);
+    values.push_back(est.value);
+    sigma2 += est.sigma * est.sigma / draws;
+  }
+  const double m = std::accumulate(values.begin(), values.end(), 0.0) / draws;
+  double ss = 0;
+  for (double v : values) ss += (v - m) * (v - m);
+  const double scatter = std::sqrt(ss / (draws - 1));
+  EXPECT_GT(std::sqrt(sigma2) / scatter, 0.9);
+  EXPECT_LT(std::sqrt(sigma2) / scatter, 2.5);
+}
+
+TEST(SampleError, AConstantRelativeErrorIsExactFromAnySampleAndOneViewHasNoSigma) {
+  const ErrorSample g(3, 20, 16, 9, glint_guide(16));
+  std::vector<Vec3> truth, values;
+  for (int k = 0; k < g.view_count(); ++k)
+    for (int t : g.texels(k)) {
+      truth.push_back(glint_truth(g.normal(k, t)));
+      values.push_back(1.1 * truth.back());
+    }
+  const ErrorEstimate e = sample_error(g, values, truth);
+  EXPECT_NEAR(e.value, 0.1, 1e-12);
+  EXPECT_NEAR(e.sigma, 0.0, 1e-12);
+  EXPECT_THROW(sample_error(g, values, {Vec3(1, 1, 1)}), std::invalid_argument);
+  const ErrorSample one(1, 10, 16, 2);
+  const std::vector<Vec3> ones(10, Vec3(1, 1, 1)), off(10, Vec3(1.2, 1.2, 1.2));
+  EXPECT_NEAR(sample_error(one, off, ones).value, 0.2, 1e-12);
+  EXPECT_EQ(sample_error(one, off, ones).sigma, 0.0);
 }
 
 }  // namespace
