@@ -25,20 +25,22 @@ using namespace rsibr;
 
 namespace {
 
-IntegratorOptions options_of(const IntegratorSetting& s) {
+// The integrator's options as the plan measured them (its seed: a FIS bake's error depends on it).
+IntegratorOptions options_of(const IntegratorSetting& s, std::uint64_t seed) {
   IntegratorOptions o;
+  o.seed = seed;
   o.samples = std::max(1, s.samples);
   o.reference_width = s.reference_width;
   return o;
 }
 
 // Bakes the setting in full and returns the wall time (integrator construction included).
-double bake_seconds(const EnvMap& env, const Brdf& brdf, const BakeSetting& s, MapSet* out) {
+double bake_seconds(const EnvMap& env, const Brdf& brdf, const BakeSetting& s, std::uint64_t seed, MapSet* out) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto integrator = make_integrator(s.integrator.method, env);
   MapSetBakeOptions o;
   o.res = s.res;
-  o.integrator = options_of(s.integrator);
+  o.integrator = options_of(s.integrator, seed);
   *out = bake_map_set(brdf, *integrator, ViewSet::named(s.views), o);
   return seconds_since(t0);
 }
@@ -52,10 +54,11 @@ nlohmann::json setting_json(const BakeSetting& s) {
 int main(int argc, char** argv) {
   std::string env_path, brdf_spec;
   double budget = 0.02;
-  int check_views = 6, check_texels = 64;
+  int check_views = 8, check_texels = 96;
   double max_bake_seconds = 600;    // longer bakes are not run: their time is the model's
   double max_sweep_seconds = 1800;  // candidates whose modelled bake is longer are not measured
   bool skip_full_reference = true;
+  std::uint64_t check_seed = 7777, plan_seed = 1;
   CLI::App app("The bake planner against a full sweep of its candidates");
   app.add_option("--env", env_path)->required();
   app.add_option("--brdf", brdf_spec, "BRDF spec (YAML text)")->required();
@@ -64,6 +67,8 @@ int main(int argc, char** argv) {
   app.add_option("--check-texels", check_texels);
   app.add_option("--max-bake-seconds", max_bake_seconds);
   app.add_option("--max-sweep-seconds", max_sweep_seconds);
+  app.add_option("--check-seed", check_seed);
+  app.add_option("--plan-seed", plan_seed);
   CLI11_PARSE(app, argc, argv);
   try {
     EnvMap env = read_environment(env_path);
@@ -77,13 +82,19 @@ int main(int argc, char** argv) {
     // The plan and its bake, checked at fresh novel views.
     BakePlanOptions po;
     po.max_error = budget;
+    po.seed = plan_seed;
     auto t0 = std::chrono::steady_clock::now();
     const BakePlan plan = plan_bake(env, *brdf, po);
     const double plan_seconds = seconds_since(t0);
     out["plan"] = plan.to_json();
     out["plan_seconds"] = plan_seconds;
-    const std::uint64_t check_seed = 7777;
-    const ErrorSample sample(check_views, check_texels, 128, check_seed);
+    // The check's texels: guided like the pilot's (plan/error_sample.h), from another seed.
+    const auto guide_integrator = make_integrator("fis", env);
+    IntegratorOptions guide_options;
+    guide_options.samples = 64;
+    guide_options.seed = check_seed;
+    const ErrorSample sample(check_views, check_texels, 128, check_seed,
+                             squared_radiance_guide(*guide_integrator, *brdf, guide_options, 32));
     const auto reference = make_integrator("reference", env);
     t0 = std::chrono::steady_clock::now();
     const std::vector<Vec3> truth = direct_values(*reference, *brdf, IntegratorOptions{}, sample);
@@ -92,17 +103,23 @@ int main(int argc, char** argv) {
       const BakeSetting& cs = plan.chosen->setting;
       out["chosen"] = setting_json(cs);
       out["chosen"]["predicted_error"] = plan.chosen->error;
+      out["chosen"]["pilot_error"] = *plan.chosen->measured_error;
+      out["chosen"]["pilot_sigma"] = *plan.chosen->measured_sigma;
       out["chosen"]["predicted_seconds"] = plan.chosen->seconds;
       if (plan.chosen->seconds <= max_bake_seconds) {
         MapSet set;
-        out["chosen"]["seconds"] = bake_seconds(env, *brdf, cs, &set);
+        out["chosen"]["seconds"] = bake_seconds(env, *brdf, cs, plan_seed, &set);
         const SampledBlend b = sampled_blend(set, ViewSet::named(cs.views), sample);
-        out["chosen"]["error"] = relative_rms(b.values, truth, &b.weights);
+        const ErrorEstimate e = sample_error(sample, b.values, truth, &b.weights);
+        out["chosen"]["error"] = e.value;
+        out["chosen"]["error_sigma"] = e.sigma;
       } else {  // too long to bake here: the same texels through the footprints, the time as predicted
         const auto in = make_integrator(cs.integrator.method, env);
-        const SampledBlend b =
-            sampled_blend(*in, *brdf, options_of(cs.integrator), ViewSet::named(cs.views), cs.res, false, sample);
-        out["chosen"]["error"] = relative_rms(b.values, truth, &b.weights);
+        const SampledBlend b = sampled_blend(*in, *brdf, options_of(cs.integrator, plan_seed), ViewSet::named(cs.views),
+                                             cs.res, false, sample);
+        const ErrorEstimate e = sample_error(sample, b.values, truth, &b.weights);
+        out["chosen"]["error"] = e.value;
+        out["chosen"]["error_sigma"] = e.sigma;
         out["chosen"]["seconds"] = plan.chosen->seconds;
         out["chosen"]["seconds_modelled"] = true;
       }
@@ -123,19 +140,22 @@ int main(int argc, char** argv) {
     std::map<std::string, double> per_texel;
     std::vector<IntegratorSetting> settings;
     nlohmann::json pruned = nlohmann::json::array();
+    nlohmann::json own_errors;  // each integrator setting's own error at the check texels
     for (const IntegratorSetting& s : po.integrators) {
       if (skip_full_reference && s.method == "reference" && s.reference_width == 0) continue;
       try {
         const Integrator& in = integrator(s.method);
         // A setting whose own error at the check texels exceeds the budget cannot meet it blended
         // (blending adds interpolation error): pruned from the sweep.
-        const double own = relative_rms(direct_values(in, *brdf, options_of(s), sample), truth);
+        const double own =
+            sample_error(sample, direct_values(in, *brdf, options_of(s, plan_seed), sample), truth).value;
+        own_errors[s.label()] = own;
         if (own > budget) {
           pruned.push_back({{"integrator", s.label()}, {"error", own}});
           continue;
         }
         const auto t = std::chrono::steady_clock::now();
-        in.radiance_map(*brdf, sample.view(0), sample.frame(0), 128, options_of(s));
+        in.radiance_map(*brdf, sample.view(0), sample.frame(0), 128, options_of(s, plan_seed));
         per_texel[s.label()] = seconds_since(t) / double(disc_texel_count(128));
         settings.push_back(s);
       } catch (const std::invalid_argument&) {
@@ -164,11 +184,14 @@ int main(int argc, char** argv) {
       if (row.model > max_sweep_seconds) break;  // bakes over this long are not candidates here
       const auto t = std::chrono::steady_clock::now();
       const BakeSetting& bs = row.setting;
-      const SampledBlend b = sampled_blend(integrator(bs.integrator.method), *brdf, options_of(bs.integrator),
-                                           ViewSet::named(bs.views), bs.res, false, sample);
-      const double error = relative_rms(b.values, truth, &b.weights);
+      const SampledBlend b =
+          sampled_blend(integrator(bs.integrator.method), *brdf, options_of(bs.integrator, plan_seed),
+                        ViewSet::named(bs.views), bs.res, false, sample);
+      const ErrorEstimate e = sample_error(sample, b.values, truth, &b.weights);
+      const double error = e.value;
       nlohmann::json r = setting_json(bs);
       r["error"] = error;
+      r["error_sigma"] = e.sigma;
       r["seconds_model"] = row.model;
       r["sweep_seconds"] = seconds_since(t);
       rows.push_back(r);
@@ -182,10 +205,11 @@ int main(int argc, char** argv) {
     out["max_sweep_seconds"] = max_sweep_seconds;
     out["sweep"] = rows;
     out["pruned"] = pruned;
+    out["own_errors"] = own_errors;
     if (best) {
       if ((*best)["seconds_model"].get<double>() <= max_bake_seconds) {
         MapSet set;
-        (*best)["seconds"] = bake_seconds(env, *brdf, best_setting, &set);
+        (*best)["seconds"] = bake_seconds(env, *brdf, best_setting, plan_seed, &set);
       } else {
         (*best)["seconds"] = (*best)["seconds_model"];
         (*best)["seconds_modelled"] = true;

@@ -144,9 +144,9 @@ int run_bake(const BakeArgs& given, const CLI::App& command) {
   if (plan) {
     check = check_bake(set, in.views, env, *brdf, a.seed + 1);
     if (!a.quiet)
-      std::cerr << "rsibr bake: checked at " << check->views << " fresh novel views: " << 100 * check->error
-                << "% against the reference (predicted " << 100 * plan->chosen->error << "%, budget "
-                << 100 * plan->options.max_error << "%)\n";
+      std::cerr << "rsibr bake: checked at " << check->views << " fresh novel views: " << 100 * check->error << "% +- "
+                << 100 * check->error_sigma << "% against the reference (predicted " << 100 * plan->chosen->error
+                << "%, budget " << 100 * plan->options.max_error << "%)\n";
     if (check->error > plan->options.max_error)
       std::cerr << "rsibr bake: warning: the checked error " << 100 * check->error << "% exceeds --max-error "
                 << a.max_error << "\n";
@@ -182,6 +182,7 @@ int run_bake(const BakeArgs& given, const CLI::App& command) {
   if (plan) {
     j["plan"] = plan->to_json();
     j["check"] = {{"error", check->error},
+                  {"error_sigma", check->error_sigma},
                   {"predicted_error", plan->chosen->error},
                   {"max_error", plan->options.max_error},
                   {"meets", check->error <= plan->options.max_error},

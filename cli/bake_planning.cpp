@@ -87,22 +87,28 @@ std::string bake_arguments(const BakeSetting& s) {
 void print_plan(std::ostream& out, const BakePlan& plan) {
   const BakePlanOptions& o = plan.options;
   out << std::fixed;
-  out << "pilot: " << o.pilot_views << " novel views x " << o.pilot_texels << " texels (" << o.pilot_size
-      << "^2 discs), truth: the full reference quadrature, " << std::setprecision(1) << plan.pilot_seconds << " s\n";
-  out << "integration error at the pilot texels, and time per texel:\n";
+  out << "pilot: " << o.pilot_views << " novel views x " << o.pilot_texels << " texels (" << o.pilot_size << "^2 discs"
+      << (o.guide_size > 0 ? ", drawn where a " + std::to_string(o.guide_size) + "^2 bake is bright" : "")
+      << "), truth: the full reference quadrature, " << std::setprecision(1) << plan.pilot_seconds << " s\n";
+  out << "integration error at the pilot texels (+- one standard error), and time per texel:\n";
   for (const IntegratorPilot& p : plan.integrators)
     out << "  " << std::left << std::setw(22) << p.setting.label() << std::right << std::setw(9) << pct(p.error)
-        << std::setw(11) << std::setprecision(2) << p.seconds_per_texel * 1e6 << " us\n";
+        << " +- " << std::left << std::setw(8) << pct(p.error_sigma) << std::right << std::setw(9)
+        << std::setprecision(2) << p.seconds_per_texel * 1e6 << " us\n";
   out << "interpolation error (warp and blend at novel views, maps without integration error):\n";
   for (const InterpolationPilot& p : plan.interpolation)
     out << "  " << std::setw(4) << p.view_count << " views " << std::setw(4) << p.res << "^2" << std::setw(9)
-        << pct(p.error) << "\n";
-  out << "candidates by predicted time (predicted error = hypot(interpolation, integration)):\n";
+        << pct(p.error) << " +- " << pct(p.error_sigma) << "\n";
+  out << "candidates by predicted time (predicted error = hypot(interpolation, integration); a candidate meets "
+         "the budget when its error plus "
+      << std::setprecision(1) << o.sigmas << " standard errors is within " << std::setprecision(0) << 100 * o.margin
+      << "% of it):\n";
   auto row = [&](const PlannedSetting& s, bool chosen) {
     out << (chosen ? "  * " : "    ") << std::setw(4) << s.setting.view_count << " views " << std::setw(4)
         << s.setting.res << "^2  " << std::left << std::setw(22) << s.setting.integrator.label() << std::right
         << std::setw(10) << (s.interpolation_error ? pct(s.error) : ">= " + pct(s.integration_error)) << std::setw(10)
-        << std::setprecision(2) << s.seconds << " s" << (s.meets ? "  meets" : "") << "\n";
+        << (s.interpolation_error ? "<= " + pct(s.upper_error) : std::string()) << std::setw(10) << std::setprecision(2)
+        << s.seconds << " s" << (s.meets ? "  meets" : "") << "\n";
   };
   const std::size_t first = 6;
   bool chosen_shown = false;

@@ -20,7 +20,7 @@ namespace {
 struct PlanArgs {
   std::string env, brdf, layout, json, max_error, views, method, lobe = "all", normalise = "none";
   int res = 0, samples = 0, reference_width = -1;
-  std::uint64_t seed = 1;
+  std::uint64_t seed = 0;  // rsibr bake's default: a plan holds for the seed it was made with
   bool sanitize = false, every_pair = false;
 };
 
@@ -59,12 +59,14 @@ int run_plan(const PlanArgs& a) {
   if (plan.chosen)
     out << "bake it: rsibr bake --env " << a.env << " --brdf " << a.brdf << " " << bake_arguments(plan.chosen->setting)
         << (a.lobe != "all" ? " --lobe " + a.lobe : "") << (knobs.normalise_albedo ? " --normalise albedo" : "")
-        << " OUTPUT.exr\n";
+        << (a.seed != 0 ? " --seed " + std::to_string(a.seed) : "") << " OUTPUT.exr\n";
   nlohmann::json j = plan.to_json();
   j["environment"] = a.env;
   j["brdf"] = a.brdf;
   j["material"] = brdf->spec();
-  if (plan.chosen) j["bake_arguments"] = bake_arguments(plan.chosen->setting);
+  if (plan.chosen)
+    j["bake_arguments"] =
+        bake_arguments(plan.chosen->setting) + (a.seed != 0 ? " --seed " + std::to_string(a.seed) : "");
   write_summary(json, j);
   outputs.commit();
   return plan.chosen ? 0 : 3;
@@ -104,7 +106,9 @@ Runner add_plan(CLI::App& app) {
       ->check(CLI::IsMember({"all", "normal", "mirror"}));
   c->add_option("--normalise", a->normalise, "none, or albedo: plan albedo-normalised maps")
       ->check(CLI::IsMember({"none", "albedo"}));
-  c->add_option("--seed", a->seed, "Seed of the pilot's novel views and texels and of the stochastic integrators")
+  c->add_option("--seed", a->seed,
+                "Seed of the pilot's novel views and texels and of the stochastic integrators; bake with the same "
+                "seed (a FIS bake's error depends on it)")
       ->check(seed_check());
   c->add_flag("--every-pair", a->every_pair,
               "Measure the interpolation error of every view set and size (a fuller table; slower)");

@@ -920,9 +920,10 @@ void step_bake(Context& c) {
     MapSetBakeOptions bo;
     bo.integrator.samples = c.o.bake_samples;
     nlohmann::json planned;
+    // Planned with the bake's own seed: a filtered-importance bake's error depends on it.
     if (c.o.bake_max_error > 0) {
       const IntegratorPlan plan =
-          plan_integrator(probe, *brdf, c.o.bake_max_error, default_integrator_settings(), c.o.seed + 1);
+          plan_integrator(probe, *brdf, c.o.bake_max_error, default_integrator_settings(), c.o.seed);
       if (!plan.chosen)
         throw std::runtime_error("no integrator is predicted to reach --max-error " +
                                  std::to_string(c.o.bake_max_error) + " on probe.exr");

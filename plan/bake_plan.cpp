@@ -45,6 +45,9 @@ struct Pilots {
   std::map<std::string, std::unique_ptr<Integrator>> made;
   std::map<std::string, double> setup;
   std::vector<IntegratorPilot> integrators;
+  std::vector<Vec3> truth;
+
+  explicit Pilots(const EnvMap& environment) : env(environment) {}
 
   const Integrator& integrator(const std::string& method) {
     auto it = made.find(method);
@@ -57,13 +60,11 @@ struct Pilots {
     return *it->second;
   }
 
-  Pilots(const EnvMap& environment, const Brdf& brdf, const ErrorSample& sample,
-         const std::vector<IntegratorSetting>& settings, std::uint64_t seed, int timing_size)
-      : env(environment) {
+  void measure(const Brdf& brdf, const ErrorSample& sample, const std::vector<IntegratorSetting>& settings,
+               std::uint64_t seed, int timing_size) {
     const Integrator& reference = integrator("reference");
     double truth_seconds = 0;
-    const std::vector<Vec3> truth =
-        direct_values(reference, brdf, options_of({"reference", 0, 0}, seed), sample, &truth_seconds);
+    truth = direct_values(reference, brdf, options_of({"reference", 0, 0}, seed), sample, &truth_seconds);
     for (const IntegratorSetting& s : settings) {
       const Integrator& chosen = integrator(s.method);
       IntegratorPilot p;
@@ -88,7 +89,9 @@ struct Pilots {
           continue;  // a setting this BRDF cannot use (sh for anything but Lambert)
         }
       }
-      p.error = relative_rms(values, truth);
+      const ErrorEstimate e = sample_error(sample, values, truth);
+      p.error = e.value;
+      p.error_sigma = e.sigma;
       p.seconds_per_texel = seconds / double(sample.count());
       // Cheap integrators: the pilot's few texels time mostly the per-call overhead; one whole map
       // times the integration itself.
@@ -133,45 +136,68 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   std::vector<ViewSet> view_sets;
   for (const std::string& name : options.view_sets) view_sets.push_back(ViewSet::named(name));
 
+  if (!(options.sigmas >= 0)) throw std::invalid_argument("plan: the number of standard errors must be >= 0");
+  if (options.guide_size != 0 && options.guide_size < 2)
+    throw std::invalid_argument("plan: the guide's size must be 0 (no guide) or at least 2");
   const auto t_start = std::chrono::steady_clock::now();
   BakePlan plan;
   plan.options = options;
-  const ErrorSample sample(options.pilot_views, options.pilot_texels, options.pilot_size, options.seed);
   const double budget = options.margin * options.max_error;
+  const double k = options.sigmas;
 
-  // The truth at the pilot texels and every integrator setting's error and time per texel.
-  Pilots pilots(env, brdf, sample, options.integrators, options.seed, options.pilot_size);
+  // The pilot's texels, guided by a cheap bake of the interpolation integrator; the truth there and
+  // every integrator setting's error and time per texel.
+  Pilots pilots(env);
+  const ErrorSample sample =
+      options.guide_size > 0
+          ? ErrorSample(options.pilot_views, options.pilot_texels, options.pilot_size, options.seed,
+                        squared_radiance_guide(pilots.integrator(kInterpolationIntegrator.method), brdf,
+                                               options_of(kInterpolationIntegrator, options.seed), options.guide_size))
+          : ErrorSample(options.pilot_views, options.pilot_texels, options.pilot_size, options.seed);
+  pilots.measure(brdf, sample, options.integrators, options.seed, options.pilot_size);
   plan.integrators = pilots.integrators;
   plan.truth_texels = sample.count();
   auto integrator_for = [&](const std::string& method) -> const Integrator& { return pilots.integrator(method); };
   if (plan.integrators.empty()) throw std::invalid_argument("plan: no integrator setting can bake this BRDF");
 
-  // e_interp(N, r), measured when first needed.
+  // e_interp(N, r) with its standard error, measured when first needed: the FIS maps' blend against
+  // FIS direct values, less (in quadrature) FIS's own error against the truth at the same texels,
+  // which the direct side carries and the blend does not share.
   std::vector<Vec3> interpolation_direct;
-  std::map<std::pair<std::size_t, int>, double> interpolation;
+  double interpolation_own = 0;
+  std::map<std::pair<std::size_t, int>, ErrorEstimate> interpolation;
   auto interpolation_error = [&](std::size_t set, int res) {
     const auto key = std::make_pair(set, res);
     if (auto it = interpolation.find(key); it != interpolation.end()) return it->second;
     const Integrator& integrator = integrator_for(kInterpolationIntegrator.method);
     const IntegratorOptions o = options_of(kInterpolationIntegrator, options.seed);
-    if (interpolation_direct.empty()) interpolation_direct = direct_values(integrator, brdf, o, sample);
+    if (interpolation_direct.empty()) {
+      interpolation_direct = direct_values(integrator, brdf, o, sample);
+      interpolation_own = sample_error(sample, interpolation_direct, pilots.truth).value;
+      plan.interpolation_integrator_error = interpolation_own;
+    }
     const SampledBlend b = sampled_blend(integrator, brdf, o, view_sets[set], res, options.normalise_albedo, sample);
     InterpolationPilot p;
     p.views = options.view_sets[set];
     p.view_count = int(view_sets[set].views().size());
     p.res = res;
-    p.error = relative_rms(b.values, interpolation_direct, &b.weights);
+    ErrorEstimate e = sample_error(sample, b.values, interpolation_direct, &b.weights);
+    p.raw_error = e.value;
+    e.value = std::sqrt(std::max(0.0, e.value * e.value - interpolation_own * interpolation_own));
+    p.error = e.value;
+    p.error_sigma = e.sigma;
     p.texels = b.texels_baked;
     p.seconds = b.seconds;
     plan.interpolation.push_back(p);
-    interpolation[key] = p.error;
-    return p.error;
+    interpolation[key] = e;
+    return e;
   };
 
   // Every candidate with its predicted time, cheapest first.
   struct Candidate {
     PlannedSetting planned;
     std::size_t set;
+    double integration_upper;  // e_int + k s_int
   };
   std::vector<Candidate> candidates;
   for (std::size_t v = 0; v < view_sets.size(); ++v)
@@ -181,8 +207,9 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
         s.setting = {options.view_sets[v], int(view_sets[v].views().size()), r, p.setting};
         s.integration_error = p.error;
         s.error = p.error;
+        s.upper_error = p.error + k * p.error_sigma;
         s.seconds = p.setup_seconds + double(s.setting.view_count) * double(disc_texel_count(r)) * p.seconds_per_texel;
-        candidates.push_back({s, v});
+        candidates.push_back({s, v, s.upper_error});
       }
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) { return a.planned.seconds < b.planned.seconds; });
@@ -190,23 +217,45 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   // least the size already misses (more views and texels do not interpolate worse): not measured.
   auto dominated = [&](std::size_t set, int res, double allowance) {
     for (const auto& [key, e] : interpolation)
-      if (view_sets[key.first].views().size() >= view_sets[set].views().size() && key.second >= res && e > allowance)
+      if (view_sets[key.first].views().size() >= view_sets[set].views().size() && key.second >= res &&
+          e.value > allowance)
         return true;
     return false;
   };
+  // The model screens, a measurement decides (see the header): a screened-in candidate is blended
+  // at the pilot texels with its own integrator and taken when that error plus k sigma fits. The
+  // screen is optimistic: an unbiased integrator's (mis) error counts at a third, the most the
+  // blend's 3 sources x 4 taps can average its noise away.
+  auto screened_integration = [](const PlannedSetting& s) {
+    return s.setting.integrator.method == "mis" ? s.integration_error / 3.0 : s.integration_error;
+  };
+  int confirmations = 0;
   for (Candidate& c : candidates) {
     PlannedSetting& s = c.planned;
-    const double allowance =
-        s.integration_error < budget ? std::sqrt(budget * budget - s.integration_error * s.integration_error) : 0.0;
-    if (options.every_pair ||
-        (!plan.chosen && s.integration_error <= budget && !dominated(c.set, s.setting.res, allowance))) {
-      s.interpolation_error = interpolation_error(c.set, s.setting.res);
+    const double ie = screened_integration(s);
+    const double allowance = ie < budget ? std::sqrt(budget * budget - ie * ie) : 0.0;
+    std::optional<ErrorEstimate> interp;
+    if (options.every_pair || (!plan.chosen && ie <= budget && !dominated(c.set, s.setting.res, allowance))) {
+      interp = interpolation_error(c.set, s.setting.res);
     } else if (auto it = interpolation.find({c.set, s.setting.res}); it != interpolation.end()) {
-      s.interpolation_error = it->second;
+      interp = it->second;
     }
-    if (s.interpolation_error) {
-      s.error = std::hypot(*s.interpolation_error, s.integration_error);
-      s.meets = s.error <= budget;
+    if (interp) {
+      s.interpolation_error = interp->value;
+      s.error = std::hypot(interp->value, s.integration_error);
+      s.upper_error = std::hypot(interp->upper(k), c.integration_upper);
+      if (!plan.chosen && std::hypot(interp->value, ie) <= budget && confirmations < options.max_confirmations) {
+        ++confirmations;
+        const SampledBlend b = sampled_blend(integrator_for(s.setting.integrator.method), brdf,
+                                             options_of(s.setting.integrator, options.seed), view_sets[c.set],
+                                             s.setting.res, options.normalise_albedo, sample);
+        const ErrorEstimate e = sample_error(sample, b.values, pilots.truth, &b.weights);
+        s.measured_error = e.value;
+        s.measured_sigma = e.sigma;
+        s.upper_error = e.upper(k);
+        s.meets = s.upper_error <= budget;
+        plan.confirm_seconds += b.seconds;
+      }
     }
     if (s.meets && !plan.chosen) plan.chosen = s;
     plan.settings.push_back(s);
@@ -217,9 +266,11 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   std::ostringstream why;
   if (plan.chosen) {
     const PlannedSetting& c = *plan.chosen;
-    why << "chosen: " << setting_text(c.setting) << ": predicted " << percent(c.error) << " (interpolation "
-        << percent(*c.interpolation_error) << ", integration " << percent(c.integration_error) << "), " << c.seconds
-        << " s; the budget is " << percent(options.max_error) << ", planned to " << percent(budget) << ".\n";
+    why << "chosen: " << setting_text(c.setting) << ": measured " << percent(*c.measured_error) << " +- "
+        << percent(*c.measured_sigma) << " at the pilot texels (at most " << percent(c.upper_error) << " with " << k
+        << " standard errors; modelled " << percent(c.error) << ": interpolation " << percent(*c.interpolation_error)
+        << ", integration " << percent(c.integration_error) << "), " << c.seconds << " s; the budget is "
+        << percent(options.max_error) << ", planned to " << percent(budget) << ".\n";
   } else {
     why << "no setting is predicted to meet " << percent(options.max_error) << " (planned to " << percent(budget)
         << "); the most accurate measured ones are listed in the table.\n";
@@ -229,11 +280,14 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
     if (plan.chosen && s.seconds >= plan.chosen->seconds) break;
     if (shown++ == 3) break;
     why << "cheaper, predicted to miss: " << setting_text(s.setting) << ": ";
-    if (s.interpolation_error)
-      why << percent(s.error) << " (interpolation " << percent(*s.interpolation_error) << ", integration "
-          << percent(s.integration_error) << ")";
+    if (s.measured_error)
+      why << "measured " << percent(*s.measured_error) << " +- " << percent(*s.measured_sigma) << " (modelled "
+          << percent(s.error) << ")";
+    else if (s.interpolation_error)
+      why << "modelled " << percent(s.error) << ", at most " << percent(s.upper_error) << " (interpolation "
+          << percent(*s.interpolation_error) << ", integration " << percent(s.integration_error) << ")";
     else
-      why << "integration alone " << percent(s.integration_error);
+      why << "integration alone " << percent(s.integration_error) << ", at most " << percent(s.upper_error);
     why << ", " << s.seconds << " s\n";
   }
   plan.why = why.str();
@@ -253,6 +307,9 @@ nlohmann::json BakePlan::to_json() const {
   auto planned_json = [&](const PlannedSetting& s) {
     nlohmann::json j = setting_json(s.setting);
     j["predicted_error"] = s.error;
+    j["upper_error"] = s.upper_error;
+    j["measured_error"] = s.measured_error ? nlohmann::json(*s.measured_error) : nlohmann::json();
+    j["measured_sigma"] = s.measured_sigma ? nlohmann::json(*s.measured_sigma) : nlohmann::json();
     j["integration_error"] = s.integration_error;
     j["interpolation_error"] = s.interpolation_error ? nlohmann::json(*s.interpolation_error) : nlohmann::json();
     j["predicted_seconds"] = s.seconds;
@@ -262,21 +319,27 @@ nlohmann::json BakePlan::to_json() const {
   nlohmann::json j;
   j["max_error"] = options.max_error;
   j["margin"] = options.margin;
-  j["pilot"] = {{"views", options.pilot_views}, {"texels_per_view", options.pilot_texels},
-                {"size", options.pilot_size},   {"seed", options.seed},
-                {"seconds", pilot_seconds},     {"truth_texels", truth_texels}};
+  j["sigmas"] = options.sigmas;
+  j["pilot"] = {{"views", options.pilot_views},       {"texels_per_view", options.pilot_texels},
+                {"size", options.pilot_size},         {"seed", options.seed},
+                {"guide_size", options.guide_size},   {"seconds", pilot_seconds},
+                {"confirm_seconds", confirm_seconds}, {"truth_texels", truth_texels}};
   j["integrators"] = nlohmann::json::array();
   for (const IntegratorPilot& p : integrators)
     j["integrators"].push_back({{"integrator", p.setting.label()},
                                 {"error", p.error},
+                                {"error_sigma", p.error_sigma},
                                 {"seconds_per_texel", p.seconds_per_texel},
                                 {"setup_seconds", p.setup_seconds}});
+  j["interpolation_integrator_error"] = interpolation_integrator_error;
   j["interpolation"] = nlohmann::json::array();
   for (const InterpolationPilot& p : interpolation)
     j["interpolation"].push_back({{"views", p.views},
                                   {"view_count", p.view_count},
                                   {"res", p.res},
                                   {"error", p.error},
+                                  {"raw_error", p.raw_error},
+                                  {"error_sigma", p.error_sigma},
                                   {"texels", p.texels},
                                   {"seconds", p.seconds}});
   j["chosen"] = chosen ? planned_json(*chosen) : nlohmann::json();
@@ -291,15 +354,19 @@ IntegratorPlan plan_integrator(const EnvMap& env, const Brdf& brdf, double max_e
   if (!(max_error > 0 && max_error < 1))
     throw std::invalid_argument("plan: the error budget must lie in (0, 1), not " + std::to_string(max_error));
   const auto t0 = std::chrono::steady_clock::now();
-  const ErrorSample sample(4, 96, 128, seed);
-  Pilots pilots(env, brdf, sample, settings, seed, 128);
+  Pilots pilots(env);
+  const ErrorSample sample(4, 96, 128, seed,
+                           squared_radiance_guide(pilots.integrator(kInterpolationIntegrator.method), brdf,
+                                                  options_of(kInterpolationIntegrator, seed), 32));
+  pilots.measure(brdf, sample, settings, seed, 128);
   if (pilots.integrators.empty()) throw std::invalid_argument("plan: no integrator setting can bake this BRDF");
   IntegratorPlan plan;
   plan.integrators = pilots.integrators;
   plan.max_error = max_error;
   plan.margin = margin;
   for (const IntegratorPilot& p : plan.integrators)
-    if (p.error <= margin * max_error && (!plan.chosen || p.seconds_per_texel < plan.chosen->seconds_per_texel))
+    if (p.error + p.error_sigma <= margin * max_error &&
+        (!plan.chosen || p.seconds_per_texel < plan.chosen->seconds_per_texel))
       plan.chosen = p;
   plan.seconds = seconds_since(t0);
   return plan;
@@ -312,6 +379,7 @@ nlohmann::json IntegratorPlan::to_json() const {
                           {"samples", p.setting.samples},
                           {"reference_width", p.setting.reference_width},
                           {"error", p.error},
+                          {"error_sigma", p.error_sigma},
                           {"seconds_per_texel", p.seconds_per_texel}};
   };
   nlohmann::json j = {{"max_error", max_error}, {"margin", margin}, {"seconds", seconds}};
@@ -324,13 +392,18 @@ nlohmann::json IntegratorPlan::to_json() const {
 BakeCheck check_bake(const MapSet& set, const ViewSet& view_set, const EnvMap& env, const Brdf& brdf,
                      std::uint64_t seed, int views, int texels, int size) {
   const auto t0 = std::chrono::steady_clock::now();
-  const ErrorSample sample(views, texels, size, seed);
+  const auto guide_integrator = make_integrator(kInterpolationIntegrator.method, env);
+  const ErrorSample sample(
+      views, texels, size, seed,
+      squared_radiance_guide(*guide_integrator, brdf, options_of(kInterpolationIntegrator, seed), 32));
   const auto reference = make_integrator("reference", env);
   IntegratorOptions o;
   const std::vector<Vec3> truth = direct_values(*reference, brdf, o, sample);
   const SampledBlend b = sampled_blend(set, view_set, sample);
   BakeCheck c;
-  c.error = relative_rms(b.values, truth, &b.weights);
+  const ErrorEstimate e = sample_error(sample, b.values, truth, &b.weights);
+  c.error = e.value;
+  c.error_sigma = e.sigma;
   c.views = views;
   c.texels = sample.count();
   c.seconds = seconds_since(t0);

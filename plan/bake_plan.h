@@ -2,22 +2,36 @@
 // blended to any view, stay within a relative RMS error of the direct bake there
 // (plan/error_sample.h defines the error).
 //
-// The prediction. The error of a setting (N views, size r, integrator m) splits into two parts that
-// come from different places and are taken as independent:
+// The model. The error of a setting (N views, size r, integrator m) has two parts that come from
+// different places, modelled as independent:
 //
 //   e(N, r, m)^2 = e_interp(N, r)^2 + e_int(m)^2
 //
 //   e_int(m): the integrator's own error, a texel against the full reference quadrature. A texel's
 //     value does not depend on the map it is in, so e_int is measured once per integrator at the
-//     pilot's sampled texels (random novel views, uniform over their discs) against the reference.
+//     pilot's sampled texels (random novel views) against the reference.
 //   e_interp(N, r): the warp and blend's error with maps that carry no integration error: the
 //     sampled blend of the N-view set at size r against the direct values, both with one fixed
-//     deterministic integrator (filtered importance sampling, 64 samples, whose smooth bias is
-//     common to both and cancels). Measured per (N, r) with only the blend's footprints baked.
+//     deterministic integrator (filtered importance sampling, 64 samples), less that integrator's
+//     own error at the same texels in quadrature: its error at a destination texel is not the one
+//     the blend carries from the sources' texels (it depends on the seed and the lobe), so it does
+//     not cancel. Measured per (N, r) with only the blend's footprints baked.
 //
-// Integration noise is not reduced by the blend's averaging in the prediction (it is, a little, in
-// fact), so predictions err high. A setting is taken when e <= margin * budget; margin < 1 leaves
-// room for the pilot's own sampling error (a relative RMS from a few hundred texels).
+// The pilot's texels are drawn guided by |D|^2 of a cheap 32^2 bake at each pilot view
+// (plan/error_sample.h: a sun's glint, where most of the squared error sits, is sampled densely and
+// weighted down), and each measured error carries its standard error (a jackknife over the pilot's
+// views).
+//
+// The model screens, a measurement decides. The model is not trusted to choose: where a glint
+// carries the error, interpolation and integration errors sit in the same texels and add more than
+// in quadrature (up to e_interp + e_int), and a noisy integrator's error is partly averaged away by
+// the blend. So a candidate the model lets through (with mis errors counted at a third) is
+// measured: the set's blend at the pilot texels, baking only the footprints with its own
+// integrator, against the truth there. It is taken when
+//
+//   e_measured + k s_measured <= margin * budget        (k = options.sigmas)
+//
+// (the sigmas cover the pilot's sampling error; margin < 1 asks for more room than that).
 //
 // The time of a setting: setup(m) + N * disc_texels(r) * t(m), with setup(m) the integrator's
 // construction (its precomputation from the environment) and t(m) its wall time per texel, both
@@ -25,7 +39,8 @@
 //
 // The choice: the settings sorted by predicted time; the first that meets the budget. The pilot
 // measures e_interp lazily, only for the (N, r) pairs it reaches and that no measured pair with at
-// least as many views and texels already rules out, unless asked for every pair.
+// least as many views and texels already rules out, unless asked for every pair; it measures at
+// most max_confirmations candidates.
 #pragma once
 
 #include "bake/brdf.h"
@@ -71,17 +86,23 @@ struct BakePlanOptions {
   std::vector<IntegratorSetting> integrators = default_integrator_settings();
   bool normalise_albedo = false;  // plan albedo-normalised maps (core/albedo_normalisation.h)
   // The pilot: novel views, texels per view and the destination size they are drawn from.
-  int pilot_views = 8;
-  int pilot_texels = 96;
+  int pilot_views = 24;
+  int pilot_texels = 32;
   int pilot_size = 128;
+  int guide_size = 32;  // the guide's bake (0: uniform texels, no guide)
+  // The pilot's draws and the integrators' seed: plan with the seed the bake will use (a filtered
+  // importance sampling bake's error depends on it as much as on its sample count).
   std::uint64_t seed = 1;
-  double margin = 0.8;      // a setting is taken when its predicted error <= margin * max_error
-  bool every_pair = false;  // measure e_interp for every (views, size) pair, not only those reached
+  double sigmas = 1.0;         // k: standard errors added to the measured error
+  int max_confirmations = 32;  // candidates measured before the plan gives up
+  double margin = 1.0;         // a setting is taken when its upper bound <= margin * max_error
+  bool every_pair = false;     // measure e_interp for every (views, size) pair, not only those reached
 };
 
 struct IntegratorPilot {
   IntegratorSetting setting;
   double error = 0;              // e_int: relative RMS against the full reference at the pilot texels
+  double error_sigma = 0;        // its standard error
   double seconds_per_texel = 0;  // wall time
   double setup_seconds = 0;      // constructing the integrator from the environment
 };
@@ -90,8 +111,10 @@ struct InterpolationPilot {
   std::string views;
   int view_count = 0;
   int res = 0;
-  double error = 0;      // e_interp
-  long long texels = 0;  // source texels baked to measure it
+  double error = 0;        // e_interp: raw_error less the FIS maps' own error in quadrature
+  double raw_error = 0;    // the FIS maps' blend against FIS direct values
+  double error_sigma = 0;  // its standard error
+  long long texels = 0;    // source texels baked to measure it
   double seconds = 0;
 };
 
@@ -100,17 +123,22 @@ struct PlannedSetting {
   double integration_error = 0;
   std::optional<double> interpolation_error;  // nullopt: not measured (not reached)
   double error = 0;                           // the prediction when interpolation_error is known, else e_int alone
+  double upper_error = 0;                     // measured + k sigma when measured, else from the model's parts
+  std::optional<double> measured_error;       // the set's blend at the pilot texels (when screened in)
+  std::optional<double> measured_sigma;       // its standard error
   double seconds = 0;                         // predicted bake time
-  bool meets = false;                         // predicted error <= margin * max_error (known only when measured)
+  bool meets = false;                         // measured, and upper_error <= margin * max_error
 };
 
 struct BakePlan {
   BakePlanOptions options;
   std::vector<IntegratorPilot> integrators;
   std::vector<InterpolationPilot> interpolation;
-  std::vector<PlannedSetting> settings;  // every candidate, by predicted time
-  std::optional<PlannedSetting> chosen;  // nullopt: no candidate is predicted to meet the budget
+  double interpolation_integrator_error = 0;  // FIS 64's own error at the pilot texels
+  std::vector<PlannedSetting> settings;       // every candidate, by predicted time
+  std::optional<PlannedSetting> chosen;       // nullopt: no candidate is predicted to meet the budget
   double pilot_seconds = 0;
+  double confirm_seconds = 0;  // of which measuring screened-in candidates
   long long truth_texels = 0;  // reference texels of the pilot's truth
   std::string why;             // a few lines for people
   nlohmann::json to_json() const;
@@ -118,26 +146,27 @@ struct BakePlan {
 
 // The integrators alone, for maps that are not interpolated (baked at the frames they are used at,
 // as `rsibr process` bakes the grey ball at the captured views): e_int and the time per texel of
-// each setting at `sample`'s texels against the full reference, and the cheapest per texel with
-// e_int <= margin * max_error (nullopt when none is).
+// each setting at 4 x 96 guided texels against the full reference, and the cheapest per texel with
+// e_int + its standard error <= margin * max_error (nullopt when none is).
 struct IntegratorPlan {
   std::vector<IntegratorPilot> integrators;
   std::optional<IntegratorPilot> chosen;
-  double max_error = 0, margin = 0.8, seconds = 0;
+  double max_error = 0, margin = 1.0, seconds = 0;
   nlohmann::json to_json() const;
 };
 IntegratorPlan plan_integrator(const EnvMap& env, const Brdf& brdf, double max_error,
                                const std::vector<IntegratorSetting>& settings = default_integrator_settings(),
-                               std::uint64_t seed = 1, double margin = 0.8);
+                               std::uint64_t seed = 1, double margin = 1.0);
 
 // Throws std::invalid_argument for a budget that is not in (0, 1), empty candidate lists, a view set
 // or size that cannot be used, and what the integrators throw on construction.
 BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& options);
 
 // The error of a baked set at fresh novel views (seed), measured as the plan predicts it: its blend
-// against the full reference quadrature at `views` x `texels` sampled texels.
+// against the full reference quadrature at `views` x `texels` texels drawn with the plan's guide.
 struct BakeCheck {
   double error = 0;
+  double error_sigma = 0;
   int views = 0, texels = 0;
   double seconds = 0;
 };
