@@ -273,13 +273,16 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
         << percent(options.max_error) << ", planned to " << percent(budget) << ".\n";
   } else {
     why << "no setting is predicted to meet " << percent(options.max_error) << " (planned to " << percent(budget)
-        << "); the most accurate measured ones are listed in the table.\n";
+        << "); the most accurate measured ones are listed in the table";
+    if (confirmations >= options.max_confirmations)
+      why << " (the plan stopped after measuring " << confirmations << " candidates that the model let through)";
+    why << ".\n";
   }
   int shown = 0;
   for (const PlannedSetting& s : plan.settings) {
     if (plan.chosen && s.seconds >= plan.chosen->seconds) break;
     if (shown++ == 3) break;
-    why << "cheaper, predicted to miss: " << setting_text(s.setting) << ": ";
+    why << "cheaper, misses: " << setting_text(s.setting) << ": ";
     if (s.measured_error)
       why << "measured " << percent(*s.measured_error) << " +- " << percent(*s.measured_sigma) << " (modelled "
           << percent(s.error) << ")";
