@@ -31,7 +31,11 @@
 //
 //   e_measured + k s_measured <= margin * budget        (k = options.sigmas)
 //
-// (the sigmas cover the pilot's sampling error; margin < 1 asks for more room than that).
+// with s the jackknife standard error over the pilot's views. The jackknife takes the views as
+// independent draws, but they are an evenly spread lattice, so it overstates the estimate's scatter
+// (1.9x on a synthetic glint, tests/plan/error_sample_test.cpp; about 1.6x between pilot and check
+// on the development environments): k = 0.5 adds about one true standard error. margin < 1 asks
+// for more room than that.
 //
 // The time of a setting: setup(m) + N * disc_texels(r) * t(m), with setup(m) the integrator's
 // construction (its precomputation from the environment) and t(m) its wall time per texel, both
@@ -93,7 +97,7 @@ struct BakePlanOptions {
   // The pilot's draws and the integrators' seed: plan with the seed the bake will use (a filtered
   // importance sampling bake's error depends on it as much as on its sample count).
   std::uint64_t seed = 1;
-  double sigmas = 1.0;         // k: standard errors added to the measured error
+  double sigmas = 0.5;         // k: jackknife standard errors added to the measured error
   int max_confirmations = 32;  // candidates measured before the plan gives up
   double margin = 1.0;         // a setting is taken when its upper bound <= margin * max_error
   bool every_pair = false;     // measure e_interp for every (views, size) pair, not only those reached

@@ -74,12 +74,12 @@ TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
     if (s.seconds < plan.chosen->seconds) {
       // Cheaper: screened out by the model, or measured and over the budget with its sigma.
       EXPECT_FALSE(s.meets) << s.setting.views << " " << s.setting.res;
-      if (s.measured_error) EXPECT_GT(*s.measured_error + *s.measured_sigma, o.margin * o.max_error);
+      if (s.measured_error) EXPECT_GT(*s.measured_error + o.sigmas * *s.measured_sigma, o.margin * o.max_error);
     }
   }
   ASSERT_TRUE(plan.chosen->measured_error);
-  EXPECT_LE(*plan.chosen->measured_error + *plan.chosen->measured_sigma, o.margin * o.max_error);
-  EXPECT_DOUBLE_EQ(plan.chosen->upper_error, *plan.chosen->measured_error + *plan.chosen->measured_sigma);
+  EXPECT_LE(*plan.chosen->measured_error + o.sigmas * *plan.chosen->measured_sigma, o.margin * o.max_error);
+  EXPECT_DOUBLE_EQ(plan.chosen->upper_error, *plan.chosen->measured_error + o.sigmas * *plan.chosen->measured_sigma);
   // More views interpolate better at the same size.
   auto interp = [&](const std::string& views, int res) {
     for (const InterpolationPilot& p : plan.interpolation)
