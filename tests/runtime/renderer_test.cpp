@@ -119,6 +119,29 @@ double interior_rms(const cv::Mat& a, const cv::Mat& ref, int* count) {
   return std::sqrt(e / std::max(1, 3 * n));
 }
 
+// A small object (an ~18 px sphere) rendered with one tap per source and with lookups at each pixel's
+// level of detail, each against a 64-sample supersampled render in the same mode: RMS of both.
+struct LodErrors {
+  double point = 0, lod = 0;
+};
+LodErrors small_sphere_lod_errors(const MapSet& set, const Mesh& mesh, RenderOptions o) {
+  const Camera cam = look_at(Vec3(2.0, 3.0, 30.0), Vec3::Zero(), Vec3(0, 1, 0), 12, 48, 48);
+  o.lod = false;
+  o.spp = 1;
+  const cv::Mat point = Renderer(mesh, {&set}, o).render(cam);
+  o.lod = true;
+  const cv::Mat lod = Renderer(mesh, {&set}, o).render(cam);
+  o.lod = false;
+  o.spp = 64;
+  const cv::Mat reference = Renderer(mesh, {&set}, o).render(cam);
+  int n = 0;
+  LodErrors e;
+  e.point = interior_rms(point, reference, &n);
+  e.lod = interior_rms(lod, reference, &n);
+  EXPECT_GT(n, 100);
+  return e;
+}
+
 struct Stats {
   double max_abs = 0, mean_abs = 0;
   int n = 0;
@@ -343,20 +366,9 @@ TEST(Renderer, MissesAreBlackWithAlphaZeroOrTheEnvironment) {
 // each pixel close to the pixel's mean, which a 64-sample supersampled render estimates.
 TEST(Renderer, LodBringsASmallObjectCloserToItsSupersampledSelf) {
   const MapSet set = checker_set("mirror", mirror_texel);
-  const Mesh mesh = sphere_mesh(24, 48);
-  const Camera cam = look_at(Vec3(2.0, 3.0, 30.0), Vec3::Zero(), Vec3(0, 1, 0), 12, 48, 48);  // ~18 px across
-  RenderOptions o;
-  const cv::Mat point = Renderer(mesh, {&set}, o).render(cam);
-  o.lod = true;
-  const cv::Mat lod = Renderer(mesh, {&set}, o).render(cam);
-  o.lod = false;
-  o.spp = 64;
-  const cv::Mat reference = Renderer(mesh, {&set}, o).render(cam);
-  int n = 0;
-  const double e_point = interior_rms(point, reference, &n), e_lod = interior_rms(lod, reference, &n);
-  ASSERT_GT(n, 100);
-  std::printf("rms point %.4f lod %.4f\n", e_point, e_lod);
-  EXPECT_LT(e_lod, std::sqrt(0.5) * e_point) << "rms point " << e_point << ", lod " << e_lod;
+  const LodErrors e = small_sphere_lod_errors(set, sphere_mesh(24, 48), RenderOptions{});
+  std::printf("rms point %.4f lod %.4f\n", e.point, e.lod);
+  EXPECT_LT(e.lod, std::sqrt(0.5) * e.point) << "rms point " << e.point << ", lod " << e.lod;
 }
 
 // Paper mode with --lod: the frame's one destination map is read at each sample's footprint level,
@@ -367,19 +379,9 @@ TEST(Renderer, PaperModeLodBringsASmallObjectCloserToItsSupersampledSelf) {
   const Mesh mesh = sphere_mesh(24, 48);
   RenderOptions o = with_mode(RenderMode::Paper);
   {  // small: about 18 pixels across
-    const Camera cam = look_at(Vec3(2.0, 3.0, 30.0), Vec3::Zero(), Vec3(0, 1, 0), 12, 48, 48);
-    const cv::Mat point = Renderer(mesh, {&set}, o).render(cam);
-    o.lod = true;
-    const cv::Mat lod = Renderer(mesh, {&set}, o).render(cam);
-    o.lod = false;
-    o.spp = 64;
-    const cv::Mat reference = Renderer(mesh, {&set}, o).render(cam);
-    o.spp = 1;
-    int n = 0;
-    const double e_point = interior_rms(point, reference, &n), e_lod = interior_rms(lod, reference, &n);
-    ASSERT_GT(n, 100);
-    std::printf("paper: rms point %.4f lod %.4f\n", e_point, e_lod);
-    EXPECT_LT(e_lod, std::sqrt(0.5) * e_point) << "rms point " << e_point << ", lod " << e_lod;
+    const LodErrors e = small_sphere_lod_errors(set, mesh, o);
+    std::printf("paper: rms point %.4f lod %.4f\n", e.point, e.lod);
+    EXPECT_LT(e.lod, std::sqrt(0.5) * e.point) << "rms point " << e.point << ", lod " << e.lod;
   }
   {  // large: the sphere fills most of the frame, a pixel spans about half a texel
     const Camera cam = look_at(Vec3(0.5, 0.8, 3.2), Vec3::Zero(), Vec3(0, 1, 0), 40, 256, 256);
