@@ -291,6 +291,14 @@ TEST(SampleError, AConstantRelativeErrorIsExactFromAnySampleAndOneViewHasNoSigma
   const std::vector<Vec3> ones(10, Vec3(1, 1, 1)), off(10, Vec3(1.2, 1.2, 1.2));
   EXPECT_NEAR(sample_error(one, off, ones).value, 0.2, 1e-12);
   EXPECT_EQ(sample_error(one, off, ones).sigma, 0.0);
+  // A black truth: 0 when the values are black too, +Inf (with an infinite sigma) when they are not.
+  const std::vector<Vec3> black(10, Vec3(0, 0, 0));
+  EXPECT_EQ(sample_error(one, black, black).value, 0.0);
+  EXPECT_TRUE(std::isinf(sample_error(one, off, black).value));
+  std::vector<Vec3> black_g(truth.size(), Vec3(0, 0, 0));
+  const ErrorEstimate inf = sample_error(g, values, black_g);
+  EXPECT_TRUE(std::isinf(inf.value));
+  EXPECT_FALSE(std::isnan(inf.sigma));
 }
 
 }  // namespace
