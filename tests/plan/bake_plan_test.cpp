@@ -74,7 +74,9 @@ TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
     if (s.seconds < plan.chosen->seconds) {
       // Cheaper: screened out by the model, or measured and over the budget with its sigma.
       EXPECT_FALSE(s.meets) << s.setting.views << " " << s.setting.res;
-      if (s.measured_error) EXPECT_GT(*s.measured_error + o.sigmas * *s.measured_sigma, o.margin * o.max_error);
+      if (s.measured_error) {
+        EXPECT_GT(*s.measured_error + o.sigmas * *s.measured_sigma, o.margin * o.max_error);
+      }
     }
   }
   ASSERT_TRUE(plan.chosen->measured_error);
@@ -101,9 +103,12 @@ TEST(IntegratorPlanTest, TheCheapestSettingWhoseErrorAndSigmaFitIsTaken) {
   EXPECT_LE(plan.chosen->error + plan.chosen->error_sigma, 0.03);
   for (const IntegratorPilot& p : plan.integrators) {
     EXPECT_GE(p.error_sigma, 0.0);
-    if (p.seconds_per_texel < plan.chosen->seconds_per_texel)
+    if (p.seconds_per_texel < plan.chosen->seconds_per_texel) {
       EXPECT_GT(p.error + p.error_sigma, 0.03) << p.setting.label();
-    if (p.setting.label() == "reference (full)") EXPECT_EQ(p.error, 0.0);
+    }
+    if (p.setting.label() == "reference (full)") {
+      EXPECT_EQ(p.error, 0.0);
+    }
   }
   EXPECT_FALSE(plan_integrator(env, *brdf, 1e-6, {{"mis", 8, 0}}, 5).chosen);
 }
