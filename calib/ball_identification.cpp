@@ -193,7 +193,7 @@ LambertFit lambert_fit(const cv::Mat& image, const LensModel& lens, const BallLo
     bool moved = true;
     while (moved) {
       moved = false;
-      for (const Vec3 d : std::array<Vec3, 4>{u, Vec3(-u), v, Vec3(-v)}) {
+      for (const Vec3& d : std::array<Vec3, 4>{u, Vec3(-u), v, Vec3(-v)}) {
         const Vec3 l = (best_l + step * d).normalized();
         const double e = sse_along(l);
         if (e < best) best = e, best_l = l, moved = true;

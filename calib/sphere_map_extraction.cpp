@@ -122,7 +122,7 @@ MapView extract_sphere_map(const cv::Mat& image, const cv::Mat& flags, const Len
   auto sample_at = [&](const Vec2& xy, const Vec3* start, Sample* out) {
     if (xy.squaredNorm() >= 1.0) return false;
     Vec3 n = cam_from_view * sphere_map::g_normal(xy);
-    Vec3 reflected;  // the direction the point reflects the camera ray into (camera frame)
+    Vec3 reflected = Vec3::Zero();  // the direction the point reflects the camera ray into (camera frame)
     if (options.indexing == SphereIndexing::reflection) {
       const Vec3 r = cam_from_view * sphere_map::g_mirror(xy);
       const auto solved = reflection_normal(centre, r, start ? *start : n);

@@ -38,8 +38,9 @@ void write_text(const fs::path& p, const std::string& text) { std::ofstream(p) <
 TEST(PoseFile, RoundTripKeepsRotationsExactAndSigmasToSixDigits) {
   PoseSet p;
   p.gauge = "up";
-  p.views.push_back({"north", Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix(), 0.0312345678901});
-  p.views.push_back({"Side-2.5_b", Eigen::AngleAxisd(-2.9, Vec3(0, 1, 0)).toRotationMatrix(), 0});
+  p.views.push_back(
+      {"north", Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix(), 0.0312345678901, std::nullopt});
+  p.views.push_back({"Side-2.5_b", Eigen::AngleAxisd(-2.9, Vec3(0, 1, 0)).toRotationMatrix(), 0, std::nullopt});
   BallCone ball;
   ball.axis = Vec3(0.1, -0.2, 1).normalized();
   ball.half_angle = 0.0998;
@@ -117,7 +118,7 @@ TEST(PoseFile, StrictReadingNamesTheFileAndTheKey) {
 TEST(PoseFile, AnInvalidSetIsNotWrittenAndLeavesNoFile) {
   const fs::path d = temp_dir();
   PoseSet p;
-  p.views.push_back({"a", Mat3::Identity() * 2, 0});
+  p.views.push_back({"a", Mat3::Identity() * 2, 0, std::nullopt});
   EXPECT_THROW(write_pose_file((d / "p.yaml").string(), p), std::invalid_argument);
   p.views[0].world_from_cam = Mat3::Identity();
   p.views[0].sigma_deg = std::numeric_limits<double>::infinity();

@@ -21,8 +21,8 @@ namespace {
 using test_support::error_of;
 
 TEST(SafeName, NamesOfLettersDigitsDotsDashesAndUnderscoresAreSafe) {
-  for (const std::string name : {std::string("north"), std::string("view00"), std::string("Grey_ball-2"),
-                                 std::string("v1.5"), std::string("0"), std::string(kMaxNameLength, 'x')})
+  for (const std::string& name : {std::string("north"), std::string("view00"), std::string("Grey_ball-2"),
+                                  std::string("v1.5"), std::string("0"), std::string(kMaxNameLength, 'x')})
     EXPECT_EQ(name_problem(name), "") << name;
 }
 
