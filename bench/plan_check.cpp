@@ -54,7 +54,7 @@ nlohmann::json setting_json(const BakeSetting& s) {
 int main(int argc, char** argv) {
   std::string env_path, brdf_spec;
   double budget = 0.02;
-  int check_views = 8, check_texels = 96;
+  int check_views = 16, check_texels = 96;
   double max_bake_seconds = 600;    // longer bakes are not run: their time is the model's
   double max_sweep_seconds = 1800;  // candidates whose modelled bake is longer are not measured
   bool skip_full_reference = true;
@@ -99,6 +99,8 @@ int main(int argc, char** argv) {
     t0 = std::chrono::steady_clock::now();
     const std::vector<Vec3> truth = direct_values(*reference, *brdf, IntegratorOptions{}, sample);
     out["truth_seconds"] = seconds_since(t0);
+    out["check_views"] = check_views;
+    out["check_texels"] = check_texels;
     if (plan.chosen) {
       const BakeSetting& cs = plan.chosen->setting;
       out["chosen"] = setting_json(cs);
