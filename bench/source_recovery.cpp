@@ -5,8 +5,14 @@
 //   rsibr_source_recovery SYNTH_DIR PROCESS_DIR     (JSON on stdout)
 //
 // Units: the merged images hold L * u_c with u_c = gain_normalised * (white balance x vignetting at
-// the pixel)_c (capture/synth_capture.h); u is read per view as the ratio of the truth's
-// <view>_radiance.exr to <view>_scene.exr at each ball's centre pixel, times gain_normalised. The
+// the pixel)_c * s_c (capture/synth_capture.h); u is read per view as the ratio of the truth's
+// <view>_radiance.exr to <view>_scene.exr at each ball's centre pixel, times gain_normalised, times
+// s_c, the recovered response's scale against the true one: the median over the codes from a
+// quarter to three quarters of the range of the recovered curve's knot over the true relative
+// exposure (PROCESS_DIR/hdr/response.json, SYNTH_DIR/truth/response.csv). The merge ties the
+// channels at the middle code (equal mid-grey codes stay neutral, hdr/response_recovery.h), so a
+// camera whose curves differ per channel there (the synthetic "measured" response) has s_c != 1:
+// a convention of the merge's unit that no photograph can reveal, not an error of it. The
 // probe is compared in the chrome ball's units (u averaged over the views), the grey maps in the
 // grey ball's (per view). Reported:
 //   probe_ratio[c]          int probe.exr / (u_c int L_true), per channel (1: the light is all there)
@@ -33,7 +39,9 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -85,8 +93,37 @@ int main(int argc, char** argv) {
       }
     }
     if (chrome_views) chrome_unit /= chrome_views;
+    // s_c: the recovered response's scale against the truth's, where the curve is best constrained.
+    Vec3 response_scale = Vec3::Ones();
+    if (fs::exists(process / "hdr" / "response.json") && fs::exists(synth / "truth" / "response.csv")) {
+      std::ifstream rj(process / "hdr" / "response.json");
+      const nlohmann::json response = nlohmann::json::parse(rj);
+      std::ifstream tc(synth / "truth" / "response.csv");
+      std::vector<std::array<double, 3>> true_x;
+      std::string line;
+      std::getline(tc, line);  // header: code,R,G,B
+      while (std::getline(tc, line)) {
+        std::array<double, 3> x{};
+        if (std::sscanf(line.c_str(), "%*d,%lf,%lf,%lf", &x[0], &x[1], &x[2]) == 3) true_x.push_back(x);
+      }
+      const auto& knots = response.at("knots");
+      const int max_code = response.at("max_code").get<int>();
+      for (int c = 0; c < 3; ++c) {
+        std::vector<double> r;
+        for (int code = max_code / 4; code <= 3 * max_code / 4; ++code)
+          if (code < int(true_x.size()) && code < int(knots.at(c).size()) && true_x[code][c] > 0)
+            r.push_back(knots.at(c).at(code).get<double>() / true_x[code][c]);
+        if (r.empty()) continue;
+        std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
+        response_scale[c] = r[r.size() / 2];
+      }
+      for (auto& [view, balls] : unit)
+        for (auto& [ball, u] : balls) u = u.cwiseProduct(response_scale);
+      chrome_unit = chrome_unit.cwiseProduct(response_scale);
+    }
     const Vec3 truth_integral = integral3(env).cwiseProduct(chrome_unit);
     nlohmann::json out;
+    out["response_scale"] = {response_scale[0], response_scale[1], response_scale[2]};
     auto ratio = [&](const fs::path& p) {
       const Vec3 i = integral3(read_environment(p.string()));
       return nlohmann::json::array({i[0] / truth_integral[0], i[1] / truth_integral[1], i[2] / truth_integral[2]});
@@ -130,7 +167,9 @@ int main(int argc, char** argv) {
       for (MapSet* set : {&c, &cap})
         for (MapView& mv : set->views) {
           const std::string image = mv.attributes.count("image") ? mv.attributes.at("image") : "";
-          const Vec3 u = unit.count(image) && unit[image].count(ball) ? unit[image][ball] : Vec3::Constant(gain);
+          const Vec3 u = unit.count(image) && unit[image].count(ball)
+                             ? unit[image][ball]
+                             : Vec3(Vec3::Constant(gain).cwiseProduct(response_scale));
           mv.rgb.forEach<cv::Vec3f>([&](cv::Vec3f& p, const int*) {
             for (int k = 0; k < 3; ++k) p[k] = float(p[k] / u[k]);
           });

@@ -125,13 +125,13 @@ def row(m):
     # stage's ball detection, not this stage).
     untrusted = m["result"]["results"]["compare"]["balls"][0].get("untrusted_views", [])
     wrong = t.get("views_left_out", {}).get("grey", 0) + len(untrusted)
-    return ("| %s | %.0f | %d / %d | %s | %s | %s | %s | %.4f -> %.4f | %s | %s | %s | %s |" % (
+    return ("| %s | %.0f | %d / %d | %s | %s | %s | %s | %.4f -> %.4f | %s | %s | %s | %s | %s |" % (
         m["name"], math.degrees(math.asin(max(-1, min(1, sun["direction"][1])))) if "direction" in sun else float("nan"),
         regions, sources, fmt3(t.get("measured_ratio")), fmt3(t.get("probe_ratio")), fmt3(missing, pct=True),
         "%.4f" % cvt if cvt is not None else "-", m["captured_vs_computed_off"], m["captured_vs_computed"],
         ("%.2f (&sigma; %.2f)" % (angle, sun.get("direction_sigma_deg", 0))) if angle is not None and sources else "-",
         fmt3(sun.get("power_ratio")) if sources else "-", fmt3(sun.get("error_over_sigma"), digits=1) if sources else "-",
-        str(wrong) if "views_left_out" in t else "-"))
+        str(wrong) if "views_left_out" in t else "-", fmt3(t.get("response_scale"))))
 
 
 def main():
@@ -183,8 +183,8 @@ def main():
     header = ("| shoot | sun elevation (deg) | clipped regions / sources | measured probe / truth (R / G / B) | "
               "probe / truth | recovered share of the light | computed grey vs truth | captured vs computed: "
               "--no-sources -> recovered | sun direction error (deg) | power / needed | (power - needed) / sigma | "
-              "views with the grey ball misdetected |\n"
-              "|---|---|---|---|---|---|---|---|---|---|---|---|")
+              "views with the grey ball misdetected | response scale (R / G / B) |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     clipped = [m for m in rows if m["summary"]["sources"]]
     worst = lambda f: max((f(m) for m in clipped), default=float("nan"))
     probe_err = worst(lambda m: max(abs(x - 1) for x in m["truth"]["probe_ratio"]))
@@ -203,13 +203,16 @@ def main():
 ball clips in every bracket, through `rsibr process` (true lens and poses), against their truth
 (`rsibr_source_recovery`, bench/source_recovery.cpp). The shoots: a chrome and a grey ball 0.3 m apart on
 stands, the photographer behind each camera, 6 handheld views at 0.8 m (balls about 56 px in radius),
-640x480 OPENCV4, 7 brackets 2 EV apart around a metered exposure, the measured response, a white-balance
-cast, under CC0 environments no test uses and no development run used (their own suns and lights) and two
+640x480 OPENCV4, 7 brackets 2 EV apart around a metered exposure, an sRGB response (in two rows the
+"measured" one, whose curves differ per channel), a white-balance cast, under CC0 environments no test uses and no development run used (their own suns and lights) and two
 analytic skies. The grey albedo (0.18) and the chrome Fresnel (the default) are the truth's, so the
 gains fitted by the comparison are ~1.
 
 Columns: the measured probe's integral over the truth's per channel (what the chrome balls saw; in the
-merge's unit: the truth times gain_normalised, white balance and vignetting at the ball); the same for the
+merge's unit: the truth times gain_normalised, white balance and vignetting at the ball, and the
+recovered response's scale against the true curve at the middle codes, the last column: the merge ties
+its channels there so that equal mid-grey codes stay neutral, and a camera whose curves differ per
+channel there gets a per-channel unit that no photograph can reveal); the same for the
 probe with the recovered sources; the share of the final probe's light the sources hold; the computed grey
 maps against the true grey maps (relative RMS after the gain fit); captured against computed grey as the
 report shows it (after the fit), with `--no-sources` (today's probe) and with the recovery; the recovered
@@ -241,7 +244,8 @@ into the source's power. The sigma is the larger of the fit's covariance (inflat
 correlation over a ball: 9 independent observations per grey view) and the spread of leave-one-view-out
 solves whose probe also leaves that view out.
 
-Regenerate: `python3 bench/source_recovery.py` (about 10 minutes on 2 cores)."""
+Regenerate: `python3 bench/source_recovery.py` (about 10 minutes on 2 cores).
+"""
     replace_section(os.path.join(ROOT, "docs", "tradeoffs.md"), "Clipped light sources (rsibr process)", body)
     print("source_recovery: wrote docs/tradeoffs.md")
 
