@@ -93,12 +93,16 @@ struct Pilots {
       p.error = e.value;
       p.error_sigma = e.sigma;
       p.seconds_per_texel = seconds / double(sample.count());
-      // Cheap integrators: the pilot's few texels time mostly the per-call overhead; one whole map
-      // times the integration itself.
-      if (seconds < 0.05) {
+      // The pilot's texels are a few per view, so their time is mostly each map's per-call
+      // overhead and rows the threads cannot share (4x a bake's per-texel time for MIS 64 on 2
+      // cores). A bake integrates whole maps: one whole map, the largest of timing_size, its half
+      // and its quarter whose predicted time is at most a quarter of a second, times that.
+      int size = timing_size;
+      while (size > 32 && p.seconds_per_texel * double(disc_texel_count(size)) > 0.25) size /= 2;
+      if (p.seconds_per_texel * double(disc_texel_count(size)) <= 0.25) {
         const auto t = std::chrono::steady_clock::now();
-        chosen.radiance_map(brdf, sample.view(0), sample.frame(0), timing_size, options_of(s, seed));
-        p.seconds_per_texel = seconds_since(t) / double(disc_texel_count(timing_size));
+        chosen.radiance_map(brdf, sample.view(0), sample.frame(0), size, options_of(s, seed));
+        p.seconds_per_texel = seconds_since(t) / double(disc_texel_count(size));
       }
       integrators.push_back(p);
     }

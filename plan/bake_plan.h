@@ -43,7 +43,9 @@
 //
 // The time of a setting: setup(m) + N * disc_texels(r) * t(m), with setup(m) the integrator's
 // construction (its precomputation from the environment) and t(m) its wall time per texel, both
-// measured in the pilot on this machine with its threads.
+// measured in the pilot on this machine with its threads: t(m) from one whole map (as a bake runs
+// it), not from the pilot's scattered texels, whose time is mostly per-map overhead; only a setting
+// too slow for a 32^2 map in a quarter of a second keeps the scattered texels' time.
 //
 // The choice: the settings sorted by predicted time; the first that meets the budget. The pilot
 // measures e_interp lazily, only for the (N, r) pairs it reaches and that no measured pair with at
