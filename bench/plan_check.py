@@ -131,6 +131,7 @@ def main():
         "| ratio | with pilot | sweep: measured / candidates |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
+    wide = sum(1 for r in results if r.get("chosen") and r["chosen"]["error_sigma"] > args.max_error / 4)
     ok_budget = ok_time = 0
     for r in results:
         c, b = r.get("chosen"), r.get("sweep_best")
@@ -158,10 +159,9 @@ def main():
             ok_budget, len(results), ok_time, len(results)) +
         (" Not run: %s." % ", ".join(missing) if missing else ""),
         "",
-        "Checks whose standard error exceeds a quarter of the budget: %d of %d (there one or two of the "
-        "check's views carry most of the error: leaving one out moves the estimate widely)." % (
-            sum(1 for r in results if r.get("chosen") and r["chosen"]["error_sigma"] > args.max_error / 4),
-            len(results)),
+        "Checks whose standard error exceeds a quarter of the budget: %d of %d%s" % (
+            wide, len(results), " (there one or two of the check's views carry most of the error: leaving one "
+            "out moves the estimate widely)." if wide else "."),
         "",
         "How the plan chooses (plan/bake_plan.h): a model (e^2 = e_interp(views, size)^2 + e_int(integrator)^2, "
         "each part measured in the pilot) screens the candidates in order of predicted time; each candidate it "
