@@ -108,7 +108,8 @@ int main(int argc, char** argv) {
       }
       const auto& knots = response.at("knots");
       const int max_code = response.at("max_code").get<int>();
-      for (int c = 0; c < 3; ++c) {
+      // One knot per code (8-bit shoots; other knot layouts keep s = 1).
+      for (int c = 0; c < 3 && int(knots.at(c).size()) == max_code + 1; ++c) {
         std::vector<double> r;
         for (int code = max_code / 4; code <= 3 * max_code / 4; ++code)
           if (code < int(true_x.size()) && code < int(knots.at(c).size()) && true_x[code][c] > 0)
