@@ -167,7 +167,8 @@ def main():
         "each part measured in the pilot) screens the candidates in order of predicted time; each candidate it "
         "lets through is blended at the pilot texels with its own integrator and seed, and the first whose "
         "measured error plus half its standard error (a jackknife over the pilot's views, which overstates "
-        "the scatter of an evenly spread set of views by about 1.6-1.9x) is within 85% of the budget is chosen. "
+        "the scatter of an evenly spread set of views by about 1.6-1.9x) is within " + "%.0f%%" % (100 * margin) +
+        " of the budget is chosen. "
         "The reserve is for the estimate's heavy tail under a low sun: the views whose glint reaches the grazing "
         "band carry most of the squared error (3 of 48 views held 40% of it for gold under `dawn`), a pilot "
         "that misses them is low in both its value and its standard error, and the first candidate to pass is "

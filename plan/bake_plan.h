@@ -27,8 +27,8 @@
 // in quadrature (up to e_interp + e_int), and a noisy integrator's error is partly averaged away by
 // the blend, while e_interp measured with FIS maps carries FIS's own error pattern and overstates
 // the blend's (up to 1.6x). So a candidate the model lets through (with mis errors counted at a
-// third and e_interp at half) is measured: the set's blend at the pilot texels, baking only the footprints with its own
-// integrator, against the truth there. It is taken when
+// third and e_interp at half) is measured: the set's blend at the pilot texels, baking only the
+// footprints with its own integrator, against the truth there. It is taken when
 //
 //   e_measured + k s_measured <= margin * budget        (k = options.sigmas)
 //
