@@ -30,7 +30,7 @@
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 #include <opencv2/photo.hpp>
 
@@ -163,7 +163,7 @@ int run(int argc, char** argv) {
     for (std::size_t j = 0; j < stack.size(); ++j)
       for (const char* ext : {".png", ".tif"}) {  // the same codes; luminance-hdr-cli reads TIFF, not PNG
         const std::string path = write_dir + "/bracket_" + std::to_string(j) + ext;
-        if (!cv::imwrite(path, stack[j])) {
+        if (!rsibr::write_image(path, stack[j])) {
           std::cerr << path << ": cannot write\n";
           return 1;
         }

@@ -10,7 +10,7 @@
 #include "capture/synth_capture.h"
 
 #include <benchmark/benchmark.h>
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 namespace rsibr {
@@ -60,7 +60,7 @@ std::size_t expose_and_encode(Setup& s, const cv::Mat& L, int bracket) {
   cv::cvtColor(codes, bgr, cv::COLOR_RGB2BGR);
   bgr.convertTo(bgr, CV_8U);
   std::vector<uchar> bytes;
-  cv::imencode(".png", bgr, bytes);
+  rsibr::encode_image(".png", bgr, bytes);
   return bytes.size();
 }
 

@@ -1,5 +1,7 @@
 #include "calib/intrinsics.h"
 
+#include "core/lazy_library.h"
+
 // mrcal's C header has no extern "C" guard of its own.
 extern "C" {
 #include <mrcal/mrcal.h>
@@ -19,6 +21,7 @@ extern "C" {
 #include <cstdlib>
 #include <numeric>
 #include <stdexcept>
+#include <type_traits>
 
 namespace rsibr {
 
@@ -381,9 +384,17 @@ std::optional<std::vector<Vec2>> find_chessboard(const cv::Mat& gray8, int gridn
   clahe->setClipLimit(8);
   clahe->apply(gray8, equalised);
   cv::blur(equalised, equalised, cv::Size(3, 3));
+  // mrgingham is opened on first use (core/lazy_library.h); the signature is checked against its header.
+  using FindFn = int (*)(std::vector<mrgingham::PointDouble>&, signed char**, int, const cv::Mat&, int, bool,
+                         mrgingham::debug_sequence_t, const char*);
+  static_assert(std::is_same_v<decltype(static_cast<FindFn>(&mrgingham::find_chessboard_from_image_array)), FindFn>);
+  static const LazyLibrary library(RSIBR_MRGINGHAM_SONAME, "finding chessboard corners");
+  static const auto find = library.function<FindFn>(
+      "_ZN9mrgingham32find_chessboard_from_image_arrayERSt6vectorINS_11PointDoubleESaIS1_EEPPaiRKN2cv3MatEibNS_16debug_"
+      "sequence_tEPKc");
   std::vector<mrgingham::PointDouble> pts;
   signed char* levels = nullptr;
-  const int level = mrgingham::find_chessboard_from_image_array(pts, &levels, gridn, equalised);
+  const int level = find(pts, &levels, gridn, equalised, -1, false, mrgingham::debug_sequence_t(), nullptr);
   std::free(levels);
   if (level < 0 || pts.size() != static_cast<std::size_t>(gridn * gridn)) return std::nullopt;
   std::vector<Vec2> out;

@@ -2,7 +2,7 @@
 
 #include "core/parallel.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -71,9 +71,9 @@ cv::Mat jpeg_compress(const cv::Mat& codes, int quality) {
   codes.convertTo(eight, CV_8U);
   cv::cvtColor(eight, bgr, cv::COLOR_RGB2BGR);
   std::vector<uchar> bytes;
-  if (!cv::imencode(".jpg", bgr, bytes, {cv::IMWRITE_JPEG_QUALITY, quality}))
+  if (!encode_image(".jpg", bgr, bytes, {cv::IMWRITE_JPEG_QUALITY, quality}))
     throw std::runtime_error("jpeg_compress: the encoder failed");
-  const cv::Mat back = cv::imdecode(bytes, cv::IMREAD_COLOR);
+  const cv::Mat back = decode_image(bytes, cv::IMREAD_COLOR);
   cv::Mat rgb, out;
   cv::cvtColor(back, rgb, cv::COLOR_BGR2RGB);
   rgb.convertTo(out, CV_16UC3);

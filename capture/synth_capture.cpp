@@ -17,7 +17,7 @@
 #include "core/patterns.h"
 
 #include <exiv2/exiv2.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 #include <yaml-cpp/yaml.h>
 
@@ -55,7 +55,7 @@ void write_codes(const fs::path& file, const cv::Mat& codes, const std::string& 
   std::vector<int> params;
   if (format == "jpeg") params = {cv::IMWRITE_JPEG_QUALITY, jpeg_quality};
   const std::string ext = format == "png" ? ".png" : format == "jpeg" ? ".jpg" : ".tif";
-  if (!cv::imencode(ext, bgr, bytes, params)) throw std::runtime_error(file.string() + ": cannot encode");
+  if (!encode_image(ext, bgr, bytes, params)) throw std::runtime_error(file.string() + ": cannot encode");
   write_bytes(file, bytes);
 }
 

@@ -13,7 +13,7 @@
 #include "runtime/make_warp.h"
 #include "plan/warp_plan.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 
 #include <chrono>
 #include <iostream>
@@ -95,7 +95,7 @@ int run_blend(const BlendArgs& a) {
   out.views.push_back(mv);
   write_map_set(exr, out);
   if (!preview.empty() &&
-      !cv::imwrite(preview, display_encode(r.rgb, a.preview_exposure ? *a.preview_exposure : preview_exposure(r.rgb))))
+      !write_image(preview, display_encode(r.rgb, a.preview_exposure ? *a.preview_exposure : preview_exposure(r.rgb))))
     throw std::runtime_error(a.preview + ": cannot write the preview image");
   nlohmann::json j;
   j["maps"] = a.maps;

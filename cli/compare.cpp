@@ -14,7 +14,7 @@
 #include "core/preview_exposure.h"
 #include "core/progress.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 
 #include <cmath>
 #include <filesystem>
@@ -60,7 +60,7 @@ std::string metrics_text(const ErrorMetrics& m) {
 
 std::vector<unsigned char> encode_png(const cv::Mat& bgr, const std::string& name) {
   std::vector<unsigned char> bytes;
-  if (!cv::imencode(".png", bgr, bytes)) throw std::runtime_error(name + ": cannot encode the PNG");
+  if (!encode_image(".png", bgr, bytes)) throw std::runtime_error(name + ": cannot encode the PNG");
   return bytes;
 }
 

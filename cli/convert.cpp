@@ -10,7 +10,7 @@
 #include "core/progress.h"
 #include "core/resample.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 
 #include <chrono>
 #include <cmath>
@@ -86,7 +86,7 @@ int run_convert(const ConvertArgs& a) {
   wo.half = a.half;
   write_environment(exr, out, wo);
   if (!preview.empty() &&
-      !cv::imwrite(preview,
+      !write_image(preview,
                    display_encode(out.pixels, a.preview_exposure ? *a.preview_exposure : preview_exposure(out.pixels))))
     throw std::runtime_error(a.preview + ": cannot write the preview image");
   const auto t3 = std::chrono::steady_clock::now();

@@ -22,7 +22,7 @@
 #include "hdr/photo_set_merge.h"
 #include "hdr/response_recovery.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 
 #include <unistd.h>
 
@@ -316,7 +316,7 @@ int run_hdr(const HdrArgs& a) {
       if (!a.no_preview) {
         const cv::Mat png = display_encode(m.radiance, stops);
         const fs::path p = file_in_folder(stage, v.name + ".png");
-        if (!cv::imwrite(p.string(), png)) throw std::runtime_error(p.string() + ": cannot write the preview");
+        if (!write_image(p.string(), png)) throw std::runtime_error(p.string() + ": cannot write the preview");
         staged.push_back({p, file_in_folder(out_dir, v.name + ".png")});
       }
       const auto t3 = std::chrono::steady_clock::now();

@@ -17,7 +17,7 @@
 #include "core/progress.h"
 #include "core/ray_scene.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 
 #include <atomic>
 #include <chrono>
@@ -107,7 +107,7 @@ int run_reference(const ReferenceArgs& a) {
     const auto r1 = std::chrono::steady_clock::now();
     const std::string out = frame_path(a.output, a.camera.turntable, k);
     write_render(exr_tmp[std::size_t(k)], im, cam, strings, o);
-    if (!a.preview.empty() && !cv::imwrite(png_tmp[std::size_t(k)],
+    if (!a.preview.empty() && !write_image(png_tmp[std::size_t(k)],
                                            display_encode(im.rgb, *(stops = stops ? stops : preview_exposure(im.rgb)))))
       throw std::runtime_error(frame_path(a.preview, a.camera.turntable, k) + ": cannot write the preview image");
     const auto r2 = std::chrono::steady_clock::now();

@@ -18,8 +18,6 @@
 #include "runtime/make_warp.h"
 #include "runtime/renderer.h"
 
-#include <opencv2/imgcodecs.hpp>
-
 #include <algorithm>
 #include <cctype>
 #include <chrono>

@@ -3,7 +3,7 @@
 #include "core/atomic_file.h"
 #include "core/colour.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 
 #include <algorithm>
 #include <cmath>
@@ -34,7 +34,7 @@ void write_rgba_png(const std::string& path, const cv::Mat& rgba, float exposure
     }
   }
   write_atomically(path, [&](const std::string& tmp) {
-    if (!cv::imwrite(tmp, bgra, {cv::IMWRITE_PNG_COMPRESSION, 3}))
+    if (!write_image(tmp, bgra, {cv::IMWRITE_PNG_COMPRESSION, 3}))
       throw std::runtime_error(path + ": cannot write the PNG image");
   });
 }

@@ -5,7 +5,7 @@
 #include "core/input_file.h"
 #include "core/text.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -104,7 +104,7 @@ void check_hdr_size(const std::string& path) {
 
 EnvMap read_hdr(const std::string& path, std::optional<LayoutKind> hint, EnvReadReport& report) {
   check_hdr_size(path);
-  cv::Mat bgr = cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
+  cv::Mat bgr = read_image(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
   if (bgr.empty()) refuse(path, "not a readable Radiance .hdr file");
   if (bgr.type() != CV_32FC3) bgr.convertTo(bgr, CV_32FC3);
   EnvMap map;

@@ -1,6 +1,6 @@
 #include "hdr/bracket_set.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -144,7 +144,7 @@ BracketSet load_brackets(const PhotoView& view, bool fit_sizes) {
       ++raw_count;
     } else {
       metadata.push_back(resolve_exposure(b));
-      ranges.push_back(to_codes(cv::imread(name, cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH), c, name, true));
+      ranges.push_back(to_codes(read_image(name, cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH), c, name, true));
       raw_info.emplace_back();
       raw_saturated.emplace_back();
     }

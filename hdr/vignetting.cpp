@@ -3,7 +3,7 @@
 #include "hdr/raw_image.h"
 
 #include <Eigen/Dense>
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -248,7 +248,7 @@ VignettingEstimate estimate_vignetting(const std::vector<VignettingBoard>& board
 
 cv::Mat read_board_codes(const std::filesystem::path& file) {
   if (is_raw_file(file)) return read_raw_image(file).codes;  // linear, as the RAW brackets
-  cv::Mat img = cv::imread(file.string(), cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH);
+  cv::Mat img = read_image(file.string(), cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH);
   if (img.empty()) throw std::runtime_error(file.string() + ": cannot read the image");
   if (img.depth() != CV_8U && img.depth() != CV_16U)
     throw std::runtime_error(file.string() + ": expected 8 or 16 bits");

@@ -2,7 +2,7 @@
 
 #include "hdr/raw_image.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -35,7 +35,7 @@ cv::Mat raw_board_grey8(const std::filesystem::path& file) {
 
 cv::Mat read_grey8(const std::filesystem::path& file) {
   if (is_raw_file(file)) return raw_board_grey8(file);
-  cv::Mat img = cv::imread(file.string(), cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
+  cv::Mat img = read_image(file.string(), cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
   if (img.empty()) throw std::runtime_error(file.string() + ": cannot read the image");
   if (img.depth() == CV_16U) img.convertTo(img, CV_8U, 1.0 / 257);
   if (img.depth() != CV_8U) throw std::runtime_error(file.string() + ": expected an 8- or 16-bit image");

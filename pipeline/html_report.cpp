@@ -12,7 +12,7 @@
 #include "pipeline/step_record.h"
 
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -347,7 +347,7 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
     const EnvMap probe = read_environment((dir / "probe.exr").string());
     const float stops = preview_exposure(probe.pixels);
     std::vector<unsigned char> png;
-    cv::imencode(".png", display_encode(probe.pixels, stops), png);
+    encode_image(".png", display_encode(probe.pixels, stops), png);
     h << "<h2>Light probe</h2><p>" << jnum(s["views"]) << " chrome views blended, "
       << num(100 * s["covered_fraction"].get<double>(), 3) << "% of the sphere seen";
     if (s.contains("well_seen_fraction"))
@@ -361,7 +361,7 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
       // Before (as measured) and after (with the recovered sources), at the final probe's exposure.
       const EnvMap measured = read_environment((dir / "probe-measured.exr").string());
       std::vector<unsigned char> before;
-      cv::imencode(".png", display_encode(measured.pixels, stops), before);
+      encode_image(".png", display_encode(measured.pixels, stops), before);
       h << "; as measured, then with the recovered sources).</p>" << img_tag(before, "probe as measured")
         << img_tag(png, "probe");
     } else {

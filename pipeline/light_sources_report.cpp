@@ -4,7 +4,7 @@
 #include "core/exr_io.h"
 #include "pipeline/html_report.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -64,7 +64,7 @@ std::vector<unsigned char> crop_png(const EnvMap& probe, const nlohmann::json& d
   cv::Mat big;
   cv::resize(crop, big, cv::Size(), 6, 6, cv::INTER_NEAREST);
   std::vector<unsigned char> png;
-  cv::imencode(".png", display_encode(big, stops), png);
+  encode_image(".png", display_encode(big, stops), png);
   return png;
 }
 

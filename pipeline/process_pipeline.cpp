@@ -52,7 +52,7 @@
 #include "pipeline/vignetting_input.h"
 #include "runtime/renderer.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -80,7 +80,7 @@ struct Context {
 
 std::vector<unsigned char> png_bytes(const cv::Mat& bgr, const std::string& name) {
   std::vector<unsigned char> bytes;
-  if (!cv::imencode(".png", bgr, bytes)) throw std::runtime_error(name + ": cannot encode the PNG");
+  if (!encode_image(".png", bgr, bytes)) throw std::runtime_error(name + ": cannot encode the PNG");
   return bytes;
 }
 

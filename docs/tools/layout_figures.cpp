@@ -14,7 +14,7 @@
 #include "core/view_set.h"
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
@@ -159,8 +159,8 @@ cv::Mat coded(const Layout& layout, int k) {
 
 void save(const std::filesystem::path& dir, const std::string& name, const cv::Mat& img) {
   const auto path = dir / name;
-  if (!cv::imwrite(path.string(), img,
-                   {cv::IMWRITE_PNG_COMPRESSION, 9, cv::IMWRITE_PNG_STRATEGY, cv::IMWRITE_PNG_STRATEGY_DEFAULT}))
+  if (!rsibr::write_image(path.string(), img,
+                          {cv::IMWRITE_PNG_COMPRESSION, 9, cv::IMWRITE_PNG_STRATEGY, cv::IMWRITE_PNG_STRATEGY_DEFAULT}))
     throw std::runtime_error(path.string() + ": cannot write");
   std::cout << path.string() << "  " << img.cols << "x" << img.rows << "  " << std::filesystem::file_size(path) / 1024
             << " KiB\n";

@@ -8,7 +8,7 @@
 
 #include <exiv2/exiv2.hpp>
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 
 #include <cmath>
 #include <optional>
@@ -52,7 +52,7 @@ TEST(PhotoOptics, FocalLengthNeedsACropFactorAndNothingGivesNothing) {
 // A small JPEG with a Canon camera's EXIF: Model, LensModel (when not empty), FocalLength, FNumber.
 void canon_jpeg(const std::string& file, const std::string& model, const std::string& lens, Exiv2::URational focal,
                 std::optional<Exiv2::URational> fnumber) {
-  cv::imwrite(file, cv::Mat(40, 60, CV_8UC3, cv::Scalar::all(90)));
+  rsibr::write_image(file, cv::Mat(40, 60, CV_8UC3, cv::Scalar::all(90)));
   auto image = Exiv2::ImageFactory::open(file);
   image->readMetadata();
   Exiv2::ExifData& exif = image->exifData();
@@ -77,7 +77,7 @@ TEST(PhotoOptics, LensfunGivesTheCropFactorOfAKnownCamera) {
   EXPECT_NEAR(*o.crop_factor, 1.613, 1e-3);
   ASSERT_TRUE(pinhole_from_optics(o, 60, 40));
   // A photo without metadata: nothing, and no error.
-  cv::imwrite(dir.file("plain.png"), cv::Mat(8, 8, CV_8UC3, cv::Scalar::all(1)));
+  rsibr::write_image(dir.file("plain.png"), cv::Mat(8, 8, CV_8UC3, cv::Scalar::all(1)));
   const PhotoOptics none = read_photo_optics(dir.path() / "plain.png");
   EXPECT_FALSE(none.focal_mm);
   EXPECT_FALSE(none.crop_factor);

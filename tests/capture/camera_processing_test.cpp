@@ -9,7 +9,7 @@
 #include "synth_cases.h"
 
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 #include <yaml-cpp/yaml.h>
 
@@ -164,7 +164,7 @@ TEST(CameraProcessing, ASynthCaptureWithProcessingWritesTheLinearOutputAsTruth) 
   const cv::Vec3f s = scene_L.at<cv::Vec3f>(30, 40), o = out.at<cv::Vec3f>(30, 40);
   const Vec3 want = M * Vec3(s[0], s[1], s[2]);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(o[c], want[c], 1e-5 * (1 + std::abs(want[c])));
-  EXPECT_TRUE(cv::imread((dir.path() / "out" / "photos" / "view00" / "view00_b01.jpg").string()).data);
+  EXPECT_TRUE(rsibr::read_image((dir.path() / "out" / "photos" / "view00" / "view00_b01.jpg").string()).data);
 }
 
 TEST(CameraProcessing, SpecErrorsNameTheirKey) {

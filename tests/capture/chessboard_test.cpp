@@ -6,7 +6,7 @@
 #include "core/test_data.h"
 
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 
 #include <cstdio>
 #include <cstdlib>
@@ -56,7 +56,7 @@ TEST(Chessboard, MrginghamFindsEveryCornerWhereTheTruthPutsIt) {
     cv::Mat png;
     codes.convertTo(png, CV_8U);
     const std::string file = dir.file("board" + std::to_string(i) + ".png");
-    ASSERT_TRUE(cv::imwrite(file, png));
+    ASSERT_TRUE(rsibr::write_image(file, png));
     const std::vector<Vec2> found = run_mrgingham(file, 10);
     ASSERT_EQ(found.size(), 100u) << "board " << i;
     for (const Vec2& t : shot.corners) {

@@ -13,7 +13,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 #include <tbb/global_control.h>
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 #include <fstream>
@@ -78,7 +78,7 @@ TEST(SynthCapture, PhotoSetLoadsBackWithExposuresAndTruth) {
   EXPECT_DOUBLE_EQ(*br[0].exposure_s, 0.0025);
   EXPECT_DOUBLE_EQ(*br[2].exposure_s, 0.04);
   EXPECT_DOUBLE_EQ(*br[1].relative_exposure(), 0.01 / 64);
-  const cv::Mat tif = cv::imread(br[2].file.string(), cv::IMREAD_UNCHANGED);
+  const cv::Mat tif = rsibr::read_image(br[2].file.string(), cv::IMREAD_UNCHANGED);
   EXPECT_EQ(tif.depth(), CV_16U);
   EXPECT_EQ(tif.cols, 96);
   const fs::path truth = dir.path() / "out" / "truth";
@@ -112,7 +112,7 @@ TEST(SynthCapture, CodesInvertToRadianceTimesExposureTimesGain) {
   const SynthReport r = write_synth_capture(scene, dir.path() / "out");
   const fs::path out = dir.path() / "out";
   const cv::Mat L = read_truth_image(out / "truth" / "views" / "view00_radiance.exr");
-  cv::Mat codes = cv::imread((out / "photos" / "view00" / "view00_b01.tif").string(), cv::IMREAD_UNCHANGED);
+  cv::Mat codes = rsibr::read_image((out / "photos" / "view00" / "view00_b01.tif").string(), cv::IMREAD_UNCHANGED);
   cv::cvtColor(codes, codes, cv::COLOR_BGR2RGB);
   const CameraResponse srgb("srgb");
   const double e = 0.01 / 64;

@@ -16,7 +16,7 @@
 #include <OpenEXR/ImfStringAttribute.h>
 #include <Imath/half.h>
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 
 #include <atomic>
 #include <cmath>
@@ -353,7 +353,7 @@ TEST(ExrIo, RadianceHdrIsReadInRgbOrder) {
     for (int c = 0; c < 16; ++c)  // B, G, R distinct and spanning magnitudes
       bgr.at<cv::Vec3f>(r, c) = cv::Vec3f(0.1f + 0.01f * c, 2.f + r, 500.f + 10.f * c);
   const std::string path = dir.file("sky.hdr");
-  ASSERT_TRUE(cv::imwrite(path, bgr));
+  ASSERT_TRUE(rsibr::write_image(path, bgr));
   EnvReadReport report;
   const EnvMap map = read_environment(path, std::nullopt, &report);
   EXPECT_EQ(report.format, "hdr");
@@ -371,7 +371,7 @@ TEST(ExrIo, RadianceHdrIsReadInRgbOrder) {
       EXPECT_NEAR(out[2], in[0], tol) << "B";
     }
   // A square .hdr needs the hint like a square EXR.
-  ASSERT_TRUE(cv::imwrite(dir.file("square.hdr"), cv::Mat(8, 8, CV_32FC3, cv::Scalar(1, 1, 1))));
+  ASSERT_TRUE(rsibr::write_image(dir.file("square.hdr"), cv::Mat(8, 8, CV_32FC3, cv::Scalar(1, 1, 1))));
   EXPECT_THROW(read_environment(dir.file("square.hdr")), std::runtime_error);
   EXPECT_EQ(read_environment(dir.file("square.hdr"), LayoutKind::Sphere).layout.kind(), LayoutKind::Sphere);
 }

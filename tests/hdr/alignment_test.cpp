@@ -8,7 +8,7 @@
 #include "core/test_data.h"
 
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 namespace rsibr {
@@ -172,7 +172,7 @@ TEST(Alignment, HandCroppedBracketsOfDifferentSizesAreRegisteredOnTheMiddleOne) 
     cv::cvtColor(s.images[std::size_t(j)](crops[j]), bgr, cv::COLOR_RGB2BGR);
     bgr.convertTo(bgr, CV_8U);
     const std::string f = dir.file("b" + std::to_string(j) + ".png");
-    ASSERT_TRUE(cv::imwrite(f, bgr));
+    ASSERT_TRUE(rsibr::write_image(f, bgr));
     v.brackets.push_back({f, s.e[std::size_t(j)] * 0.01, 100.0, 1.0});
   }
   try {
@@ -203,7 +203,7 @@ TEST(Alignment, HandCroppedBracketsOfDifferentSizesAreRegisteredOnTheMiddleOne) 
   cv::Mat bgr;
   cv::cvtColor(small, bgr, cv::COLOR_RGB2BGR);
   bgr.convertTo(bgr, CV_8U);
-  cv::imwrite(dir.file("b0.png"), bgr);
+  rsibr::write_image(dir.file("b0.png"), bgr);
   EXPECT_THROW(load_brackets(v, true), std::runtime_error);
 }
 

@@ -6,7 +6,7 @@
 
 #include <exiv2/exiv2.hpp>
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 
 #include <fstream>
 
@@ -26,7 +26,7 @@ void write_exif(const std::string& file, Exiv2::Rational exposure, long iso, Exi
 TEST(ExposureMetadata, ExifFillsWhatTheYamlLeavesOut) {
   testing::TempDir dir;
   const cv::Mat img(8, 8, CV_8UC3, cv::Scalar(10, 20, 30));
-  cv::imwrite(dir.file("a.jpg"), img);
+  rsibr::write_image(dir.file("a.jpg"), img);
   write_exif(dir.file("a.jpg"), {1, 250}, 400, {8, 1});
   BracketPhoto p;
   p.file = dir.file("a.jpg");
@@ -46,7 +46,7 @@ TEST(ExposureMetadata, ExifFillsWhatTheYamlLeavesOut) {
 
 TEST(ExposureMetadata, SixteenBitTiffExifIsRead) {
   testing::TempDir dir;
-  cv::imwrite(dir.file("a.tif"), cv::Mat(8, 8, CV_16UC3, cv::Scalar(1000, 2000, 3000)));
+  rsibr::write_image(dir.file("a.tif"), cv::Mat(8, 8, CV_16UC3, cv::Scalar(1000, 2000, 3000)));
   write_exif(dir.file("a.tif"), {60, 1}, 100, {28, 10});
   BracketPhoto p;
   p.file = dir.file("a.tif");
@@ -56,7 +56,7 @@ TEST(ExposureMetadata, SixteenBitTiffExifIsRead) {
 
 TEST(ExposureMetadata, MissingExposureIsAnErrorNamingTheFile) {
   testing::TempDir dir;
-  cv::imwrite(dir.file("plain.png"), cv::Mat(4, 4, CV_8UC3, cv::Scalar::all(1)));
+  rsibr::write_image(dir.file("plain.png"), cv::Mat(4, 4, CV_8UC3, cv::Scalar::all(1)));
   BracketPhoto p;
   p.file = dir.file("plain.png");
   try {
@@ -70,8 +70,8 @@ TEST(ExposureMetadata, MissingExposureIsAnErrorNamingTheFile) {
 
 TEST(BracketSet, LoadsAViewSortedByExposureInRgbOrder) {
   testing::TempDir dir;
-  cv::imwrite(dir.file("long.png"), cv::Mat(6, 5, CV_8UC3, cv::Scalar(30, 20, 10)));  // BGR on disk
-  cv::imwrite(dir.file("short.png"), cv::Mat(6, 5, CV_8UC3, cv::Scalar(3, 2, 1)));
+  rsibr::write_image(dir.file("long.png"), cv::Mat(6, 5, CV_8UC3, cv::Scalar(30, 20, 10)));  // BGR on disk
+  rsibr::write_image(dir.file("short.png"), cv::Mat(6, 5, CV_8UC3, cv::Scalar(3, 2, 1)));
   std::ofstream(dir.file("photoset.yaml")) << "rsibr_photoset: 1\nviews:\n  - name: v\n    brackets:\n"
                                               "      - {file: long.png, exposure_s: 0.1}\n"
                                               "      - {file: short.png, exposure_s: 0.01}\n";

@@ -12,7 +12,7 @@
 #include "hdr/photo_set_merge.h"
 
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
+#include "core/image_codecs.h"
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -259,7 +259,7 @@ TEST(RawFiles, TheExposureComesFromTheFileWhenTheYamlLeavesItOut) {
     EXPECT_NEAR(load_brackets(one).metadata[0].exposure_s / t, 1.0, 1e-6) << t;
   }
   // A view mixing RAW and other images is refused with a message saying so.
-  cv::imwrite(dir.file("c.png"), cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(100)));
+  rsibr::write_image(dir.file("c.png"), cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(100)));
   v.brackets.push_back({dir.path() / "c.png", 0.04, 200.0, 4.0});
   try {
     load_brackets(v);

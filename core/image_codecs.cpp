@@ -1,0 +1,54 @@
+#include "core/image_codecs.h"
+
+#include "core/lazy_library.h"
+
+#include <type_traits>
+
+namespace rsibr {
+namespace {
+
+// The build passes the SONAME of the opencv_imgcodecs it compiled against (CMakeLists.txt).
+const LazyLibrary& codecs() {
+  static const LazyLibrary library(RSIBR_IMGCODECS_SONAME, "reading and writing image files");
+  return library;
+}
+
+// Each signature is spelled once here; the static_cast makes the compiler check it against
+// OpenCV's header (a mismatch with the mangled name below would be a crash, not an error).
+using ReadFn = cv::Mat (*)(const cv::String&, int);
+using WriteFn = bool (*)(const cv::String&, cv::InputArray, const std::vector<int>&);
+using EncodeFn = bool (*)(const cv::String&, cv::InputArray, std::vector<uchar>&, const std::vector<int>&);
+using DecodeFn = cv::Mat (*)(cv::InputArray, int);
+static_assert(std::is_same_v<decltype(static_cast<ReadFn>(&cv::imread)), ReadFn>);
+static_assert(std::is_same_v<decltype(static_cast<WriteFn>(&cv::imwrite)), WriteFn>);
+static_assert(std::is_same_v<decltype(static_cast<EncodeFn>(&cv::imencode)), EncodeFn>);
+static_assert(std::is_same_v<decltype(static_cast<DecodeFn>(&cv::imdecode)), DecodeFn>);
+
+}  // namespace
+
+cv::Mat read_image(const std::string& path, int flags) {
+  static const auto f =
+      codecs().function<ReadFn>("_ZN2cv6imreadERKNSt7__cxx1112basic_stringIcSt11char_traitsIcESaIcEEEi");
+  return f(path, flags);
+}
+
+bool write_image(const std::string& path, const cv::Mat& image, const std::vector<int>& params) {
+  static const auto f = codecs().function<WriteFn>(
+      "_ZN2cv7imwriteERKNSt7__cxx1112basic_stringIcSt11char_traitsIcESaIcEEERKNS_11_InputArrayERKSt6vectorIiSaIiEE");
+  return f(path, image, params);
+}
+
+bool encode_image(const std::string& extension, const cv::Mat& image, std::vector<unsigned char>& bytes,
+                  const std::vector<int>& params) {
+  static const auto f = codecs().function<EncodeFn>(
+      "_ZN2cv8imencodeERKNSt7__cxx1112basic_stringIcSt11char_traitsIcESaIcEEERKNS_11_InputArrayERSt6vectorIhSaIhEERKSB_"
+      "IiSaIiEE");
+  return f(extension, image, bytes, params);
+}
+
+cv::Mat decode_image(const std::vector<unsigned char>& bytes, int flags) {
+  static const auto f = codecs().function<DecodeFn>("_ZN2cv8imdecodeERKNS_11_InputArrayEi");
+  return f(bytes, flags);
+}
+
+}  // namespace rsibr

@@ -1,0 +1,22 @@
+// Image files (PNG, JPEG, TIFF, ...) through OpenCV's codecs, loaded on first use
+// (core/lazy_library.h says why). The same contracts as cv::imread, cv::imwrite, cv::imencode and
+// cv::imdecode, whose flags and parameters (cv::IMREAD_*, cv::IMWRITE_*) they take; an empty
+// Mat or `false` on failure, as there. Throws std::runtime_error only when the codec library
+// cannot be loaded.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>  // the flags only: the functions are looked up at run time
+
+#include <string>
+#include <vector>
+
+namespace rsibr {
+
+cv::Mat read_image(const std::string& path, int flags = cv::IMREAD_COLOR);
+bool write_image(const std::string& path, const cv::Mat& image, const std::vector<int>& params = {});
+bool encode_image(const std::string& extension, const cv::Mat& image, std::vector<unsigned char>& bytes,
+                  const std::vector<int>& params = {});
+cv::Mat decode_image(const std::vector<unsigned char>& bytes, int flags);
+
+}  // namespace rsibr
