@@ -88,7 +88,8 @@ Runner add_plan(CLI::App& app) {
       candidates_text() +
       ". --views, --res, --method, --samples and --reference-width fix a knob. rsibr bake --max-error plans, bakes "
       "and checks the result.\n"
-      "Exit status: 0 with a setting, 3 when no candidate is predicted to meet the budget.\n"
+      "Exit status: 0 with a setting, 3 when no candidate is predicted to meet the budget (the plan then names the "
+      "closest measured setting and the budget it would meet).\n"
       "Example: rsibr plan --env sky.exr --brdf copper.yaml --max-error 2%");
   c->add_option("--env", a->env, "Environment map (EXR or .hdr)")->required();
   c->add_option("--brdf", a->brdf, "BRDF spec (YAML)")->required();

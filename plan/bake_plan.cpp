@@ -272,6 +272,9 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
     plan.settings.push_back(s);
   }
   plan.pilot_seconds = seconds_since(t_start);
+  if (!plan.chosen)
+    for (const PlannedSetting& s : plan.settings)
+      if (s.measured_error && (!plan.closest || s.upper_error < plan.closest->upper_error)) plan.closest = s;
 
   // Why, in a few lines.
   std::ostringstream why;
@@ -288,6 +291,12 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
     if (confirmations >= options.max_confirmations)
       why << " (the plan stopped after measuring " << confirmations << " candidates that the model let through)";
     why << ".\n";
+    if (plan.closest) {
+      const PlannedSetting& c = *plan.closest;
+      why << "closest: " << setting_text(c.setting) << ": measured " << percent(*c.measured_error) << " +- "
+          << percent(*c.measured_sigma) << " (at most " << percent(c.upper_error) << "), " << c.seconds
+          << " s; it is planned to meet a budget of " << percent(c.upper_error / options.margin) << ".\n";
+    }
   }
   int shown = 0;
   for (const PlannedSetting& s : plan.settings) {
@@ -357,6 +366,7 @@ nlohmann::json BakePlan::to_json() const {
                                   {"texels", p.texels},
                                   {"seconds", p.seconds}});
   j["chosen"] = chosen ? planned_json(*chosen) : nlohmann::json();
+  j["closest"] = closest ? planned_json(*closest) : nlohmann::json();
   j["settings"] = nlohmann::json::array();
   for (const PlannedSetting& s : settings) j["settings"].push_back(planned_json(s));
   j["why"] = why;

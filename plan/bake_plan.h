@@ -148,6 +148,9 @@ struct BakePlan {
   double interpolation_integrator_error = 0;  // FIS 64's own error at the pilot texels
   std::vector<PlannedSetting> settings;       // every candidate, by predicted time
   std::optional<PlannedSetting> chosen;       // nullopt: no candidate is predicted to meet the budget
+  // Without a choice: the measured candidate with the least upper error (nullopt when none was
+  // measured), the nearest thing to a setting; it meets a budget of upper_error / margin.
+  std::optional<PlannedSetting> closest;
   double pilot_seconds = 0;
   double confirm_seconds = 0;  // of which measuring screened-in candidates
   long long truth_texels = 0;  // reference texels of the pilot's truth

@@ -130,6 +130,31 @@ TEST(BakePlan, AnUnreachableBudgetChoosesNothingAndSaysSo) {
   EXPECT_TRUE(plan.to_json()["chosen"].is_null());
 }
 
+// When nothing meets the budget, the plan names the measured candidate nearest to it: here every
+// measurement's upper bound is pushed past the budget (100 standard errors) and the plan stops after
+// two measurements.
+TEST(BakePlan, WithoutAChoiceTheClosestMeasuredSettingIsNamed) {
+  const EnvMap env = sky(Vec3(0.2, 0.7, 0.4), 32);
+  const auto brdf = parse_brdf("{type: phong, albedo: [0.6, 0.5, 0.4], exponent: 20}");
+  BakePlanOptions o = small(0.05);
+  o.sigmas = 100;
+  o.max_confirmations = 2;
+  const BakePlan plan = plan_bake(env, *brdf, o);
+  ASSERT_FALSE(plan.chosen);
+  ASSERT_TRUE(plan.closest) << plan.why;
+  int measured = 0;
+  for (const PlannedSetting& s : plan.settings) {
+    if (!s.measured_error) continue;
+    ++measured;
+    EXPECT_GE(s.upper_error, plan.closest->upper_error);
+  }
+  EXPECT_EQ(measured, 2);
+  EXPECT_NE(plan.why.find("closest: " + std::to_string(plan.closest->setting.view_count)), std::string::npos)
+      << plan.why;
+  EXPECT_EQ(plan.to_json()["closest"]["upper_error"].get<double>(), plan.closest->upper_error);
+  EXPECT_TRUE(plan_bake(env, *brdf, small(1e-5)).to_json()["closest"].is_null());  // nothing was measured
+}
+
 TEST(BakePlan, TheFullReferenceHasNoIntegrationErrorAndCoarserWidthsHaveMore) {
   const EnvMap env = sky(Vec3(0.5, 0.5, 0.5), 64);
   const auto brdf = parse_brdf("{type: lambert, albedo: [0.8, 0.8, 0.8]}");
