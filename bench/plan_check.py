@@ -136,6 +136,13 @@ def main():
     for r in results:
         c, b = r.get("chosen"), r.get("sweep_best")
         chosen = "%d views %d^2, %s" % (c["views"], c["res"], c["integrator"]) if c else "none"
+        if not c:  # the plan's nearest miss (plan/bake_plan.h, BakePlan::closest)
+            measured = [s for s in r["plan"]["settings"] if s.get("measured_error") is not None]
+            if measured:
+                m = min(measured, key=lambda s: s["upper_error"])
+                chosen += " (closest: %d views %d^2, %s, %s ± %s, %.1f s)" % (
+                    m["view_count"], m["res"], m["integrator"], pct(m["measured_error"]), pct(m["measured_sigma"]),
+                    m["predicted_seconds"])
         best = "%d views %d^2, %s" % (b["views"], b["res"], b["integrator"]) if b else "none"
         ratio = c["seconds"] / b["seconds"] if c and b else float("nan")
         with_pilot = (c["seconds"] + r["plan_seconds"]) / b["seconds"] if c and b else float("nan")
