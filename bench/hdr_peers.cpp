@@ -27,10 +27,10 @@
 #include "hdr/merge.h"
 #include "hdr/noise_model.h"
 #include "hdr/response_recovery.h"
+#include "core/image_codecs.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
-#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 #include <opencv2/photo.hpp>
 

@@ -8,9 +8,9 @@
 #include "capture/rig_renderer.h"
 #include "capture/sensor_noise.h"
 #include "capture/synth_capture.h"
+#include "core/image_codecs.h"
 
 #include <benchmark/benchmark.h>
-#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 namespace rsibr {

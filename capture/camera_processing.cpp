@@ -1,8 +1,8 @@
 #include "capture/camera_processing.h"
 
 #include "core/parallel.h"
-
 #include "core/image_codecs.h"
+
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>

@@ -15,9 +15,9 @@
 #include "core/atomic_folder.h"
 #include "core/exr_io.h"
 #include "core/patterns.h"
+#include "core/image_codecs.h"
 
 #include <exiv2/exiv2.hpp>
-#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 #include <yaml-cpp/yaml.h>
 

@@ -4,8 +4,8 @@
 #include "core/colour.h"
 #include "core/input_file.h"
 #include "core/text.h"
-
 #include "core/image_codecs.h"
+
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>

@@ -13,6 +13,8 @@ const LazyLibrary& codecs() {
   return library;
 }
 
+// The mangled names below are those of libstdc++'s C++11 string ABI, the one Debian builds OpenCV with.
+static_assert(_GLIBCXX_USE_CXX11_ABI, "core/image_codecs.cpp: the mangled names assume the C++11 string ABI");
 // Each signature is spelled once here; the static_cast makes the compiler check it against
 // OpenCV's header (a mismatch with the mangled name below would be a crash, not an error).
 using ReadFn = cv::Mat (*)(const cv::String&, int);

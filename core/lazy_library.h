@@ -1,6 +1,6 @@
 // A shared library opened on first use (dlopen), not when the program starts.
-// Why: OpenCV's image codecs (and mrgingham, which links them) bring in about 130 more libraries
-// (GDAL, GDCM, the HEIF and JPEG 2000 codecs...). Loading and relocating them took 0.2 s of every
+// Why: OpenCV's image codecs (and mrgingham, which links them) bring in about 100 more libraries
+// (GDAL, GDCM, the HEIF and JPEG 2000 codecs...). Loading and relocating them took 0.26 s of every
 // rsibr start, most of the time of a short command; they are now loaded by the commands that read
 // or write an image file, and only then.
 // Contract: `soname` is the library's SONAME (the build writes it, see CMakeLists.txt); `symbol`

@@ -1,6 +1,6 @@
 #include "hdr/bracket_set.h"
-
 #include "core/image_codecs.h"
+
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>

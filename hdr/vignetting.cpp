@@ -1,9 +1,9 @@
 #include "hdr/vignetting.h"
 
 #include "hdr/raw_image.h"
+#include "core/image_codecs.h"
 
 #include <Eigen/Dense>
-#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>

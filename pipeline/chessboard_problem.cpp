@@ -1,8 +1,8 @@
 #include "pipeline/chessboard_problem.h"
 
 #include "hdr/raw_image.h"
-
 #include "core/image_codecs.h"
+
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>

@@ -10,9 +10,9 @@
 #include "pipeline/process_pipeline.h"
 #include "pipeline/response_choice_html.h"
 #include "pipeline/step_record.h"
+#include "core/image_codecs.h"
 
 #include <nlohmann/json.hpp>
-#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>

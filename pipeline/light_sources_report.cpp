@@ -3,8 +3,8 @@
 #include "core/colour.h"
 #include "core/exr_io.h"
 #include "pipeline/html_report.h"
-
 #include "core/image_codecs.h"
+
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>

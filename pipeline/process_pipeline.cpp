@@ -51,8 +51,8 @@
 #include "pipeline/torus_mesh.h"
 #include "pipeline/vignetting_input.h"
 #include "runtime/renderer.h"
-
 #include "core/image_codecs.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>

@@ -1,12 +1,12 @@
 # Run at build time (cmake -P), after a module's test executable is linked: lists its tests
 # (--gtest_list_tests) and writes a ctest file with one test per suite instead of one per test
 # (a suite's long tests are one more, `<suite>.long`, so a fixture shared by a suite is built once).
-# Why: every ctest test is a process of its own, and starting one that links OpenCV, Ceres, OpenEXR
-# and Embree costs about 0.3 s (0.6 s under the sanitizers), more than most tests take. gtest still
-# reports each test by name inside its suite's output.
+# Why: every ctest test is a process of its own; each pays the start-up (0.05 s, 0.35 s under the
+# sanitizers) and any fixture its suite builds in SetUpTestSuite, often more than the test takes.
+# gtest still reports each test by name inside its suite's output.
 # Inputs (-D): EXE, OUT (the file to write), MODULE (the label), COST, LONG (':'-separated gtest
-# names or `Suite.*` patterns: labelled `long` only, which the sanitizer preset leaves out), SHARED (':'-separated suites
-# that run as `<suite>.all`, added by tests/CMakeLists.txt: left out here).
+# names or `Suite.*` patterns: labelled `long` only, which the sanitizer preset leaves out),
+# SHARED (':'-separated suites that run as `<suite>.all`, added by tests/CMakeLists.txt: left out).
 # Disabled tests (DISABLED_ prefix) are measurement sweeps, run by hand with the executable.
 cmake_minimum_required(VERSION 3.25)
 string(REPLACE ":" ";" LONG "${LONG}")

@@ -12,9 +12,9 @@
 #include "core/patterns.h"
 #include "core/sphere_map.h"
 #include "core/view_set.h"
+#include "core/image_codecs.h"
 
 #include <opencv2/core.hpp>
-#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>

@@ -5,10 +5,10 @@
 #include "capture/synth_capture.h"
 #include "capture/synth_cases.h"
 #include "core/test_data.h"
+#include "core/image_codecs.h"
 
 #include <exiv2/exiv2.hpp>
 #include <gtest/gtest.h>
-#include "core/image_codecs.h"
 
 #include <cmath>
 #include <optional>

@@ -7,9 +7,9 @@
 #include "core/test_data.h"
 #include "core/truth_image.h"
 #include "synth_cases.h"
+#include "core/image_codecs.h"
 
 #include <gtest/gtest.h>
-#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 #include <yaml-cpp/yaml.h>
 

@@ -4,9 +4,9 @@
 
 #include "capture/sensor_noise.h"
 #include "core/test_data.h"
+#include "core/image_codecs.h"
 
 #include <gtest/gtest.h>
-#include "core/image_codecs.h"
 
 #include <cstdio>
 #include <cstdlib>

@@ -9,11 +9,11 @@
 #include "core/map_set.h"
 #include "core/test_data.h"
 #include "synth_cases.h"
+#include "core/image_codecs.h"
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 #include <tbb/global_control.h>
-#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 #include <fstream>

@@ -4,6 +4,7 @@
 #include "core/colour.h"
 #include "bitwise_equal.h"
 #include "test_data.h"
+#include "core/image_codecs.h"
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfChromaticitiesAttribute.h>
@@ -16,7 +17,6 @@
 #include <OpenEXR/ImfStringAttribute.h>
 #include <Imath/half.h>
 #include <gtest/gtest.h>
-#include "core/image_codecs.h"
 
 #include <atomic>
 #include <cmath>

@@ -6,9 +6,9 @@
 #include "hdr/response_curve.h"
 
 #include "core/test_data.h"
+#include "core/image_codecs.h"
 
 #include <gtest/gtest.h>
-#include "core/image_codecs.h"
 #include <opencv2/imgproc.hpp>
 
 namespace rsibr {

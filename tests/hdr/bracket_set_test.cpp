@@ -3,10 +3,10 @@
 
 #include "core/photo_set.h"
 #include "core/test_data.h"
+#include "core/image_codecs.h"
 
 #include <exiv2/exiv2.hpp>
 #include <gtest/gtest.h>
-#include "core/image_codecs.h"
 
 #include <fstream>
 

@@ -10,9 +10,9 @@
 #include "core/truth_image.h"
 #include "hdr/bracket_set.h"
 #include "hdr/photo_set_merge.h"
+#include "core/image_codecs.h"
 
 #include <gtest/gtest.h>
-#include "core/image_codecs.h"
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
