@@ -150,6 +150,8 @@ void Warp::warp_block(CentralDirection kind, const Mat3& source_from_dest, int w
   }
 }
 
+bool Warp::central_block(CentralDirection, int, int, int, int, int, float*, float*, float*) const { return false; }
+
 void ExactWarp::warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row,
                            int c_begin, int c_end, float* disc_x, float* disc_y, float* rim) const {
   float m[9];
@@ -160,6 +162,12 @@ void ExactWarp::warp_block(CentralDirection kind, const Mat3& source_from_dest, 
     central_directions_row(kind, width, height, row, c, e, x, y, z);
     warp_directions(kind, m, e - c, x, y, z, disc_x + o, disc_y + o, rim + o);
   }
+}
+
+bool ExactWarp::central_block(CentralDirection kind, int width, int height, int row, int c_begin, int c_end, float* x,
+                              float* y, float* z) const {
+  central_directions_row(kind, width, height, row, c_begin, c_end, x, y, z);
+  return true;
 }
 
 void ExactWarp::warp_row(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row,
@@ -218,6 +226,19 @@ void PrecomputedWarp::warp_block(CentralDirection kind, const Mat3& source_from_
   const float* p = planes_.data() + std::size_t(3 * int(kind)) * count + std::size_t(row) * std::size_t(width) +
                    std::size_t(c_begin);
   warp_directions(kind, m, c_end - c_begin, p, p + count, p + 2 * count, disc_x, disc_y, rim);
+}
+
+bool PrecomputedWarp::central_block(CentralDirection kind, int width, int height, int row, int c_begin, int c_end,
+                                    float* x, float* y, float* z) const {
+  check_size(width, height);
+  const std::size_t count = std::size_t(width) * std::size_t(height);
+  const float* p = planes_.data() + std::size_t(3 * int(kind)) * count + std::size_t(row) * std::size_t(width) +
+                   std::size_t(c_begin);
+  const std::size_t n = std::size_t(c_end - c_begin);
+  std::copy(p, p + n, x);
+  std::copy(p + count, p + count + n, y);
+  std::copy(p + 2 * count, p + 2 * count + n, z);
+  return true;
 }
 
 }  // namespace rsibr

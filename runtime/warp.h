@@ -82,6 +82,13 @@ class Warp {
   // samples; the exact and precomputed warps compute it in vectorised float loops.
   virtual void warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row,
                           int c_begin, int c_end, float* disc_x, float* disc_y, float* rim) const;
+  // For a caller that warps one destination into several sources (the blend engine): the central
+  // directions (x, y, z)[c - c_begin] that warp_block rotates, so that warp_directions(kind, m, ...) on
+  // them gives warp_block's result to the bit, computed once for all sources. False (nothing
+  // written) for a warp that does not rotate central directions (the tessellated and
+  // double-indirection warps interpolate); the caller then calls warp_block per source.
+  virtual bool central_block(CentralDirection kind, int width, int height, int row, int c_begin, int c_end, float* x,
+                             float* y, float* z) const;
 };
 
 // Per texel, from scratch: disc coordinates, g, rotation, g^-1.
@@ -93,6 +100,8 @@ class ExactWarp final : public Warp {
   // central_directions_row then warp_directions, in blocks of 64 texels on the stack.
   void warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
                   int c_end, float* disc_x, float* disc_y, float* rim) const override;
+  bool central_block(CentralDirection kind, int width, int height, int row, int c_begin, int c_end, float* x, float* y,
+                     float* z) const override;
 };
 
 // The destination texels' central directions (g_mirror and g_normal of every texel centre, in the
@@ -112,6 +121,8 @@ class PrecomputedWarp final : public Warp {
                 int c_end, WarpSample* out) const override;
   void warp_block(CentralDirection kind, const Mat3& source_from_dest, int width, int height, int row, int c_begin,
                   int c_end, float* disc_x, float* disc_y, float* rim) const override;
+  bool central_block(CentralDirection kind, int width, int height, int row, int c_begin, int c_end, float* x, float* y,
+                     float* z) const override;
 
  private:
   void check_size(int width, int height) const;

@@ -190,3 +190,46 @@ TEST(Warp, RowWarpAgreesWithWarpDirectionToFloatRounding) {
 
 }  // namespace
 }  // namespace rsibr
+
+#include "runtime/tessellated_warp.h"
+
+namespace rsibr {
+namespace {
+
+// central_block is what lets the blend engine compute a row's central directions once for all of
+// its sources: warp_directions on them must give warp_block's bits, for the exact and the
+// precomputed warp; a warp that interpolates (tessellated) declines and writes nothing.
+TEST(Warp, CentralBlockThenRotationEqualsWarpBlockToTheBit) {
+  std::mt19937 rng(17);
+  for (auto [W, H] : {std::pair{64, 64}, std::pair{37, 29}}) {
+    const ExactWarp exact;
+    const PrecomputedWarp pre(W, H);
+    int compared = 0;
+    for (int trial = 0; trial < 4; ++trial) {
+      const Mat3 M = random_frame(rng).transpose() * random_frame(rng);
+      float m[9];
+      for (int i = 0; i < 9; ++i) m[i] = float(M(i / 3, i % 3));
+      for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal})
+        for (int r = 0; r < H; ++r) {
+          const auto [c0, c1] = disc_span(r, W, H);
+          const std::size_t n = std::size_t(std::max(0, c1 - c0));
+          for (const Warp* warp : {static_cast<const Warp*>(&exact), static_cast<const Warp*>(&pre)}) {
+            std::vector<float> x(n), y(n), z(n), a(n), b(n), c(n), p(n), q(n), s(n);
+            ASSERT_TRUE(warp->central_block(kind, W, H, r, c0, c1, x.data(), y.data(), z.data())) << warp->name();
+            warp_directions(kind, m, int(n), x.data(), y.data(), z.data(), a.data(), b.data(), c.data());
+            warp->warp_block(kind, M, W, H, r, c0, c1, p.data(), q.data(), s.data());
+            ASSERT_TRUE(a == p && b == q && c == s) << warp->name() << " row " << r;
+            compared += int(n);
+          }
+        }
+    }
+    EXPECT_GT(compared, 4 * 2 * 2 * W * H / 2);
+  }
+  const TessellatedWarp mesh(32, 32);
+  float x[4] = {7, 7, 7, 7}, y[4], z[4];
+  EXPECT_FALSE(mesh.central_block(CentralDirection::Mirror, 32, 32, 16, 10, 14, x, y, z));
+  EXPECT_EQ(x[0], 7.0f);
+}
+
+}  // namespace
+}  // namespace rsibr
