@@ -290,14 +290,8 @@ void fallback(const Source* const* sources, int n, const WarpOf& warp_of, float*
   for (int j = 0; j < 3; ++j) out[j] = ok ? float(L[j]) : 0.0f;
 }
 
-// --- Row forms of the kernel's first steps (vectorised, also for AVX2). ---
+// --- Row forms of the kernel (vectorised, also for AVX2). ---
 
-RSIBR_AVX2_CLONES void fade_row(int n, float weight, float inv_fade, const float* __restrict rim, float* __restrict a) {
-  for (int i = 0; i < n; ++i) a[i] = faded(weight, rim[i], inv_fade);
-}
-
-// The footprint of disc point (x, y) for a source weight a: the offset, the four tap weights times
-// a, and whether all four taps are valid (inside the grid's interior radius).
 // The footprint of disc point (x, y) for a source weight a: the offset of its top-left tap (>= 0
 // when all four taps are valid, inside the grid's interior radius; kRim otherwise; kSkip where a
 // is not > 0), fx, and the row weights times a: ya = (1 - fy) a, yb = fy a. The four tap weights
@@ -326,27 +320,27 @@ __attribute__((noinline)) float contribute_rim(const Source& s, float a, float x
   return accumulate(s, a, o, fx, fy, x, y, acc);
 }
 
-// Adds source s's contribution to acc (R, G, B, total) and returns it (a c; 0: none). Interior
-// footprints: the four taps times the premultiplied weights (every tap valid, so no renormalisation:
-// the weights sum to a up to rounding), times the confidence c = sum w k / sum w (the same products
-// in the same order for a confidence of 1, so exactly 1). Rim footprints: accumulate().
-inline float contribute(const Source& s, const Taps& t, float a, float x, float y, v4f& acc) {
-  if (t.offset < 0) return t.offset == kSkip ? 0.0f : contribute_rim(s, a, x, y, acc);
-  const float* t0 = s.texels.data() + t.offset;
-  const float* t1 = t0 + s.grid.stride;
+// An interior footprint's contribution (every tap valid, offset >= 0): the four taps times the
+// premultiplied weights (no renormalisation: the weights sum to a up to rounding), times the
+// confidence c = sum w k / sum w when kConfidence (the same products in the same order for a
+// confidence of 1, so exactly 1). Adds it to acc (R, G, B, total) and returns a c (0: none).
+template <bool kConfidence>
+inline float contribute_interior(const float* texels, const float* confidence, int stride, int conf_stride,
+                                 const Taps& t, float a, v4f& acc) {
+  const float* t0 = texels + t.offset;
   const float gx = 1.0f - t.fx;
   const v8f X = {gx, gx, gx, gx, t.fx, t.fx, t.fx, t.fx};
   v8f T0, T1;
   load8(t0, T0);
-  load8(t1, T1);
+  load8(t0 + stride, T1);
   const v4f S = halves_sum(X * (t.ya * T0 + t.yb * T1));  // lanes 0-3: (1 - fx) column, 4-7: fx column
-  if (s.confidence.empty()) {
+  if (!kConfidence) {
     acc += S;
     return a;
   }
   const float w00 = gx * t.ya, w01 = t.fx * t.ya, w10 = gx * t.yb, w11 = t.fx * t.yb;
-  const float* k0 = s.confidence.data() + t.offset / 4;
-  const float* k1 = k0 + s.conf_stride;
+  const float* k0 = confidence + t.offset / 4;
+  const float* k1 = k0 + conf_stride;
   const float c = (w00 * k0[0] + w01 * k0[1] + w10 * k1[0] + w11 * k1[1]) / (w00 + w01 + w10 + w11);
   const float conf = c > 0.0f ? c : 0.0f;  // negative or NaN counts as 0
   if (!(conf > 0.0f)) return 0.0f;
@@ -354,18 +348,32 @@ inline float contribute(const Source& s, const Taps& t, float a, float x, float 
   return a * conf;
 }
 
-// taps() for a row of points, structure of arrays (so that the loop vectorises, also for AVX2).
+// Adds source s's contribution to acc (R, G, B, total) and returns it (a c; 0: none): interior
+// footprints by contribute_interior, rim footprints by accumulate() (renormalised, or sample_disc's
+// inward steps).
+inline float contribute(const Source& s, const Taps& t, float a, float x, float y, v4f& acc) {
+  if (t.offset < 0) return t.offset == kSkip ? 0.0f : contribute_rim(s, a, x, y, acc);
+  return s.confidence.empty()
+             ? contribute_interior<false>(s.texels.data(), nullptr, s.grid.stride, 0, t, a, acc)
+             : contribute_interior<true>(s.texels.data(), s.confidence.data(), s.grid.stride, s.conf_stride, t, a, acc);
+}
+
+// The source weights a = weight * fade(rim) and taps() for a row of points, structure of arrays (one
+// loop that vectorises, also for AVX2).
 constexpr int kTileCols = 64;  // destination texels per tile row
 struct TapRows {
   int offset[kTileCols];
   float fx[kTileCols], ya[kTileCols], yb[kTileCols];
   Taps at(int i) const { return {offset[i], fx[i], ya[i], yb[i]}; }
 };
-RSIBR_AVX2_CLONES void taps_row(const Source::Grid& grid, int n, const float* __restrict x, const float* __restrict y,
-                                const float* __restrict a, TapRows& out) {
+RSIBR_AVX2_CLONES void taps_row(const Source::Grid& grid, int n, float weight, float inv_fade,
+                                const float* __restrict x, const float* __restrict y, const float* __restrict rim,
+                                float* __restrict a, TapRows& out) {
   const Source::Grid g = grid;  // a local: the stores below could otherwise alias it
   for (int i = 0; i < n; ++i) {
-    const Taps t = taps(g, x[i], y[i], a[i]);
+    const float ai = faded(weight, rim[i], inv_fade);
+    a[i] = ai;
+    const Taps t = taps(g, x[i], y[i], ai);
     out.offset[i] = t.offset;
     out.fx[i] = t.fx;
     out.ya[i] = t.ya;
@@ -373,14 +381,54 @@ RSIBR_AVX2_CLONES void taps_row(const Source::Grid& grid, int n, const float* __
   }
 }
 
-// contribute() for a row of texels (acc and source_weight per texel; source_weight may be null).
+// finish() for a row of n texels: out (RGB), out_w; the texels whose total is not > 0 get weight 0
+// and are listed in `missing` for the fallback (their count returned). The same arithmetic as finish.
+RSIBR_AVX2_CLONES int finish_row(int n, const v4f* __restrict acc, float* __restrict out, float* __restrict out_w,
+                                 int* __restrict missing) {
+  float inv[kTileCols];
+  for (int i = 0; i < n; ++i) {
+    const float total = acc[i][3];
+    const bool some = total > 0.0f;
+    inv[i] = 1.0f / (some ? total : 1.0f);
+    out_w[i] = some ? (total < 1.0f ? total : 1.0f) : 0.0f;
+  }
+  for (int i = 0; i < n; ++i) {
+    out[3 * i] = acc[i][0] * inv[i];
+    out[3 * i + 1] = acc[i][1] * inv[i];
+    out[3 * i + 2] = acc[i][2] * inv[i];
+  }
+  int count = 0;
+  for (int i = 0; i < n; ++i)
+    if (!(acc[i][3] > 0.0f)) missing[count++] = i;
+  return count;
+}
+
+// contribute() for a row of texels (acc and source_weight per texel; source_weight may be null), with
+// the source's pointers and the two options hoisted out of the loop (four forms).
+template <bool kConfidence, bool kSourceWeight>
+inline void gather_row_t(const Source& s, int n, const float* a, const float* x, const float* y, const TapRows& t,
+                         v4f* acc, float* source_weight) {
+  const float* texels = s.texels.data();
+  const float* confidence = s.confidence.data();
+  const int stride = s.grid.stride, conf_stride = s.conf_stride;
+  for (int i = 0; i < n; ++i) {
+    const int offset = t.offset[i];
+    if (offset == kSkip) continue;
+    const float c =
+        offset >= 0 ? contribute_interior<kConfidence>(texels, confidence, stride, conf_stride, t.at(i), a[i], acc[i])
+                    : contribute_rim(s, a[i], x[i], y[i], acc[i]);
+    if (kSourceWeight) source_weight[i] = c;
+  }
+}
 RSIBR_AVX2_CLONES void gather_row(const Source& s, int n, const float* a, const float* x, const float* y,
                                   const TapRows& t, v4f* acc, float* source_weight) {
-  for (int i = 0; i < n; ++i) {
-    if (t.offset[i] == kSkip) continue;
-    const float c = contribute(s, t.at(i), a[i], x[i], y[i], acc[i]);
-    if (source_weight) source_weight[i] = c;
-  }
+  const bool conf = !s.confidence.empty();
+  if (source_weight)
+    conf ? gather_row_t<true, true>(s, n, a, x, y, t, acc, source_weight)
+         : gather_row_t<false, true>(s, n, a, x, y, t, acc, source_weight);
+  else
+    conf ? gather_row_t<true, false>(s, n, a, x, y, t, acc, nullptr)
+         : gather_row_t<false, false>(s, n, a, x, y, t, acc, nullptr);
 }
 
 // --- Lookups at a footprint (radiance at a level of detail). ---
@@ -672,6 +720,12 @@ Vec3 BlendEngine::radiance(const ViewWeights& located, const Vec3& v, const Vec3
 }
 
 BlendResult BlendEngine::map(const Vec3& view_dir, const Vec3& up, const MapRequest& request) const {
+  BlendResult result;
+  map(view_dir, up, request, result);
+  return result;
+}
+
+void BlendEngine::map(const Vec3& view_dir, const Vec3& up, const MapRequest& request, BlendResult& result) const {
   if (!view_dir.allFinite() || !(view_dir.norm() > 0))
     throw std::invalid_argument("blend: view direction must be finite and non-zero");
   if ((request.width > 0) != (request.height > 0) || request.width < 0 || request.height < 0)
@@ -685,9 +739,11 @@ BlendResult BlendEngine::map(const Vec3& view_dir, const Vec3& up, const MapRequ
     throw std::invalid_argument(std::string("blend: the ") + warp.name() + " warp does not support " +
                                 std::to_string(W) + "x" + std::to_string(H));
 
-  if (mixed_) return mixed_map(view_dir, up, W, H);
+  if (mixed_) {
+    result = mixed_map(view_dir, up, W, H);
+    return;
+  }
 
-  BlendResult result;
   result.world_from_view = world_from_view_for(view_dir, up);
   result.located = locate(view_dir);
   const ViewWeights& located = result.located;
@@ -702,57 +758,74 @@ BlendResult BlendEngine::map(const Vec3& view_dir, const Vec3& up, const MapRequ
     if (located.weights[std::size_t(k)] > 0) active[m++] = k;
   }
   const float inv_fade = rule_.rim_fade > 0 ? float(1.0 / rule_.rim_fade) : 0.0f;
+  // Per located source: the rotation in float (warp_directions' form) and the weight; which central
+  // direction kinds the active sources use (computed once per destination row for all of them).
+  float rotation[3][9], weight[3];
+  bool kinds_used[2] = {false, false};
+  for (int k = 0; k < n; ++k) {
+    for (int i = 0; i < 9; ++i) rotation[k][i] = float(source_from_dest[k](i / 3, i % 3));
+    weight[k] = float(located.weights[std::size_t(k)]);
+  }
+  for (int j = 0; j < m; ++j) kinds_used[int(sources[active[j]]->kind)] = true;
 
   result.rgb.create(H, W, CV_32FC3);
   result.weight.create(H, W, CV_32FC1);
-  if (request.source_weights)
-    for (int k = 0; k < 3; ++k) result.source_weight[std::size_t(k)] = cv::Mat::zeros(H, W, CV_32FC1);
+  for (int k = 0; k < 3; ++k) {
+    cv::Mat& sw = result.source_weight[std::size_t(k)];
+    if (request.source_weights) {
+      sw.create(H, W, CV_32FC1);
+      sw.setTo(0.0f);
+    } else {
+      sw.release();
+    }
+  }
 
   // Tiles of kTileRows x kTileCols destination texels: a tile's footprint in each source is compact
   // (tens of KiB for three sources), so the bilinear taps hit the cache and the TLB; a whole
   // destination row sweeps a curve across hundreds of source rows. Per texel the arithmetic does not
   // depend on the tiling or the threads.
   constexpr int kTileRows = 16;
-  // One tile: rows [r0, r1) (at most kTileRows), columns [cb, cb + kTileCols) cut to each row's
-  // disc span (spans[r - r0]). Source by source: per row the warp, the fades and the footprints as
-  // row loops, then its taps added to the tile's sums, so each source's texels are read in one sweep
-  // (faster than all sources per texel with the sums in registers); then the normalisation.
+  // One tile: rows [r0, r1) (at most kTileRows), columns [cb, cb + kTileCols) cut to each row's disc
+  // span (spans[r - r0]). Row by row: the central directions once (when the warp rotates them), then
+  // source by source the warp, the footprints and the taps as row loops into the row's sums (so one
+  // source's texels are read in one sweep; faster than all sources per texel with the sums in
+  // registers), then the normalisation, and the fallback for the texels no source reached.
   const auto tile = [&](int r0, int r1, int cb, const std::pair<int, int>* spans) {
-    v4f acc[kTileRows][kTileCols];
-    int lo[kTileRows], hi[kTileRows];
-    for (int r = r0; r < r1; ++r) {
-      lo[r - r0] = std::max(spans[r - r0].first, cb);
-      hi[r - r0] = std::min(spans[r - r0].second, cb + kTileCols);
-      for (int i = 0; i < hi[r - r0] - lo[r - r0]; ++i) acc[r - r0][i] = v4f{0.0f, 0.0f, 0.0f, 0.0f};
-    }
+    v4f acc[kTileCols];
     float x[kTileCols], y[kTileCols], rim[kTileCols], a[kTileCols];
+    float cx[2][kTileCols], cy[2][kTileCols], cz[2][kTileCols];  // central directions, per kind
+    int missing[kTileCols];
     TapRows t;
-    for (int j = 0; j < m; ++j) {
-      const int k = active[j];
-      const Source& s = *sources[k];
-      const float w = float(located.weights[std::size_t(k)]);
-      for (int r = r0; r < r1; ++r) {
-        const int c0 = lo[r - r0], c1 = hi[r - r0], span = c1 - c0;
-        if (span <= 0) continue;
-        warp.warp_block(s.kind, source_from_dest[k], W, H, r, c0, c1, x, y, rim);
-        fade_row(span, w, inv_fade, rim, a);
-        taps_row(s.grid, span, x, y, a, t);
-        float* sw = request.source_weights ? result.source_weight[std::size_t(k)].ptr<float>(r) + c0 : nullptr;
-        gather_row(s, span, a, x, y, t, acc[r - r0], sw);
-      }
-    }
     for (int r = r0; r < r1; ++r) {
-      const int c0 = lo[r - r0], span = hi[r - r0] - c0;
+      const int c0 = std::max(spans[r - r0].first, cb), c1 = std::min(spans[r - r0].second, cb + kTileCols);
+      const int span = c1 - c0;
+      if (span <= 0) continue;
+      std::fill(acc, acc + span, v4f{0.0f, 0.0f, 0.0f, 0.0f});
+      bool shared[2] = {false, false};
+      for (int kind = 0; kind < 2; ++kind)
+        if (kinds_used[kind])
+          shared[kind] = warp.central_block(CentralDirection(kind), W, H, r, c0, c1, cx[kind], cy[kind], cz[kind]);
+      for (int j = 0; j < m; ++j) {
+        const int k = active[j];
+        const Source& s = *sources[k];
+        const int kind = int(s.kind);
+        if (shared[kind])
+          warp_directions(s.kind, rotation[k], span, cx[kind], cy[kind], cz[kind], x, y, rim);
+        else
+          warp.warp_block(s.kind, source_from_dest[k], W, H, r, c0, c1, x, y, rim);
+        taps_row(s.grid, span, weight[k], inv_fade, x, y, rim, a, t);
+        float* sw = request.source_weights ? result.source_weight[std::size_t(k)].ptr<float>(r) + c0 : nullptr;
+        gather_row(s, span, a, x, y, t, acc, sw);
+      }
       float* out = result.rgb.ptr<float>(r) + 3 * c0;
-      float* out_w = result.weight.ptr<float>(r) + c0;
-      for (int i = 0; i < span; ++i) {
-        if (finish(acc[r - r0][i], out + 3 * i, out_w + i)) continue;
-        out_w[i] = 0.0f;
+      const int count = finish_row(span, acc, out, result.weight.ptr<float>(r) + c0, missing);
+      for (int q = 0; q < count; ++q) {
+        const int i = missing[q];
         const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c0 + i, r), W, H);
         fallback(
             sources, n,
-            [&](int q) {
-              return warp_direction(sources[q]->kind, source_from_dest[q] * central_direction(sources[q]->kind, xy));
+            [&](int p) {
+              return warp_direction(sources[p]->kind, source_from_dest[p] * central_direction(sources[p]->kind, xy));
             },
             out + 3 * i);
       }
@@ -781,7 +854,6 @@ BlendResult BlendEngine::map(const Vec3& view_dir, const Vec3& up, const MapRequ
   // Albedo-normalised sets: the destination texel p has n.d = g_normal(p).z in d's own frame.
   const std::vector<float>& albedo = maps_.views.front().albedo;
   if (!albedo.empty()) denormalise_by_albedo(result.rgb, albedo);
-  return result;
 }
 
 }  // namespace rsibr

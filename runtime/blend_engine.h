@@ -104,6 +104,10 @@ class BlendEngine {
   // Throws std::invalid_argument for a zero or non-finite view_dir, a bad size, or a warp that does
   // not support the destination size.
   BlendResult map(const Vec3& view_dir, const Vec3& up, const MapRequest& request = {}) const;
+  // The same into `out`, reusing its images where their size and type match (a caller that blends
+  // every frame keeps one BlendResult: no allocation and no first-touch page faults per frame). The
+  // images are written in place, so any cv::Mat sharing their data sees the new frame.
+  void map(const Vec3& view_dir, const Vec3& up, const MapRequest& request, BlendResult& out) const;
 
   const MapSet& maps() const { return maps_; }
   const ViewSet& view_set() const { return view_set_; }

@@ -140,7 +140,7 @@ const BlendResult& GlMapSet::update_destination(const Vec3& view, const Vec3& up
   MapRequest request;
   request.width = request.height = map_size_;
   request.warp = warp_.get();
-  destination_ = engine_->map(view, up, request);
+  engine_->map(view, up, request, destination_);  // the last frame's images reused
   cv::Mat rgba(map_size_, map_size_, CV_32FC4);
   const cv::Mat parts[] = {destination_.rgb, destination_.weight};
   const int from_to[] = {0, 0, 1, 1, 2, 2, 3, 3};

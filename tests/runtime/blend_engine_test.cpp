@@ -168,6 +168,36 @@ TEST(BlendEngine, FiniteAndBoundedOutsideANonSurroundingSet) {
     }
 }
 
+// A caller that blends every frame keeps one BlendResult: map() into it must give a fresh map()'s
+// bits whatever the kept result held before (another view, another size, source weights or not).
+TEST(BlendEngine, MapIntoAKeptResultEqualsAFreshMap) {
+  const ViewSet views = ViewSet::icosahedron();
+  const MapSet set = analytic_map_set(views, 32, 32, "mirror", fresnel_mirror_texel);
+  const BlendEngine engine(set, views);
+  const std::vector<Vec3> dests = random_directions(4, 21);
+  const auto same = [](const cv::Mat& a, const cv::Mat& b) {
+    return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0.0;
+  };
+  BlendResult kept;
+  for (std::size_t i = 0; i < dests.size(); ++i) {
+    MapRequest request;
+    request.width = request.height = i == 2 ? 48 : 32;
+    request.source_weights = i % 2 == 1;
+    engine.map(dests[i], Vec3(0, 1, 0), request, kept);
+    const BlendResult fresh = engine.map(dests[i], Vec3(0, 1, 0), request);
+    EXPECT_TRUE(same(kept.rgb, fresh.rgb)) << "destination " << i;
+    EXPECT_TRUE(same(kept.weight, fresh.weight)) << "destination " << i;
+    EXPECT_TRUE(kept.world_from_view == fresh.world_from_view);
+    EXPECT_EQ(kept.located.views, fresh.located.views);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(kept.source_weight[std::size_t(k)].empty(), !request.source_weights);
+      if (request.source_weights) {
+        EXPECT_TRUE(same(kept.source_weight[std::size_t(k)], fresh.source_weight[std::size_t(k)]));
+      }
+    }
+  }
+}
+
 TEST(BlendEngine, RejectsAViewSetThatIsNotTheMapSets) {
   const MapSet set = analytic_map_set(ViewSet::icosahedron(), 8, 8, "mirror", mirror_texel);
   const ViewSet other = ViewSet::geodesic(1);
