@@ -2,10 +2,13 @@
 """Runs the Google Benchmark program and writes docs/performance.md: each measurement as a ratio
 to the baseline measured in the same run (never as an absolute threshold).
 
-Usage: bench/performance.py [--bench build/release/rsibr_bench] [--filter REGEX] [--out FILE].
+Usage: bench/performance.py [--bench build/release/rsibr_bench] [--filter REGEX] [--repetitions N]
+                            [--out FILE].
 --filter runs only the matching benchmarks (Google Benchmark's --benchmark_filter): the sections it
 produces replace theirs in the existing output, the others are kept as they were (each section's
-ratios come from one run either way).
+ratios come from one run either way). --repetitions N (> 1) runs each benchmark N times in random
+interleaving (a shared machine's slow spells fall on ours and the baseline alike) and reports the
+medians.
 Standard library only.
 """
 import argparse
@@ -59,17 +62,24 @@ def main():
     ap.add_argument("--bench", default=os.path.join(ROOT, "build/release/rsibr_bench"))
     ap.add_argument("--filter", default="", help="only benchmarks matching this regex")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs/performance.md"))
+    ap.add_argument("--repetitions", type=int, default=1, help="runs per benchmark, interleaved; medians reported")
     args = ap.parse_args()
     with tempfile.NamedTemporaryFile(suffix=".json", delete=False) as f:
         out = f.name
     cmd = [args.bench, "--benchmark_format=console", f"--benchmark_out={out}", "--benchmark_out_format=json"]
     if args.filter:
         cmd.append(f"--benchmark_filter={args.filter}")
+    if args.repetitions > 1:
+        cmd += [f"--benchmark_repetitions={args.repetitions}", "--benchmark_enable_random_interleaving=true",
+                "--benchmark_report_aggregates_only=true"]
     subprocess.run(cmd, check=True)
     with open(out) as f:
         data = json.load(f)
     os.unlink(out)
-    by_name = {b["name"]: b for b in data["benchmarks"] if b.get("run_type", "iteration") == "iteration"}
+    if args.repetitions > 1:  # the medians, named as a single run's results
+        by_name = {b["run_name"]: b for b in data["benchmarks"] if b.get("aggregate_name") == "median"}
+    else:
+        by_name = {b["name"]: b for b in data["benchmarks"] if b.get("run_type", "iteration") == "iteration"}
     # The same, named without the min_time/iterations/real_time suffixes (baselines are looked up here).
     plain = {"/".join([n.split("/")[0]] + parts(n)): b for n, b in by_name.items()}
     ctx = data["context"]
@@ -117,7 +127,8 @@ def main():
         lines += rows
         lines.append("")
         if ctx.get("load_avg"):  # the machine may be shared: timings scale with it, ratios less so
-            lines += ["Load average (1, 5, 15 min) when measured: " + ", ".join(f"{x:.2f}" for x in ctx["load_avg"]) + ".", ""]
+            lines += ["Load average (1, 5, 15 min) when measured: " + ", ".join(f"{x:.2f}" for x in ctx["load_avg"]) + "." +
+                      (f" Medians of {args.repetitions} interleaved runs." if args.repetitions > 1 else ""), ""]
     # Sections other scripts write (bench/viewer_fps.py: "## Viewer", bench/hdr_merge.py: "## HDR merge", ...)
     # are kept as they were: every section whose title is none of this script's families.
     ours = tuple(f"## {TITLES.get(family, family[3:])} (" for family in PAIRS)
@@ -134,10 +145,10 @@ def main():
         "parts per frame: the exact warp's coordinate maps and fade weights (rows in parallel), cv::remap of",
         "each source, a weighted sum and a per-texel division (no tap dropping at the rim, no fallback).",
         "Blend cases: size / warp (0 exact, 1 precomputed, 2 tessellated) / path (0 the blend engine, built once",
-        "and called per frame, as the renderer and the viewer hold it; 1 blend(), one call per frame, which lays",
-        "out the three located sources each time). Blend engine cases: size / warp, against the tile path the",
-        "blend had before the engine (bench/previous_blend.cpp, frozen: warp in double, taps from the 3-channel",
-        "maps) in the same run.",
+        "and called per frame into one kept BlendResult, as the viewer holds them; 1 blend(), one call per frame,",
+        "which lays out the three located sources and allocates the result each time). Blend engine cases: size /",
+        "warp, against the tile path the blend had before the engine (bench/previous_blend.cpp, frozen: warp in",
+        "double, taps from the 3-channel maps, a new result per frame) in the same run.",
         "Rendering traces primary rays as Embree packets of 16 in 16x16 tiles, only inside the image rectangle",
         "the mesh's bounding box projects to, then shades the hits: paper mode blends one destination map per",
         "frame and reads it by normal; per-pixel mode blends the located sources for every hit's own view.",
