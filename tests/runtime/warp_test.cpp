@@ -18,6 +18,23 @@ Mat3 random_frame(std::mt19937& rng) {
   return world_from_view_for(Vec3(g(rng), g(rng), g(rng)), Vec3(g(rng), g(rng), g(rng)));
 }
 
+// For `trials` random source_from_dest rotations M (and m, M in float, row-major), both central
+// direction kinds and every row of a W x H destination: f(kind, M, m, row, c0, c1) over the row's
+// disc span [c0, c1).
+template <class F>
+void for_each_row_warp(std::mt19937& rng, int trials, int W, int H, const F& f) {
+  for (int trial = 0; trial < trials; ++trial) {
+    const Mat3 M = random_frame(rng).transpose() * random_frame(rng);
+    float m[9];
+    for (int i = 0; i < 9; ++i) m[i] = float(M(i / 3, i % 3));
+    for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal})
+      for (int r = 0; r < H; ++r) {
+        const auto [c0, c1] = disc_span(r, W, H);
+        f(kind, M, m, r, c0, c1);
+      }
+  }
+}
+
 TEST(Warp, WarpDirectionAgreesBitwiseWithCoreInverses) {
   for (const Vec3& d : random_directions(2000, 1)) {
     const WarpSample m = warp_direction(CentralDirection::Mirror, d);
@@ -149,35 +166,27 @@ TEST(Warp, RowWarpAgreesWithWarpDirectionToFloatRounding) {
     int differing_blocks = 0;
     const PrecomputedWarp pre(W, H);
     const ExactWarp exact;
-    for (int trial = 0; trial < 10; ++trial) {
-      const Mat3 M = random_frame(rng).transpose() * random_frame(rng);
-      float m[9];
-      for (int i = 0; i < 9; ++i) m[i] = float(M(i / 3, i % 3));
-      for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal})
-        for (int r = 0; r < H; ++r) {
-          const auto [c0, c1] = disc_span(r, W, H);
-          const int n = c1 - c0;
-          const std::size_t count = std::size_t(n);
-          std::vector<float> x(count), y(count), z(count), dx(count), dy(count), rim(count);
-          central_directions_row(kind, W, H, r, c0, c1, x.data(), y.data(), z.data());
-          warp_directions(kind, m, n, x.data(), y.data(), z.data(), dx.data(), dy.data(), rim.data());
-          for (int i = 0; i < n; ++i) {
-            const Vec3 dir = central_direction(kind, sphere_map::disc_from_pixel(Vec2(c0 + i, r), W, H));
-            worst_dir =
-                std::max(worst_dir, (dir - Vec3(x[std::size_t(i)], y[std::size_t(i)], z[std::size_t(i)])).norm());
-            const WarpSample s = warp_direction(kind, M * dir);
-            worst_rim = std::max(worst_rim, std::abs(s.rim - rim[std::size_t(i)]));
-            // Conditioning: d disc / d direction ~ 1 / (2 rim) (mirror), 1 / |n_xy| (normal behind).
-            const double cond = std::max(
-                kind == CentralDirection::Normal && s.rim < 0 ? (M * dir).head<2>().norm() : std::abs(s.rim), 1e-3);
-            worst_disc = std::max(worst_disc, cond * (s.disc - Vec2(dx[std::size_t(i)], dy[std::size_t(i)])).norm());
-          }
-          std::vector<float> ex(count), ey(count), er(count), px(count), py(count), pr(count);
-          exact.warp_block(kind, M, W, H, r, c0, c1, ex.data(), ey.data(), er.data());
-          pre.warp_block(kind, M, W, H, r, c0, c1, px.data(), py.data(), pr.data());
-          differing_blocks += ex != px || ey != py || er != pr;
-        }
-    }
+    for_each_row_warp(rng, 10, W, H, [&](CentralDirection kind, const Mat3& M, const float* m, int r, int c0, int c1) {
+      const int n = c1 - c0;
+      const std::size_t count = std::size_t(n);
+      std::vector<float> x(count), y(count), z(count), dx(count), dy(count), rim(count);
+      central_directions_row(kind, W, H, r, c0, c1, x.data(), y.data(), z.data());
+      warp_directions(kind, m, n, x.data(), y.data(), z.data(), dx.data(), dy.data(), rim.data());
+      for (int i = 0; i < n; ++i) {
+        const Vec3 dir = central_direction(kind, sphere_map::disc_from_pixel(Vec2(c0 + i, r), W, H));
+        worst_dir = std::max(worst_dir, (dir - Vec3(x[std::size_t(i)], y[std::size_t(i)], z[std::size_t(i)])).norm());
+        const WarpSample s = warp_direction(kind, M * dir);
+        worst_rim = std::max(worst_rim, std::abs(s.rim - rim[std::size_t(i)]));
+        // Conditioning: d disc / d direction ~ 1 / (2 rim) (mirror), 1 / |n_xy| (normal behind).
+        const double cond = std::max(
+            kind == CentralDirection::Normal && s.rim < 0 ? (M * dir).head<2>().norm() : std::abs(s.rim), 1e-3);
+        worst_disc = std::max(worst_disc, cond * (s.disc - Vec2(dx[std::size_t(i)], dy[std::size_t(i)])).norm());
+      }
+      std::vector<float> ex(count), ey(count), er(count), px(count), py(count), pr(count);
+      exact.warp_block(kind, M, W, H, r, c0, c1, ex.data(), ey.data(), er.data());
+      pre.warp_block(kind, M, W, H, r, c0, c1, px.data(), py.data(), pr.data());
+      differing_blocks += ex != px || ey != py || er != pr;
+    });
     std::printf("[ row warp %dx%d ] direction %.2e, rim %.2e, disc x rim %.2e\n", W, H, worst_dir, worst_rim,
                 worst_disc);
     // float: 2^-24 = 6e-8 per rounding; a handful of roundings per result.
@@ -205,24 +214,17 @@ TEST(Warp, CentralBlockThenRotationEqualsWarpBlockToTheBit) {
     const ExactWarp exact;
     const PrecomputedWarp pre(W, H);
     int compared = 0;
-    for (int trial = 0; trial < 4; ++trial) {
-      const Mat3 M = random_frame(rng).transpose() * random_frame(rng);
-      float m[9];
-      for (int i = 0; i < 9; ++i) m[i] = float(M(i / 3, i % 3));
-      for (CentralDirection kind : {CentralDirection::Mirror, CentralDirection::Normal})
-        for (int r = 0; r < H; ++r) {
-          const auto [c0, c1] = disc_span(r, W, H);
-          const std::size_t n = std::size_t(std::max(0, c1 - c0));
-          for (const Warp* warp : {static_cast<const Warp*>(&exact), static_cast<const Warp*>(&pre)}) {
-            std::vector<float> x(n), y(n), z(n), a(n), b(n), c(n), p(n), q(n), s(n);
-            ASSERT_TRUE(warp->central_block(kind, W, H, r, c0, c1, x.data(), y.data(), z.data())) << warp->name();
-            warp_directions(kind, m, int(n), x.data(), y.data(), z.data(), a.data(), b.data(), c.data());
-            warp->warp_block(kind, M, W, H, r, c0, c1, p.data(), q.data(), s.data());
-            ASSERT_TRUE(a == p && b == q && c == s) << warp->name() << " row " << r;
-            compared += int(n);
-          }
-        }
-    }
+    for_each_row_warp(rng, 4, W, H, [&](CentralDirection kind, const Mat3& M, const float* m, int r, int c0, int c1) {
+      const std::size_t n = std::size_t(std::max(0, c1 - c0));
+      for (const Warp* warp : {static_cast<const Warp*>(&exact), static_cast<const Warp*>(&pre)}) {
+        std::vector<float> x(n), y(n), z(n), a(n), b(n), c(n), p(n), q(n), s(n);
+        ASSERT_TRUE(warp->central_block(kind, W, H, r, c0, c1, x.data(), y.data(), z.data())) << warp->name();
+        warp_directions(kind, m, int(n), x.data(), y.data(), z.data(), a.data(), b.data(), c.data());
+        warp->warp_block(kind, M, W, H, r, c0, c1, p.data(), q.data(), s.data());
+        ASSERT_TRUE(a == p && b == q && c == s) << warp->name() << " row " << r;
+        compared += int(n);
+      }
+    });
     EXPECT_GT(compared, 4 * 2 * 2 * W * H / 2);
   }
   const TessellatedWarp mesh(32, 32);
