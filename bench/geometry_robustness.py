@@ -138,7 +138,7 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build/release"))
     ap.add_argument("--work", default="/tmp/rsibr-geometry")
     ap.add_argument("--keep", action="store_true", help="keep the shoots and runs under --work")
-    ap.add_argument("--only", nargs="*", help="shoots to run (default: all)")
+    ap.add_argument("--only", nargs="*", help="shoots to run (default: all); their rows are printed, docs/ left as it is")
     args = ap.parse_args()
     rsibr = os.path.join(args.build, "rsibr")
     measure = os.path.join(args.build, "rsibr_geometry_robustness")
@@ -214,6 +214,9 @@ def main():
                 notes.append("- %s, %s: %s" % (m["name"], k if k != "*" else "view", w))
     if notes:
         lines += ["", "Balls and views left out, as the runs report them:", ""] + notes
+    if args.only:  # the section's table holds every shoot of one run: a partial run only prints its rows
+        print("\n".join(lines))
+        return
     replace_section(os.path.join(ROOT, "docs", "tradeoffs.md"), "Robust geometry (rsibr process on shoots)", "\n".join(lines))
 
 
