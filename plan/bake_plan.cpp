@@ -434,4 +434,31 @@ BakeCheck check_bake(const MapSet& set, const ViewSet& view_set, const EnvMap& e
   return c;
 }
 
+BudgetCheck check_bake_for_budget(const MapSet& set, const ViewSet& view_set, const EnvMap& env, const Brdf& brdf,
+                                  std::uint64_t seed, double budget, const BakeCheckOptions& o) {
+  if (!(budget > 0)) throw std::invalid_argument("check: the error budget must be > 0");
+  if (o.views < 1 || o.max_views < o.views || o.texels < 1 || !(o.sigmas >= 0))
+    throw std::invalid_argument("check: views >= 1, max_views >= views, texels >= 1 and sigmas >= 0 are needed");
+  BudgetCheck out;
+  for (int views = o.views;; views = std::min(2 * views, o.max_views)) {
+    out.check = check_bake(set, view_set, env, brdf, seed + std::uint64_t(out.rounds), views, o.texels, o.size);
+    out.seconds += out.check.seconds;
+    ++out.rounds;
+    const double e = out.check.error, s = out.check.error_sigma;
+    if (e + o.sigmas * s <= budget) {
+      out.verdict = "meets";
+      break;
+    }
+    if (e - o.sigmas * s > budget) {
+      out.verdict = "exceeds";
+      break;
+    }
+    if (s <= o.target_sigma * budget || views >= o.max_views) {
+      out.verdict = "undecided";
+      break;
+    }
+  }
+  return out;
+}
+
 }  // namespace rsibr

@@ -95,6 +95,12 @@ same = lambda c: {k: v for k, v in c.items() if k != 'predicted_seconds'}  # a t
 assert same(b['plan']['chosen']) == same(p['chosen']), (b['plan']['chosen'], p['chosen'])
 k = b['check']
 assert k['error'] >= 0 and k['error_sigma'] >= 0 and k['meets'] == (k['error'] <= 0.05), k
+# The check's rounds: 8 views, then twice as many, until its rule decides.
+assert k['rounds'] >= 1 and k['views'] == min(64, 8 << (k['rounds'] - 1)), k
+e, s = k['error'], k['error_sigma']
+rule = 'meets' if e + 2 * s <= 0.05 else 'exceeds' if e - 2 * s > 0.05 else 'undecided'
+assert k['verdict'] == rule, k
+assert k['verdict'] != 'undecided' or s <= 0.005 or k['views'] == 64, k
 " "$work/plan.json" "$work/planned.json"
 # bake --lobe: each part of a clear coat is its own set, warped from the part's central direction.
 check "bake --help mentions --lobe" bash -c "'$rsibr' bake --help | grep -q -- --lobe"

@@ -60,6 +60,51 @@ TEST(BakePlan, ThePlannedSettingMeetsItsBudgetAtFreshNovelViews) {
   }
 }
 
+// The budget check decides: far under or over the budget one round settles it; at the budget (the
+// first round's own estimate) it takes rounds of twice the views, and its verdict follows its rule
+// on the last round's numbers.
+TEST(BakePlan, TheBudgetCheckTakesMoreViewsOnlyWhereTheAnswerIsClose) {
+  const EnvMap env = sky(Vec3(0.3, 0.7, 0.4), 32);
+  const auto brdf = parse_brdf("{type: ggx, roughness: 0.4, fresnel: {type: schlick, f0: [0.9, 0.7, 0.5]}}");
+  BakeSetting setting;
+  setting.views = "icosa";
+  setting.res = 16;
+  setting.integrator = {"reference", 0, 16};
+  const MapSet set = bake(env, *brdf, setting);
+  const ViewSet views = ViewSet::named("icosa");
+  BakeCheckOptions o;
+  o.texels = 24;
+  o.size = 32;
+  o.max_views = 32;
+  const BakeCheck first = check_bake(set, views, env, *brdf, 5, o.views, o.texels, o.size);
+  ASSERT_GT(first.error, 0.0);
+  ASSERT_GT(first.error_sigma, 0.0);
+
+  const BudgetCheck easy = check_bake_for_budget(set, views, env, *brdf, 5, 10 * first.error, o);
+  EXPECT_EQ(easy.verdict, "meets");
+  EXPECT_EQ(easy.rounds, 1);
+  EXPECT_EQ(easy.check.error, first.error);  // round 0 is check_bake with the same seed
+  const BudgetCheck hard = check_bake_for_budget(set, views, env, *brdf, 5, 0.1 * first.error, o);
+  EXPECT_EQ(hard.verdict, "exceeds");
+  EXPECT_EQ(hard.rounds, 1);
+
+  const BudgetCheck close = check_bake_for_budget(set, views, env, *brdf, 5, first.error, o);
+  EXPECT_GE(close.rounds, 2);
+  EXPECT_EQ(close.check.views, std::min(o.max_views, o.views << (close.rounds - 1)));
+  const double e = close.check.error, sd = close.check.error_sigma, b = first.error;
+  const std::string rule = e + 2 * sd <= b ? "meets" : e - 2 * sd > b ? "exceeds" : "undecided";
+  EXPECT_EQ(close.verdict, rule) << e << " +- " << sd << " against " << b;
+  if (close.verdict == "undecided") {
+    EXPECT_TRUE(sd <= 0.1 * b || close.check.views == o.max_views);
+  }
+  EXPECT_GE(close.seconds, close.check.seconds);
+
+  BakeCheckOptions bad = o;
+  bad.max_views = 4;
+  EXPECT_THROW(check_bake_for_budget(set, views, env, *brdf, 5, 0.02, bad), std::invalid_argument);
+  EXPECT_THROW(check_bake_for_budget(set, views, env, *brdf, 5, 0.0, o), std::invalid_argument);
+}
+
 TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
   const EnvMap env = sky(Vec3(0.1, 0.9, -0.3), 64);
   const auto brdf = parse_brdf("{type: ggx, roughness: 0.5, fresnel: {type: schlick, f0: [0.9, 0.8, 0.6]}}");
