@@ -31,26 +31,25 @@ Mat3 kabsch(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
 
 OrientationSolution solve_orientations(int views, int features, const std::vector<DirectionObservation>& obs,
                                        const OrientationOptions& options) {
-  if (views < 2) throw std::invalid_argument("orientation: " + std::to_string(views) + " view(s), need at least 2");
+  if (views < 2) throw OrientationError(-1, std::to_string(views) + " view(s), need at least 2");
   for (const auto& o : obs)
     if (o.view < 0 || o.view >= views || o.feature < 0 || o.feature >= features || !(o.sigma > 0) ||
         !o.direction.allFinite() || std::abs(o.direction.norm() - 1) > 1e-6)
-      throw std::invalid_argument("orientation: invalid observation (view " + std::to_string(o.view) + ", feature " +
-                                  std::to_string(o.feature) + ")");
+      throw OrientationError(o.view, "invalid observation (feature " + std::to_string(o.feature) + ")");
   std::vector<std::map<int, Vec3>> seen(views);  // per view: feature -> direction
   if (!options.balls.empty()) {
     if (static_cast<int>(options.balls.size()) != views)
-      throw std::invalid_argument("orientation: ball priors must be given for every view or none");
+      throw OrientationError(-1, "ball priors must be given for every view or none");
     for (const BallPrior& b : options.balls)
       if (!b.axis.allFinite() || std::abs(b.axis.norm() - 1) > 1e-6 || !(b.half_angle > 0 && b.half_angle < kPi / 2) ||
           !(b.sigma_axis > 0) || !std::isfinite(b.sigma_axis) || !(b.sigma_half_angle >= 0) ||
           !std::isfinite(b.sigma_half_angle))
-        throw std::invalid_argument("orientation: invalid ball prior");
+        throw OrientationError(-1, "invalid ball prior");
   }
   for (const auto& o : obs) seen[o.view][o.feature] = o.direction;
   const bool fixed = !options.fixed_world_from_cam.empty();
   if (fixed && static_cast<int>(options.fixed_world_from_cam.size()) != views)
-    throw std::invalid_argument("orientation: fixed rotations must be given for every view or none");
+    throw OrientationError(-1, "fixed rotations must be given for every view or none");
 
   // Start: place views one by one against the world directions known so far (view 0 is the gauge).
   std::vector<Mat3> r(views, Mat3::Identity());
@@ -84,10 +83,9 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
     }
     if (best_v < 0) break;
     if (best_shared.size() < 3) {
-      const std::string why = "orientation: view " + std::to_string(best_v) + " shares " +
-                              std::to_string(best_shared.size()) +
-                              " feature(s) with the other views; need at least 3 to orient it";
-      if (!options.leave_out_unplaced) throw std::invalid_argument(why);
+      if (!options.leave_out_unplaced)
+        throw OrientationError(best_v, "shares " + std::to_string(best_shared.size()) +
+                                           " feature(s) with the other views; need at least 3 to orient it");
       // The view sharing the most cannot be placed: neither can the rest.
       for (int v = 0; v < views; ++v)
         if (!placed[v] && !dropped[v]) {
@@ -112,8 +110,7 @@ OrientationSolution solve_orientations(int views, int features, const std::vecto
     }
     if (best_in.size() < 3) {
       const std::string why = "no rotation agrees with 3 or more shared features";
-      if (!options.leave_out_unplaced)
-        throw std::invalid_argument("orientation: view " + std::to_string(v) + ": " + why);
+      if (!options.leave_out_unplaced) throw OrientationError(v, why);
       dropped[v] = 1;
       left_out[v] = why;
       continue;

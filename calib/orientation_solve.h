@@ -20,10 +20,29 @@
 
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace rsibr {
+
+// An input the solve cannot use, kept as data: the view it concerns (its index in the solve's
+// order; -1 when it concerns none) and the problem; callers name the view in their own terms.
+// what() = "orientation: [view <index>: ]<problem>". An std::invalid_argument: the input is at fault.
+class OrientationError : public std::invalid_argument {
+ public:
+  OrientationError(int view, const std::string& problem)
+      : std::invalid_argument("orientation: " + (view >= 0 ? "view " + std::to_string(view) + ": " : std::string()) +
+                              problem),
+        view_(view),
+        problem_(problem) {}
+  int view() const noexcept { return view_; }
+  const std::string& problem() const noexcept { return problem_; }
+
+ private:
+  int view_;
+  std::string problem_;
+};
 
 struct DirectionObservation {
   int view = 0, feature = 0;

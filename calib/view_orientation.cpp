@@ -4,28 +4,19 @@
 
 #include <algorithm>
 #include <cmath>
-#include <regex>
 #include <stdexcept>
 
 namespace rsibr {
 
 namespace {
 
-// "view 3" in the solver's messages -> "view 'name'".
-std::string with_names(const std::string& what, const std::vector<std::string>& names) {
-  std::string out;
-  const std::regex re("view (\\d+)");
-  auto it = std::sregex_iterator(what.begin(), what.end(), re);
-  std::size_t last = 0;
-  for (; it != std::sregex_iterator(); ++it) {
-    const std::size_t v = std::stoul((*it)[1].str());
-    out += what.substr(last, it->position() - last);
-    out += v < names.size() ? "view '" + names[v] + "'" : it->str();
-    last = it->position() + it->length();
-  }
-  out += what.substr(last);
-  if (out.rfind("orientation: ", 0) == 0) out = "orient: " + out.substr(13);
-  return out;
+// The solve's error in the user's terms: the view's name for its index.
+std::invalid_argument named(const OrientationError& e, const std::vector<std::string>& names) {
+  std::string view;
+  if (e.view() >= 0)
+    view = std::size_t(e.view()) < names.size() ? "view '" + names[std::size_t(e.view())] + "': "
+                                                : "view " + std::to_string(e.view()) + ": ";
+  return std::invalid_argument("orient: " + view + e.problem());
 }
 
 }  // namespace
@@ -233,8 +224,8 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
     OrientationSolution first;
     try {
       first = solve_orientations(static_cast<int>(names.size()), tracks, obs, probe);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(with_names(e.what(), names));
+    } catch (const OrientationError& e) {
+      throw named(e, names);
     }
     std::vector<char> keep = first.oriented;
     if (std::count(keep.begin(), keep.end(), 1) == static_cast<long>(keep.size())) {
@@ -278,8 +269,8 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
         s = solve_orientations(nv, tracks, refined, so);
       }
     }
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(with_names(e.what(), names));
+  } catch (const OrientationError& e) {
+    throw named(e, names);
   }
   if (options.refine_balls)
     for (std::size_t v = 0; v < n; ++v) {

@@ -162,8 +162,17 @@ TEST(OrientationSolve, TooFewViewsOrNoSharedFeaturesAreClearErrors) {
   try {
     solve_orientations(2, 20, obs);
     FAIL();
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("view 1 shares 0 feature"), std::string::npos) << e.what();
+  } catch (const OrientationError& e) {  // the view as data, for the caller to name
+    EXPECT_EQ(e.view(), 1);
+    EXPECT_EQ(e.problem().rfind("shares 0 feature(s)", 0), 0u) << e.problem();
+    EXPECT_EQ(std::string(e.what()), "orientation: view 1: " + e.problem());
+  }
+  try {
+    solve_orientations(1, 400, t.obs);
+    FAIL();
+  } catch (const OrientationError& e) {  // concerns no view
+    EXPECT_EQ(e.view(), -1);
+    EXPECT_EQ(std::string(e.what()), "orientation: " + e.problem());
   }
 }
 
