@@ -290,7 +290,7 @@ void fallback(const Source* const* sources, int n, const WarpOf& warp_of, float*
   for (int j = 0; j < 3; ++j) out[j] = ok ? float(L[j]) : 0.0f;
 }
 
-// --- Row forms of the kernel (vectorised, also for AVX2). ---
+// --- Row forms of the kernel (vectorised, also for AVX2 and AVX-512). ---
 
 // The footprint of disc point (x, y) for a source weight a: the offset of its top-left tap (>= 0
 // when all four taps are valid, inside the grid's interior radius; kRim otherwise; kSkip where a
@@ -359,16 +359,16 @@ inline float contribute(const Source& s, const Taps& t, float a, float x, float 
 }
 
 // The source weights a = weight * fade(rim) and taps() for a row of points, structure of arrays (one
-// loop that vectorises, also for AVX2).
+// loop that vectorises, also for AVX2 and AVX-512).
 constexpr int kTileCols = 64;  // destination texels per tile row
 struct TapRows {
   int offset[kTileCols];
   float fx[kTileCols], ya[kTileCols], yb[kTileCols];
   Taps at(int i) const { return {offset[i], fx[i], ya[i], yb[i]}; }
 };
-RSIBR_AVX2_CLONES void taps_row(const Source::Grid& grid, int n, float weight, float inv_fade,
-                                const float* __restrict x, const float* __restrict y, const float* __restrict rim,
-                                float* __restrict a, TapRows& out) {
+RSIBR_AVX512_CLONES void taps_row(const Source::Grid& grid, int n, float weight, float inv_fade,
+                                  const float* __restrict x, const float* __restrict y, const float* __restrict rim,
+                                  float* __restrict a, TapRows& out) {
   const Source::Grid g = grid;  // a local: the stores below could otherwise alias it
   for (int i = 0; i < n; ++i) {
     const float ai = faded(weight, rim[i], inv_fade);
@@ -383,8 +383,8 @@ RSIBR_AVX2_CLONES void taps_row(const Source::Grid& grid, int n, float weight, f
 
 // finish() for a row of n texels: out (RGB), out_w; the texels whose total is not > 0 get weight 0
 // and are listed in `missing` for the fallback (their count returned). The same arithmetic as finish.
-RSIBR_AVX2_CLONES int finish_row(int n, const v4f* __restrict acc, float* __restrict out, float* __restrict out_w,
-                                 int* __restrict missing) {
+RSIBR_AVX512_CLONES int finish_row(int n, const v4f* __restrict acc, float* __restrict out, float* __restrict out_w,
+                                   int* __restrict missing) {
   float inv[kTileCols];
   for (int i = 0; i < n; ++i) {
     const float total = acc[i][3];
@@ -420,8 +420,8 @@ inline void gather_row_t(const Source& s, int n, const float* a, const float* x,
     if (kSourceWeight) source_weight[i] = c;
   }
 }
-RSIBR_AVX2_CLONES void gather_row(const Source& s, int n, const float* a, const float* x, const float* y,
-                                  const TapRows& t, v4f* acc, float* source_weight) {
+RSIBR_AVX512_CLONES void gather_row(const Source& s, int n, const float* a, const float* x, const float* y,
+                                    const TapRows& t, v4f* acc, float* source_weight) {
   const bool conf = !s.confidence.empty();
   if (source_weight)
     conf ? gather_row_t<true, true>(s, n, a, x, y, t, acc, source_weight)

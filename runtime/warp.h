@@ -52,7 +52,7 @@ std::pair<int, int> disc_span(int row, int width, int height);
 
 // Structure-of-arrays forms of the exact warp in single precision, for the blend engine's row loops
 // (runtime/blend_engine.h) that the compiler vectorises (no branches, no calls per texel; 8 texels a
-// vector with AVX2).
+// vector with AVX2, 16 with AVX-512, the same bits on every path).
 //   central_directions_row: the central directions of `kind` (the destination's own frame) of the
 //     destination texels (c, row), c in [c_begin, c_end): out_x/y/z[c - c_begin], the arithmetic of
 //     g_normal / g_mirror in float. The texel centres must lie inside the disc (within disc_span).
