@@ -68,8 +68,8 @@ std::pair<int, int> disc_span(int row, int width, int height) {
 // Computed in double and rounded once: for texels near the rim, z = sqrt(1 - x^2 - y^2) cancels, and
 // float's x alone would move z (and the mirror direction) by ~1e-5 at 129^2.
 RSIBR_AVX512_CLONES void central_directions_row(CentralDirection kind, int width, int height, int row, int c_begin,
-                                              int c_end, float* __restrict out_x, float* __restrict out_y,
-                                              float* __restrict out_z) {
+                                                int c_end, float* __restrict out_x, float* __restrict out_y,
+                                                float* __restrict out_z) {
   const double y = 1.0 - (2.0 * row + 1.0) / height;
   const double inv_w = 1.0 / width;
   const int n = c_end - c_begin;
@@ -92,8 +92,8 @@ RSIBR_AVX512_CLONES void central_directions_row(CentralDirection kind, int width
 // Also built for AVX2 (8 floats a vector; chosen at load time where the CPU has it). No FMA: the
 // results are the same to the bit on either path.
 RSIBR_AVX512_CLONES void warp_directions(CentralDirection kind, const float m[9], int n, const float* __restrict x,
-                                       const float* __restrict y, const float* __restrict z, float* __restrict disc_x,
-                                       float* __restrict disc_y, float* __restrict rim) {
+                                         const float* __restrict y, const float* __restrict z, float* __restrict disc_x,
+                                         float* __restrict disc_y, float* __restrict rim) {
   const float m0 = m[0], m1 = m[1], m2 = m[2], m3 = m[3], m4 = m[4], m5 = m[5], m6 = m[6], m7 = m[7], m8 = m[8];
   if (kind == CentralDirection::Mirror) {
     for (int i = 0; i < n; ++i) {
