@@ -193,9 +193,10 @@ BakeCheck check_bake(const MapSet& set, const ViewSet& view_set, const EnvMap& e
 //   error - sigmas * sigma >  budget  -> "exceeds"
 //   sigma <= target_sigma * budget, or max_views reached -> "undecided" (at the budget within its
 //   standard error; `error` is still the best estimate)
-// A check of a few views is only good to 15-20% of a 2% budget (a sun's glint sits in few of
-// them), so a fixed small check passes or fails a setting at the budget by chance; the rounds
-// spend views only where the answer is close. Cost: about twice the last round.
+// A check of a few views scatters widely near the budget (a sun's glint sits in few of them;
+// docs/tradeoffs.md, "Planning for an error budget"), so a fixed small check passes or fails a
+// setting at the budget by chance; the rounds spend views only where the answer is close. Cost:
+// about twice the last round.
 struct BakeCheckOptions {
   int views = 8;
   int texels = 96;
