@@ -484,6 +484,20 @@ std::vector<int> assign_balls_in_view(const std::vector<BallCandidate>& cands, c
   return best;
 }
 
+RigSuspects rig_suspects(const std::vector<double>& disagreement, const RigSuspectOptions& options) {
+  RigSuspects out;
+  out.suspect.assign(disagreement.size(), 0);
+  std::vector<double> checked;
+  for (double d : disagreement)
+    if (d >= 0) checked.push_back(d);
+  if (checked.size() < 3) return out;
+  std::nth_element(checked.begin(), checked.begin() + checked.size() / 2, checked.end());
+  out.median = checked[checked.size() / 2];
+  out.limit = std::max(options.radii, options.median_factor * out.median);
+  for (std::size_t v = 0; v < disagreement.size(); ++v) out.suspect[v] = disagreement[v] > out.limit;
+  return out;
+}
+
 BallCone predicted_cone(const BallCone& chrome, const Mat3& world_from_cam, const Vec3& offset, double scale) {
   const Vec3 b = centre_in_radii(chrome) + world_from_cam.transpose() * offset;  // chrome radii, camera frame
   BallCone cone;

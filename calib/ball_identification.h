@@ -178,6 +178,24 @@ std::vector<BallFinding> identify_view_balls(const ViewBalls& view, const std::v
                                              const LensModel& lens, const RigOptions& rig_options = {},
                                              const BallSearchOptions& search = {}, bool trust_view = false);
 
+// Views whose balls disagree with the rig. A chrome outline found on a reflection's edge inside the
+// rim (a bright limb against a bright background) moves the ball's centre a few pixels, and the
+// orientation solve turns the view by degrees to match its features, with a small sigma: its other
+// balls then lie far from where the rig puts them. Per view its largest disagreement (chrome radii;
+// < 0: none checked) -> per view whether it is suspect: farther than max(radii, median_factor x the
+// median of the checked views), when 3 or more were checked. Why these numbers: docs/tradeoffs.md,
+// "Robust geometry".
+struct RigSuspectOptions {
+  double radii = 0.25;
+  double median_factor = 4;
+};
+struct RigSuspects {
+  std::vector<char> suspect;
+  double median = -1;  // of the checked views (-1: fewer than 3)
+  double limit = -1;
+};
+RigSuspects rig_suspects(const std::vector<double>& disagreement, const RigSuspectOptions& options = {});
+
 // The cone of a ball at `offset` (world, chrome radii) and radius `scale` from the chrome cone of a view.
 BallCone predicted_cone(const BallCone& chrome, const Mat3& world_from_cam, const Vec3& offset, double scale);
 

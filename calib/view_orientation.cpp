@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace rsibr {
@@ -35,13 +36,18 @@ Mat3 gauge_world_from_first_cam(const std::optional<Vec3>& up) {
   return cam_from_world.transpose();
 }
 
-WorldUp level_pose_set(PoseSet& poses, const WorldUpOptions& options, const std::vector<VerticalLine>& lines) {
+WorldUp level_pose_set(PoseSet& poses, const WorldUpOptions& options, const std::vector<VerticalLine>& lines,
+                       const std::vector<char>& in_estimate) {
   if (poses.views.empty()) throw std::invalid_argument("level: no views");
+  if (!in_estimate.empty() && in_estimate.size() != poses.views.size())
+    throw std::invalid_argument("level: in_estimate must be given for every view or none");
   std::vector<Mat3> r;
-  for (const ViewPose& v : poses.views) r.push_back(v.world_from_cam);
+  for (std::size_t v = 0; v < poses.views.size(); ++v)
+    if (in_estimate.empty() || in_estimate[v]) r.push_back(poses.views[v].world_from_cam);
+  if (r.empty()) throw std::invalid_argument("level: no view joins the estimate");
   WorldUp wu = estimate_world_up(r, lines, options);
   // Up in the first camera's frame; the new world from the first camera is the gauge's.
-  const Mat3 first_from_world = r.front().transpose();
+  const Mat3 first_from_world = poses.views.front().world_from_cam.transpose();
   wu.up = (first_from_world * wu.up).normalized();
   const Mat3 new_from_old = gauge_world_from_first_cam(wu.up) * first_from_world;
   for (ViewPose& v : poses.views) v.world_from_cam = new_from_old * v.world_from_cam;
@@ -294,10 +300,45 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
     if (options.refine_balls) out.views.back().ball = rep.balls[v].fit.cone;
   }
   // The solve's world is the first oriented camera's frame: levelled by the estimated up, with the
-  // stands under the chrome balls as vertical lines where they show.
+  // stands under the chrome balls as vertical lines where they show; views whose balls disagree
+  // with the rig stay out of it.
   if (known.empty() && !options.up && options.estimate_up) {
+    rep.rig_disagreement.assign(n, -1.0);
+    rep.rig_suspect.assign(n, 0);
+    const bool other_balls =
+        std::count_if(balls.begin(), balls.end(), [](const ListedBall& b) { return b.kind != BallKind::chrome; }) > 0;
+    if (options.rig_check && other_balls && n >= 3) {
+      std::vector<ViewBalls> vb(n);
+      std::vector<std::size_t> image_of(n);
+      for (std::size_t v = 0; v < n; ++v) {
+        image_of[v] = std::size_t(std::find(all_names.begin(), all_names.end(), names[v]) - all_names.begin());
+        vb[v].name = names[v];
+        if (searched[image_of[v]]) vb[v].candidates = searched[image_of[v]]->cands;
+        vb[v].chrome = rep.balls[v].fit.cone;
+        vb[v].world_from_cam = s.world_from_cam[v];
+      }
+      const std::vector<RigMember> rig = fit_ball_rig(vb, balls);
+      for (std::size_t v = 0; v < n; ++v) {
+        if (vb[v].candidates.empty()) continue;
+        for (const BallFinding& f : identify_view_balls(vb[v], rig, balls, all_views[image_of[v]].radiance, lens))
+          if (f.found() && f.disagreement > 0)
+            rep.rig_disagreement[v] = std::max(rep.rig_disagreement[v], f.disagreement);
+      }
+      const RigSuspects sus = rig_suspects(rep.rig_disagreement, options.rig_suspect);
+      rep.rig_suspect = sus.suspect;
+      for (std::size_t v = 0; v < n; ++v)
+        if (rep.rig_suspect[v]) {
+          char note[220];
+          std::snprintf(note, sizeof note,
+                        "its other balls lie %.2f chrome radii from where the rig puts them (median of the views "
+                        "%.2f): its chrome ball or its rotation is off; left out of the world-up estimate",
+                        rep.rig_disagreement[v], sus.median);
+          rep.notes.push_back(names[v] + ": " + note);
+        }
+    }
     std::vector<VerticalLine> lines;
     for (std::size_t v = 0; v < n && options.stand_lines; ++v) {
+      if (rep.rig_suspect[v]) continue;
       const std::size_t i = std::size_t(std::find(all_names.begin(), all_names.end(), names[v]) - all_names.begin());
       if (const auto line = find_stand_line(all_views[i].radiance, lens, rep.balls[v].fit.cone, options.stand))
         lines.push_back({s.world_from_cam[v] * line->plane_normal, line->sigma_deg, names[v] + ": stand"});
@@ -305,7 +346,9 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
     // One stand seen from every view: its tilt is common to all its lines.
     for (VerticalLine& l : lines)
       l.sigma_deg = std::max(l.sigma_deg, options.stand.verticality_deg * std::sqrt(double(lines.size())));
-    rep.world_up = level_pose_set(out, options.up_options, lines);
+    std::vector<char> in_estimate(n);
+    for (std::size_t v = 0; v < n; ++v) in_estimate[v] = !rep.rig_suspect[v];
+    rep.world_up = level_pose_set(out, options.up_options, lines, in_estimate);
   }
   if (report) *report = rep;
   return out;

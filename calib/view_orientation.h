@@ -73,6 +73,11 @@ struct ViewOrientationOptions {
   // in docs/tradeoffs.md, "Orientation" and "Measured choices in the code".
   bool refine_tracks = true;
   TrackRefinementOptions tracks;
+  // With estimate_up and other listed balls: each view's other balls checked against the rig fitted
+  // on all views; a suspect view (calib/ball_identification.h, rig_suspects) is left out of the
+  // world-up estimate and noted.
+  bool rig_check = true;
+  RigSuspectOptions rig_suspect;
   OrientationOptions solve;  // its first_world_from_cam is set from the gauge
 };
 
@@ -88,6 +93,11 @@ struct ViewOrientationReport {
   int tracks = 0, observations = 0, inliers = 0;
   double rms_sigmas = 0;
   TrackRefinementReport track_refinement;  // zero when tracks were not re-located
+  // Per view oriented: the largest distance (chrome radii) of its other listed balls from where the
+  // rig fitted on all views puts them (calib/ball_identification.h), -1 where none was checked; and
+  // whether that makes it a view left out of the world-up estimate (ViewOrientationOptions::rig_check).
+  std::vector<double> rig_disagreement;
+  std::vector<char> rig_suspect;
 };
 
 // The world_from_cam of the first view for the gauge (identity without `up`). Throws
@@ -99,7 +109,10 @@ Mat3 gauge_world_from_first_cam(const std::optional<Vec3>& up);
 // so that it is +Y and the first view's forward axis, made horizontal, is +Z (the "up" gauge with
 // the estimated up); gauge becomes "estimated-up". Returns the estimate, up in the first view's
 // camera frame. Throws std::invalid_argument for an empty set.
-WorldUp level_pose_set(PoseSet& poses, const WorldUpOptions& options = {}, const std::vector<VerticalLine>& lines = {});
+// `in_estimate`: per view, whether its rotation joins the estimate (empty: every view); every view
+// is levelled.
+WorldUp level_pose_set(PoseSet& poses, const WorldUpOptions& options = {}, const std::vector<VerticalLine>& lines = {},
+                       const std::vector<char>& in_estimate = {});
 
 // The cone to extract a located ball with: the pose's refined chrome ball (ViewPose::ball) when it is
 // the same ball (its centre's pixel within half the located radius of the located centre), else the

@@ -297,5 +297,28 @@ TEST(BallIdentification, ThePredictedConeOfATrueOffsetIsTheTrueCone) {
   EXPECT_NEAR(std::sin(g.half_angle), 0.04 / grey_cam.norm(), 1e-12);
 }
 
+// rig_suspects: a view is suspect beyond max(0.25 chrome radii, 4 x the checked views' median);
+// unchecked views (< 0) never are; with fewer than 3 checked views nothing is judged; a rig that
+// every view fits loosely (a high median) leaves every view in.
+TEST(BallIdentification, RigSuspectsAreTheViewsFarBeyondTheMedianDisagreement) {
+  const RigSuspects s = rig_suspects({0.05, 0.61, 0.06, 0.44, 0.07, 0.04, 0.08, 0.05, -1.0});
+  EXPECT_DOUBLE_EQ(s.median, 0.07);  // of the 8 checked: the upper middle value
+  EXPECT_DOUBLE_EQ(s.limit, 4 * 0.07);
+  EXPECT_EQ(s.suspect, (std::vector<char>{0, 1, 0, 1, 0, 0, 0, 0, 0}));
+  const RigSuspects at_limit = rig_suspects({0.25, 0.05, 0.05, 0.05, 0.05, 0.2501});
+  EXPECT_DOUBLE_EQ(at_limit.limit, 0.25);
+  EXPECT_EQ(at_limit.suspect, (std::vector<char>{0, 0, 0, 0, 0, 1}));
+  const RigSuspects loose = rig_suspects({0.3, 0.35, 0.32, 1.3, 1.5});
+  EXPECT_DOUBLE_EQ(loose.limit, 4 * 0.35);
+  EXPECT_EQ(loose.suspect, (std::vector<char>{0, 0, 0, 0, 1}));
+  const RigSuspects few = rig_suspects({0.05, 3.0, -1.0, -1.0});
+  EXPECT_LT(few.median, 0);
+  EXPECT_EQ(few.suspect, (std::vector<char>{0, 0, 0, 0}));
+  RigSuspectOptions strict;
+  strict.radii = 0.1;
+  strict.median_factor = 1;
+  EXPECT_EQ(rig_suspects({0.05, 0.11, 0.06, 0.07}, strict).suspect, (std::vector<char>{0, 1, 0, 0}));
+}
+
 }  // namespace
 }  // namespace rsibr
