@@ -58,6 +58,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -509,9 +510,17 @@ void step_orient(Context& c) {
       vo.estimate_up = c.o.estimate_up;
       poses = orient_views(names, images, lens, vo, &report);
       source = "solved (chrome-ball features)";
-      solve = {{"tracks", report.tracks},     {"observations", report.observations},
-               {"inliers", report.inliers},   {"rms_sigmas", report.rms_sigmas},
-               {"features", report.features}, {"tracks_relocated", report.track_refinement.tracks_refined}};
+      solve = {{"tracks", report.tracks},
+               {"observations", report.observations},
+               {"inliers", report.inliers},
+               {"rms_sigmas", report.rms_sigmas},
+               {"features", report.features},
+               {"tracks_relocated", report.track_refinement.tracks_refined},
+               {"rig_disagreement_radii", report.rig_disagreement}};
+      std::vector<std::string> suspects;
+      for (std::size_t v = 0; v < report.rig_suspect.size(); ++v)
+        if (report.rig_suspect[v]) suspects.push_back(report.names[v]);
+      solve["left_out_of_up"] = suspects;
       for (const std::string& w : report.left_out) left_out.push_back(w);
       for (const std::string& w : report.notes) notes.push_back(w);
       if (report.world_up) up = world_up_json(*report.world_up);
@@ -643,10 +652,14 @@ void step_extract(Context& c) {
     // Pass 2: each view's balls decided, extracted; the chrome maps masked.
     std::vector<MapSet> sets(listed.size());
     FolderContents masks;
+    std::vector<double> view_disagreement(vb.size(), -1.0);  // per view: its other balls' largest
     for (std::size_t k = 0; k < vb.size(); ++k) {
       const PhotoView& v = *used[k];
       const ViewImage img = read_view(v);
       std::vector<BallFinding> found = identify_view_balls(vb[k], rig, listed, img.radiance, lens, {}, {}, trust_views);
+      for (std::size_t b = 0; b < listed.size(); ++b)
+        if (int(b) != chrome_index && found[b].found() && found[b].disagreement > 0)
+          view_disagreement[k] = std::max(view_disagreement[k], found[b].disagreement);
       for (std::size_t b = 0; b < listed.size(); ++b)
         if (auto g = find_override(overrides, v.name, listed[b].name)) {
           found[b] = BallFinding{};
@@ -723,6 +736,34 @@ void step_extract(Context& c) {
       bar.update(double(vb.size() + k + 1) / steps);
     }
     bar.done();
+    // A view whose other balls disagree with the rig has its chrome ball or its rotation off
+    // (calib/ball_identification.h, rig_suspects): its chrome map stays out of the probe.
+    const RigSuspects suspects = rig_suspects(view_disagreement);
+    if (chrome_index >= 0 && std::count(suspects.suspect.begin(), suspects.suspect.end(), 1) > 0) {
+      std::vector<MapView> kept;
+      for (MapView& mv : sets[std::size_t(chrome_index)].views) {
+        const std::size_t k = std::size_t(
+            std::find_if(vb.begin(), vb.end(), [&](const ViewBalls& x) { return x.name == mv.attributes["image"]; }) -
+            vb.begin());
+        if (k < vb.size() && suspects.suspect[k]) {
+          for (auto& vj : views)
+            if (vj["name"] == vb[k].name)
+              for (auto& bj : vj["balls"])
+                if (bj["ball"] == listed[std::size_t(chrome_index)].name) {
+                  char note[200];
+                  std::snprintf(note, sizeof note,
+                                "left out of the probe: the view's other balls lie %.2f chrome radii from where the "
+                                "rig puts them (median of the views %.2f): its chrome ball or its rotation is off",
+                                view_disagreement[k], suspects.median);
+                  bj["status"] = "left out: disagrees with the rig";
+                  bj["note"] = note;
+                }
+          continue;
+        }
+        kept.push_back(std::move(mv));
+      }
+      sets[std::size_t(chrome_index)].views = std::move(kept);
+    }
     // Grey balls: what one view alone sees differently (the photographer's shadow) is masked, a view
     // mostly so is left out (calib/lambert_consensus.h).
     auto ball_entry = [&](const std::string& view, const std::string& ball) -> nlohmann::json* {
