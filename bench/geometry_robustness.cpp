@@ -8,8 +8,11 @@
 //   balls        per listed ball: found, wrong (centre farther than a fifth of its radius from the
 //                truth's), missing (with the views), cut (found and flagged / truly cut)
 //   views        oriented / listed
-//   tilt_deg     angle between the run's +Y and the true up, through every oriented view's rotations
-//                (true_from_run = R_true R_run^T, averaged as up vectors); sigma_deg the run's own
+//   tilt_deg     angle between the run's +Y and the true up, through the oriented views' rotations
+//                (true_from_run = R_true R_run^T, averaged as up vectors over the views within 2 degrees
+//                of their medoid); sigma_deg the run's own
+//   misoriented  the other views, with their angle from the medoid (degrees)
+//   left_out_of_up  the views the run left out of its world-up estimate (their balls disagree with the rig)
 //   vignetting   the corner's fall-off estimated and true, in stops
 //   grey         per view: log RMS (stops) of the captured grey map against the true one after the
 //                global gain fit, the map moved into the truth's world through the view's true
@@ -27,6 +30,7 @@
 #include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -89,10 +93,36 @@ int main(int argc, char** argv) {
     const PoseSet est = read_pose_file((run / "poses.yaml").string());
     const PoseSet tru = read_given_poses((syn / "truth" / "truth.yaml").string());
     out["views"] = {{"oriented", est.views.size()}, {"listed", tru.views.size()}};
+    // Per view true_from_run = R_true R_run^T (one rotation for a well-oriented set). The medoid
+    // (least summed angle to the others) and the views within 2 degrees of it give the run's world;
+    // the rest are misoriented, listed with their angle from the medoid.
+    std::vector<Mat3> q;
+    for (const ViewPose& v : est.views) q.push_back(tru.find(v.name)->world_from_cam * v.world_from_cam.transpose());
+    auto rot_deg = [](const Mat3& a, const Mat3& b) {
+      return std::acos(std::clamp(((a.transpose() * b).trace() - 1) / 2, -1.0, 1.0)) * 180 / kPi;
+    };
+    std::size_t medoid = 0;
+    double best = 1e300;
+    for (std::size_t i = 0; i < q.size(); ++i) {
+      double sum = 0;
+      for (const Mat3& r : q) sum += rot_deg(q[i], r);
+      if (sum < best) best = sum, medoid = i;
+    }
     Vec3 up = Vec3::Zero();
-    for (const ViewPose& v : est.views)
-      up += tru.find(v.name)->world_from_cam * v.world_from_cam.transpose() * Vec3(0, 1, 0);
+    nlohmann::json misoriented = nlohmann::json::array();
+    for (std::size_t i = 0; i < q.size(); ++i) {
+      const double d = rot_deg(q[i], q[medoid]);
+      if (d <= 2.0)
+        up += q[i] * Vec3(0, 1, 0);
+      else
+        misoriented.push_back({{"view", est.views[i].name}, {"deg", d}});
+    }
     out["tilt_deg"] = angle_between(up, Vec3(0, 1, 0)) * 180 / kPi;
+    out["misoriented"] = misoriented;
+    out["left_out_of_up"] = orient["summary"].contains("solve") && orient["summary"]["solve"].is_object() &&
+                                    orient["summary"]["solve"].contains("left_out_of_up")
+                                ? orient["summary"]["solve"]["left_out_of_up"]
+                                : nlohmann::json::array();
     out["sigma_deg"] = orient["summary"].contains("world_up") && orient["summary"]["world_up"].is_object()
                            ? orient["summary"]["world_up"]["sigma_deg"]
                            : nlohmann::json(nullptr);

@@ -185,15 +185,18 @@ def main():
         "tests/pipeline/process_geometry_test.cpp, not on these). Each: `rsibr synth`, then `rsibr process` as a user",
         "runs it (lens from the chessboards, orientations solved, world up estimated, vignetting from the chessboards),",
         "then `rsibr_geometry_robustness` against the truth. A ball is wrong when its centre is farther than a fifth of",
-        "its radius from the truth's. Tilt: the run's +Y against the true up; sigma: the run's own. Grey: the captured",
+        "its radius from the truth's. Tilt: the run's +Y against the true up, through the views oriented within 2",
+        "degrees of the others (their medoid); misoriented: the other views, with their error; left out of up: the views",
+        "the run itself left out of its world-up estimate (its other balls disagree with the rig fitted on all views);",
+        "sigma: the run's own. Grey: the captured",
         "grey maps against the true (unoccluded) ones after the global gain fit, log RMS per view: the photographer",
         "and the chrome ball beside the grey one are in these scenes, and what their shadows and bodies do to the",
         "grey ball's light (real light, which the truth maps leave out) counts as error there. The last column holds",
         "the pipeline's own error: the grey maps against those of the same shoot processed from the true scene",
         "radiance (before vignetting), poses and lens, which have every physical effect and no pipeline error.",
         "",
-        "| shoot | views oriented | balls found / wrong | missing | cut flagged / cut | tilt (deg) | sigma (deg) | vignetting corner est / true (stops) | grey vs truth per view (stops) | worst | grey vs physical reference, worst (stops) |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "| shoot | views oriented | balls found / wrong | missing | cut flagged / cut | tilt (deg) | misoriented (deg) | left out of up | sigma (deg) | vignetting corner est / true (stops) | grey vs truth per view (stops) | worst | grey vs physical reference, worst (stops) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for m in rows:
         found = sum(b["found"] for k, b in m["balls"].items() if k != "*")
@@ -203,9 +206,11 @@ def main():
         cut_t = sum(b.get("cut_true", 0) for b in m["balls"].values())
         grey = " ".join("%.3f" % g["stops"] for g in m["grey"])
         sigma = "%.2f" % m["sigma_deg"] if m.get("sigma_deg") is not None else "-"
-        lines.append("| %s | %d / %d | %d / %d | %d | %d / %d | %.2f | %s | %.2f / %.2f | %s | %.3f | %.3f |" % (
+        mis = ", ".join("%s %.1f" % (x["view"], x["deg"]) for x in m.get("misoriented", [])) or "-"
+        out_up = ", ".join(m.get("left_out_of_up", [])) or "-"
+        lines.append("| %s | %d / %d | %d / %d | %d | %d / %d | %.2f | %s | %s | %s | %.2f / %.2f | %s | %.3f | %.3f |" % (
             m["name"], m["views"]["oriented"], m["views"]["listed"], found, wrong, missing, cut_f, cut_t,
-            m["tilt_deg"], sigma, m["vignetting"]["estimated_corner_stops"], m["vignetting"]["true_corner_stops"],
+            m["tilt_deg"], mis, out_up, sigma, m["vignetting"]["estimated_corner_stops"], m["vignetting"]["true_corner_stops"],
             grey, m["grey_worst_stops"], m["reference"]["worst_stops"]))
     notes = []
     for m in rows:
