@@ -219,6 +219,7 @@ def main():
                 notes.append("- %s, %s: %s" % (m["name"], k if k != "*" else "view", w))
     if notes:
         lines += ["", "Balls and views left out, as the runs report them:", ""] + notes
+    lines.append("")  # a blank line before the next section
     if args.only:  # the section's table holds every shoot of one run: a partial run only prints its rows
         print("\n".join(lines))
         return
