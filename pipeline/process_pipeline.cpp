@@ -736,6 +736,13 @@ void step_extract(Context& c) {
       bar.update(double(vb.size() + k + 1) / steps);
     }
     bar.done();
+    auto ball_entry = [&](const std::string& view, const std::string& ball) -> nlohmann::json* {
+      for (auto& vj : views)
+        if (vj["name"] == view)
+          for (auto& bj : vj["balls"])
+            if (bj["ball"] == ball) return &bj;
+      return nullptr;
+    };
     // A view whose other balls disagree with the rig has its chrome ball or its rotation off
     // (calib/ball_identification.h, rig_suspects): its chrome map stays out of the probe.
     const RigSuspects suspects = rig_suspects(view_disagreement);
@@ -746,18 +753,15 @@ void step_extract(Context& c) {
             std::find_if(vb.begin(), vb.end(), [&](const ViewBalls& x) { return x.name == mv.attributes["image"]; }) -
             vb.begin());
         if (k < vb.size() && suspects.suspect[k]) {
-          for (auto& vj : views)
-            if (vj["name"] == vb[k].name)
-              for (auto& bj : vj["balls"])
-                if (bj["ball"] == listed[std::size_t(chrome_index)].name) {
-                  char note[200];
-                  std::snprintf(note, sizeof note,
-                                "left out of the probe: the view's other balls lie %.2f chrome radii from where the "
-                                "rig puts them (median of the views %.2f): its chrome ball or its rotation is off",
-                                view_disagreement[k], suspects.median);
-                  bj["status"] = "left out: disagrees with the rig";
-                  bj["note"] = note;
-                }
+          if (nlohmann::json* bj = ball_entry(vb[k].name, listed[std::size_t(chrome_index)].name)) {
+            char note[200];
+            std::snprintf(note, sizeof note,
+                          "left out of the probe: the view's other balls lie %.2f chrome radii from where the rig "
+                          "puts them (median of the views %.2f): its chrome ball or its rotation is off",
+                          view_disagreement[k], suspects.median);
+            (*bj)["status"] = "left out: disagrees with the rig";
+            (*bj)["note"] = note;
+          }
           continue;
         }
         kept.push_back(std::move(mv));
@@ -766,13 +770,6 @@ void step_extract(Context& c) {
     }
     // Grey balls: what one view alone sees differently (the photographer's shadow) is masked, a view
     // mostly so is left out (calib/lambert_consensus.h).
-    auto ball_entry = [&](const std::string& view, const std::string& ball) -> nlohmann::json* {
-      for (auto& vj : views)
-        if (vj["name"] == view)
-          for (auto& bj : vj["balls"])
-            if (bj["ball"] == ball) return &bj;
-      return nullptr;
-    };
     for (std::size_t b = 0; b < listed.size(); ++b) {
       if (listed[b].kind != BallKind::grey) continue;
       const std::vector<LambertConsensusView> cons = mask_lambert_inconsistencies(sets[b].views);
