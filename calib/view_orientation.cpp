@@ -46,6 +46,10 @@ WorldUp level_pose_set(PoseSet& poses, const WorldUpOptions& options, const std:
     if (in_estimate.empty() || in_estimate[v]) r.push_back(poses.views[v].world_from_cam);
   if (r.empty()) throw std::invalid_argument("level: no view joins the estimate");
   WorldUp wu = estimate_world_up(r, lines, options);
+  // Every view's roll from level, the views left out included (their roll shows why).
+  wu.roll_deg.clear();
+  for (const ViewPose& v : poses.views)
+    wu.roll_deg.push_back(std::asin(std::clamp(v.world_from_cam.col(0).dot(wu.up), -1.0, 1.0)) * 180 / kPi);
   // Up in the first camera's frame; the new world from the first camera is the gauge's.
   const Mat3 first_from_world = poses.views.front().world_from_cam.transpose();
   wu.up = (first_from_world * wu.up).normalized();

@@ -110,7 +110,7 @@ Mat3 gauge_world_from_first_cam(const std::optional<Vec3>& up);
 // the estimated up); gauge becomes "estimated-up". Returns the estimate, up in the first view's
 // camera frame. Throws std::invalid_argument for an empty set.
 // `in_estimate`: per view, whether its rotation joins the estimate (empty: every view); every view
-// is levelled.
+// is levelled, and the returned roll_deg is per view of the set (those left out included).
 WorldUp level_pose_set(PoseSet& poses, const WorldUpOptions& options = {}, const std::vector<VerticalLine>& lines = {},
                        const std::vector<char>& in_estimate = {});
 

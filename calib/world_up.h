@@ -45,7 +45,7 @@ struct WorldUp {
   double sigma_deg = 0;       // std dev, both axes together
   double roll_sigma_deg = 0;  // the cameras' roll scatter used
   bool roll_sigma_estimated = false;
-  std::vector<double> roll_deg;  // per camera given: asin(x_i . u), its roll from level
+  std::vector<double> roll_deg;  // per camera: asin(x_i . u), its roll from level
   int lines = 0;
   double tilt_from_first_deg = 0;  // angle between u and the first camera's -y axis
 };

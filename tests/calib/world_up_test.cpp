@@ -195,7 +195,17 @@ TEST(WorldUp, ViewsLeftOutOfTheEstimateAreLevelledButDoNotTiltIt) {
   const WorldUp without = level_pose_set(some, o, {}, {1, 1, 0, 1, 1, 0, 1, 1});
   EXPECT_GT(angle_between(with.up, up) / kDeg, 1.0);
   EXPECT_LT(angle_between(without.up, up) / kDeg, 0.3);
-  EXPECT_EQ(without.roll_deg.size(), 6u);
+  // Rolls per view, the two left out included: a turn of 12 degrees about a forward axis at elevation
+  // e lifts the x axis out of level by asin(sin 12 cos e).
+  ASSERT_EQ(without.roll_deg.size(), 8u);
+  for (std::size_t v = 0; v < 8; ++v) {
+    const double f_up = poses[v].world_from_cam.col(2).dot(Vec3(0, 1, 0));
+    const double turned = std::asin(std::sin(12 * kDeg) * std::sqrt(1 - f_up * f_up)) / kDeg;
+    if (v == 2 || v == 5)
+      EXPECT_NEAR(std::abs(without.roll_deg[v]), turned, 0.3) << v;
+    else
+      EXPECT_LT(std::abs(without.roll_deg[v]), 1.0) << v;
+  }
   // Every view, the two left out included, is turned by the same levelling.
   for (std::size_t v = 0; v < r.size(); ++v) {
     const Mat3 new_from_old = some.views[v].world_from_cam * r[v].transpose();
