@@ -184,7 +184,7 @@ std::vector<BallFinding> identify_view_balls(const ViewBalls& view, const std::v
 // balls then lie far from where the rig puts them. Per view its largest disagreement (chrome radii;
 // < 0: none checked) -> per view whether it is suspect: farther than max(radii, median_factor x the
 // median of the checked views), when 3 or more were checked. Why these numbers: docs/tradeoffs.md,
-// "Robust geometry".
+// "Measured choices in the code".
 struct RigSuspectOptions {
   double radii = 0.25;
   double median_factor = 4;

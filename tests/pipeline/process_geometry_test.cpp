@@ -167,6 +167,19 @@ TEST_F(ProcessGeometry, TheProbeIsLevelWithinADegree) {
   EXPECT_GT(result_->summary["orient"]["world_up"]["tilt_from_first_camera_deg"].get<double>(), 15.0);
 }
 
+// The rig check behind the world-up estimate: every view is checked (its grey ball found, the cut
+// one included), and on a shoot whose views are all well oriented none is left out of the estimate.
+TEST_F(ProcessGeometry, EveryViewIsCheckedAgainstTheRigAndNoneIsLeftOut) {
+  const auto& solve = result_->summary["orient"]["solve"];
+  const auto d = solve["rig_disagreement_radii"].get<std::vector<double>>();
+  ASSERT_EQ(d.size(), 8u);
+  for (double x : d) {
+    EXPECT_GE(x, 0.0) << "a view was not checked";
+    EXPECT_LT(x, 0.25);
+  }
+  EXPECT_TRUE(solve["left_out_of_up"].empty()) << solve["left_out_of_up"];
+}
+
 // The vignetting estimated from the chessboards: the corner's fall-off within 0.1 stop of the truth.
 TEST_F(ProcessGeometry, TheVignettingIsEstimatedAndReported) {
   const auto& v = result_->summary["hdr"]["vignetting"];
