@@ -71,7 +71,7 @@ std::optional<Vec3> reflection_normal(const Vec3& centre, const Vec3& r, const V
 }
 
 MapView extract_sphere_map(const cv::Mat& image, const cv::Mat& flags, const LensModel& lens, const BallCone& cone,
-                           const Mat3& world_from_cam, const ExtractOptions& options) {
+                           const Mat3& world_from_cam, const ExtractOptions& options, cv::Mat* hidden) {
   if (image.type() != CV_32FC3 || image.cols != lens.width() || image.rows != lens.height())
     throw std::invalid_argument("extract: the image must be float RGB of the lens model's size (" +
                                 std::to_string(lens.width()) + "x" + std::to_string(lens.height()) + ")");
@@ -110,6 +110,7 @@ MapView extract_sphere_map(const cv::Mat& image, const cv::Mat& flags, const Len
   mv.rgb = cv::Mat(size, size, CV_32FC3, cv::Scalar::all(0));
   mv.confidence = cv::Mat(size, size, CV_32FC1, cv::Scalar(0));
   if (!flags.empty()) mv.clipped = cv::Mat(size, size, CV_32FC1, cv::Scalar(0));
+  if (hidden) *hidden = cv::Mat(size, size, CV_8UC1, cv::Scalar(0));
 
   // One sample: the disc point's surface normal (start: the guess for the reflection solve), its
   // image point, and the incidence cosine; false when it has none (outside the disc or the image,
@@ -191,7 +192,10 @@ MapView extract_sphere_map(const cv::Mat& image, const cv::Mat& flags, const Len
       if (options.mirror && options.camera_mask_deg > 0)
         conf *= smoothstep(cos_cam_zero, cos_cam_full, s.reflected.dot(to_camera));
       for (const Occluder& occ : options.in_front)
-        if (ray_hits(occ, Vec3::Zero(), p.normalized(), p.norm())) conf = 0;
+        if (ray_hits(occ, Vec3::Zero(), p.normalized(), p.norm())) {
+          conf = 0;
+          if (hidden) hidden->at<unsigned char>(row, col) = 1;
+        }
       if (options.mirror)
         for (const Occluder& occ : options.occluders)
           if (ray_hits(occ, p, s.reflected.normalized())) conf = 0;

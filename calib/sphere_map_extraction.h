@@ -87,9 +87,11 @@ struct ExtractOptions {
 };
 
 // `image` CV_32FC3 RGB linear of the lens's size; `flags` empty or CV_8UC1 of that size.
+// `hidden`, if given, gets a CV_8UC1 map of the map's size: 1 where an `in_front` occluder hides
+// the texel's surface point (its rgb then shows that occluder, not this ball).
 // Throws std::invalid_argument for mismatched sizes or an invalid cone.
 MapView extract_sphere_map(const cv::Mat& image, const cv::Mat& flags, const LensModel& lens, const BallCone& cone,
-                           const Mat3& world_from_cam, const ExtractOptions& options = {});
+                           const Mat3& world_from_cam, const ExtractOptions& options = {}, cv::Mat* hidden = nullptr);
 
 // The surface normal (camera frame, unit) whose point reflects the camera ray into `r` (camera
 // frame, unit), for a ball of radius 1 centred at C (camera at the origin); `start` is the first

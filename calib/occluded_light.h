@@ -1,0 +1,80 @@
+// The light a scene's occluders take from a Lambertian (grey) ball, put back, so that its captured
+// map is that of the ball under the environment alone (what a bake from the probe computes).
+//
+// A grey ball's texel shows albedo / pi * E_scene(n): the irradiance of what its surface point
+// c + n sees, which is the environment except where the chrome ball beside it, another ball or the
+// photographer stands. The open irradiance E_open(n) replaces those by the environment behind them:
+//   E_open(n)  = sum_w L(w) max(0, n.w) dw
+//   E_scene(n) = sum_w L_s(w) max(0, n.w) dw,  L_s(w) = the occluder's radiance where the ray
+//                c + n + t w meets one first, L(w) otherwise
+// and the corrected texel is the captured one times E_open / E_scene, per channel (the albedo and
+// the exposure cancel). The sum runs over a lat-long quadrature of the probe; a direction the probe
+// did not see (weight below min_weight) counts as L_s in both sums (nothing is known to restore).
+// The occluders' radiance:
+//   mirror ball     F(cos) L(r), r the direction reflected at the hit point (F = 1 when the probe
+//                   holds F L, i.e. no Fresnel was divided out of it)
+//   lambert ball    albedo E_open(m) / pi at the hit point's normal m
+//   seen by chrome  the photographer and the camera: what the same view's chrome map shows in the
+//                   ray's direction w (the mean of its texels in w's quadrature cell, or where the
+//                   cell holds none, the texel of w), over F (the photographer stands far compared with the balls'
+//                   distance apart, and where the capsule is empty the chrome ball sees the far
+//                   environment there); a direction the chrome map did not fill or holds clipped
+//                   (a lower bound), or where the grey ball itself stands in the chrome ball's way
+//                   along w, is L(w)
+// Frames and units: the camera frame of the view (x right, y down, z forward), lengths in radii of
+// the grey ball, as calib/occluders.h; directions of the probe and the maps in their own frames.
+#pragma once
+
+#include "bake/fresnel.h"
+#include "calib/ball_cone.h"
+#include "calib/occluders.h"
+#include "core/env_map.h"
+#include "core/map_set.h"
+
+#include <opencv2/core.hpp>
+
+#include <vector>
+
+namespace rsibr {
+
+struct OccluderLight {
+  Occluder shape;  // camera frame, the grey ball's radii
+  enum Source { mirror_ball, lambert_ball, seen_by_chrome } source = seen_by_chrome;
+  double albedo = 0.5;  // lambert_ball
+};
+
+// The open environment as a quadrature: a lat-long probe (world frame) and its summed confidence.
+struct OpenLight {
+  EnvMap env;              // lat-long, RGB
+  cv::Mat seen;            // CV_8UC1: 1 where the probe's weight reached min_weight
+  cv::Mat solid_angle;     // CV_64FC1, per texel
+  EnvMap irradiance;       // lat-long, E_open at each texel's direction (for lambert balls)
+  const Fresnel* fresnel;  // the chrome's, divided out of the probe; null: the probe holds F L
+};
+
+// The probe reduced to a `width` x width/2 quadrature (area-weighted), its coverage and irradiance.
+// `weight` is the probe's summed confidence (calib/probe.h), of the probe's size.
+OpenLight open_light(const EnvMap& probe, const cv::Mat& weight, const Fresnel* fresnel, int width = 64,
+                     double min_weight = 1e-3);
+
+struct OccludedLight {
+  cv::Mat ratio;           // CV_32FC3: E_open / E_scene per texel (1 outside the disc)
+  double mean_stops = 0;   // mean |log2| of the luminance ratio over the disc's confident texels
+  double max_stops = 0;    // largest
+  double clamp_stops = 1;  // ratios are clamped to 2^+-clamp_stops
+};
+
+// The ratio for one grey map (orthographic indexing, calib/sphere_map_extraction.h) extracted from
+// the view whose camera has `world_from_cam`, the ball's cone `grey`; `chrome` is the same view's
+// chrome map (mirror, reflection indexing) with its centre `chrome_centre` (camera frame, grey
+// radii), or null (seen_by_chrome occluders then restore nothing); `chrome_hidden` (empty, or
+// CV_8UC1 of the chrome map's size, calib/sphere_map_extraction.h) marks its texels that show
+// another ball in front of it, which are not read.
+OccludedLight occluded_light(const MapView& grey, const Mat3& world_from_cam, const BallCone& grey_cone,
+                             const std::vector<OccluderLight>& occluders, const OpenLight& light, const MapView* chrome,
+                             const Vec3& chrome_centre, const cv::Mat& chrome_hidden = {});
+
+// grey.rgb times the ratio, per channel.
+void restore_occluded_light(MapView& grey, const OccludedLight& r);
+
+}  // namespace rsibr
