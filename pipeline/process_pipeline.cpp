@@ -9,6 +9,7 @@
 #include "calib/intrinsics.h"
 #include "calib/photo_optics.h"
 #include "calib/lambert_consensus.h"
+#include "calib/occluded_light.h"
 #include "calib/occluders.h"
 #include "calib/probe.h"
 #include "calib/sphere_map_extraction.h"
@@ -580,8 +581,9 @@ void step_extract(Context& c) {
   for (const BallSpec& b : c.set.balls) balls.push_back({b.name, to_string(b.kind), b.diameter_m.value_or(0.0)});
   for (const BallOverride& o : overrides)
     given.push_back({o.view, o.ball, o.guess.centre_px.x(), o.guess.centre_px.y(), o.guess.radius_px});
-  const nlohmann::json settings = {
-      {"map_size", c.o.map_size}, {"balls", balls}, {"given", given}, {"identification", 4}};
+  nlohmann::json settings = {{"map_size", c.o.map_size}, {"balls", balls}, {"given", given}, {"identification", 4}};
+  if (c.o.occluder_light)
+    settings["occluder_light"] = {{"fresnel", c.o.chrome_fresnel}, {"probe_width", c.o.probe_width}};
   run_step(c, "extract", settings, inputs, [&](StepRecord& r) {
     if (c.set.balls.empty()) throw std::invalid_argument(c.o.photoset + ": balls: the photo set lists no ball");
     const LensModel lens = LensModel::read(c.dir / "lens.cameramodel");
@@ -653,6 +655,17 @@ void step_extract(Context& c) {
     std::vector<MapSet> sets(listed.size());
     FolderContents masks;
     std::vector<double> view_disagreement(vb.size(), -1.0);  // per view: its other balls' largest
+    // Per grey map: what occludes its light (calib/occluded_light.h), restored once the probe is known.
+    struct GreyScene {
+      std::size_t ball;
+      std::string view;
+      BallCone cone;
+      Mat3 world_from_cam;
+      std::vector<OccluderLight> occluders;
+      Vec3 chrome_centre = Vec3::Zero();  // camera frame, the grey ball's radii
+    };
+    std::vector<GreyScene> grey_scenes;
+    std::map<std::string, cv::Mat> chrome_hidden;  // per view: the chrome texels another ball hides
     for (std::size_t k = 0; k < vb.size(); ++k) {
       const PhotoView& v = *used[k];
       const ViewImage img = read_view(v);
@@ -717,7 +730,23 @@ void step_extract(Context& c) {
           eo.in_front.push_back(f);
         }
         if (eo.mirror && int(b) == chrome_index) eo.occluders = chrome_occluders(cone, rest, down_cam, chrome_radius_m);
-        MapView mv = extract_sphere_map(img.radiance, img.flags, lens, cone, world_from_cam, eo);
+        if (ball.kind == BallKind::grey && c.o.occluder_light && chrome_index >= 0 &&
+            found[std::size_t(chrome_index)].found()) {
+          // The photographer, in this ball's radii, lit as the view's chrome ball sees it. The other
+          // balls are not restored: restoring the chrome ball beside the grey one did not lower the
+          // error on the held-out shoots (docs/tradeoffs.md, "calib/occluded_light.h: what is restored").
+          GreyScene g{b, v.name, cone, world_from_cam, {}, Vec3::Zero()};
+          for (const OtherBall& o : rest)
+            if (o.name == listed[std::size_t(chrome_index)].name)
+              g.chrome_centre = o.scale / own_scale * o.cone.axis.normalized() / std::sin(o.cone.half_angle);
+          for (const Occluder& o : chrome_occluders(cone, {}, down_cam, chrome_radius_m * own_scale))
+            if (o.what == "photographer") g.occluders.push_back({o, OccluderLight::seen_by_chrome, 0});
+          grey_scenes.push_back(std::move(g));
+        }
+        cv::Mat hidden;
+        MapView mv = extract_sphere_map(img.radiance, img.flags, lens, cone, world_from_cam, eo,
+                                        int(b) == chrome_index ? &hidden : nullptr);
+        if (int(b) == chrome_index) chrome_hidden[v.name] = hidden;
         mv.attributes["image"] = v.name;
         mv.attributes["ball"] = ball.name;
         mv.attributes["ballKind"] = to_string(ball.kind);
@@ -746,6 +775,7 @@ void step_extract(Context& c) {
     // A view whose other balls disagree with the rig has its chrome ball or its rotation off
     // (calib/ball_identification.h, rig_suspects): its chrome map stays out of the probe.
     const RigSuspects suspects = rig_suspects(view_disagreement);
+    std::vector<MapView> chrome_left_out;  // still the view's own light for its grey ball (below)
     if (chrome_index >= 0 && std::count(suspects.suspect.begin(), suspects.suspect.end(), 1) > 0) {
       std::vector<MapView> kept;
       for (MapView& mv : sets[std::size_t(chrome_index)].views) {
@@ -762,11 +792,45 @@ void step_extract(Context& c) {
             (*bj)["status"] = "left out: disagrees with the rig";
             (*bj)["note"] = note;
           }
+          chrome_left_out.push_back(std::move(mv));
           continue;
         }
         kept.push_back(std::move(mv));
       }
       sets[std::size_t(chrome_index)].views = std::move(kept);
+    }
+    // Grey balls: the light the photographer takes from them restored, from the chrome maps' probe
+    // and each view's own chrome map (calib/occluded_light.h).
+    if (!grey_scenes.empty() && !sets[std::size_t(chrome_index)].views.empty()) {
+      const auto fresnel = chrome_fresnel_from_spec(c.o.chrome_fresnel, "--chrome-fresnel");
+      ProbeOptions po;
+      po.width = c.o.probe_width;
+      po.fresnel = fresnel.get();
+      const Probe probe = assemble_probe(sets[std::size_t(chrome_index)], po);
+      const OpenLight light = open_light(probe.env, probe.weight, fresnel.get(), std::min(64, c.o.probe_width));
+      for (const GreyScene& g : grey_scenes) {
+        auto of_view = [&](std::vector<MapView>& maps) -> MapView* {
+          for (MapView& mv : maps)
+            if (mv.attributes["image"] == g.view) return &mv;
+          return nullptr;
+        };
+        MapView* grey = of_view(sets[g.ball].views);
+        if (!grey) continue;
+        // A view left out of the probe keeps its own chrome map here: the photographer's light is
+        // read in the view's frame, whatever its rotation's error.
+        const MapView* chrome = of_view(sets[std::size_t(chrome_index)].views);
+        if (!chrome) chrome = of_view(chrome_left_out);
+        const OccludedLight ol = occluded_light(*grey, g.world_from_cam, g.cone, g.occluders, light, chrome,
+                                                g.chrome_centre, chrome_hidden[g.view]);
+        restore_occluded_light(*grey, ol);
+        char text[160];
+        std::snprintf(text, sizeof text, "restored: mean %.3f, largest %.3f stops%s", ol.mean_stops, ol.max_stops,
+                      chrome ? "" : " (none: the view has no chrome map)");
+        grey->attributes["occluderLight"] = text;
+        if (nlohmann::json* bj = ball_entry(g.view, listed[g.ball].name))
+          (*bj)["occluder_light"] = {
+              {"mean_stops", ol.mean_stops}, {"largest_stops", ol.max_stops}, {"photographer", chrome != nullptr}};
+      }
     }
     // Grey balls: what one view alone sees differently (the photographer's shadow) is masked, a view
     // mostly so is left out (calib/lambert_consensus.h).
