@@ -164,12 +164,21 @@ int main(int argc, char** argv) {
       }
       out["grey_overall_stops"] = c.after.log_rms_stops;
       if (argc == 4) {
-        const MapSet ref = read_map_set((fs::path(argv[3]) / "maps" / ("captured-" + name + ".exr")).string());
-        const Comparison r = compare_map_sets(m, ref, co);
+        // The views both runs kept (each may leave out different ones).
+        MapSet ref = read_map_set((fs::path(argv[3]) / "maps" / ("captured-" + name + ".exr")).string());
+        auto has = [](const MapSet& s, const std::string& img) {
+          return std::any_of(s.views.begin(), s.views.end(),
+                             [&](const MapView& v) { return v.attributes.at("image") == img; });
+        };
+        MapSet both;
+        for (const MapView& v : m.views)
+          if (has(ref, v.attributes.at("image"))) both.views.push_back(v);
+        std::erase_if(ref.views, [&](const MapView& v) { return !has(both, v.attributes.at("image")); });
+        const Comparison r = compare_map_sets(both, ref, co);
         nlohmann::json per = nlohmann::json::array();
         double rw = 0;
         for (const PairComparison& p : r.pairs) {
-          per.push_back({{"view", m.views[p.index_a].attributes.at("image")}, {"stops", p.after.log_rms_stops}});
+          per.push_back({{"view", both.views[p.index_a].attributes.at("image")}, {"stops", p.after.log_rms_stops}});
           rw = std::max(rw, p.after.log_rms_stops);
         }
         out["reference"] = {

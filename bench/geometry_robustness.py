@@ -133,6 +133,15 @@ def run(*cmd):
     return r.stdout
 
 
+def grey_left_out(run_dir, greys):
+    """The views whose grey ball a run's extract step left out (found, then judged inconsistent or suspect)."""
+    with open(os.path.join(run_dir, "steps", "extract.json")) as f:
+        ex = json.load(f)
+    ex = ex.get("summary", ex)
+    return [v["name"] for v in ex["views"] for b in v["balls"]
+            if b["ball"] in greys and b.get("status", "").startswith("left out")]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default=os.path.join(ROOT, "build/release"))
@@ -173,6 +182,20 @@ def main():
             "--lens", os.path.join(folder, "syn", "truth", "camera.cameramodel"), "--chrome-fresnel", FRESNEL, "-q")
         m = json.loads(run(measure, os.path.join(folder, "syn"), os.path.join(folder, "run"), os.path.join(folder, "ref")))
         m["name"], m["seconds_synth"], m["seconds_process"] = name, t1 - t0, t2 - t1
+        # The same run with the photographer's light restored (--occluder-light): the steps before
+        # extract are reused, extract and the later ones redone.
+        occ = os.path.join(folder, "run-occluder-light")
+        shutil.copytree(os.path.join(folder, "run"), occ)
+        run(rsibr, "process", os.path.join(folder, "syn", "photos"), "--out", occ, "--chrome-fresnel", FRESNEL,
+            "--occluder-light", "-q")
+        greys = {g["ball"] for g in m["grey"]}
+        m["left_out"], m["occluder_left_out"] = grey_left_out(os.path.join(folder, "run"), greys), grey_left_out(occ, greys)
+        try:
+            mo = json.loads(run(measure, os.path.join(folder, "syn"), occ))
+            m["occluder_grey"], m["occluder_worst"] = mo["grey"], mo["grey_worst_stops"]
+        except SystemExit as e:
+            m["occluder_grey"], m["occluder_worst"] = None, None
+            m["occluder_error"] = str(e).strip().splitlines()[-1]
         rows.append(m)
         print("%s: %s" % (name, json.dumps({k: m[k] for k in ("balls", "tilt_deg", "grey_worst_stops")})), flush=True)
         if not args.keep:
@@ -212,6 +235,23 @@ def main():
             m["name"], m["views"]["oriented"], m["views"]["listed"], found, wrong, missing, cut_f, cut_t,
             m["tilt_deg"], mis, out_up, sigma, m["vignetting"]["estimated_corner_stops"], m["vignetting"]["true_corner_stops"],
             grey, m["grey_worst_stops"], m["reference"]["worst_stops"]))
+    lines += [
+        "",
+        "With `--occluder-light` (calib/occluded_light.h), the same runs: each grey map gets back the light the",
+        "photographer takes from it (the photographer a capsule behind the camera, calib/occluders.h, its radiance",
+        "what the same view's chrome ball sees in that direction, the light it hides the probe's). Left out: grey views",
+        "the run leaves out (the Lambert consensus finds them inconsistent with the other views).",
+        "",
+        "| shoot | grey vs truth per view, --occluder-light (stops) | worst | worst without (the default) | left out: with / without |",
+        "|---|---|---|---|---|",
+    ]
+    for m in rows:
+        if m.get("occluder_grey") is None:
+            lines.append("| %s | failed: %s | - | %.3f | - |" % (m["name"], m.get("occluder_error", "?"), m["grey_worst_stops"]))
+            continue
+        lines.append("| %s | %s | %.3f | %.3f | %s / %s |" % (
+            m["name"], " ".join("%.3f" % g["stops"] for g in m["occluder_grey"]), m["occluder_worst"],
+            m["grey_worst_stops"], ", ".join(m["occluder_left_out"]) or "-", ", ".join(m["left_out"]) or "-"))
     notes = []
     for m in rows:
         for k, b in m["balls"].items():
