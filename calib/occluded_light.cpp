@@ -135,10 +135,20 @@ OccludedLight occluded_light(const MapView& grey, const Mat3& world_from_cam, co
   };
   const Vec3 centre = grey_cone.axis.normalized() / std::sin(grey_cone.half_angle);
   const Mat3 cam_from_view = cam_from_world * grey.world_from_view;
+  // One chrome texel's radiance over F(cos_i), or nullopt where it is not filled, clipped (a lower
+  // bound) or shows another ball in front.
+  auto chrome_texel = [&](int c, int r, double cos_i) -> std::optional<Vec3> {
+    if (c < 0 || r < 0 || c >= chrome->rgb.cols || r >= chrome->rgb.rows) return std::nullopt;
+    if (!chrome_hidden.empty() && chrome_hidden.at<unsigned char>(r, c)) return std::nullopt;
+    if (!chrome->clipped.empty() && chrome->clipped.at<float>(r, c) > 0) return std::nullopt;
+    const Vec3 v = pixel_rgb(chrome->rgb, c, r);
+    if (!(v.maxCoeff() > 0) || !v.allFinite()) return std::nullopt;
+    if (!light.fresnel) return v;
+    return Vec3(v.cwiseQuotient(light.fresnel->eval(cos_i).cwiseMax(Vec3::Constant(1e-3))));
+  };
   // What the view's chrome ball sees, as the quadrature's cells: the mean of its texels whose
-  // mirror direction falls in each cell, over F (a mirror map's texels subtend equal solid angles
-  // about its centre, dw = 4 dx dy), so that it is an area mean as the probe's cells are. Texels
-  // not filled, clipped (a lower bound) or showing another ball in front are left out.
+  // mirror direction falls in each cell (a mirror map's texels subtend equal solid angles about its
+  // centre, dw = 4 dx dy), so that it is an area mean as the probe's cells are.
   cv::Mat chrome_sum(q.height(), q.width(), CV_64FC3, cv::Scalar::all(0));
   cv::Mat chrome_count(q.height(), q.width(), CV_32SC1, cv::Scalar(0));
   if (chrome) {
@@ -147,17 +157,13 @@ OccludedLight occluded_light(const MapView& grey, const Mat3& world_from_cam, co
       for (int c = 0; c < cw; ++c) {
         const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), cw, ch);
         if (xy.squaredNorm() >= 1) continue;
-        if (!chrome_hidden.empty() && chrome_hidden.at<unsigned char>(r, c)) continue;
-        if (!chrome->clipped.empty() && chrome->clipped.at<float>(r, c) > 0) continue;
-        Vec3 v = pixel_rgb(chrome->rgb, c, r);
-        if (!(v.maxCoeff() > 0) || !v.allFinite()) continue;
-        if (light.fresnel)
-          v = v.cwiseQuotient(light.fresnel->eval(sphere_map::g_normal(xy).z()).cwiseMax(Vec3::Constant(1e-3)));
+        const std::optional<Vec3> v = chrome_texel(c, r, sphere_map::g_normal(xy).z());
+        if (!v) continue;
         const Vec2 px = q.pixel(chrome->world_from_view * sphere_map::g_mirror(xy));
         const int x = std::clamp(int(std::floor(px.x() + 0.5)), 0, q.width() - 1);
         const int y = std::clamp(int(std::floor(px.y() + 0.5)), 0, q.height() - 1);
         cv::Vec3d& acc = chrome_sum.at<cv::Vec3d>(y, x);
-        for (int k = 0; k < 3; ++k) acc[k] += v[k];
+        for (int k = 0; k < 3; ++k) acc[k] += (*v)[k];
         ++chrome_count.at<int>(y, x);
       }
   }
@@ -193,16 +199,9 @@ OccludedLight occluded_light(const MapView& grey, const Mat3& world_from_cam, co
     // A cell smaller than the chrome map's texels (toward the poles): the texel of w.
     const Vec3 r_view = chrome->world_from_view.transpose() * (world_from_cam * w);
     const Vec2 px = sphere_map::pixel_from_disc(sphere_map::g_mirror_inv(r_view), chrome->rgb.cols, chrome->rgb.rows);
-    const int c = int(std::lround(px.x())), r = int(std::lround(px.y()));
-    if (c < 0 || r < 0 || c >= chrome->rgb.cols || r >= chrome->rgb.rows) return std::nullopt;
-    if (!chrome_hidden.empty() && chrome_hidden.at<unsigned char>(r, c)) return std::nullopt;
-    if (!chrome->clipped.empty() && chrome->clipped.at<float>(r, c) > 0) return std::nullopt;
-    const Vec3 v = pixel_rgb(chrome->rgb, c, r);
-    if (!(v.maxCoeff() > 0) || !v.allFinite()) return std::nullopt;
-    if (!light.fresnel) return v;
     // Mirror direction r = 2 (n.z) n - z, so n.z = sqrt((1 + r.z) / 2).
-    const Vec3 F = light.fresnel->eval(std::sqrt(std::clamp(0.5 * (1 + r_view.z()), 1e-6, 1.0)));
-    return Vec3(v.cwiseQuotient(F.cwiseMax(Vec3::Constant(1e-3))));
+    return chrome_texel(int(std::lround(px.x())), int(std::lround(px.y())),
+                        std::sqrt(std::clamp(0.5 * (1 + r_view.z()), 1e-6, 1.0)));
   };
   const double hi = std::exp2(out.clamp_stops), lo = 1 / hi;
   std::vector<double> row_sum(std::size_t(size_y), 0), row_max(std::size_t(size_y), 0), row_w(std::size_t(size_y), 0);

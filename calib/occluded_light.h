@@ -16,11 +16,11 @@
 //   lambert ball    albedo E_open(m) / pi at the hit point's normal m
 //   seen by chrome  the photographer and the camera: what the same view's chrome map shows in the
 //                   ray's direction w (the mean of its texels in w's quadrature cell, or where the
-//                   cell holds none, the texel of w), over F (the photographer stands far compared with the balls'
-//                   distance apart, and where the capsule is empty the chrome ball sees the far
-//                   environment there); a direction the chrome map did not fill or holds clipped
-//                   (a lower bound), or where the grey ball itself stands in the chrome ball's way
-//                   along w, is L(w)
+//                   cell holds none, the texel of w), over F. The photographer stands far compared
+//                   with the balls' distance apart, and where the capsule is empty the chrome ball
+//                   sees the far environment there. A direction the chrome map did not fill or holds
+//                   clipped (a lower bound), or where the grey ball itself stands in the chrome
+//                   ball's way along w, is L(w)
 // Frames and units: the camera frame of the view (x right, y down, z forward), lengths in radii of
 // the grey ball, as calib/occluders.h; directions of the probe and the maps in their own frames.
 #pragma once

@@ -745,8 +745,8 @@ void step_extract(Context& c) {
         }
         cv::Mat hidden;
         MapView mv = extract_sphere_map(img.radiance, img.flags, lens, cone, world_from_cam, eo,
-                                        int(b) == chrome_index ? &hidden : nullptr);
-        if (int(b) == chrome_index) chrome_hidden[v.name] = hidden;
+                                        c.o.occluder_light && int(b) == chrome_index ? &hidden : nullptr);
+        if (c.o.occluder_light && int(b) == chrome_index) chrome_hidden[v.name] = hidden;
         mv.attributes["image"] = v.name;
         mv.attributes["ball"] = ball.name;
         mv.attributes["ballKind"] = to_string(ball.kind);

@@ -108,6 +108,35 @@ TEST(OccludedLight, ThePhotographersRadianceIsWhatTheChromeBallSees) {
   EXPECT_EQ(centre_ratio(hidden), 1.0f);
 }
 
+TEST(OccludedLight, ChromeTexelsClippedInEveryBracketAreNotRead) {
+  // A half-bright chrome map whose every texel is a lower bound: nothing is known to restore.
+  MapView chrome = uniform_chrome(0.5f);
+  chrome.clipped = cv::Mat(64, 64, CV_32FC1, cv::Scalar(1));
+  const OccludedLight r =
+      occluded_light(grey_map(), Mat3::Identity(), grey_cone(), {ball_ahead(OccluderLight::seen_by_chrome)},
+                     uniform_light(), &chrome, Vec3(5, 0, 10));
+  EXPECT_EQ(centre_ratio(r), 1.0f);
+}
+
+TEST(OccludedLight, ASunAGigaTimesBrighterAndANonFiniteTexelStayFinite) {
+  // A uniform probe of 1 with a sun of 1e9 behind the black ball (+z) and a NaN texel elsewhere:
+  // the NaN is not seen, the sun's hidden light is restored up to the clamp, everything finite.
+  const Layout layout(LayoutKind::LatLong, 256, 128);
+  EnvMap probe = EnvMap::zeros(layout);
+  probe.pixels.setTo(cv::Scalar::all(1));
+  const Vec2 sun = layout.pixel(Vec3(0, 0, 1)), nan = layout.pixel(Vec3(0, 0, -1));
+  probe.pixels.at<cv::Vec3f>(int(sun.y()), int(sun.x())) = cv::Vec3f(1e9f, 1e9f, 1e9f);
+  probe.pixels.at<cv::Vec3f>(int(nan.y()), int(nan.x())) = cv::Vec3f(NAN, NAN, NAN);
+  const OpenLight light = open_light(probe, cv::Mat(128, 256, CV_32FC1, cv::Scalar(1)), nullptr, 64);
+  EXPECT_TRUE(cv::checkRange(light.env.pixels));
+  EXPECT_TRUE(cv::checkRange(light.irradiance.pixels));
+  const OccludedLight r = occluded_light(grey_map(), Mat3::Identity(), grey_cone(),
+                                         {ball_ahead(OccluderLight::lambert_ball, 0.0)}, light, nullptr, Vec3::Zero());
+  EXPECT_TRUE(cv::checkRange(r.ratio));
+  EXPECT_NEAR(centre_ratio(r), std::exp2(r.clamp_stops), 1e-5);
+  EXPECT_TRUE(std::isfinite(r.mean_stops) && std::isfinite(r.max_stops));
+}
+
 TEST(OccludedLight, LightTheProbeDidNotSeeRestoresNothing) {
   const OpenLight light = uniform_light([](const Vec3& w) { return w.z() > 0.5; });
   const OccludedLight r = occluded_light(grey_map(), Mat3::Identity(), grey_cone(),
