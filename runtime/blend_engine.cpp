@@ -294,19 +294,22 @@ void fallback(const Source* const* sources, int n, const WarpOf& warp_of, float*
 
 // The footprint of disc point (x, y) for a source weight a: the offset of its top-left tap (>= 0
 // when all four taps are valid, inside the grid's interior radius; kRim otherwise; kSkip where a
-// is not > 0), fx, and the row weights times a: ya = (1 - fy) a, yb = fy a. The four tap weights
-// are (1 - fx) ya, fx ya, (1 - fx) yb, fx yb.
+// is not > 0) and the four tap weights times a, w = (w00, w01, w10, w11) = ((1 - fx)(1 - fy),
+// fx (1 - fy), (1 - fx) fy, fx fy) a: top-left, top-right, bottom-left, bottom-right.
 constexpr int kSkip = -1, kRim = -2;
 struct Taps {
   int offset;
-  float fx, ya, yb;
+  float w[4];
 };
 inline Taps taps(const Source::Grid& g, float x, float y, float a) {
   Taps t;
-  float fy;
-  footprint(g, x, y, t.offset, t.fx, fy);
-  t.ya = (1.0f - fy) * a;
-  t.yb = fy * a;
+  float fx, fy;
+  footprint(g, x, y, t.offset, fx, fy);
+  const float ya = (1.0f - fy) * a, yb = fy * a, gx = 1.0f - fx;
+  t.w[0] = gx * ya;
+  t.w[1] = fx * ya;
+  t.w[2] = gx * yb;
+  t.w[3] = fx * yb;
   const bool interior = x * x + y * y <= g.interior2;
   t.offset = a > 0.0f ? (interior ? t.offset : kRim) : kSkip;
   return t;
@@ -320,28 +323,34 @@ __attribute__((noinline)) float contribute_rim(const Source& s, float a, float x
   return accumulate(s, a, o, fx, fy, x, y, acc);
 }
 
-// An interior footprint's contribution (every tap valid, offset >= 0): the four taps times the
-// premultiplied weights (no renormalisation: the weights sum to a up to rounding), times the
-// confidence c = sum w k / sum w when kConfidence (the same products in the same order for a
-// confidence of 1, so exactly 1). Adds it to acc (R, G, B, total) and returns a c (0: none).
-template <bool kConfidence>
-inline float contribute_interior(const float* texels, const float* confidence, int stride, int conf_stride,
-                                 const Taps& t, float a, v4f& acc) {
-  const float* t0 = texels + t.offset;
-  const float gx = 1.0f - t.fx;
-  const v8f X = {gx, gx, gx, gx, t.fx, t.fx, t.fx, t.fx};
+// The weighted sum of an interior footprint's four RGBA taps, in one order for every path (so the
+// single texel here and the pairs in gather_row give the same bits): per lane
+// (w00 t00 + w10 t10) + (w01 t01 + w11 t11).
+inline v4f interior_sum(const float* t0, int stride, const float* w) {
+  const v8f W0 = {w[0], w[0], w[0], w[0], w[1], w[1], w[1], w[1]};
+  const v8f W1 = {w[2], w[2], w[2], w[2], w[3], w[3], w[3], w[3]};
   v8f T0, T1;
   load8(t0, T0);
   load8(t0 + stride, T1);
-  const v4f S = halves_sum(X * (t.ya * T0 + t.yb * T1));  // lanes 0-3: (1 - fx) column, 4-7: fx column
+  return halves_sum(W0 * T0 + W1 * T1);
+}
+
+// An interior footprint's contribution (every tap valid, offset >= 0): the four taps times the
+// premultiplied weights (no renormalisation: the weights sum to a up to rounding), times the
+// confidence c = sum w k / sum w when kConfidence (exactly 1 for a confidence of 1: the same products
+// in the same order above and below the division). Adds it to acc (R, G, B, total) and returns a c
+// (0: none).
+template <bool kConfidence>
+inline float contribute_interior(const float* texels, const float* confidence, int stride, int conf_stride, int offset,
+                                 const float* w, float a, v4f& acc) {
+  const v4f S = interior_sum(texels + offset, stride, w);
   if (!kConfidence) {
     acc += S;
     return a;
   }
-  const float w00 = gx * t.ya, w01 = t.fx * t.ya, w10 = gx * t.yb, w11 = t.fx * t.yb;
-  const float* k0 = confidence + t.offset / 4;
+  const float* k0 = confidence + offset / 4;
   const float* k1 = k0 + conf_stride;
-  const float c = (w00 * k0[0] + w01 * k0[1] + w10 * k1[0] + w11 * k1[1]) / (w00 + w01 + w10 + w11);
+  const float c = (w[0] * k0[0] + w[1] * k0[1] + w[2] * k1[0] + w[3] * k1[1]) / (w[0] + w[1] + w[2] + w[3]);
   const float conf = c > 0.0f ? c : 0.0f;  // negative or NaN counts as 0
   if (!(conf > 0.0f)) return 0.0f;
   acc += conf * S;
@@ -354,17 +363,18 @@ inline float contribute_interior(const float* texels, const float* confidence, i
 inline float contribute(const Source& s, const Taps& t, float a, float x, float y, v4f& acc) {
   if (t.offset < 0) return t.offset == kSkip ? 0.0f : contribute_rim(s, a, x, y, acc);
   return s.confidence.empty()
-             ? contribute_interior<false>(s.texels.data(), nullptr, s.grid.stride, 0, t, a, acc)
-             : contribute_interior<true>(s.texels.data(), s.confidence.data(), s.grid.stride, s.conf_stride, t, a, acc);
+             ? contribute_interior<false>(s.texels.data(), nullptr, s.grid.stride, 0, t.offset, t.w, a, acc)
+             : contribute_interior<true>(s.texels.data(), s.confidence.data(), s.grid.stride, s.conf_stride, t.offset,
+                                         t.w, a, acc);
 }
 
-// The source weights a = weight * fade(rim) and taps() for a row of points, structure of arrays (one
-// loop that vectorises, also for AVX2 and AVX-512).
-constexpr int kTileCols = 64;  // destination texels per tile row
+// The source weights a = weight * fade(rim) and taps() for a row of points, structure of arrays for
+// the offsets, the four weights of texel i at w[4i .. 4i + 3] (one loop that vectorises, also for
+// AVX2 and AVX-512).
+constexpr int kTileCols = 512;  // destination texels per tile row
 struct TapRows {
   int offset[kTileCols];
-  float fx[kTileCols], ya[kTileCols], yb[kTileCols];
-  Taps at(int i) const { return {offset[i], fx[i], ya[i], yb[i]}; }
+  alignas(64) float w[4 * kTileCols];
 };
 RSIBR_AVX512_CLONES void taps_row(const Source::Grid& grid, int n, float weight, float inv_fade,
                                   const float* __restrict x, const float* __restrict y, const float* __restrict rim,
@@ -375,9 +385,10 @@ RSIBR_AVX512_CLONES void taps_row(const Source::Grid& grid, int n, float weight,
     a[i] = ai;
     const Taps t = taps(g, x[i], y[i], ai);
     out.offset[i] = t.offset;
-    out.fx[i] = t.fx;
-    out.ya[i] = t.ya;
-    out.yb[i] = t.yb;
+    out.w[4 * i] = t.w[0];
+    out.w[4 * i + 1] = t.w[1];
+    out.w[4 * i + 2] = t.w[2];
+    out.w[4 * i + 3] = t.w[3];
   }
 }
 
@@ -386,9 +397,11 @@ RSIBR_AVX512_CLONES void taps_row(const Source::Grid& grid, int n, float weight,
 RSIBR_AVX512_CLONES int finish_row(int n, const v4f* __restrict acc, float* __restrict out, float* __restrict out_w,
                                    int* __restrict missing) {
   float inv[kTileCols];
+  int none = 0;  // texels without a sum (rare: the scan below runs only when there are some)
   for (int i = 0; i < n; ++i) {
     const float total = acc[i][3];
     const bool some = total > 0.0f;
+    none += some ? 0 : 1;
     inv[i] = 1.0f / (some ? total : 1.0f);
     out_w[i] = some ? (total < 1.0f ? total : 1.0f) : 0.0f;
   }
@@ -398,27 +411,65 @@ RSIBR_AVX512_CLONES int finish_row(int n, const v4f* __restrict acc, float* __re
     out[3 * i + 2] = acc[i][2] * inv[i];
   }
   int count = 0;
-  for (int i = 0; i < n; ++i)
-    if (!(acc[i][3] > 0.0f)) missing[count++] = i;
+  if (none > 0)
+    for (int i = 0; i < n; ++i)
+      if (!(acc[i][3] > 0.0f)) missing[count++] = i;
   return count;
 }
 
 // contribute() for a row of texels (acc and source_weight per texel; source_weight may be null), with
-// the source's pointers and the two options hoisted out of the loop (four forms).
+// the source's pointers and the two options hoisted out of the loop (four forms). Without a
+// confidence channel, two neighbouring interior texels are summed at once (16 lanes: both texels'
+// top tap pairs, then their bottom pairs), with interior_sum's arithmetic per lane.
+typedef float v16f __attribute__((vector_size(64)));
 template <bool kConfidence, bool kSourceWeight>
-inline void gather_row_t(const Source& s, int n, const float* a, const float* x, const float* y, const TapRows& t,
-                         v4f* acc, float* source_weight) {
+__attribute__((always_inline)) inline void gather_row_t(const Source& s, int n, const float* a, const float* x,
+                                                        const float* y, const TapRows& t, v4f* acc,
+                                                        float* source_weight) {
   const float* texels = s.texels.data();
   const float* confidence = s.confidence.data();
   const int stride = s.grid.stride, conf_stride = s.conf_stride;
-  for (int i = 0; i < n; ++i) {
+  const auto one = [&](int i) __attribute__((always_inline)) {
     const int offset = t.offset[i];
-    if (offset == kSkip) continue;
-    const float c =
-        offset >= 0 ? contribute_interior<kConfidence>(texels, confidence, stride, conf_stride, t.at(i), a[i], acc[i])
-                    : contribute_rim(s, a[i], x[i], y[i], acc[i]);
+    if (offset == kSkip) return;
+    const float c = offset >= 0 ? contribute_interior<kConfidence>(texels, confidence, stride, conf_stride, offset,
+                                                                   t.w + 4 * i, a[i], acc[i])
+                                : contribute_rim(s, a[i], x[i], y[i], acc[i]);
     if (kSourceWeight) source_weight[i] = c;
-  }
+  };
+  int i = 0;
+  if (!kConfidence)
+    for (; i + 1 < n; i += 2) {
+      const int o0 = t.offset[i], o1 = t.offset[i + 1];
+      if ((o0 | o1) < 0) {  // a rim or skipped texel: one at a time
+        one(i);
+        one(i + 1);
+        continue;
+      }
+      v8f w, A0, A1, B0, B1;
+      std::memcpy(&w, t.w + 4 * i, sizeof w);
+      load8(texels + o0, A0);
+      load8(texels + o0 + stride, A1);
+      load8(texels + o1, B0);
+      load8(texels + o1 + stride, B1);
+      const v16f T0 = __builtin_shufflevector(A0, B0, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+      const v16f T1 = __builtin_shufflevector(A1, B1, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+      const v16f W0 = __builtin_shufflevector(w, w, 0, 0, 0, 0, 1, 1, 1, 1, 4, 4, 4, 4, 5, 5, 5, 5);
+      const v16f W1 = __builtin_shufflevector(w, w, 2, 2, 2, 2, 3, 3, 3, 3, 6, 6, 6, 6, 7, 7, 7, 7);
+      const v16f S = W0 * T0 + W1 * T1;
+      // Lanes 0-3 + 4-7: texel i's sum; 8-11 + 12-15: texel i + 1's (halves_sum's order).
+      const v8f lo = __builtin_shufflevector(S, S, 0, 1, 2, 3, 8, 9, 10, 11);
+      const v8f hi = __builtin_shufflevector(S, S, 4, 5, 6, 7, 12, 13, 14, 15);
+      v8f pair;
+      std::memcpy(&pair, acc + i, sizeof pair);
+      pair += lo + hi;
+      std::memcpy(acc + i, &pair, sizeof pair);
+      if (kSourceWeight) {
+        source_weight[i] = a[i];
+        source_weight[i + 1] = a[i + 1];
+      }
+    }
+  for (; i < n; ++i) one(i);
 }
 RSIBR_AVX512_CLONES void gather_row(const Source& s, int n, const float* a, const float* x, const float* y,
                                     const TapRows& t, v4f* acc, float* source_weight) {
@@ -780,11 +831,11 @@ void BlendEngine::map(const Vec3& view_dir, const Vec3& up, const MapRequest& re
     }
   }
 
-  // Tiles of kTileRows x kTileCols destination texels: a tile's footprint in each source is compact
-  // (tens of KiB for three sources), so the bilinear taps hit the cache and the TLB; a whole
-  // destination row sweeps a curve across hundreds of source rows. Per texel the arithmetic does not
-  // depend on the tiling or the threads.
-  constexpr int kTileRows = 16;
+  // Tiles of kTileRows x kTileCols destination texels (whole rows up to 512 wide): the row loops run
+  // long enough to amortise their set-up, and a row's taps in three sources (about 100 KiB at 512^2)
+  // stay in the core's cache for the next row's. Per texel the arithmetic does not depend on the
+  // tiling or the threads.
+  constexpr int kTileRows = 8;
   // One tile: rows [r0, r1) (at most kTileRows), columns [cb, cb + kTileCols) cut to each row's disc
   // span (spans[r - r0]). Row by row: the central directions once (when the warp rotates them), then
   // source by source the warp, the footprints and the taps as row loops into the row's sums (so one
