@@ -23,10 +23,12 @@
 namespace rsibr {
 namespace {
 
-// A view-independent mirror map set of the direction-coded environment over the icosahedron.
-const MapSet& mirror_set(int size) {
-  static std::map<int, MapSet> cache;
-  auto it = cache.find(size);
+// A view-independent mirror map set of the direction-coded environment over the icosahedron. With
+// `confidence`, each map carries a confidence channel as captured maps do (1 at the centre falling
+// to 0.2 at the rim).
+const MapSet& mirror_set(int size, bool confidence = false) {
+  static std::map<std::pair<int, bool>, MapSet> cache;
+  auto it = cache.find({size, confidence});
   if (it != cache.end()) return it->second;
   MapSet set;
   const auto f = patterns::direction_coded();
@@ -38,9 +40,16 @@ const MapSet& mirror_set(int size) {
     const Mat3 T = mv.world_from_view;
     mv.rgb =
         render_pattern([&](const Vec3& d) { return f(T * d); }, Layout::with_size(LayoutKind::Sphere, size), 1).pixels;
+    if (confidence) {
+      mv.confidence.create(size, size, CV_32FC1);
+      for (int r = 0; r < size; ++r)
+        for (int c = 0; c < size; ++c)
+          mv.confidence.at<float>(r, c) =
+              float(1.0 - 0.8 * sphere_map::disc_from_pixel(Vec2(c, r), size, size).squaredNorm());
+    }
     set.views.push_back(std::move(mv));
   }
-  return cache.emplace(size, std::move(set)).first->second;
+  return cache.emplace(std::make_pair(size, confidence), std::move(set)).first->second;
 }
 
 const Vec3 kView = Vec3(0.3, 0.5, 0.8).normalized();
@@ -120,12 +129,13 @@ void BM_OpenCvBlend(benchmark::State& state) {
   state.SetLabel(std::to_string(n) + "^2, 3 sources: warp maps + remap + weighted sum");
 }
 
-// One frame's blend of size^2 for warp kind 0 exact, 1 precomputed, 2 tessellated (16 x 64). Paths:
+// One frame's blend of size^2 for warp kind 0 exact, 1 precomputed, 2 tessellated (16 x 64), 3 exact
+// with a confidence channel in every source (as captured maps carry). Paths:
 // 0 the blend engine, built once (sources laid out once, as the renderer and the viewer hold it), one
 // map() per frame; 1 blend(), one call per frame (an engine per call: the located sources laid out
 // each time); 2 the tile path before the engine (bench/previous_blend.h).
 void blend_frames(benchmark::State& state, int n, int kind, int path) {
-  const MapSet& set = mirror_set(n);
+  const MapSet& set = mirror_set(n, kind == 3);
   const ViewSet views = set.view_set();
   const PrecomputedWarp table(n, n);
   const TessellatedWarp mesh(n, n);
@@ -145,7 +155,8 @@ void blend_frames(benchmark::State& state, int n, int kind, int path) {
                               : previous::blend(set, views, kView, Vec3(0, 1, 0), options);
     benchmark::DoNotOptimize(r.rgb.data);
   }
-  const char* names[] = {"exact warp", "precomputed directions", "tessellated disk 16x64"};
+  const char* names[] = {"exact warp", "precomputed directions", "tessellated disk 16x64",
+                         "exact warp, confidence channel"};
   const char* paths[] = {"engine", "blend(), one call", "previous tile path"};
   state.SetLabel(std::to_string(n) + "^2, " + names[kind] + ", " + paths[path]);
 }
@@ -161,8 +172,8 @@ void BM_PreviousTilePath(benchmark::State& state) { blend_frames(state, int(stat
 BENCHMARK(BM_RemapThreeMaps)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_OpenCvBlend)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Blend)->ArgsProduct({{256, 512}, {0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_PreviousTilePath)->ArgsProduct({{256, 512}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_BlendEngine)->ArgsProduct({{256, 512}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PreviousTilePath)->ArgsProduct({{256, 512}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_BlendEngine)->ArgsProduct({{256, 512}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace rsibr

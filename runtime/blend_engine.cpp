@@ -335,10 +335,18 @@ inline v4f interior_sum(const float* t0, int stride, const float* w) {
   return halves_sum(W0 * T0 + W1 * T1);
 }
 
+// The confidence of an interior footprint, c = sum w k / sum w (exactly 1 for a confidence of 1: the
+// same products in the same order above and below the division); negative or NaN counts as 0.
+inline float tap_confidence(const float* confidence, int conf_stride, int offset, const float* w) {
+  const float* k0 = confidence + offset / 4;
+  const float* k1 = k0 + conf_stride;
+  const float c = (w[0] * k0[0] + w[1] * k0[1] + w[2] * k1[0] + w[3] * k1[1]) / (w[0] + w[1] + w[2] + w[3]);
+  return c > 0.0f ? c : 0.0f;
+}
+
 // An interior footprint's contribution (every tap valid, offset >= 0): the four taps times the
 // premultiplied weights (no renormalisation: the weights sum to a up to rounding), times the
-// confidence c = sum w k / sum w when kConfidence (exactly 1 for a confidence of 1: the same products
-// in the same order above and below the division). Adds it to acc (R, G, B, total) and returns a c
+// confidence c (tap_confidence) when kConfidence. Adds it to acc (R, G, B, total) and returns a c
 // (0: none).
 template <bool kConfidence>
 inline float contribute_interior(const float* texels, const float* confidence, int stride, int conf_stride, int offset,
@@ -348,10 +356,7 @@ inline float contribute_interior(const float* texels, const float* confidence, i
     acc += S;
     return a;
   }
-  const float* k0 = confidence + offset / 4;
-  const float* k1 = k0 + conf_stride;
-  const float c = (w[0] * k0[0] + w[1] * k0[1] + w[2] * k1[0] + w[3] * k1[1]) / (w[0] + w[1] + w[2] + w[3]);
-  const float conf = c > 0.0f ? c : 0.0f;  // negative or NaN counts as 0
+  const float conf = tap_confidence(confidence, conf_stride, offset, w);
   if (!(conf > 0.0f)) return 0.0f;
   acc += conf * S;
   return a * conf;
@@ -418,9 +423,10 @@ RSIBR_AVX512_CLONES int finish_row(int n, const v4f* __restrict acc, float* __re
 }
 
 // contribute() for a row of texels (acc and source_weight per texel; source_weight may be null), with
-// the source's pointers and the two options hoisted out of the loop (four forms). Without a
-// confidence channel, two neighbouring interior texels are summed at once (16 lanes: both texels'
-// top tap pairs, then their bottom pairs), with interior_sum's arithmetic per lane.
+// the source's pointers and the two options hoisted out of the loop (four forms). Two neighbouring
+// interior texels are summed at once (16 lanes: both texels' top tap pairs, then their bottom pairs),
+// with contribute_interior's arithmetic per lane; a pair with a rim or skipped texel, or a texel of
+// confidence 0, goes one texel at a time.
 typedef float v16f __attribute__((vector_size(64)));
 template <bool kConfidence, bool kSourceWeight>
 __attribute__((always_inline)) inline void gather_row_t(const Source& s, int n, const float* a, const float* x,
@@ -438,37 +444,42 @@ __attribute__((always_inline)) inline void gather_row_t(const Source& s, int n, 
     if (kSourceWeight) source_weight[i] = c;
   };
   int i = 0;
-  if (!kConfidence)
-    for (; i + 1 < n; i += 2) {
-      const int o0 = t.offset[i], o1 = t.offset[i + 1];
-      if ((o0 | o1) < 0) {  // a rim or skipped texel: one at a time
-        one(i);
-        one(i + 1);
-        continue;
-      }
-      v8f w, A0, A1, B0, B1;
-      std::memcpy(&w, t.w + 4 * i, sizeof w);
-      load8(texels + o0, A0);
-      load8(texels + o0 + stride, A1);
-      load8(texels + o1, B0);
-      load8(texels + o1 + stride, B1);
-      const v16f T0 = __builtin_shufflevector(A0, B0, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-      const v16f T1 = __builtin_shufflevector(A1, B1, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-      const v16f W0 = __builtin_shufflevector(w, w, 0, 0, 0, 0, 1, 1, 1, 1, 4, 4, 4, 4, 5, 5, 5, 5);
-      const v16f W1 = __builtin_shufflevector(w, w, 2, 2, 2, 2, 3, 3, 3, 3, 6, 6, 6, 6, 7, 7, 7, 7);
-      const v16f S = W0 * T0 + W1 * T1;
-      // Lanes 0-3 + 4-7: texel i's sum; 8-11 + 12-15: texel i + 1's (halves_sum's order).
-      const v8f lo = __builtin_shufflevector(S, S, 0, 1, 2, 3, 8, 9, 10, 11);
-      const v8f hi = __builtin_shufflevector(S, S, 4, 5, 6, 7, 12, 13, 14, 15);
-      v8f pair;
-      std::memcpy(&pair, acc + i, sizeof pair);
-      pair += lo + hi;
-      std::memcpy(acc + i, &pair, sizeof pair);
-      if (kSourceWeight) {
-        source_weight[i] = a[i];
-        source_weight[i + 1] = a[i + 1];
-      }
+  for (; i + 1 < n; i += 2) {
+    const int o0 = t.offset[i], o1 = t.offset[i + 1];
+    float c0 = 1.0f, c1 = 1.0f;
+    if (kConfidence && (o0 | o1) >= 0) {
+      c0 = tap_confidence(confidence, conf_stride, o0, t.w + 4 * i);
+      c1 = tap_confidence(confidence, conf_stride, o1, t.w + 4 * i + 4);
     }
+    if ((o0 | o1) < 0 || !(c0 > 0.0f) || !(c1 > 0.0f)) {
+      one(i);
+      one(i + 1);
+      continue;
+    }
+    v8f w, A0, A1, B0, B1;
+    std::memcpy(&w, t.w + 4 * i, sizeof w);
+    load8(texels + o0, A0);
+    load8(texels + o0 + stride, A1);
+    load8(texels + o1, B0);
+    load8(texels + o1 + stride, B1);
+    const v16f T0 = __builtin_shufflevector(A0, B0, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    const v16f T1 = __builtin_shufflevector(A1, B1, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    const v16f W0 = __builtin_shufflevector(w, w, 0, 0, 0, 0, 1, 1, 1, 1, 4, 4, 4, 4, 5, 5, 5, 5);
+    const v16f W1 = __builtin_shufflevector(w, w, 2, 2, 2, 2, 3, 3, 3, 3, 6, 6, 6, 6, 7, 7, 7, 7);
+    const v16f S = W0 * T0 + W1 * T1;
+    // Lanes 0-3 + 4-7: texel i's sum; 8-11 + 12-15: texel i + 1's (halves_sum's order).
+    const v8f lo = __builtin_shufflevector(S, S, 0, 1, 2, 3, 8, 9, 10, 11);
+    const v8f hi = __builtin_shufflevector(S, S, 4, 5, 6, 7, 12, 13, 14, 15);
+    v8f sum = lo + hi, pair;
+    if (kConfidence) sum *= v8f{c0, c0, c0, c0, c1, c1, c1, c1};
+    std::memcpy(&pair, acc + i, sizeof pair);
+    pair += sum;
+    std::memcpy(acc + i, &pair, sizeof pair);
+    if (kSourceWeight) {
+      source_weight[i] = kConfidence ? a[i] * c0 : a[i];
+      source_weight[i + 1] = kConfidence ? a[i + 1] * c1 : a[i + 1];
+    }
+  }
   for (; i < n; ++i) one(i);
 }
 RSIBR_AVX512_CLONES void gather_row(const Source& s, int n, const float* a, const float* x, const float* y,
