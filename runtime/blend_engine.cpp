@@ -843,7 +843,7 @@ void BlendEngine::map(const Vec3& view_dir, const Vec3& up, const MapRequest& re
   }
 
   // Tiles of kTileRows x kTileCols destination texels (whole rows up to 512 wide): the row loops run
-  // long enough to amortise their set-up, and a row's taps in three sources (about 100 KiB at 512^2)
+  // long enough to amortise their set-up, and a row's taps in three sources (about 50 KiB at 512^2)
   // stay in the core's cache for the next row's. Per texel the arithmetic does not depend on the
   // tiling or the threads.
   constexpr int kTileRows = 8;
