@@ -23,9 +23,11 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 
 namespace rsibr::cli {
@@ -93,6 +95,8 @@ int run_bake(const BakeArgs& given, const CLI::App& command) {
   // runs with the chosen setting and is checked at fresh novel views until the check decides
   // (plan/bake_plan.h, check_bake_for_budget).
   std::optional<BakePlan> plan;
+  const PlannedSetting* planned = nullptr;  // plan->chosen, or the closest measured setting
+  bool fallback = false;
   if (!a.max_error.empty()) {
     BakeKnobs knobs;
     if (command.count("--views")) knobs.views = a.views;
@@ -102,12 +106,22 @@ int run_bake(const BakeArgs& given, const CLI::App& command) {
     if (command.count("--reference-width")) knobs.reference_width = a.reference_width;
     knobs.normalise_albedo = a.normalise == "albedo";
     plan = plan_bake(env, *in.brdf, bake_plan_options(parse_error_budget(a.max_error), knobs, a.seed));
-    if (!plan->chosen) {
+    planned = setting_to_bake(*plan, &fallback);
+    if (!planned) {
       std::cerr << "rsibr bake: error: " << a.brdf << ": no setting is predicted to meet --max-error " << a.max_error
                 << " under " << a.env << " (rsibr plan shows the candidates); nothing written\n";
       return 3;
     }
-    const BakeSetting& s = plan->chosen->setting;
+    if (fallback) {
+      std::ostringstream m;
+      m << std::fixed << std::setprecision(2) << "rsibr bake: warning: no setting clears the plan's reserve ("
+        << std::lround(100 * plan->options.margin) << "% of --max-error " << a.max_error
+        << "); baking the closest measured one, " << planned->setting.view_count << " views x " << planned->setting.res
+        << "^2, " << planned->setting.integrator.label() << " (measured " << 100 * *planned->measured_error << "% +- "
+        << 100 * *planned->measured_sigma << "% at the pilot texels), and checking it\n";
+      std::cerr << m.str();
+    }
+    const BakeSetting& s = planned->setting;
     a.views = s.views;
     a.res = s.res;
     a.method = s.integrator.method;
@@ -148,8 +162,8 @@ int run_bake(const BakeArgs& given, const CLI::App& command) {
     if (!a.quiet)
       std::cerr << "rsibr bake: checked at " << k.views << " fresh novel views (" << check->rounds
                 << (check->rounds == 1 ? " round" : " rounds") << "): " << 100 * k.error << "% +- "
-                << 100 * k.error_sigma << "% against the reference (predicted " << 100 * plan->chosen->error
-                << "%, budget " << 100 * plan->options.max_error << "%): " << check->verdict << "\n";
+                << 100 * k.error_sigma << "% against the reference (predicted " << 100 * planned->error << "%, budget "
+                << 100 * plan->options.max_error << "%): " << check->verdict << "\n";
     if (check->verdict == "exceeds")
       std::cerr << "rsibr bake: warning: the checked error " << 100 * k.error << "% exceeds --max-error " << a.max_error
                 << " by more than twice its standard error\n";
@@ -190,11 +204,12 @@ int run_bake(const BakeArgs& given, const CLI::App& command) {
     const BakeCheck& k = check->check;
     j["check"] = {{"error", k.error},
                   {"error_sigma", k.error_sigma},
-                  {"predicted_error", plan->chosen->error},
+                  {"predicted_error", planned->error},
+                  {"planned_from", fallback ? "closest" : "chosen"},
                   {"max_error", plan->options.max_error},
                   {"meets", k.error <= plan->options.max_error},
                   {"verdict", check->verdict},
-                  {"predicted_seconds", plan->chosen->seconds},
+                  {"predicted_seconds", planned->seconds},
                   {"seconds", secs(t2 - t1)},
                   {"views", k.views},
                   {"texels", k.texels},

@@ -56,17 +56,22 @@ int run_plan(const PlanArgs& a) {
   const BakePlan plan = plan_bake(env, *brdf, options);
   std::ostream& out = a.json == "-" ? std::cerr : std::cout;
   print_plan(out, plan);
-  if (plan.chosen)
-    out << "bake it: rsibr bake --env " << a.env << " --brdf " << a.brdf << " " << bake_arguments(plan.chosen->setting)
+  bool fallback = false;
+  const PlannedSetting* to_bake = setting_to_bake(plan, &fallback);
+  if (to_bake)
+    out << (fallback ? "none clears the reserve; rsibr bake --max-error would bake the closest measured setting "
+                       "and check it: rsibr bake"
+                     : "bake it: rsibr bake")
+        << " --env " << a.env << " --brdf " << a.brdf << " " << bake_arguments(to_bake->setting)
         << (a.lobe != "all" ? " --lobe " + a.lobe : "") << (knobs.normalise_albedo ? " --normalise albedo" : "")
         << (a.seed != 0 ? " --seed " + std::to_string(a.seed) : "") << " OUTPUT.exr\n";
   nlohmann::json j = plan.to_json();
   j["environment"] = a.env;
   j["brdf"] = a.brdf;
   j["material"] = brdf->spec();
-  if (plan.chosen)
-    j["bake_arguments"] =
-        bake_arguments(plan.chosen->setting) + (a.seed != 0 ? " --seed " + std::to_string(a.seed) : "");
+  if (to_bake)
+    j[fallback ? "closest_bake_arguments" : "bake_arguments"] =
+        bake_arguments(to_bake->setting) + (a.seed != 0 ? " --seed " + std::to_string(a.seed) : "");
   write_summary(json, j);
   outputs.commit();
   return plan.chosen ? 0 : 3;

@@ -128,6 +128,15 @@ std::vector<IntegratorSetting> default_integrator_settings() {
   return s;
 }
 
+const PlannedSetting* setting_to_bake(const BakePlan& plan, bool* fallback) {
+  if (fallback) *fallback = false;
+  if (plan.chosen) return &*plan.chosen;
+  const auto& c = plan.closest;
+  if (!c || !c->measured_error || !(*c->measured_error <= plan.options.max_error)) return nullptr;
+  if (fallback) *fallback = true;
+  return &*c;
+}
+
 BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& options) {
   if (!(options.max_error > 0 && options.max_error < 1))
     throw std::invalid_argument("plan: the error budget must lie in (0, 1) (a relative RMS, e.g. 0.02 for 2%), not " +

@@ -176,6 +176,13 @@ IntegratorPlan plan_integrator(const EnvMap& env, const Brdf& brdf, double max_e
 // or size that cannot be used, and what the integrators throw on construction.
 BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& options);
 
+// The setting a bake for `plan` uses: the chosen one; without a choice, the closest measured one
+// when its measured error (the pilot's estimate, without the reserve and the standard errors) is
+// within the budget, with *fallback set: no candidate cleared the plan's reserve, but baking the
+// nearest one and checking it (check_bake_for_budget, whose verdict then decides) serves a user
+// better than nothing; else none (nullptr).
+const PlannedSetting* setting_to_bake(const BakePlan& plan, bool* fallback = nullptr);
+
 // The error of a baked set at fresh novel views (seed), measured as the plan predicts it: its blend
 // against the full reference quadrature at `views` x `texels` texels drawn with the plan's guide.
 struct BakeCheck {

@@ -102,6 +102,29 @@ rule = 'meets' if e + 2 * s <= 0.05 else 'exceeds' if e - 2 * s > 0.05 else 'und
 assert k['verdict'] == rule, k
 assert k['verdict'] != 'undecided' or s <= 0.005 or k['views'] == 64, k
 " "$work/plan.json" "$work/planned.json"
+# Where no setting clears the plan's reserve (85% of the budget) but the closest measured one is within
+# the budget itself (here 18% +- 3% against 21%), bake --max-error bakes that one, says so and checks
+# it; plan names it and still exits 3 (no choice).
+"$rsibr" bake --env "$work/sky.exr" --brdf "$work/ggx.yaml" --max-error 21% --views 42 --res 16 --method fis \
+  --samples 32 --seed 3 -q --json "$work/closest.json" "$work/closest.exr" 2>"$work/closest.err"
+check "bake --max-error without a choice: the closest measured setting, said and checked" python3 -c "
+import json, sys
+b = json.load(open(sys.argv[1]))
+assert b['plan']['chosen'] is None and b['plan']['closest'] is not None, b['plan']
+assert b['check']['planned_from'] == 'closest' and b['views'] == 42 and b['res'] == 16, b['check']
+assert b['plan']['closest']['measured_error'] <= 0.21 < b['plan']['closest']['upper_error'] / 0.85, b['plan']['closest']
+assert 'no setting clears the plan' in open(sys.argv[2]).read()
+" "$work/closest.json" "$work/closest.err"
+"$rsibr" plan --env "$work/sky.exr" --brdf "$work/ggx.yaml" --max-error 21% --views 42 --res 16 --method fis \
+  --samples 32 --seed 3 --json "$work/closest-plan.json" >"$work/closest-plan.txt" 2>&1
+status=$?
+check "plan without a choice: exit 3, the closest setting's bake arguments" python3 -c "
+import json, sys
+p = json.load(open(sys.argv[1]))
+assert int(sys.argv[3]) == 3 and 'bake_arguments' not in p, p.keys()
+assert p['closest_bake_arguments'].startswith('--views 42 --res 16 --method fis --samples 32'), p['closest_bake_arguments']
+assert 'would bake the closest measured setting' in open(sys.argv[2]).read()
+" "$work/closest-plan.json" "$work/closest-plan.txt" "$status"
 # bake --lobe: each part of a clear coat is its own set, warped from the part's central direction.
 check "bake --help mentions --lobe" bash -c "'$rsibr' bake --help | grep -q -- --lobe"
 printf '%s\n' '{type: clearcoat, coat: {ior: 1.5, roughness: 0.05}, flakes: {coverage: 0.3, roughness: 0.3, fresnel: {type: schlick, f0: [0.9, 0.7, 0.4]}}, base: {albedo: [0.5, 0.05, 0.03]}}' >"$work/paint.yaml"

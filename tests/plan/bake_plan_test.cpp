@@ -200,6 +200,42 @@ TEST(BakePlan, WithoutAChoiceTheClosestMeasuredSettingIsNamed) {
   EXPECT_TRUE(plan_bake(env, *brdf, small(1e-5)).to_json()["closest"].is_null());  // nothing was measured
 }
 
+// What a bake uses: the choice; without one, the closest measured setting only when its measured
+// error is within the budget itself (the reserve and the standard errors left to the bake's check).
+TEST(BakePlan, ABakeTakesTheChoiceElseTheClosestMeasuredSettingWithinTheBudget) {
+  BakePlan plan;
+  plan.options.max_error = 0.02;
+  PlannedSetting closest;
+  closest.setting = {"fib324", 324, 64, {"fis", 128, 0}};
+  closest.measured_error = 0.0166;
+  closest.measured_sigma = 0.0027;
+  closest.upper_error = 0.0166 + 0.5 * 0.0027;  // over margin x budget = 0.017: no choice
+  bool fallback = true;
+  EXPECT_EQ(setting_to_bake(plan, &fallback), nullptr);  // nothing measured
+  EXPECT_FALSE(fallback);
+  plan.closest = closest;
+  const PlannedSetting* s = setting_to_bake(plan, &fallback);
+  ASSERT_NE(s, nullptr);
+  EXPECT_TRUE(fallback);
+  EXPECT_EQ(s->setting.view_count, 324);
+  plan.closest->measured_error = 0.0201;  // over the budget itself: nothing to bake
+  EXPECT_EQ(setting_to_bake(plan, &fallback), nullptr);
+  plan.closest->measured_error = std::nan("");
+  EXPECT_EQ(setting_to_bake(plan, &fallback), nullptr);
+  plan.closest->measured_error.reset();
+  EXPECT_EQ(setting_to_bake(plan, &fallback), nullptr);
+  PlannedSetting chosen = closest;
+  chosen.setting.view_count = 642;
+  chosen.meets = true;
+  plan.chosen = chosen;
+  plan.closest->measured_error = 0.0166;
+  s = setting_to_bake(plan, &fallback);
+  ASSERT_NE(s, nullptr);
+  EXPECT_FALSE(fallback);
+  EXPECT_EQ(s->setting.view_count, 642);
+  EXPECT_EQ(setting_to_bake(plan), s);  // the flag is optional
+}
+
 TEST(BakePlan, TheFullReferenceHasNoIntegrationErrorAndCoarserWidthsHaveMore) {
   const EnvMap env = sky(Vec3(0.5, 0.5, 0.5), 64);
   const auto brdf = parse_brdf("{type: lambert, albedo: [0.8, 0.8, 0.8]}");
