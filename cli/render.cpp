@@ -123,10 +123,11 @@ int run_render(const RenderArgs& a) {
   double render_total = 0;
   long long hits_total = 0;
   std::optional<float> stops = a.exposure;
+  cv::Mat image;  // one frame buffer for every frame of a turntable
   for (int k = 0; k < frames; ++k) {
     const Camera cam = make_camera(a.camera, mesh.bounds(), k);
     RenderStats stats;
-    const cv::Mat image = renderer.render(cam, &stats);
+    renderer.render(cam, image, &stats);
     render_total += stats.seconds;
     hits_total += stats.hits;
     const std::string path = frame_path(a.output, a.camera.turntable, k);

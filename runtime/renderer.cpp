@@ -194,6 +194,12 @@ long long Renderer::trace_only(const Camera& camera) const {
 }
 
 cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
+  cv::Mat out;
+  render(camera, out, stats);
+  return out;
+}
+
+void Renderer::render(const Camera& camera, cv::Mat& out, RenderStats* stats) const {
   const auto t0 = std::chrono::steady_clock::now();
   if (camera.width < 1 || camera.height < 1) throw std::invalid_argument("render: empty image size");
   const RayScene& scene = *impl_->scene;
@@ -245,7 +251,8 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
   }
   const auto t1 = std::chrono::steady_clock::now();
 
-  cv::Mat out = cv::Mat::zeros(camera.height, camera.width, CV_32FC4);
+  out.create(camera.height, camera.width, CV_32FC4);  // kept when its size and type match
+  out.setTo(cv::Scalar::all(0));
   const TileGrid grid(camera.width, camera.height);
   const int k = impl_->spp_k;
   const double inv_spp = 1.0 / (k * k);
@@ -370,7 +377,6 @@ cv::Mat Renderer::render(const Camera& camera, RenderStats* stats) const {
     stats->seconds_blend = std::chrono::duration<double>(t1 - t0).count();
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
-  return out;
 }
 
 }  // namespace rsibr

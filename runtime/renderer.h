@@ -100,6 +100,10 @@ class Renderer {
 
   // One frame (camera.width x camera.height). Thread-safe for concurrent calls.
   cv::Mat render(const Camera& camera, RenderStats* stats = nullptr) const;
+  // The same into `out`, reusing its buffer when its size and type match (a caller that renders many
+  // frames keeps one image: a fresh 15 MB image per 1280x720 frame costs its page faults every frame).
+  // Any cv::Mat sharing out's data sees the new frame.
+  void render(const Camera& camera, cv::Mat& out, RenderStats* stats = nullptr) const;
 
   // The primary-ray pass alone (same rays and tiles, no shading): the count of hits. For benchmarks.
   long long trace_only(const Camera& camera) const;

@@ -342,6 +342,32 @@ TEST(Renderer, RenderDoesNotDependOnTheThreadCount) {
   }
 }
 
+// A kept frame buffer (a turntable's): rendering into it reuses its memory and gives each frame
+// exactly what a fresh render gives, with nothing of the previous frame left (here a frame where the
+// sphere covers other pixels, then one of another size).
+TEST(Renderer, RenderingIntoAKeptBufferEqualsAFreshRenderAndReusesIt) {
+  const Mesh mesh = sphere_mesh(24, 48);
+  const MapSet set = analytic_map_set(ViewSet::icosahedron(), 32, 32, "mirror", fresnel_mirror_texel);
+  const Camera a = look_at(Vec3(0.4, 0.3, 3.0), Vec3::Zero(), Vec3(0, 1, 0), 50, 80, 60);
+  const Camera b = look_at(Vec3(-2.5, 1.0, 4.0), Vec3(0.6, 0, 0), Vec3(0, 1, 0), 30, 80, 60);
+  const Camera c = look_at(Vec3(0.4, 0.3, 3.0), Vec3::Zero(), Vec3(0, 1, 0), 50, 40, 30);
+  for (RenderMode mode : {RenderMode::PerPixel, RenderMode::Paper}) {
+    const Renderer renderer(mesh, {&set}, with_mode(mode));
+    cv::Mat kept;
+    renderer.render(a, kept);
+    EXPECT_EQ(cv::norm(kept, renderer.render(a), cv::NORM_INF), 0.0) << to_string(mode);
+    const uchar* data = kept.data;
+    renderer.render(b, kept);
+    EXPECT_EQ(kept.data, data) << to_string(mode);  // the same buffer
+    const cv::Mat fresh = renderer.render(b);
+    EXPECT_GT(cv::norm(fresh, renderer.render(a), cv::NORM_INF), 0.0);  // the frames differ
+    EXPECT_EQ(cv::norm(kept, fresh, cv::NORM_INF), 0.0) << to_string(mode);
+    renderer.render(c, kept);
+    ASSERT_EQ(kept.size(), cv::Size(40, 30));
+    EXPECT_EQ(cv::norm(kept, renderer.render(c), cv::NORM_INF), 0.0) << to_string(mode);
+  }
+}
+
 TEST(Renderer, MissesAreBlackWithAlphaZeroOrTheEnvironment) {
   const Mesh mesh = sphere_mesh(12, 24);
   const MapSet set = analytic_map_set(ViewSet::icosahedron(), 16, 16, "normal", lambert_texel);
