@@ -8,19 +8,31 @@
 //   E_scene(n) = sum_w L_s(w) max(0, n.w) dw,  L_s(w) = the occluder's radiance where the ray
 //                c + n + t w meets one first, L(w) otherwise
 // and the corrected texel is the captured one times E_open / E_scene, per channel (the albedo and
-// the exposure cancel). The sum runs over a lat-long quadrature of the probe; a direction the probe
-// did not see (weight below min_weight) counts as L_s in both sums (nothing is known to restore).
+// the exposure cancel), where the model explains the texel: captured ~ k E_scene, k the map's
+// median of captured / E_scene. Where it does not (by over 2x; blended from 1.25x), chiefly at a
+// sun's terminator, which the quadrature places coarsely, the difference is added in the map's
+// scale instead: captured + k (E_open - E_scene). The sum runs over a lat-long quadrature of the
+// probe; a direction the probe did not see (weight below min_weight) is left out of both sums
+// (nothing is known to restore).
 // The occluders' radiance:
 //   mirror ball     F(cos) L(r), r the direction reflected at the hit point (F = 1 when the probe
 //                   holds F L, i.e. no Fresnel was divided out of it)
 //   lambert ball    albedo E_open(m) / pi at the hit point's normal m
-//   seen by chrome  the photographer and the camera: what the same view's chrome map shows in the
-//                   ray's direction w (the mean of its texels in w's quadrature cell, or where the
-//                   cell holds none, the texel of w), over F. The photographer stands far compared
-//                   with the balls' distance apart, and where the capsule is empty the chrome ball
-//                   sees the far environment there. A direction the chrome map did not fill or holds
-//                   clipped (a lower bound), or where the grey ball itself stands in the chrome
-//                   ball's way along w, is L(w)
+//   seen by chrome  the photographer and the camera: the probe's L(w) plus what the same view's
+//                   chrome ball sees beyond the far environment toward the hit point h (the ray's
+//                   closest approach to the capsule's axis), D(u) = chrome(u) / F - probe(u),
+//                   u = h - chrome centre, the mean of the chrome texels in u's quadrature cell
+//                   (the texel of u where the cell holds none) against the probe read at the
+//                   texels' footprint. Where the capsule is empty D is resampling noise about 0;
+//                   where a body stands L + D = body + L(w) - L(u), exact when what it hides looks
+//                   alike from both balls. A chrome texel clipped in every bracket, within 2
+//                   texels of one, or brighter than 4 E_max / pi (no lit diffuse body is) counts
+//                   as D = 0 (light, not a body); one showing another ball in front, or where the
+//                   grey ball itself stands in the chrome ball's way toward h, is not read (that
+//                   direction restores nothing)
+// The probe must hold the whole light, the light clipped in every view included (the pipeline
+// passes lights/recovered_probe.h's): the ratio is the photographer's light over all of it, and a
+// probe short of a clipped sun overstates it (2-3x where the sun is 60% of the light).
 // Frames and units: the camera frame of the view (x right, y down, z forward), lengths in radii of
 // the grey ball, as calib/occluders.h; directions of the probe and the maps in their own frames.
 #pragma once
@@ -45,7 +57,10 @@ struct OccluderLight {
 
 // The open environment as a quadrature: a lat-long probe (world frame) and its summed confidence.
 struct OpenLight {
-  EnvMap env;              // lat-long, RGB
+  EnvMap env;   // lat-long, RGB
+  EnvMap fine;  // the probe itself, with its weight: what a chrome texel is compared with
+  cv::Mat fine_weight;
+  double min_weight = 1e-3;
   cv::Mat seen;            // CV_8UC1: 1 where the probe's weight reached min_weight
   cv::Mat solid_angle;     // CV_64FC1, per texel
   EnvMap irradiance;       // lat-long, E_open at each texel's direction (for lambert balls)

@@ -2,6 +2,8 @@
 // under a uniform environment, occluders as bright as what they hide, unseen and hidden light.
 #include "calib/occluded_light.h"
 
+#include "core/sphere_map.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -106,6 +108,104 @@ TEST(OccludedLight, ThePhotographersRadianceIsWhatTheChromeBallSees) {
       occluded_light(grey_map(), Mat3::Identity(), grey_cone(), {ball_ahead(OccluderLight::seen_by_chrome)},
                      uniform_light(), &chrome, Vec3(5, 0, 10), cv::Mat(64, 64, CV_8UC1, cv::Scalar(1)));
   EXPECT_EQ(centre_ratio(hidden), 1.0f);
+}
+
+// A 64 x 64 chrome map (no Fresnel, world = view frame) rendered from its centre `c`: each texel
+// shows the probe in its mirror direction, or `head_radiance` where that ray meets the sphere
+// (head_centre, head_radius).
+MapView rendered_chrome(const EnvMap& probe, const Vec3& c, const Vec3& head_centre, double head_radius,
+                        float head_radiance) {
+  MapView mv;
+  mv.rgb = cv::Mat(64, 64, CV_32FC3, cv::Scalar::all(0));
+  Occluder head;
+  head.centre = head_centre;
+  head.radius = head_radius;
+  for (int r = 0; r < 64; ++r)
+    for (int col = 0; col < 64; ++col) {
+      const Vec2 xy = sphere_map::disc_from_pixel(Vec2(col, r), 64, 64);
+      if (xy.squaredNorm() >= 1) continue;
+      const Vec3 d = sphere_map::g_mirror(xy);
+      float v[3];
+      sample_bilinear(probe, d, v);
+      if (head_radius > 0 && ray_hits(head, c, d)) v[0] = v[1] = v[2] = head_radiance;
+      mv.rgb.at<cv::Vec3f>(r, col) = cv::Vec3f(v[0], v[1], v[2]);
+    }
+  return mv;
+}
+
+// A photographer's capsule about a vertical axis through (5, 0, 30), 6 radii wide.
+OccluderLight photographer_capsule() {
+  OccluderLight o;
+  o.shape.kind = Occluder::capsule;
+  o.shape.centre = Vec3(5, -4, 30);
+  o.shape.axis = Vec3(0, 1, 0);
+  o.shape.length = 8;
+  o.shape.radius = 6;
+  o.source = OccluderLight::seen_by_chrome;
+  return o;
+}
+
+TEST(OccludedLight, AHeadInFrontOfASunForTheChromeBallHidesNothingOfItFromTheGreyBall) {
+  // A sun of 1000 within 3 degrees of +z. The chrome ball (centre (5, 0, 10)) sees a head of
+  // radiance 0.1 at (5, 0, 30) right in front of it; the grey ball's texel facing +z (p = (0, 0,
+  // 11)) sees the sun past the head, 14 degrees away. Its ray toward the sun meets the capsule
+  // at (0, 0, 30), where the chrome ball sees the far environment: nothing of the sun is restored
+  // (read along the ray's own direction, the chrome ball's head would hide the sun: a ratio of ~3.7).
+  const Layout layout(LayoutKind::LatLong, 256, 128);
+  EnvMap probe = EnvMap::zeros(layout);
+  for (int y = 0; y < layout.height(); ++y)
+    for (int x = 0; x < layout.width(); ++x) {
+      const double v = layout.texel_direction(x, y)->z() > std::cos(3 * kPi / 180) ? 1000 : 1;
+      probe.pixels.at<cv::Vec3f>(y, x) = cv::Vec3f(float(v), float(v), float(v));
+    }
+  const OpenLight light = open_light(probe, cv::Mat(128, 256, CV_32FC1, cv::Scalar(1)), nullptr, 128);
+  const Vec3 chrome_centre(5, 0, 10);
+  const MapView chrome = rendered_chrome(probe, chrome_centre, Vec3(5, 0, 30), 2, 0.1f);
+  const OccludedLight r = occluded_light(grey_map(), Mat3::Identity(), grey_cone(), {photographer_capsule()}, light,
+                                         &chrome, chrome_centre);
+  EXPECT_GE(centre_ratio(r), 1.0f);
+  EXPECT_LT(centre_ratio(r), 1.01f);
+}
+
+TEST(OccludedLight, AnEmptyCapsuleOnATexturedEnvironmentRestoresNothing) {
+  // A checker of 0.2 and 5 (11 degree squares); the chrome ball sees it and nothing else. Its
+  // texels differ from the probe's area means by up to 25x at the squares' edges, yet what the
+  // capsule adds averages out.
+  const Layout layout(LayoutKind::LatLong, 256, 128);
+  EnvMap probe = EnvMap::zeros(layout);
+  for (int y = 0; y < layout.height(); ++y)
+    for (int x = 0; x < layout.width(); ++x) {
+      const float v = ((x / 8 + y / 8) % 2) ? 5.0f : 0.2f;
+      probe.pixels.at<cv::Vec3f>(y, x) = cv::Vec3f(v, v, v);
+    }
+  const OpenLight light = open_light(probe, cv::Mat(128, 256, CV_32FC1, cv::Scalar(1)), nullptr, 64);
+  const Vec3 chrome_centre(5, 0, 10);
+  const MapView chrome = rendered_chrome(probe, chrome_centre, Vec3::Zero(), 0, 0);
+  const OccludedLight r = occluded_light(grey_map(), Mat3::Identity(), grey_cone(), {photographer_capsule()}, light,
+                                         &chrome, chrome_centre);
+  EXPECT_NEAR(centre_ratio(r), 1.0, 0.03);
+  EXPECT_LT(r.mean_stops, 0.03);
+}
+
+TEST(OccludedLight, ABodyBrighterThanWhatItHidesDarkensTheMap) {
+  // A photographer of radiance 2 (lit, before a uniform environment of 1), within the brightest a
+  // diffuse body can be (4 E_max / pi = 4): E_scene = pi - pi / 4 + 2 pi / 4, a ratio of 1 / 1.25.
+  const MapView chrome = uniform_chrome(2.0f);
+  const OccludedLight r =
+      occluded_light(grey_map(), Mat3::Identity(), grey_cone(), {ball_ahead(OccluderLight::seen_by_chrome)},
+                     uniform_light(), &chrome, Vec3(5, 0, 10));
+  EXPECT_NEAR(centre_ratio(r), 1 / 1.25, 0.01);
+}
+
+TEST(OccludedLight, ChromeTexelsBrighterThanAnyLitBodyShowLightNotABody) {
+  // Texels of 1000 under an environment of 1: lamps, not a body (no diffuse surface lit by it
+  // exceeds 4 E_max / pi = 4), so nothing is darkened (read as a body, the ratio would hit the
+  // clamp, 1/2).
+  const MapView chrome = uniform_chrome(1000.0f);
+  const OccludedLight r =
+      occluded_light(grey_map(), Mat3::Identity(), grey_cone(), {ball_ahead(OccluderLight::seen_by_chrome)},
+                     uniform_light(), &chrome, Vec3(5, 0, 10));
+  EXPECT_NEAR(centre_ratio(r), 1.0, 1e-6);
 }
 
 TEST(OccludedLight, ChromeTexelsClippedInEveryBracketAreNotRead) {
