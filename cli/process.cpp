@@ -127,10 +127,9 @@ Runner add_process(CLI::App& app) {
   c->add_option("--glossy-brdf", a->o.glossy_brdf,
                 "The glossy balls' BRDF spec (YAML text): they then constrain the recovered sources");
   c->add_option("--grey-albedo", a->o.grey_albedo, "The grey ball's albedo")->check(CLI::Range(0.001, 1.0));
-  c->add_flag("--occluder-light", a->o.occluder_light,
-              "Restore the light the photographer takes from the grey balls, read from each view's chrome ball "
-              "(docs/tradeoffs.md, \"Robust geometry\": it helps where the photographer stands far from the "
-              "balls and over-corrects close handheld views)");
+  c->add_flag("!--no-occluder-light", a->o.occluder_light,
+              "Leave the grey maps as photographed: do not restore the light the photographer takes from "
+              "them (read from each view's chrome ball; docs/tradeoffs.md, \"Robust geometry\")");
   c->add_option("--bake-method", a->o.bake_method, "Integrator of the computed maps: mis, fis, sh, reference");
   c->add_option("--bake-samples", a->o.bake_samples, "Samples per texel (mis, fis)")->check(CLI::Range(1, 1 << 20));
   c->add_option("--max-error", a->max_error,
