@@ -182,20 +182,20 @@ def main():
             "--lens", os.path.join(folder, "syn", "truth", "camera.cameramodel"), "--chrome-fresnel", FRESNEL, "-q")
         m = json.loads(run(measure, os.path.join(folder, "syn"), os.path.join(folder, "run"), os.path.join(folder, "ref")))
         m["name"], m["seconds_synth"], m["seconds_process"] = name, t1 - t0, t2 - t1
-        # The same run with the photographer's light restored (--occluder-light): the steps before
-        # extract are reused, extract and the later ones redone.
-        occ = os.path.join(folder, "run-occluder-light")
+        # The same run without restoring the photographer's light (--no-occluder-light): the steps
+        # before extract are reused, extract and the later ones redone.
+        occ = os.path.join(folder, "run-as-photographed")
         shutil.copytree(os.path.join(folder, "run"), occ)
         run(rsibr, "process", os.path.join(folder, "syn", "photos"), "--out", occ, "--chrome-fresnel", FRESNEL,
-            "--occluder-light", "-q")
+            "--no-occluder-light", "-q")
         greys = {g["ball"] for g in m["grey"]}
-        m["left_out"], m["occluder_left_out"] = grey_left_out(os.path.join(folder, "run"), greys), grey_left_out(occ, greys)
+        m["left_out"], m["photographed_left_out"] = grey_left_out(os.path.join(folder, "run"), greys), grey_left_out(occ, greys)
         try:
             mo = json.loads(run(measure, os.path.join(folder, "syn"), occ))
-            m["occluder_grey"], m["occluder_worst"] = mo["grey"], mo["grey_worst_stops"]
+            m["photographed_grey"], m["photographed_worst"] = mo["grey"], mo["grey_worst_stops"]
         except SystemExit as e:
-            m["occluder_grey"], m["occluder_worst"] = None, None
-            m["occluder_error"] = str(e).strip().splitlines()[-1]
+            m["photographed_grey"], m["photographed_worst"] = None, None
+            m["photographed_error"] = str(e).strip().splitlines()[-1]
         rows.append(m)
         print("%s: %s" % (name, json.dumps({k: m[k] for k in ("balls", "tilt_deg", "grey_worst_stops")})), flush=True)
         if not args.keep:
@@ -213,8 +213,9 @@ def main():
         "the run itself left out of its world-up estimate (its other balls disagree with the rig fitted on all views);",
         "sigma: the run's own. Grey: the captured",
         "grey maps against the true (unoccluded) ones after the global gain fit, log RMS per view: the photographer",
-        "and the chrome ball beside the grey one are in these scenes, and what their shadows and bodies do to the",
-        "grey ball's light (real light, which the truth maps leave out) counts as error there. The last column holds",
+        "and the chrome ball beside the grey one are in these scenes; the run restores the light the photographer",
+        "takes from the grey ball (the default, calib/occluded_light.h), and what the chrome ball's shadow and the",
+        "restoration's own error do to the grey ball's light counts as error there. The last column holds",
         "the pipeline's own error: the grey maps against those of the same shoot processed from the true scene",
         "radiance (before vignetting), poses and lens, which have every physical effect and no pipeline error.",
         "",
@@ -237,21 +238,23 @@ def main():
             grey, m["grey_worst_stops"], m["reference"]["worst_stops"]))
     lines += [
         "",
-        "With `--occluder-light` (calib/occluded_light.h), the same runs: each grey map gets back the light the",
-        "photographer takes from it (the photographer a capsule behind the camera, calib/occluders.h, its radiance",
-        "what the same view's chrome ball sees in that direction, the light it hides the probe's). Left out: grey views",
-        "the run leaves out (the Lambert consensus finds them inconsistent with the other views).",
+        "With `--no-occluder-light`, the same runs with the grey maps as photographed: the photographer's own shadow",
+        "and body stay in them (calib/lambert_consensus.h masks only what one view alone sees). Restored (the",
+        "default), each grey map gets back the light the photographer takes from it: the photographer a capsule",
+        "behind the camera (calib/occluders.h), the light he sends what the same view's chrome ball sees toward him",
+        "beyond the far environment, the light he hides the probe's with the clipped light recovered. Left out: grey",
+        "views the run leaves out (the Lambert consensus finds them inconsistent with the other views).",
         "",
-        "| shoot | grey vs truth per view, --occluder-light (stops) | worst | worst without (the default) | left out: with / without |",
+        "| shoot | grey vs truth per view, --no-occluder-light (stops) | worst | worst restored (the default) | left out: as photographed / restored |",
         "|---|---|---|---|---|",
     ]
     for m in rows:
-        if m.get("occluder_grey") is None:
-            lines.append("| %s | failed: %s | - | %.3f | - |" % (m["name"], m.get("occluder_error", "?"), m["grey_worst_stops"]))
+        if m.get("photographed_grey") is None:
+            lines.append("| %s | failed: %s | - | %.3f | - |" % (m["name"], m.get("photographed_error", "?"), m["grey_worst_stops"]))
             continue
         lines.append("| %s | %s | %.3f | %.3f | %s / %s |" % (
-            m["name"], " ".join("%.3f" % g["stops"] for g in m["occluder_grey"]), m["occluder_worst"],
-            m["grey_worst_stops"], ", ".join(m["occluder_left_out"]) or "-", ", ".join(m["left_out"]) or "-"))
+            m["name"], " ".join("%.3f" % g["stops"] for g in m["photographed_grey"]), m["photographed_worst"],
+            m["grey_worst_stops"], ", ".join(m["photographed_left_out"]) or "-", ", ".join(m["left_out"]) or "-"))
     notes = []
     for m in rows:
         for k, b in m["balls"].items():
