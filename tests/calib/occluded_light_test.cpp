@@ -208,6 +208,22 @@ TEST(OccludedLight, ChromeTexelsBrighterThanAnyLitBodyShowLightNotABody) {
   EXPECT_NEAR(centre_ratio(r), 1.0, 1e-6);
 }
 
+TEST(OccludedLight, ATexelTheModelDoesNotExplainGetsTheDifferenceNotTheRatio) {
+  // The black ball ahead takes pi / 4 of the centre texel's pi. That texel holds 10x what the
+  // rest of the map says the model gives it (sunlight the quadrature misses, as at a terminator):
+  // the light taken is added in the map's scale, k pi / 4 with k ~ 1 / (0.9 pi), a ratio of about
+  // 1.03; multiplied, it would be 4 / 3 of a bright texel.
+  MapView g = grey_map();
+  g.rgb.at<cv::Vec3f>(16, 16) = cv::Vec3f(10, 10, 10);
+  const OccludedLight r =
+      occluded_light(g, Mat3::Identity(), grey_cone(), {ball_ahead(OccluderLight::lambert_ball, 0.0)}, uniform_light(),
+                     nullptr, Vec3::Zero());
+  EXPECT_GT(centre_ratio(r), 1.0f);
+  EXPECT_LT(centre_ratio(r), 1.05f);
+  // Its neighbour, which the model explains, keeps the ratio of the irradiances (a little under 4 / 3).
+  EXPECT_GT(r.ratio.at<cv::Vec3f>(16, 17)[1], 1.25f);
+}
+
 TEST(OccludedLight, ChromeTexelsClippedInEveryBracketAreNotRead) {
   // A half-bright chrome map whose every texel is a lower bound: nothing is known to restore.
   MapView chrome = uniform_chrome(0.5f);
