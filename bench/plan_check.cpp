@@ -5,6 +5,11 @@
 // meets the budget, the sweep's cheapest, which is then baked and timed too. bench/plan_check.py runs it over held-out
 // environments and BRDFs and writes the docs/tradeoffs.md section "Planning for an error budget".
 // Output: one JSON object on stdout.
+//
+// The sweep does not depend on the planner (the same check texels, seeds and candidates), and it is
+// most of the run: --sweep-only writes it alone, and --sweep-from reads one back (its environment,
+// BRDF, budget, seeds and check size must match), re-timing only the sweep's best bake, so that a
+// planner change is checked at the cost of the plan, the truth and two bakes.
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
 #include "bake/map_set_bake.h"
@@ -18,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <fstream>
 #include <iostream>
 #include <map>
 
@@ -58,6 +64,8 @@ int main(int argc, char** argv) {
   double max_bake_seconds = 600;    // longer bakes are not run: their time is the model's
   double max_sweep_seconds = 1800;  // candidates whose modelled bake is longer are not measured
   bool skip_full_reference = true;
+  bool sweep_only = false;
+  std::string sweep_from;
   std::uint64_t check_seed = 7777, plan_seed = 1;
   CLI::App app("The bake planner against a full sweep of its candidates");
   app.add_option("--env", env_path)->required();
@@ -69,6 +77,8 @@ int main(int argc, char** argv) {
   app.add_option("--max-sweep-seconds", max_sweep_seconds);
   app.add_option("--check-seed", check_seed);
   app.add_option("--plan-seed", plan_seed);
+  app.add_flag("--sweep-only", sweep_only, "run the sweep alone (no plan, no bakes)");
+  app.add_option("--sweep-from", sweep_from, "a --sweep-only output to reuse instead of sweeping");
   CLI11_PARSE(app, argc, argv);
   try {
     EnvMap env = read_environment(env_path);
@@ -78,16 +88,20 @@ int main(int argc, char** argv) {
     out["env"] = env_path;
     out["brdf"] = brdf->spec();
     out["max_error"] = budget;
+    out["check_seed"] = check_seed;
+    out["plan_seed"] = plan_seed;
 
     // The plan and its bake, checked at fresh novel views.
     BakePlanOptions po;
     po.max_error = budget;
     po.seed = plan_seed;
     auto t0 = std::chrono::steady_clock::now();
-    const BakePlan plan = plan_bake(env, *brdf, po);
-    const double plan_seconds = seconds_since(t0);
-    out["plan"] = plan.to_json();
-    out["plan_seconds"] = plan_seconds;
+    BakePlan plan;
+    if (!sweep_only) {
+      plan = plan_bake(env, *brdf, po);
+      out["plan"] = plan.to_json();
+      out["plan_seconds"] = seconds_since(t0);
+    }
     // The check's texels: guided like the pilot's (plan/error_sample.h), from another seed.
     const auto guide_integrator = make_integrator("fis", env);
     IntegratorOptions guide_options;
@@ -101,7 +115,7 @@ int main(int argc, char** argv) {
     out["truth_seconds"] = seconds_since(t0);
     out["check_views"] = check_views;
     out["check_texels"] = check_texels;
-    if (plan.chosen) {
+    if (!sweep_only && plan.chosen) {
       const BakeSetting& cs = plan.chosen->setting;
       out["chosen"] = setting_json(cs);
       out["chosen"]["predicted_error"] = plan.chosen->error;
@@ -127,88 +141,116 @@ int main(int argc, char** argv) {
       }
     }
 
-    // The sweep: every candidate's real error at the check texels; its time from the cost per texel
-    // measured here (a whole 128^2 map per integrator setting).
-    std::map<std::string, std::unique_ptr<Integrator>> made;
-    std::map<std::string, double> setup;
-    auto integrator = [&](const std::string& m) -> const Integrator& {
-      if (!made.count(m)) {
-        const auto t = std::chrono::steady_clock::now();
-        made[m] = make_integrator(m, env);
-        setup[m] = seconds_since(t);
-      }
-      return *made[m];
-    };
-    std::map<std::string, double> per_texel;
-    std::vector<IntegratorSetting> settings;
-    nlohmann::json pruned = nlohmann::json::array();
-    nlohmann::json own_errors;  // each integrator setting's own error at the check texels
-    for (const IntegratorSetting& s : po.integrators) {
-      if (skip_full_reference && s.method == "reference" && s.reference_width == 0) continue;
-      try {
-        const Integrator& in = integrator(s.method);
-        // A setting whose own error at the check texels exceeds the budget cannot meet it blended
-        // (blending adds interpolation error): pruned from the sweep.
-        const double own =
-            sample_error(sample, direct_values(in, *brdf, options_of(s, plan_seed), sample), truth).value;
-        own_errors[s.label()] = own;
-        if (own > budget) {
-          pruned.push_back({{"integrator", s.label()}, {"error", own}});
-          continue;
-        }
-        const auto t = std::chrono::steady_clock::now();
-        in.radiance_map(*brdf, sample.view(0), sample.frame(0), 128, options_of(s, plan_seed));
-        per_texel[s.label()] = seconds_since(t) / double(disc_texel_count(128));
-        settings.push_back(s);
-      } catch (const std::invalid_argument&) {
-      }
-    }
-    // Every candidate by modelled time; errors measured in that order until one meets the budget:
-    // that one is the sweep's cheapest (every candidate after it takes longer), so the candidates
-    // after it need no measurement.
-    struct Row {
-      BakeSetting setting;
-      double model;
-    };
-    std::vector<Row> all;
-    for (const std::string& views : po.view_sets) {
-      const int count = int(ViewSet::named(views).views().size());
-      for (int res : po.sizes)
-        for (const IntegratorSetting& s : settings)
-          all.push_back({{views, count, res, s},
-                         setup[s.method] + double(count) * double(disc_texel_count(res)) * per_texel[s.label()]});
-    }
-    std::stable_sort(all.begin(), all.end(), [](const Row& a, const Row& b) { return a.model < b.model; });
-    nlohmann::json rows = nlohmann::json::array();
     std::optional<nlohmann::json> best;
     BakeSetting best_setting;
-    for (const Row& row : all) {
-      if (row.model > max_sweep_seconds) break;  // bakes over this long are not candidates here
-      const auto t = std::chrono::steady_clock::now();
-      const BakeSetting& bs = row.setting;
-      const SampledBlend b =
-          sampled_blend(integrator(bs.integrator.method), *brdf, options_of(bs.integrator, plan_seed),
-                        ViewSet::named(bs.views), bs.res, false, sample);
-      const ErrorEstimate e = sample_error(sample, b.values, truth, &b.weights);
-      const double error = e.value;
-      nlohmann::json r = setting_json(bs);
-      r["error"] = error;
-      r["error_sigma"] = e.sigma;
-      r["seconds_model"] = row.model;
-      r["sweep_seconds"] = seconds_since(t);
-      rows.push_back(r);
-      if (error <= budget) {
-        best = r;
-        best_setting = bs;
-        break;
+    if (!sweep_from.empty()) {
+      std::ifstream f(sweep_from);
+      if (!f) throw std::runtime_error(sweep_from + ": cannot open");
+      const nlohmann::json kept = nlohmann::json::parse(f);
+      for (const char* key : {"env", "brdf", "max_error", "check_seed", "plan_seed", "check_views", "check_texels"})
+        if (!kept.contains(key) || kept[key] != out[key])
+          throw std::runtime_error(sweep_from + ": its " + key + " differs from this run's");
+      for (const char* key : {"candidates", "max_sweep_seconds", "sweep", "pruned", "own_errors", "sweep_seconds"})
+        out[key] = kept.at(key);
+      if (kept.contains("sweep_best")) {
+        best = kept["sweep_best"];
+        const nlohmann::json& b = *best;
+        const std::string label = b["integrator"];
+        for (const IntegratorSetting& s : po.integrators)
+          if (s.label() == label) best_setting.integrator = s;
+        if (best_setting.integrator.method.empty()) throw std::runtime_error(sweep_from + ": unknown " + label);
+        for (const std::string& views : po.view_sets)
+          if (int(ViewSet::named(views).views().size()) == b["views"].get<int>()) best_setting.views = views;
+        best_setting.view_count = b["views"];
+        best_setting.res = b["res"];
       }
+      out["sweep_from"] = sweep_from;
+    } else {
+      // The sweep: every candidate's real error at the check texels; its time from the cost per
+      // texel measured here (a whole 128^2 map per integrator setting).
+      const auto sweep_start = std::chrono::steady_clock::now();
+      std::map<std::string, std::unique_ptr<Integrator>> made;
+      std::map<std::string, double> setup;
+      auto integrator = [&](const std::string& m) -> const Integrator& {
+        if (!made.count(m)) {
+          const auto t = std::chrono::steady_clock::now();
+          made[m] = make_integrator(m, env);
+          setup[m] = seconds_since(t);
+        }
+        return *made[m];
+      };
+      std::map<std::string, double> per_texel;
+      std::vector<IntegratorSetting> settings;
+      nlohmann::json pruned = nlohmann::json::array();
+      nlohmann::json own_errors;  // each integrator setting's own error at the check texels
+      for (const IntegratorSetting& s : po.integrators) {
+        if (skip_full_reference && s.method == "reference" && s.reference_width == 0) continue;
+        try {
+          const Integrator& in = integrator(s.method);
+          // A setting whose own error at the check texels exceeds the budget cannot meet it blended
+          // (blending adds interpolation error): pruned from the sweep.
+          const double own =
+              sample_error(sample, direct_values(in, *brdf, options_of(s, plan_seed), sample), truth).value;
+          own_errors[s.label()] = own;
+          if (own > budget) {
+            pruned.push_back({{"integrator", s.label()}, {"error", own}});
+            continue;
+          }
+          const auto t = std::chrono::steady_clock::now();
+          in.radiance_map(*brdf, sample.view(0), sample.frame(0), 128, options_of(s, plan_seed));
+          per_texel[s.label()] = seconds_since(t) / double(disc_texel_count(128));
+          settings.push_back(s);
+        } catch (const std::invalid_argument&) {
+        }
+      }
+      // Every candidate by modelled time; errors measured in that order until one meets the budget:
+      // that one is the sweep's cheapest (every candidate after it takes longer), so the candidates
+      // after it need no measurement.
+      struct Row {
+        BakeSetting setting;
+        double model;
+      };
+      std::vector<Row> all;
+      for (const std::string& views : po.view_sets) {
+        const int count = int(ViewSet::named(views).views().size());
+        for (int res : po.sizes)
+          for (const IntegratorSetting& s : settings)
+            all.push_back({{views, count, res, s},
+                           setup[s.method] + double(count) * double(disc_texel_count(res)) * per_texel[s.label()]});
+      }
+      std::stable_sort(all.begin(), all.end(), [](const Row& a, const Row& b) { return a.model < b.model; });
+      nlohmann::json rows = nlohmann::json::array();
+      for (const Row& row : all) {
+        if (row.model > max_sweep_seconds) break;  // bakes over this long are not candidates here
+        const auto t = std::chrono::steady_clock::now();
+        const BakeSetting& bs = row.setting;
+        const SampledBlend b =
+            sampled_blend(integrator(bs.integrator.method), *brdf, options_of(bs.integrator, plan_seed),
+                          ViewSet::named(bs.views), bs.res, false, sample);
+        const ErrorEstimate e = sample_error(sample, b.values, truth, &b.weights);
+        const double error = e.value;
+        nlohmann::json r = setting_json(bs);
+        r["error"] = error;
+        r["error_sigma"] = e.sigma;
+        r["seconds_model"] = row.model;
+        r["sweep_seconds"] = seconds_since(t);
+        rows.push_back(r);
+        if (error <= budget) {
+          best = r;
+          best_setting = bs;
+          break;
+        }
+      }
+      out["candidates"] = all.size();
+      out["max_sweep_seconds"] = max_sweep_seconds;
+      out["sweep"] = rows;
+      out["pruned"] = pruned;
+      out["own_errors"] = own_errors;
+      out["sweep_seconds"] = seconds_since(sweep_start);
     }
-    out["candidates"] = all.size();
-    out["max_sweep_seconds"] = max_sweep_seconds;
-    out["sweep"] = rows;
-    out["pruned"] = pruned;
-    out["own_errors"] = own_errors;
-    if (best) {
+    if (best && sweep_only) {
+      out["sweep_best"] = *best;
+    } else if (best) {
       if ((*best)["seconds_model"].get<double>() <= max_bake_seconds) {
         MapSet set;
         (*best)["seconds"] = bake_seconds(env, *brdf, best_setting, plan_seed, &set);
