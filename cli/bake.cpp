@@ -118,7 +118,7 @@ int run_bake(const BakeArgs& given, const CLI::App& command) {
         << std::lround(100 * plan->options.margin) << "% of --max-error " << a.max_error
         << "); baking the closest measured one, " << planned->setting.view_count << " views x " << planned->setting.res
         << "^2, " << planned->setting.integrator.label() << " (measured " << 100 * *planned->measured_error << "% +- "
-        << 100 * *planned->measured_sigma << "% at the pilot texels), and checking it\n";
+        << 100 * *planned->measured_sigma << "% at the confirmation texels), and checking it\n";
       std::cerr << m.str();
     }
     const BakeSetting& s = planned->setting;

@@ -90,6 +90,9 @@ void print_plan(std::ostream& out, const BakePlan& plan) {
   out << "pilot: " << o.pilot_views << " novel views x " << o.pilot_texels << " texels (" << o.pilot_size << "^2 discs"
       << (o.guide_size > 0 ? ", drawn where a " + std::to_string(o.guide_size) + "^2 bake is bright" : "")
       << "), truth: the full reference quadrature, " << std::setprecision(1) << plan.pilot_seconds << " s\n";
+  if (o.confirm_views > 0)
+    out << "confirmations: " << o.confirm_views << " further novel views x " << o.pilot_texels
+        << " texels, drawn the same way\n";
   out << "integration error at the pilot texels (+- one standard error), and time per texel:\n";
   for (const IntegratorPilot& p : plan.integrators)
     out << "  " << std::left << std::setw(22) << p.setting.label() << std::right << std::setw(9) << pct(p.error)

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -150,6 +151,8 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   for (const std::string& name : options.view_sets) view_sets.push_back(ViewSet::named(name));
 
   if (!(options.sigmas >= 0)) throw std::invalid_argument("plan: the number of standard errors must be >= 0");
+  if (options.confirm_views < 0)
+    throw std::invalid_argument("plan: the confirmation's views must be >= 0 (0: the pilot's own)");
   if (options.guide_size != 0 && options.guide_size < 2)
     throw std::invalid_argument("plan: the guide's size must be 0 (no guide) or at least 2");
   const auto t_start = std::chrono::steady_clock::now();
@@ -172,6 +175,27 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   plan.truth_texels = sample.count();
   auto integrator_for = [&](const std::string& method) -> const Integrator& { return pilots.integrator(method); };
   if (plan.integrators.empty()) throw std::invalid_argument("plan: no integrator setting can bake this BRDF");
+
+  // The confirmations' texels: a larger sample of their own (another seed, drawn the same way), with
+  // the truth there; the pilot's own when confirm_views is 0.
+  std::optional<ErrorSample> confirm_own;
+  std::vector<Vec3> confirm_truth;
+  if (options.confirm_views > 0) {
+    const std::uint64_t confirm_seed = options.seed ^ 0x9e3779b97f4a7c15ull;
+    confirm_own.emplace(
+        options.guide_size > 0
+            ? ErrorSample(
+                  options.confirm_views, options.pilot_texels, options.pilot_size, confirm_seed,
+                  squared_radiance_guide(pilots.integrator(kInterpolationIntegrator.method), brdf,
+                                         options_of(kInterpolationIntegrator, options.seed), options.guide_size))
+            : ErrorSample(options.confirm_views, options.pilot_texels, options.pilot_size, confirm_seed));
+    confirm_truth = direct_values(pilots.integrator("reference"), brdf, options_of({"reference", 0, 0}, options.seed),
+                                  *confirm_own);
+    plan.truth_texels += confirm_own->count();
+  }
+  const ErrorSample& confirm_sample = confirm_own ? *confirm_own : sample;
+  const std::vector<Vec3>& confirm_values_truth = confirm_own ? confirm_truth : pilots.truth;
+  plan.confirm_texels = confirm_sample.count();
 
   // e_interp(N, r) with its standard error, measured when first needed: the FIS maps' blend against
   // FIS direct values, less (in quadrature) FIS's own error against the truth at the same texels,
@@ -242,12 +266,20 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
     return false;
   };
   // The model screens, a measurement decides (see the header): a screened-in candidate is blended
-  // at the pilot texels with its own integrator and taken when that error plus k sigma fits. The
+  // at the confirmation texels with its own integrator and taken when that error plus k sigma fits. The
   // screen is optimistic: an unbiased integrator's (mis) error counts at a third, the most the
   // blend's 3 sources x 4 taps can average its noise away, and e_interp at half (above).
   auto screened_integration = [](const PlannedSetting& s) {
     return s.setting.integrator.method == "mis" ? s.integration_error / 3.0 : s.integration_error;
   };
+  // The screen, calibrated by what the measurements say: after each confirmation its screened
+  // error is scaled by the least ratio of measured to screened error seen so far (1 before any).
+  // The screen stays as optimistic as the most favourable candidate measured, but it no longer
+  // spends the confirmations on candidates that the model's own halving lets through and every
+  // measurement so far says will miss (under a low sun the ratio is about 2 for every method, and
+  // 32 confirmations ran out before the candidates that could pass).
+  double screen_scale = 1.0;
+  bool calibrated = false;
   int confirmations = 0;
   for (Candidate& c : candidates) {
     PlannedSetting& s = c.planned;
@@ -263,18 +295,27 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
       s.interpolation_error = interp->value;
       s.error = std::hypot(interp->value, s.integration_error);
       s.upper_error = std::hypot(interp->upper(k), c.integration_upper);
-      if (!plan.chosen && std::hypot(kInterpolationScreen * interp->value, ie) <= budget &&
-          confirmations < options.max_confirmations) {
+      const double screened = std::hypot(kInterpolationScreen * interp->value, ie);
+      if (!plan.chosen) {
+        s.screened_error = screened;
+        s.screen_scale = screen_scale;
+      }
+      if (!plan.chosen && screen_scale * screened <= budget && confirmations < options.max_confirmations) {
         ++confirmations;
         const SampledBlend b = sampled_blend(integrator_for(s.setting.integrator.method), brdf,
                                              options_of(s.setting.integrator, options.seed), view_sets[c.set],
-                                             s.setting.res, options.normalise_albedo, sample);
-        const ErrorEstimate e = sample_error(sample, b.values, pilots.truth, &b.weights);
+                                             s.setting.res, options.normalise_albedo, confirm_sample);
+        const ErrorEstimate e = sample_error(confirm_sample, b.values, confirm_values_truth, &b.weights);
         s.measured_error = e.value;
         s.measured_sigma = e.sigma;
         s.upper_error = e.upper(k);
         s.meets = s.upper_error <= budget;
         plan.confirm_seconds += b.seconds;
+        if (screened > 0) {
+          const double ratio = e.value / screened;
+          screen_scale = calibrated ? std::min(screen_scale, ratio) : ratio;
+          calibrated = true;
+        }
       }
     }
     if (s.meets && !plan.chosen) plan.chosen = s;
@@ -290,10 +331,10 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   if (plan.chosen) {
     const PlannedSetting& c = *plan.chosen;
     why << "chosen: " << setting_text(c.setting) << ": measured " << percent(*c.measured_error) << " +- "
-        << percent(*c.measured_sigma) << " at the pilot texels (at most " << percent(c.upper_error) << " with " << k
-        << " standard errors; modelled " << percent(c.error) << ": interpolation " << percent(*c.interpolation_error)
-        << ", integration " << percent(c.integration_error) << "), " << c.seconds << " s; the budget is "
-        << percent(options.max_error) << ", planned to " << percent(budget) << ".\n";
+        << percent(*c.measured_sigma) << " at the confirmation texels (at most " << percent(c.upper_error) << " with "
+        << k << " standard errors; modelled " << percent(c.error) << ": interpolation "
+        << percent(*c.interpolation_error) << ", integration " << percent(c.integration_error) << "), " << c.seconds
+        << " s; the budget is " << percent(options.max_error) << ", planned to " << percent(budget) << ".\n";
   } else {
     why << "no setting is predicted to meet " << percent(options.max_error) << " (planned to " << percent(budget)
         << "); the most accurate measured ones are listed in the table";
@@ -345,6 +386,8 @@ nlohmann::json BakePlan::to_json() const {
     j["integration_error"] = s.integration_error;
     j["interpolation_error"] = s.interpolation_error ? nlohmann::json(*s.interpolation_error) : nlohmann::json();
     j["predicted_seconds"] = s.seconds;
+    j["screened_error"] = s.screened_error ? nlohmann::json(*s.screened_error) : nlohmann::json();
+    j["screen_scale"] = s.screened_error ? nlohmann::json(s.screen_scale) : nlohmann::json();
     j["meets"] = s.meets;
     return j;
   };
@@ -352,10 +395,16 @@ nlohmann::json BakePlan::to_json() const {
   j["max_error"] = options.max_error;
   j["margin"] = options.margin;
   j["sigmas"] = options.sigmas;
-  j["pilot"] = {{"views", options.pilot_views},       {"texels_per_view", options.pilot_texels},
-                {"size", options.pilot_size},         {"seed", options.seed},
-                {"guide_size", options.guide_size},   {"seconds", pilot_seconds},
-                {"confirm_seconds", confirm_seconds}, {"truth_texels", truth_texels}};
+  j["pilot"] = {{"views", options.pilot_views},
+                {"texels_per_view", options.pilot_texels},
+                {"size", options.pilot_size},
+                {"seed", options.seed},
+                {"guide_size", options.guide_size},
+                {"seconds", pilot_seconds},
+                {"confirm_seconds", confirm_seconds},
+                {"truth_texels", truth_texels},
+                {"confirm_views", options.confirm_views},
+                {"confirm_texels", confirm_texels}};
   j["integrators"] = nlohmann::json::array();
   for (const IntegratorPilot& p : integrators)
     j["integrators"].push_back({{"integrator", p.setting.label()},

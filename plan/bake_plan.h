@@ -27,20 +27,22 @@
 // in quadrature (up to e_interp + e_int), and a noisy integrator's error is partly averaged away by
 // the blend, while e_interp measured with FIS maps carries FIS's own error pattern and overstates
 // the blend's (up to 1.6x). So a candidate the model lets through (with mis errors counted at a
-// third and e_interp at half) is measured: the set's blend at the pilot texels, baking only the
-// footprints with its own integrator, against the truth there. It is taken when
+// third and e_interp at half, then scaled by the least ratio of measured to screened error among
+// the candidates measured so far) is measured: the set's blend at the confirmation texels (a sample
+// of its own, confirm_views novel views, 4x the pilot's by default), baking only the footprints with
+// its own integrator, against the truth there. It is taken when
 //
 //   e_measured + k s_measured <= margin * budget        (k = options.sigmas)
 //
-// with s the jackknife standard error over the pilot's views. The jackknife takes the views as
-// independent draws, but they are an evenly spread lattice, so it overstates the estimate's scatter
-// (1.9x on a synthetic glint, tests/plan/error_sample_test.cpp; about 1.6x between pilot and check
-// on the development environments): k = 0.5 adds about one true standard error. That is not
+// with s the jackknife standard error over the confirmation's views. The jackknife takes the views
+// as independent draws, but they are an evenly spread lattice, so it overstates the estimate's
+// scatter (1.9x on a synthetic glint, tests/plan/error_sample_test.cpp; about 1.6x between pilot and
+// check on the development environments): k = 0.5 adds about one true standard error. That is not
 // enough on its own: where a low sun's glint reaches the grazing band of a few views, the estimate
 // is heavy-tailed, a sample that misses the tail is low in both its value and its standard error,
-// and the plan takes the first candidate that passes, so a low draw is what it selects. The
-// margin (0.85 by default) plans to 85% of the budget, a reserve about as wide as the pilot's
-// scatter between seeds (15% relative for a GGX conductor under a dawn sun).
+// and the plan takes the first candidate that passes, so a low draw is what it selects. The margin
+// (0.9 by default) plans to 90% of the budget, a reserve about as wide as the confirmation's scatter
+// between seeds (docs/tradeoffs.md, "Planning for an error budget").
 //
 // The time of a setting: setup(m) + N * disc_texels(r) * t(m), with setup(m) the integrator's
 // construction (its precomputation from the environment) and t(m) its wall time per texel, both
@@ -104,9 +106,13 @@ struct BakePlanOptions {
   // The pilot's draws and the integrators' seed: plan with the seed the bake will use (a filtered
   // importance sampling bake's error depends on it as much as on its sample count).
   std::uint64_t seed = 1;
+  // The confirmations' own sample: confirm_views novel views x pilot_texels (another seed, drawn
+  // the same way); 0: the pilot's texels. Four times the pilot's views halve the scatter of the
+  // estimate that decides, at four times the cost of each confirmation.
+  int confirm_views = 128;
   double sigmas = 0.5;         // k: jackknife standard errors added to the measured error
   int max_confirmations = 32;  // candidates measured before the plan gives up
-  double margin = 0.85;        // a setting is taken when its upper bound <= margin * max_error
+  double margin = 0.9;         // a setting is taken when its upper bound <= margin * max_error
   bool every_pair = false;     // measure e_interp for every (views, size) pair, not only those reached
 };
 
@@ -135,10 +141,14 @@ struct PlannedSetting {
   std::optional<double> interpolation_error;  // nullopt: not measured (not reached)
   double error = 0;                           // the prediction when interpolation_error is known, else e_int alone
   double upper_error = 0;                     // measured + k sigma when measured, else from the model's parts
-  std::optional<double> measured_error;       // the set's blend at the pilot texels (when screened in)
+  std::optional<double> measured_error;       // the set's blend at the confirmation texels (screened in)
   std::optional<double> measured_sigma;       // its standard error
-  double seconds = 0;                         // predicted bake time
-  bool meets = false;                         // measured, and upper_error <= margin * max_error
+  // The screen's optimistic error (interpolation at half, mis integration at a third) and the
+  // calibration it was scaled by (the least measured / screened ratio so far); nullopt: not screened.
+  std::optional<double> screened_error;
+  double screen_scale = 1;
+  double seconds = 0;  // predicted bake time
+  bool meets = false;  // measured, and upper_error <= margin * max_error
 };
 
 struct BakePlan {
@@ -152,9 +162,10 @@ struct BakePlan {
   // measured), the nearest thing to a setting; it meets a budget of upper_error / margin.
   std::optional<PlannedSetting> closest;
   double pilot_seconds = 0;
-  double confirm_seconds = 0;  // of which measuring screened-in candidates
-  long long truth_texels = 0;  // reference texels of the pilot's truth
-  std::string why;             // a few lines for people
+  double confirm_seconds = 0;    // of which measuring screened-in candidates
+  long long truth_texels = 0;    // reference texels of the pilot's and the confirmations' truth
+  long long confirm_texels = 0;  // texels each confirmation is measured at
+  std::string why;               // a few lines for people
   nlohmann::json to_json() const;
 };
 

@@ -102,8 +102,8 @@ rule = 'meets' if e + 2 * s <= 0.05 else 'exceeds' if e - 2 * s > 0.05 else 'und
 assert k['verdict'] == rule, k
 assert k['verdict'] != 'undecided' or s <= 0.005 or k['views'] == 64, k
 " "$work/plan.json" "$work/planned.json"
-# Where no setting clears the plan's reserve (85% of the budget) but the closest measured one is within
-# the budget itself (here 18% +- 3% against 21%), bake --max-error bakes that one, says so and checks
+# Where no setting clears the plan's reserve (90% of the budget) but the closest measured one is within
+# the budget itself (here 18.9% +- 1.4% against 21%), bake --max-error bakes that one, says so and checks
 # it; plan names it and still exits 3 (no choice).
 "$rsibr" bake --env "$work/sky.exr" --brdf "$work/ggx.yaml" --max-error 21% --views 42 --res 16 --method fis \
   --samples 32 --seed 3 -q --json "$work/closest.json" "$work/closest.exr" 2>"$work/closest.err"
@@ -112,7 +112,7 @@ import json, sys
 b = json.load(open(sys.argv[1]))
 assert b['plan']['chosen'] is None and b['plan']['closest'] is not None, b['plan']
 assert b['check']['planned_from'] == 'closest' and b['views'] == 42 and b['res'] == 16, b['check']
-assert b['plan']['closest']['measured_error'] <= 0.21 < b['plan']['closest']['upper_error'] / 0.85, b['plan']['closest']
+assert b['plan']['closest']['measured_error'] <= 0.21 < b['plan']['closest']['upper_error'] / 0.9, b['plan']['closest']
 assert 'no setting clears the plan' in open(sys.argv[2]).read()
 " "$work/closest.json" "$work/closest.err"
 "$rsibr" plan --env "$work/sky.exr" --brdf "$work/ggx.yaml" --max-error 21% --views 42 --res 16 --method fis \

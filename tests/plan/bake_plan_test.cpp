@@ -28,6 +28,7 @@ BakePlanOptions small(double budget) {
   o.pilot_views = 8;
   o.pilot_texels = 24;
   o.pilot_size = 32;
+  o.confirm_views = 16;
   return o;
 }
 
@@ -53,7 +54,9 @@ TEST(BakePlan, ThePlannedSettingMeetsItsBudgetAtFreshNovelViews) {
     const BakePlan plan = plan_bake(env, *brdf, small(0.1));
     ASSERT_TRUE(plan.chosen) << spec << "\n" << plan.why << plan.to_json().dump(1);
     EXPECT_LE(plan.chosen->upper_error, plan.options.margin * 0.1);
-    EXPECT_GE(plan.chosen->upper_error, plan.chosen->error);
+    ASSERT_TRUE(plan.chosen->measured_error && plan.chosen->measured_sigma);  // a measurement decides
+    EXPECT_DOUBLE_EQ(plan.chosen->upper_error,
+                     *plan.chosen->measured_error + plan.options.sigmas * *plan.chosen->measured_sigma);
     const MapSet set = bake(env, *brdf, plan.chosen->setting);
     const BakeCheck check = check_bake(set, ViewSet::named(plan.chosen->setting.views), env, *brdf, 99, 8, 32, 32);
     EXPECT_LE(check.error, 0.1) << spec << ": predicted " << plan.chosen->error << "\n" << plan.why;
@@ -114,6 +117,8 @@ TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
   ASSERT_TRUE(plan.chosen) << plan.why << plan.to_json().dump();
   ASSERT_EQ(plan.settings.size(), 3u * 2u * 4u);  // sh cannot bake GGX: left out
   double previous = 0;
+  double least_ratio = 1;
+  bool measured_any = false;
   for (const PlannedSetting& s : plan.settings) {
     EXPECT_GE(s.seconds, previous);  // sorted by predicted time
     previous = s.seconds;
@@ -124,11 +129,22 @@ TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
       if (s.measured_error) {
         EXPECT_GT(*s.measured_error + o.sigmas * *s.measured_sigma, o.margin * o.max_error);
       }
-      // The screen is optimistic (mis integration error at a third, interpolation at half): every
+      // The screen is optimistic (mis integration error at a third, interpolation at half), scaled
+      // by the least measured / screened ratio of the candidates measured before it: every
       // candidate it lets through is measured, not rejected by the model alone.
       const double ie = s.setting.integrator.method == "mis" ? s.integration_error / 3 : s.integration_error;
-      if (std::hypot(0.5 * *s.interpolation_error, ie) <= o.margin * o.max_error) {
+      ASSERT_TRUE(s.screened_error);
+      EXPECT_NEAR(*s.screened_error, std::hypot(0.5 * *s.interpolation_error, ie), 1e-12);
+      EXPECT_NEAR(s.screen_scale, least_ratio, 1e-12) << s.setting.views << " " << s.setting.res;
+      if (least_ratio * *s.screened_error <= o.margin * o.max_error) {
         EXPECT_TRUE(s.measured_error) << s.setting.views << " " << s.setting.res << " " << s.setting.integrator.label();
+      } else {
+        EXPECT_FALSE(s.measured_error) << s.setting.views << " " << s.setting.res;
+      }
+      if (s.measured_error) {
+        const double ratio = *s.measured_error / *s.screened_error;
+        least_ratio = measured_any ? std::min(least_ratio, ratio) : ratio;
+        measured_any = true;
       }
     }
   }
@@ -177,7 +193,7 @@ TEST(BakePlan, AnUnreachableBudgetChoosesNothingAndSaysSo) {
 
 // When nothing meets the budget, the plan names the measured candidate nearest to it: here every
 // measurement's upper bound is pushed past the budget (100 standard errors) and the plan stops after
-// two measurements.
+// at most two measurements (the calibrated screen may let fewer through).
 TEST(BakePlan, WithoutAChoiceTheClosestMeasuredSettingIsNamed) {
   const EnvMap env = sky(Vec3(0.2, 0.7, 0.4), 32);
   const auto brdf = parse_brdf("{type: phong, albedo: [0.6, 0.5, 0.4], exponent: 20}");
@@ -193,7 +209,8 @@ TEST(BakePlan, WithoutAChoiceTheClosestMeasuredSettingIsNamed) {
     ++measured;
     EXPECT_GE(s.upper_error, plan.closest->upper_error);
   }
-  EXPECT_EQ(measured, 2);
+  EXPECT_GE(measured, 1);
+  EXPECT_LE(measured, 2);
   EXPECT_NE(plan.why.find("closest: " + std::to_string(plan.closest->setting.view_count)), std::string::npos)
       << plan.why;
   EXPECT_EQ(plan.to_json()["closest"]["upper_error"].get<double>(), plan.closest->upper_error);
@@ -208,8 +225,8 @@ TEST(BakePlan, ABakeTakesTheChoiceElseTheClosestMeasuredSettingWithinTheBudget) 
   PlannedSetting closest;
   closest.setting = {"fib324", 324, 64, {"fis", 128, 0}};
   closest.measured_error = 0.0166;
-  closest.measured_sigma = 0.0027;
-  closest.upper_error = 0.0166 + 0.5 * 0.0027;  // over margin x budget = 0.017: no choice
+  closest.measured_sigma = 0.0040;
+  closest.upper_error = 0.0166 + 0.5 * 0.0040;  // over margin x budget = 0.018: no choice
   bool fallback = true;
   EXPECT_EQ(setting_to_bake(plan, &fallback), nullptr);  // nothing measured
   EXPECT_FALSE(fallback);
@@ -262,6 +279,34 @@ TEST(BakePlan, BadBudgetsAndEmptyChoicesAreRefused) {
   o.integrators = {{"sh", 0, 0}};
   const auto ggx = parse_brdf("{type: ggx, roughness: 0.3, fresnel: {type: none}}");
   EXPECT_THROW(plan_bake(env, *ggx, o), std::invalid_argument);  // nothing can bake it
+  o = small(0.05);
+  o.confirm_views = -1;
+  EXPECT_THROW(plan_bake(env, *brdf, o), std::invalid_argument);
+}
+
+// Confirming at the pilot's own texels (confirm_views 0) and at a sample of their own both decide by
+// a measurement at the sample they name; the larger sample's standard error is the smaller.
+TEST(BakePlan, TheConfirmationSampleIsTheOneNamedAndMoreViewsNarrowIt) {
+  const EnvMap env = sky(Vec3(0.3, 0.6, 0.5), 64);
+  const auto brdf = parse_brdf("{type: ggx, roughness: 0.4, fresnel: {type: schlick, f0: [0.9, 0.7, 0.5]}}");
+  BakePlanOptions o = small(0.5);  // a budget the screen lets the one candidate through for
+  o.view_sets = {"162"};
+  o.sizes = {32};
+  o.integrators = {{"reference", 0, 16}};
+  o.confirm_views = 0;
+  const BakePlan own = plan_bake(env, *brdf, o);
+  o.confirm_views = 64;
+  const BakePlan larger = plan_bake(env, *brdf, o);
+  ASSERT_EQ(own.settings.size(), 1u);
+  ASSERT_EQ(larger.settings.size(), 1u);
+  ASSERT_TRUE(own.settings[0].measured_error && larger.settings[0].measured_error) << own.why << larger.why;
+  EXPECT_EQ(own.confirm_texels, own.truth_texels);  // the pilot's texels: no truth of its own
+  EXPECT_EQ(larger.confirm_texels, larger.truth_texels - own.truth_texels);
+  EXPECT_LE(larger.confirm_texels, 64 * o.pilot_texels);
+  EXPECT_GT(larger.confirm_texels, 2 * own.confirm_texels);
+  EXPECT_NE(*own.settings[0].measured_error, *larger.settings[0].measured_error);
+  EXPECT_LT(*larger.settings[0].measured_sigma, *own.settings[0].measured_sigma);
+  EXPECT_EQ(larger.to_json()["pilot"]["confirm_texels"].get<long long>(), larger.confirm_texels);
 }
 
 }  // namespace
