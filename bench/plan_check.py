@@ -189,8 +189,9 @@ def main():
         "",
         "How the plan chooses (plan/bake_plan.h): a model (e^2 = e_interp(views, size)^2 + e_int(integrator)^2, "
         "each part measured in the pilot) screens the candidates in order of predicted time, optimistically "
-        "(interpolation at half, MIS integration at a third), scaled by the least ratio of measured to screened "
-        "error among the candidates measured so far; each candidate it lets through is blended at the "
+        "(MIS integration at a third; interpolation at half until measurements calibrate it: the least factor a "
+        "with measured^2 = (a e_interp)^2 + e_int^2 among the candidates measured so far whose interpolation "
+        "part dominates their screen); each candidate it lets through is blended at the "
         "confirmation texels with its own integrator and seed, and the first whose measured error plus half its "
         "standard error (a jackknife over the views, which overstates the scatter of an evenly spread set of "
         "views by about 1.6-1.9x) is within " + "%.0f%%" % (100 * margin) + " of the budget is chosen. "

@@ -272,13 +272,15 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   auto screened_integration = [](const PlannedSetting& s) {
     return s.setting.integrator.method == "mis" ? s.integration_error / 3.0 : s.integration_error;
   };
-  // The screen, calibrated by what the measurements say: after each confirmation its screened
-  // error is scaled by the least ratio of measured to screened error seen so far (1 before any).
-  // The screen stays as optimistic as the most favourable candidate measured, but it no longer
-  // spends the confirmations on candidates that the model's own halving lets through and every
-  // measurement so far says will miss (under a low sun the ratio is about 2 for every method, and
-  // 32 confirmations ran out before the candidates that could pass).
-  double screen_scale = 1.0;
+  // The screen, calibrated by what the measurements say. Its interpolation factor starts at half
+  // and becomes the least factor a that the measurements so far imply, measured^2 = (a e_interp)^2 +
+  // e_int'^2 (e_int': the screen's integration part), taken only from measurements whose screened
+  // interpolation part is at least their integration part (elsewhere a is ill-determined). The
+  // screen stays as optimistic as the most favourable candidate measured, but it no longer spends
+  // the confirmations on candidates that every measurement so far says will miss (under a low sun
+  // the implied factor was about 1 for every method, and 32 confirmations at half ran out before
+  // the candidates that could pass). The integration part keeps its own optimism (mis at a third).
+  double interpolation_screen = kInterpolationScreen;
   bool calibrated = false;
   int confirmations = 0;
   for (Candidate& c : candidates) {
@@ -295,12 +297,12 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
       s.interpolation_error = interp->value;
       s.error = std::hypot(interp->value, s.integration_error);
       s.upper_error = std::hypot(interp->upper(k), c.integration_upper);
-      const double screened = std::hypot(kInterpolationScreen * interp->value, ie);
+      const double screened = std::hypot(interpolation_screen * interp->value, ie);
       if (!plan.chosen) {
         s.screened_error = screened;
-        s.screen_scale = screen_scale;
+        s.interpolation_screen = interpolation_screen;
       }
-      if (!plan.chosen && screen_scale * screened <= budget && confirmations < options.max_confirmations) {
+      if (!plan.chosen && screened <= budget && confirmations < options.max_confirmations) {
         ++confirmations;
         const SampledBlend b = sampled_blend(integrator_for(s.setting.integrator.method), brdf,
                                              options_of(s.setting.integrator, options.seed), view_sets[c.set],
@@ -311,9 +313,9 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
         s.upper_error = e.upper(k);
         s.meets = s.upper_error <= budget;
         plan.confirm_seconds += b.seconds;
-        if (screened > 0) {
-          const double ratio = e.value / screened;
-          screen_scale = calibrated ? std::min(screen_scale, ratio) : ratio;
+        if (interpolation_screen * interp->value >= ie && interp->value > 0) {
+          const double a = std::sqrt(std::max(0.0, e.value * e.value - ie * ie)) / interp->value;
+          interpolation_screen = calibrated ? std::min(interpolation_screen, a) : a;
           calibrated = true;
         }
       }
@@ -387,7 +389,7 @@ nlohmann::json BakePlan::to_json() const {
     j["interpolation_error"] = s.interpolation_error ? nlohmann::json(*s.interpolation_error) : nlohmann::json();
     j["predicted_seconds"] = s.seconds;
     j["screened_error"] = s.screened_error ? nlohmann::json(*s.screened_error) : nlohmann::json();
-    j["screen_scale"] = s.screened_error ? nlohmann::json(s.screen_scale) : nlohmann::json();
+    j["interpolation_screen"] = s.screened_error ? nlohmann::json(s.interpolation_screen) : nlohmann::json();
     j["meets"] = s.meets;
     return j;
   };

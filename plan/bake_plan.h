@@ -27,8 +27,8 @@
 // in quadrature (up to e_interp + e_int), and a noisy integrator's error is partly averaged away by
 // the blend, while e_interp measured with FIS maps carries FIS's own error pattern and overstates
 // the blend's (up to 1.6x). So a candidate the model lets through (with mis errors counted at a
-// third and e_interp at half, then scaled by the least ratio of measured to screened error among
-// the candidates measured so far) is measured: the set's blend at the confirmation texels (a sample
+// third and e_interp at half until measurements say by how much to count it: the least factor the
+// candidates measured so far imply) is measured: the set's blend at the confirmation texels (a sample
 // of its own, confirm_views novel views, 4x the pilot's by default), baking only the footprints with
 // its own integrator, against the truth there. It is taken when
 //
@@ -143,10 +143,11 @@ struct PlannedSetting {
   double upper_error = 0;                     // measured + k sigma when measured, else from the model's parts
   std::optional<double> measured_error;       // the set's blend at the confirmation texels (screened in)
   std::optional<double> measured_sigma;       // its standard error
-  // The screen's optimistic error (interpolation at half, mis integration at a third) and the
-  // calibration it was scaled by (the least measured / screened ratio so far); nullopt: not screened.
+  // The screen's optimistic error, hypot(a e_interp, e_int') with e_int' the integration error (mis
+  // at a third), and a, the interpolation factor it used (half until measurements calibrate it: the
+  // least that they imply); nullopt: not screened.
   std::optional<double> screened_error;
-  double screen_scale = 1;
+  double interpolation_screen = 0.5;
   double seconds = 0;  // predicted bake time
   bool meets = false;  // measured, and upper_error <= margin * max_error
 };

@@ -117,7 +117,7 @@ TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
   ASSERT_TRUE(plan.chosen) << plan.why << plan.to_json().dump();
   ASSERT_EQ(plan.settings.size(), 3u * 2u * 4u);  // sh cannot bake GGX: left out
   double previous = 0;
-  double least_ratio = 1;
+  double factor = 0.5;
   bool measured_any = false;
   for (const PlannedSetting& s : plan.settings) {
     EXPECT_GE(s.seconds, previous);  // sorted by predicted time
@@ -129,21 +129,24 @@ TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
       if (s.measured_error) {
         EXPECT_GT(*s.measured_error + o.sigmas * *s.measured_sigma, o.margin * o.max_error);
       }
-      // The screen is optimistic (mis integration error at a third, interpolation at half), scaled
-      // by the least measured / screened ratio of the candidates measured before it: every
-      // candidate it lets through is measured, not rejected by the model alone.
+      // The screen is optimistic (mis integration error at a third, interpolation at half until
+      // measurements calibrate it: the least factor a with measured^2 = (a e_interp)^2 + e_int'^2
+      // among the candidates measured before it whose screened interpolation part is at least their
+      // integration part): every candidate it lets through is measured, not rejected by the model
+      // alone.
       const double ie = s.setting.integrator.method == "mis" ? s.integration_error / 3 : s.integration_error;
       ASSERT_TRUE(s.screened_error);
-      EXPECT_NEAR(*s.screened_error, std::hypot(0.5 * *s.interpolation_error, ie), 1e-12);
-      EXPECT_NEAR(s.screen_scale, least_ratio, 1e-12) << s.setting.views << " " << s.setting.res;
-      if (least_ratio * *s.screened_error <= o.margin * o.max_error) {
+      EXPECT_NEAR(s.interpolation_screen, factor, 1e-12) << s.setting.views << " " << s.setting.res;
+      EXPECT_NEAR(*s.screened_error, std::hypot(factor * *s.interpolation_error, ie), 1e-12);
+      if (*s.screened_error <= o.margin * o.max_error) {
         EXPECT_TRUE(s.measured_error) << s.setting.views << " " << s.setting.res << " " << s.setting.integrator.label();
       } else {
         EXPECT_FALSE(s.measured_error) << s.setting.views << " " << s.setting.res;
       }
-      if (s.measured_error) {
-        const double ratio = *s.measured_error / *s.screened_error;
-        least_ratio = measured_any ? std::min(least_ratio, ratio) : ratio;
+      if (s.measured_error && factor * *s.interpolation_error >= ie && *s.interpolation_error > 0) {
+        const double m = *s.measured_error;
+        const double a = std::sqrt(std::max(0.0, m * m - ie * ie)) / *s.interpolation_error;
+        factor = measured_any ? std::min(factor, a) : a;
         measured_any = true;
       }
     }
