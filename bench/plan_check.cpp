@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -148,8 +149,13 @@ int main(int argc, char** argv) {
       if (!f) throw std::runtime_error(sweep_from + ": cannot open");
       const nlohmann::json kept = nlohmann::json::parse(f);
       for (const char* key : {"env", "brdf", "max_error", "check_seed", "plan_seed", "check_views", "check_texels"})
-        if (!kept.contains(key) || kept[key] != out[key])
-          throw std::runtime_error(sweep_from + ": its " + key + " differs from this run's");
+        if (!kept.contains(key) || kept[key] != out[key]) {
+          // The environment by its file name: a kept sweep travels with the repository.
+          const bool same_env = std::string(key) == "env" && kept[key].is_string() &&
+                                std::filesystem::path(kept[key].get<std::string>()).filename() ==
+                                    std::filesystem::path(env_path).filename();
+          if (!same_env) throw std::runtime_error(sweep_from + ": its " + key + " differs from this run's");
+        }
       for (const char* key : {"candidates", "max_sweep_seconds", "sweep", "pruned", "own_errors", "sweep_seconds"})
         out[key] = kept.at(key);
       if (kept.contains("sweep_best")) {
