@@ -45,6 +45,12 @@ BRDFS = {
     "clearcoat": "{type: clearcoat, coat: {ior: 1.5, roughness: 0.1}, flakes: {coverage: 0.2, roughness: 0.3, "
                  "fresnel: {type: conductor, eta: [1.66, 0.88, 0.52], k: [9.22, 6.27, 4.84]}}, "
                  "base: {albedo: [0.3, 0.35, 0.6]}}",
+    # Kept for a check on cases the planner has never run on (with sunset, warehouse and city).
+    "copper": "{type: ggx, roughness: 0.15, fresnel: {type: conductor, eta: [0.27, 0.68, 1.22], k: [3.61, 2.63, 2.29]}}",
+    "rubber": "{type: phong, albedo: [0.08, 0.08, 0.09], exponent: 6}",
+    "pearl": "{type: clearcoat, coat: {ior: 1.5, roughness: 0.05}, flakes: {coverage: 0.1, roughness: 0.2, "
+             "fresnel: {type: conductor, eta: [0.155, 0.117, 0.138], k: [4.83, 3.12, 2.15]}}, "
+             "base: {albedo: [0.8, 0.78, 0.75]}}",
 }
 
 
