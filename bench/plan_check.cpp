@@ -167,6 +167,8 @@ int main(int argc, char** argv) {
         if (best_setting.integrator.method.empty()) throw std::runtime_error(sweep_from + ": unknown " + label);
         for (const std::string& views : po.view_sets)
           if (int(ViewSet::named(views).views().size()) == b["views"].get<int>()) best_setting.views = views;
+        if (best_setting.views.empty())
+          throw std::runtime_error(sweep_from + ": no candidate view set has " + b["views"].dump() + " views");
         best_setting.view_count = b["views"];
         best_setting.res = b["res"];
       }

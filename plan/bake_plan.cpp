@@ -177,25 +177,30 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   if (plan.integrators.empty()) throw std::invalid_argument("plan: no integrator setting can bake this BRDF");
 
   // The confirmations' texels: a larger sample of their own (another seed, drawn the same way), with
-  // the truth there; the pilot's own when confirm_views is 0.
+  // the truth there; the pilot's own when confirm_views is 0. Made at the first confirmation: a plan
+  // that measures no candidate does not pay for its truth.
   std::optional<ErrorSample> confirm_own;
   std::vector<Vec3> confirm_truth;
-  if (options.confirm_views > 0) {
-    const std::uint64_t confirm_seed = options.seed ^ 0x9e3779b97f4a7c15ull;
-    confirm_own.emplace(
-        options.guide_size > 0
-            ? ErrorSample(
-                  options.confirm_views, options.pilot_texels, options.pilot_size, confirm_seed,
-                  squared_radiance_guide(pilots.integrator(kInterpolationIntegrator.method), brdf,
-                                         options_of(kInterpolationIntegrator, options.seed), options.guide_size))
-            : ErrorSample(options.confirm_views, options.pilot_texels, options.pilot_size, confirm_seed));
-    confirm_truth = direct_values(pilots.integrator("reference"), brdf, options_of({"reference", 0, 0}, options.seed),
-                                  *confirm_own);
-    plan.truth_texels += confirm_own->count();
-  }
-  const ErrorSample& confirm_sample = confirm_own ? *confirm_own : sample;
-  const std::vector<Vec3>& confirm_values_truth = confirm_own ? confirm_truth : pilots.truth;
-  plan.confirm_texels = confirm_sample.count();
+  bool confirm_made = false;
+  auto confirmation = [&]() -> std::pair<const ErrorSample&, const std::vector<Vec3>&> {
+    if (!confirm_made && options.confirm_views > 0) {
+      const std::uint64_t confirm_seed = options.seed ^ 0x9e3779b97f4a7c15ull;
+      confirm_own.emplace(
+          options.guide_size > 0
+              ? ErrorSample(
+                    options.confirm_views, options.pilot_texels, options.pilot_size, confirm_seed,
+                    squared_radiance_guide(pilots.integrator(kInterpolationIntegrator.method), brdf,
+                                           options_of(kInterpolationIntegrator, options.seed), options.guide_size))
+              : ErrorSample(options.confirm_views, options.pilot_texels, options.pilot_size, confirm_seed));
+      confirm_truth = direct_values(pilots.integrator("reference"), brdf, options_of({"reference", 0, 0}, options.seed),
+                                    *confirm_own);
+      plan.truth_texels += confirm_own->count();
+    }
+    confirm_made = true;
+    plan.confirm_texels = confirm_own ? confirm_own->count() : sample.count();
+    if (confirm_own) return {*confirm_own, confirm_truth};
+    return {sample, pilots.truth};
+  };
 
   // e_interp(N, r) with its standard error, measured when first needed: the FIS maps' blend against
   // FIS direct values, less (in quadrature) FIS's own error against the truth at the same texels,
@@ -304,6 +309,7 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
       }
       if (!plan.chosen && screened <= budget && confirmations < options.max_confirmations) {
         ++confirmations;
+        const auto [confirm_sample, confirm_values_truth] = confirmation();
         const SampledBlend b = sampled_blend(integrator_for(s.setting.integrator.method), brdf,
                                              options_of(s.setting.integrator, options.seed), view_sets[c.set],
                                              s.setting.res, options.normalise_albedo, confirm_sample);

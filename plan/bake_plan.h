@@ -165,7 +165,7 @@ struct BakePlan {
   double pilot_seconds = 0;
   double confirm_seconds = 0;    // of which measuring screened-in candidates
   long long truth_texels = 0;    // reference texels of the pilot's and the confirmations' truth
-  long long confirm_texels = 0;  // texels each confirmation is measured at
+  long long confirm_texels = 0;  // texels each confirmation is measured at (0: no candidate measured)
   std::string why;               // a few lines for people
   nlohmann::json to_json() const;
 };

@@ -151,6 +151,7 @@ TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
       }
     }
   }
+  EXPECT_TRUE(measured_any);  // a measurement calibrated the screen before the choice
   ASSERT_TRUE(plan.chosen->measured_error);
   EXPECT_LE(*plan.chosen->measured_error + o.sigmas * *plan.chosen->measured_sigma, o.margin * o.max_error);
   EXPECT_DOUBLE_EQ(plan.chosen->upper_error, *plan.chosen->measured_error + o.sigmas * *plan.chosen->measured_sigma);
@@ -190,6 +191,9 @@ TEST(BakePlan, AnUnreachableBudgetChoosesNothingAndSaysSo) {
   const auto brdf = parse_brdf("{type: ggx, roughness: 0.1, fresnel: {type: schlick, f0: [0.9, 0.9, 0.9]}}");
   const BakePlan plan = plan_bake(env, *brdf, small(1e-5));
   EXPECT_FALSE(plan.chosen);
+  // Nothing was measured, so the confirmation sample and its truth were never made.
+  EXPECT_EQ(plan.confirm_texels, 0);
+  EXPECT_LE(plan.truth_texels, plan.options.pilot_views * plan.options.pilot_texels);
   EXPECT_NE(plan.why.find("no setting"), std::string::npos);
   EXPECT_TRUE(plan.to_json()["chosen"].is_null());
 }
