@@ -98,7 +98,11 @@ void print_plan(std::ostream& out, const BakePlan& plan) {
     out << "  " << std::left << std::setw(22) << p.setting.label() << std::right << std::setw(9) << pct(p.error)
         << " +- " << std::left << std::setw(8) << pct(p.error_sigma) << std::right << std::setw(9)
         << std::setprecision(2) << p.seconds_per_texel * 1e6 << " us\n";
-  out << "interpolation error (warp and blend at novel views, maps without integration error):\n";
+  out << "interpolation error (warp and blend at novel views, maps without integration error";
+  if (!plan.interpolation.empty())
+    out << "; measured with " << plan.interpolation_integrator.label() << ", whose own error is "
+        << pct(plan.interpolation_integrator_error);
+  out << "):\n";
   for (const InterpolationPilot& p : plan.interpolation)
     out << "  " << std::setw(4) << p.view_count << " views " << std::setw(4) << p.res << "^2" << std::setw(9)
         << pct(p.error) << " +- " << pct(p.error_sigma) << "\n";

@@ -24,9 +24,28 @@ IntegratorOptions options_of(const IntegratorSetting& s, std::uint64_t seed) {
   return o;
 }
 
-// The integrator that measures e_interp: deterministic (no noise to mistake for blend error) and
-// accurate enough that its smooth bias is common to the sources and the direct values.
+// The integrator of the pilot's guide: deterministic for a seed and cheap.
 const IntegratorSetting kInterpolationIntegrator{"fis", 64, 0};
+
+// The integrator that measures e_interp: FIS (deterministic for a seed: no noise to mistake for
+// blend error), the cheapest of the pilot's FIS settings whose own error is at most a third of the
+// planned budget (the most accurate when none is), FIS 64 when the pilot has none. Its own error is
+// not the blend's (see the header), and what the subtraction in quadrature does not take out is
+// then small beside the budget: with FIS 64 under a sharp coat (own error 2.5%, the blend's raw
+// error 0.9-2.3%) the subtraction left e_interp at 0 for every pair of 162 views or more, the
+// screen passed them all, and 32 confirmations measured 1.8-3.0% against a 1.8% plan.
+IntegratorSetting interpolation_integrator(const std::vector<IntegratorPilot>& pilots, double budget) {
+  const IntegratorPilot* cheapest = nullptr;
+  const IntegratorPilot* most_accurate = nullptr;
+  for (const IntegratorPilot& p : pilots) {
+    if (p.setting.method != "fis") continue;
+    if (!most_accurate || p.error < most_accurate->error) most_accurate = &p;
+    if (p.error <= budget / 3 && (!cheapest || p.seconds_per_texel < cheapest->seconds_per_texel)) cheapest = &p;
+  }
+  if (cheapest) return cheapest->setting;
+  if (most_accurate) return most_accurate->setting;
+  return kInterpolationIntegrator;
+}
 
 std::string percent(double e) {
   std::ostringstream s;
@@ -205,14 +224,15 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   // e_interp(N, r) with its standard error, measured when first needed: the FIS maps' blend against
   // FIS direct values, less (in quadrature) FIS's own error against the truth at the same texels,
   // which the direct side carries and the blend does not share.
+  plan.interpolation_integrator = interpolation_integrator(plan.integrators, budget);
   std::vector<Vec3> interpolation_direct;
   double interpolation_own = 0;
   std::map<std::pair<std::size_t, int>, ErrorEstimate> interpolation;
   auto interpolation_error = [&](std::size_t set, int res) {
     const auto key = std::make_pair(set, res);
     if (auto it = interpolation.find(key); it != interpolation.end()) return it->second;
-    const Integrator& integrator = integrator_for(kInterpolationIntegrator.method);
-    const IntegratorOptions o = options_of(kInterpolationIntegrator, options.seed);
+    const Integrator& integrator = integrator_for(plan.interpolation_integrator.method);
+    const IntegratorOptions o = options_of(plan.interpolation_integrator, options.seed);
     if (interpolation_direct.empty()) {
       interpolation_direct = direct_values(integrator, brdf, o, sample);
       interpolation_own = sample_error(sample, interpolation_direct, pilots.truth).value;
@@ -261,32 +281,34 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   // 64^2 was 2.9% while the whole setting checked at 1.86%), and a pessimistic screen keeps the
   // cheaper candidates from ever being measured.
   constexpr double kInterpolationScreen = 0.5;
+  // The model screens, a measurement decides (see the header): a screened-in candidate is blended
+  // at the confirmation texels with its own integrator and taken when that error plus k sigma fits. The
+  // screen is optimistic: an unbiased integrator's (mis) error counts at a third, the most the
+  // blend's 3 sources x 4 taps can average its noise away, and e_interp at half (above).
+  constexpr double kMisScreen = 1.0 / 3.0;
+  // The screen, calibrated by what the measurements say. Each factor starts as above and becomes
+  // the least that the measurements so far imply, from measured^2 = (a e_interp)^2 + (b e_int)^2:
+  // the interpolation factor a from the measurements whose screened interpolation part is at least
+  // their integration part, mis's factor b from mis measurements whose integration part is the
+  // larger (elsewhere the factor is ill-determined). The screen stays as optimistic as the most
+  // favourable candidate measured, but it no longer spends the confirmations on candidates that
+  // every measurement so far says will miss (under a low sun the implied a was about 1 for every
+  // method, and 32 confirmations at half ran out before the candidates that could pass).
+  double interpolation_screen = kInterpolationScreen;
+  double mis_screen = kMisScreen;
+  bool calibrated = false, mis_calibrated = false;
+  auto screened_integration = [&](const PlannedSetting& s) {
+    return s.setting.integrator.method == "mis" ? mis_screen * s.integration_error : s.integration_error;
+  };
   // A pair (N, r) cannot meet an allowance that a measured pair with at least as many views and at
   // least the size already misses (more views and texels do not interpolate worse): not measured.
   auto dominated = [&](std::size_t set, int res, double allowance) {
     for (const auto& [key, e] : interpolation)
       if (view_sets[key.first].views().size() >= view_sets[set].views().size() && key.second >= res &&
-          kInterpolationScreen * e.value > allowance)
+          interpolation_screen * e.value > allowance)
         return true;
     return false;
   };
-  // The model screens, a measurement decides (see the header): a screened-in candidate is blended
-  // at the confirmation texels with its own integrator and taken when that error plus k sigma fits. The
-  // screen is optimistic: an unbiased integrator's (mis) error counts at a third, the most the
-  // blend's 3 sources x 4 taps can average its noise away, and e_interp at half (above).
-  auto screened_integration = [](const PlannedSetting& s) {
-    return s.setting.integrator.method == "mis" ? s.integration_error / 3.0 : s.integration_error;
-  };
-  // The screen, calibrated by what the measurements say. Its interpolation factor starts at half
-  // and becomes the least factor a that the measurements so far imply, measured^2 = (a e_interp)^2 +
-  // e_int'^2 (e_int': the screen's integration part), taken only from measurements whose screened
-  // interpolation part is at least their integration part (elsewhere a is ill-determined). The
-  // screen stays as optimistic as the most favourable candidate measured, but it no longer spends
-  // the confirmations on candidates that every measurement so far says will miss (under a low sun
-  // the implied factor was about 1 for every method, and 32 confirmations at half ran out before
-  // the candidates that could pass). The integration part keeps its own optimism (mis at a third).
-  double interpolation_screen = kInterpolationScreen;
-  bool calibrated = false;
   int confirmations = 0;
   for (Candidate& c : candidates) {
     PlannedSetting& s = c.planned;
@@ -306,6 +328,7 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
       if (!plan.chosen) {
         s.screened_error = screened;
         s.interpolation_screen = interpolation_screen;
+        s.mis_screen = mis_screen;
       }
       if (!plan.chosen && screened <= budget && confirmations < options.max_confirmations) {
         ++confirmations;
@@ -319,10 +342,15 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
         s.upper_error = e.upper(k);
         s.meets = s.upper_error <= budget;
         plan.confirm_seconds += b.seconds;
-        if (interpolation_screen * interp->value >= ie && interp->value > 0) {
+        const double ip = interpolation_screen * interp->value;
+        if (ip >= ie && interp->value > 0) {
           const double a = std::sqrt(std::max(0.0, e.value * e.value - ie * ie)) / interp->value;
           interpolation_screen = calibrated ? std::min(interpolation_screen, a) : a;
           calibrated = true;
+        } else if (s.setting.integrator.method == "mis" && s.integration_error > 0) {
+          const double b = std::sqrt(std::max(0.0, e.value * e.value - ip * ip)) / s.integration_error;
+          mis_screen = mis_calibrated ? std::min(mis_screen, b) : b;
+          mis_calibrated = true;
         }
       }
     }
@@ -396,6 +424,7 @@ nlohmann::json BakePlan::to_json() const {
     j["predicted_seconds"] = s.seconds;
     j["screened_error"] = s.screened_error ? nlohmann::json(*s.screened_error) : nlohmann::json();
     j["interpolation_screen"] = s.screened_error ? nlohmann::json(s.interpolation_screen) : nlohmann::json();
+    j["mis_screen"] = s.screened_error ? nlohmann::json(s.mis_screen) : nlohmann::json();
     j["meets"] = s.meets;
     return j;
   };
@@ -420,6 +449,7 @@ nlohmann::json BakePlan::to_json() const {
                                 {"error_sigma", p.error_sigma},
                                 {"seconds_per_texel", p.seconds_per_texel},
                                 {"setup_seconds", p.setup_seconds}});
+  j["interpolation_integrator"] = interpolation_integrator.label();
   j["interpolation_integrator_error"] = interpolation_integrator_error;
   j["interpolation"] = nlohmann::json::array();
   for (const InterpolationPilot& p : interpolation)

@@ -11,8 +11,9 @@
 //     value does not depend on the map it is in, so e_int is measured once per integrator at the
 //     pilot's sampled texels (random novel views) against the reference.
 //   e_interp(N, r): the warp and blend's error with maps that carry no integration error: the
-//     sampled blend of the N-view set at size r against the direct values, both with one fixed
-//     deterministic integrator (filtered importance sampling, 64 samples), less that integrator's
+//     sampled blend of the N-view set at size r against the direct values, both with one
+//     deterministic integrator (filtered importance sampling: the cheapest of the pilot's FIS
+//     settings whose own error is at most a third of the planned budget), less that integrator's
 //     own error at the same texels in quadrature: its error at a destination texel is not the one
 //     the blend carries from the sources' texels (it depends on the seed and the lobe), so it does
 //     not cancel. Measured per (N, r) with only the blend's footprints baked.
@@ -27,8 +28,8 @@
 // in quadrature (up to e_interp + e_int), and a noisy integrator's error is partly averaged away by
 // the blend, while e_interp measured with FIS maps carries FIS's own error pattern and overstates
 // the blend's (up to 1.6x). So a candidate the model lets through (with mis errors counted at a
-// third and e_interp at half until measurements say by how much to count it: the least factor the
-// candidates measured so far imply) is measured: the set's blend at the confirmation texels (a sample
+// third and e_interp at half until measurements say by how much to count them: the least factors
+// the candidates measured so far imply) is measured: the set's blend at the confirmation texels (a sample
 // of its own, confirm_views novel views, 4x the pilot's by default), baking only the footprints with
 // its own integrator, against the truth there. It is taken when
 //
@@ -143,11 +144,12 @@ struct PlannedSetting {
   double upper_error = 0;                     // measured + k sigma when measured, else from the model's parts
   std::optional<double> measured_error;       // the set's blend at the confirmation texels (screened in)
   std::optional<double> measured_sigma;       // its standard error
-  // The screen's optimistic error, hypot(a e_interp, e_int') with e_int' the integration error (mis
-  // at a third), and a, the interpolation factor it used (half until measurements calibrate it: the
-  // least that they imply); nullopt: not screened.
+  // The screen's optimistic error, hypot(a e_interp, e_int') with e_int' the integration error (b
+  // e_int for mis), and the factors it used: a for interpolation (half) and b for mis (a third),
+  // until measurements calibrate them to the least that they imply; nullopt: not screened.
   std::optional<double> screened_error;
   double interpolation_screen = 0.5;
+  double mis_screen = 1.0 / 3.0;
   double seconds = 0;  // predicted bake time
   bool meets = false;  // measured, and upper_error <= margin * max_error
 };
@@ -156,9 +158,10 @@ struct BakePlan {
   BakePlanOptions options;
   std::vector<IntegratorPilot> integrators;
   std::vector<InterpolationPilot> interpolation;
-  double interpolation_integrator_error = 0;  // FIS 64's own error at the pilot texels
-  std::vector<PlannedSetting> settings;       // every candidate, by predicted time
-  std::optional<PlannedSetting> chosen;       // nullopt: no candidate is predicted to meet the budget
+  IntegratorSetting interpolation_integrator;  // the FIS setting that measured e_interp
+  double interpolation_integrator_error = 0;   // its own error at the pilot texels
+  std::vector<PlannedSetting> settings;        // every candidate, by predicted time
+  std::optional<PlannedSetting> chosen;        // nullopt: no candidate is predicted to meet the budget
   // Without a choice: the measured candidate with the least upper error (nullopt when none was
   // measured), the nearest thing to a setting; it meets a budget of upper_error / margin.
   std::optional<PlannedSetting> closest;

@@ -116,9 +116,17 @@ TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
   const BakePlan plan = plan_bake(env, *brdf, o);
   ASSERT_TRUE(plan.chosen) << plan.why << plan.to_json().dump();
   ASSERT_EQ(plan.settings.size(), 3u * 2u * 4u);  // sh cannot bake GGX: left out
+  // e_interp is measured with the cheapest FIS setting of the pilot whose own error is within a
+  // third of the planned budget.
+  EXPECT_EQ(plan.interpolation_integrator.method, "fis");
+  for (const IntegratorPilot& p : plan.integrators)
+    if (p.setting.method == "fis" && p.setting.samples == plan.interpolation_integrator.samples) {
+      EXPECT_LE(p.error, o.margin * o.max_error / 3);
+      EXPECT_NEAR(plan.interpolation_integrator_error, p.error, 0.5 * p.error);  // the same sample's texels
+    }
   double previous = 0;
-  double factor = 0.5;
-  bool measured_any = false;
+  double factor = 0.5, mis_factor = 1.0 / 3.0;
+  bool measured_any = false, mis_measured = false;
   for (const PlannedSetting& s : plan.settings) {
     EXPECT_GE(s.seconds, previous);  // sorted by predicted time
     previous = s.seconds;
@@ -130,24 +138,32 @@ TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
         EXPECT_GT(*s.measured_error + o.sigmas * *s.measured_sigma, o.margin * o.max_error);
       }
       // The screen is optimistic (mis integration error at a third, interpolation at half until
-      // measurements calibrate it: the least factor a with measured^2 = (a e_interp)^2 + e_int'^2
-      // among the candidates measured before it whose screened interpolation part is at least their
-      // integration part): every candidate it lets through is measured, not rejected by the model
-      // alone.
-      const double ie = s.setting.integrator.method == "mis" ? s.integration_error / 3 : s.integration_error;
+      // measurements calibrate them: the least factors with measured^2 = (a e_interp)^2 + (b
+      // e_int)^2 among the candidates measured before it, a from those whose screened interpolation
+      // part is at least their integration part, b from mis ones where it is less): every candidate
+      // it lets through is measured, not rejected by the model alone.
+      const bool mis = s.setting.integrator.method == "mis";
+      const double ie = mis ? mis_factor * s.integration_error : s.integration_error;
       ASSERT_TRUE(s.screened_error);
       EXPECT_NEAR(s.interpolation_screen, factor, 1e-12) << s.setting.views << " " << s.setting.res;
+      EXPECT_NEAR(s.mis_screen, mis_factor, 1e-12) << s.setting.views << " " << s.setting.res;
       EXPECT_NEAR(*s.screened_error, std::hypot(factor * *s.interpolation_error, ie), 1e-12);
       if (*s.screened_error <= o.margin * o.max_error) {
         EXPECT_TRUE(s.measured_error) << s.setting.views << " " << s.setting.res << " " << s.setting.integrator.label();
       } else {
         EXPECT_FALSE(s.measured_error) << s.setting.views << " " << s.setting.res;
       }
-      if (s.measured_error && factor * *s.interpolation_error >= ie && *s.interpolation_error > 0) {
+      const double ip = factor * *s.interpolation_error;
+      if (s.measured_error && ip >= ie && *s.interpolation_error > 0) {
         const double m = *s.measured_error;
         const double a = std::sqrt(std::max(0.0, m * m - ie * ie)) / *s.interpolation_error;
         factor = measured_any ? std::min(factor, a) : a;
         measured_any = true;
+      } else if (s.measured_error && mis && s.integration_error > 0) {
+        const double m = *s.measured_error;
+        const double b = std::sqrt(std::max(0.0, m * m - ip * ip)) / s.integration_error;
+        mis_factor = mis_measured ? std::min(mis_factor, b) : b;
+        mis_measured = true;
       }
     }
   }
@@ -162,6 +178,32 @@ TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
     return -1.0;
   };
   EXPECT_LT(interp("42", 32), interp("icosa", 32));
+}
+
+// Where mis's noise is the error (a smooth BRDF, many views), the screen's mis factor becomes what
+// the first mis measurement implies, and the next mis candidate is screened with it.
+TEST(BakePlan, TheMisScreenTakesTheFactorItsMeasurementsImply) {
+  const EnvMap env = sky(Vec3(0.2, 0.8, 0.4), 64);
+  const auto brdf = parse_brdf("{type: lambert, albedo: [0.6, 0.6, 0.6]}");
+  BakePlanOptions o = small(0.03);
+  o.view_sets = {"162"};
+  o.sizes = {16};
+  o.integrators = {{"mis", 4, 0}, {"mis", 16, 0}, {"mis", 64, 0}, {"reference", 0, 0}};
+  const BakePlan plan = plan_bake(env, *brdf, o);
+  std::vector<const PlannedSetting*> mis;
+  for (const PlannedSetting& s : plan.settings)
+    if (s.setting.integrator.method == "mis" && s.measured_error) mis.push_back(&s);
+  ASSERT_GE(mis.size(), 2u) << plan.why << plan.to_json()["settings"].dump(0);
+  const PlannedSetting& first = *mis[0];
+  EXPECT_DOUBLE_EQ(first.mis_screen, 1.0 / 3.0);
+  const double ip = first.interpolation_screen * *first.interpolation_error;
+  ASSERT_LT(ip, first.mis_screen * first.integration_error);  // the integration part is the larger
+  const double m = *first.measured_error;
+  const double b = std::sqrt(m * m - ip * ip) / first.integration_error;
+  EXPECT_NEAR(mis[1]->mis_screen, b, 1e-12);
+  EXPECT_NEAR(*mis[1]->screened_error,
+              std::hypot(mis[1]->interpolation_screen * *mis[1]->interpolation_error, b * mis[1]->integration_error),
+              1e-12);
 }
 
 // The integrator alone (maps baked at the frames they are used at): the cheapest setting per texel
