@@ -54,7 +54,9 @@
 // The choice: the settings sorted by predicted time; the first that meets the budget. The pilot
 // measures e_interp lazily, only for the (N, r) pairs it reaches and that no measured pair with at
 // least as many views and texels already rules out, unless asked for every pair; it measures at
-// most max_confirmations candidates.
+// most max_confirmations candidates. When the screen lets none through, the candidate with the least
+// screened error is measured if that is within twice the planned budget, so that the plan can name
+// the closest setting.
 #pragma once
 
 #include "bake/brdf.h"

@@ -240,6 +240,40 @@ TEST(BakePlan, AnUnreachableBudgetChoosesNothingAndSaysSo) {
   EXPECT_TRUE(plan.to_json()["chosen"].is_null());
 }
 
+// When the screen lets nothing through but its least screened candidate is within twice the planned
+// budget, that one candidate is measured, so that the plan names the closest setting.
+TEST(BakePlan, WhenTheScreenPassesNothingItsLeastScreenedCandidateIsMeasured) {
+  const EnvMap env = sky(Vec3(0.3, 0.6, 0.5), 32);
+  const auto brdf = parse_brdf("{type: ggx, roughness: 0.3, fresnel: {type: schlick, f0: [0.9, 0.8, 0.6]}}");
+  BakePlanOptions o = small(0.05);
+  o.every_pair = true;
+  o.max_confirmations = 0;  // the screen alone: every candidate's screened error, nothing measured
+  const BakePlan screen_only = plan_bake(env, *brdf, o);
+  double least = 1e300;
+  for (const PlannedSetting& s : screen_only.settings) {
+    EXPECT_FALSE(s.measured_error);
+    if (s.screened_error) least = std::min(least, *s.screened_error);
+  }
+  ASSERT_LT(least, 1.0);
+  o.max_confirmations = 32;
+  o.max_error = least / 1.5 / o.margin;  // the least screened error is 1.5x the planned budget
+  const BakePlan plan = plan_bake(env, *brdf, o);
+  int measured = 0;
+  for (const PlannedSetting& s : plan.settings)
+    if (s.measured_error) {
+      ++measured;
+      EXPECT_DOUBLE_EQ(*s.screened_error, least);
+    }
+  EXPECT_EQ(measured, 1);
+  ASSERT_TRUE(plan.chosen || plan.closest);
+  if (!plan.chosen) {
+    EXPECT_DOUBLE_EQ(*plan.closest->screened_error, least);
+  }
+  // Beyond twice the plan, nothing is measured.
+  o.max_error = least / 2.5 / o.margin;
+  for (const PlannedSetting& s : plan_bake(env, *brdf, o).settings) EXPECT_FALSE(s.measured_error);
+}
+
 // When nothing meets the budget, the plan names the measured candidate nearest to it: here every
 // measurement's upper bound is pushed past the budget (100 standard errors) and the plan stops after
 // at most two measurements (the calibrated screen may let fewer through).
