@@ -249,10 +249,14 @@ TEST(BakePlan, WhenTheScreenPassesNothingItsLeastScreenedCandidateIsMeasured) {
   o.every_pair = true;
   o.max_confirmations = 0;  // the screen alone: every candidate's screened error, nothing measured
   const BakePlan screen_only = plan_bake(env, *brdf, o);
+  // The full reference is left out (its measurement costs the full quadrature at every texel read).
+  auto full_reference = [](const PlannedSetting& s) {
+    return s.setting.integrator.method == "reference" && s.setting.integrator.reference_width == 0;
+  };
   double least = 1e300;
   for (const PlannedSetting& s : screen_only.settings) {
     EXPECT_FALSE(s.measured_error);
-    if (s.screened_error) least = std::min(least, *s.screened_error);
+    if (s.screened_error && !full_reference(s)) least = std::min(least, *s.screened_error);
   }
   ASSERT_LT(least, 1.0);
   o.max_confirmations = 32;
@@ -263,6 +267,7 @@ TEST(BakePlan, WhenTheScreenPassesNothingItsLeastScreenedCandidateIsMeasured) {
     if (s.measured_error) {
       ++measured;
       EXPECT_DOUBLE_EQ(*s.screened_error, least);
+      EXPECT_FALSE(full_reference(s));
     }
   EXPECT_EQ(measured, 1);
   ASSERT_TRUE(plan.chosen || plan.closest);
