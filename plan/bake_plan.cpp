@@ -31,9 +31,9 @@ const IntegratorSetting kInterpolationIntegrator{"fis", 64, 0};
 // blend error), the cheapest of the pilot's FIS settings whose own error is at most a third of the
 // planned budget (the most accurate when none is), FIS 64 when the pilot has none. Its own error is
 // not the blend's (see the header), and what the subtraction in quadrature does not take out is
-// then small beside the budget: with FIS 64 under a sharp coat (own error 2.5%, the blend's raw
-// error 0.9-2.3%) the subtraction left e_interp at 0 for every pair of 162 views or more, the
-// screen passed them all, and 32 confirmations measured 1.8-3.0% against a 1.8% plan.
+// then small beside the budget. A fixed FIS 64 fails under a sharp coat: its own error exceeds the
+// blend's raw error, the subtraction leaves e_interp at 0 for the larger view sets, and the screen
+// lets through candidates that every confirmation then finds over the budget.
 IntegratorSetting interpolation_integrator(const std::vector<IntegratorPilot>& pilots, double budget) {
   const IntegratorPilot* cheapest = nullptr;
   const IntegratorPilot* most_accurate = nullptr;
@@ -365,10 +365,11 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   }
   // When the screen let nothing through but its least screened candidate is within twice the plan,
   // that one is measured, so that the plan can name the closest setting and the error it reaches
-  // (a near-mirror coat under a small lamp screened at 2.7% and up against a 1.8% plan, and the
-  // plan had nothing to name). Taken if it meets the budget after all. The full reference is left
-  // out: its measurement integrates the full quadrature at every texel the blend reads (1053 s
-  // there, for a setting of 10 days), and MIS 1024 on the same set screened within 0.1% of it.
+  // (a near-mirror coat under a small bright lamp is screened out everywhere, and the plan would
+  // have nothing to name). Taken if it meets the budget after all. The full reference is left out:
+  // its measurement integrates the full quadrature at every texel the blend reads (minutes), for a
+  // setting that would bake for days, and the most accurate sampled integrator on the same set
+  // screens within a hair of it.
   if (!plan.chosen && confirmations == 0 && options.max_confirmations > 0) {
     Candidate* least = nullptr;
     for (Candidate& c : candidates) {
