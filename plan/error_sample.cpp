@@ -142,6 +142,20 @@ cv::Mat ErrorSample::mask(int k) const {
   return m;
 }
 
+ErrorSample ErrorSample::views(int first, int last) const {
+  if (!(0 <= first && first < last && last <= view_count()))
+    throw std::invalid_argument("error sample: views [" + std::to_string(first) + ", " + std::to_string(last) +
+                                ") are not a part of the sample's " + std::to_string(view_count()));
+  ErrorSample s;
+  s.size_ = size_;
+  s.guided_ = guided_;
+  s.views_.assign(views_.begin() + first, views_.begin() + last);
+  s.frames_.assign(frames_.begin() + first, frames_.begin() + last);
+  s.texels_.assign(texels_.begin() + first, texels_.begin() + last);
+  s.weights_.assign(weights_.begin() + first, weights_.begin() + last);
+  return s;
+}
+
 int ErrorSample::count() const {
   int n = 0;
   for (const auto& t : texels_) n += int(t.size());
@@ -194,8 +208,11 @@ SampledBlend sampled_blend(const Integrator& integrator, const Brdf& brdf, const
   const std::vector<Vec3>& vs = views.views();
   const CentralDirection kind = brdf.central_direction();
   // The footprints: for every sampled texel and located source, the 2 x 2 bilinear taps around the
-  // warped point and a one-texel margin (4 x 4), so float rounding in the engine's warp cannot
-  // reach an unbaked texel.
+  // warped point (the engine's taps are floor(p) and floor(p) + 1 of pixel_from_disc's p). A tap's
+  // neighbour is added where p lies within kRound of a texel boundary, so that float rounding in the
+  // engine's warp cannot move the footprint onto an unbaked texel; near the rim (where a footprint's
+  // taps may fall outside the disc and the engine steps inward) the whole one-texel margin (4 x 4).
+  constexpr double kRound = 1e-2;
   std::vector<cv::Mat> masks(vs.size());
   for (int k = 0; k < sample.view_count(); ++k) {
     const Vec3& d = sample.view(k);
@@ -211,8 +228,12 @@ SampledBlend sampled_blend(const Integrator& integrator, const Brdf& brdf, const
         cv::Mat& m = masks[std::size_t(i)];
         if (m.empty()) m = cv::Mat(res, res, CV_8UC1, cv::Scalar(0));
         const int c0 = int(std::floor(px.x())), r0 = int(std::floor(px.y()));
-        for (int r = std::max(0, r0 - 1); r <= std::min(res - 1, r0 + 2); ++r)
-          for (int c = std::max(0, c0 - 1); c <= std::min(res - 1, c0 + 2); ++c) m.at<unsigned char>(r, c) = 255;
+        const double fx = px.x() - c0, fy = px.y() - r0;
+        const bool rim = w.disc.norm() > 1.0 - 3.0 / res;
+        const int c_lo = c0 - (rim || fx < kRound ? 1 : 0), c_hi = c0 + 1 + (rim || fx > 1 - kRound ? 1 : 0);
+        const int r_lo = r0 - (rim || fy < kRound ? 1 : 0), r_hi = r0 + 1 + (rim || fy > 1 - kRound ? 1 : 0);
+        for (int r = std::max(0, r_lo); r <= std::min(res - 1, r_hi); ++r)
+          for (int c = std::max(0, c_lo); c <= std::min(res - 1, c_hi); ++c) m.at<unsigned char>(r, c) = 255;
       }
     }
   }
@@ -245,6 +266,48 @@ SampledBlend sampled_blend(const Integrator& integrator, const Brdf& brdf, const
   SampledBlend b = blend_at_samples(set, views, sample, rule);
   out.values = std::move(b.values);
   out.weights = std::move(b.weights);
+  return out;
+}
+
+BlendErrorMeasure sampled_blend_error(const Integrator& integrator, const Brdf& brdf, const IntegratorOptions& options,
+                                      const ViewSet& views, int res, bool normalise_albedo, const ErrorSample& sample,
+                                      const std::vector<Vec3>& truth, const BlendErrorOptions& stop) {
+  if (stop.step < 1) throw std::invalid_argument("sampled blend error: the step must be at least one view");
+  if (truth.size() != std::size_t(sample.count()))
+    throw std::invalid_argument("sampled blend error: the truth differs in size from the sample");
+  const int K = sample.view_count();
+  double truth_norm2 = 0;
+  std::size_t i = 0;
+  for (int v = 0; v < K; ++v)
+    for (double w : sample.weights(v)) truth_norm2 += w * truth[i++].squaredNorm();
+  const double bound = stop.stop_above * stop.stop_above * truth_norm2;
+  BlendErrorMeasure out;
+  SampledBlend all;
+  double partial = 0;
+  i = 0;
+  while (out.views < K) {
+    const int first = out.views, last = std::min(K, first + stop.step);
+    std::optional<ErrorSample> piece;
+    if (first > 0 || last < K) piece.emplace(sample.views(first, last));
+    const SampledBlend b =
+        sampled_blend(integrator, brdf, options, views, res, normalise_albedo, piece ? *piece : sample);
+    out.seconds += b.seconds;
+    std::size_t j = 0;  // b's texel j is the sample's i + j
+    for (int v = first; v < last; ++v)
+      for (double w : sample.weights(v)) {
+        if (b.weights[j] > 0) partial += w * (b.values[j] - truth[i + j]).squaredNorm();
+        ++j;
+      }
+    i += j;
+    all.values.insert(all.values.end(), b.values.begin(), b.values.end());
+    all.weights.insert(all.weights.end(), b.weights.begin(), b.weights.end());
+    out.views = last;
+    if (out.views < K && partial > bound) {
+      out.at_least = std::sqrt(partial / truth_norm2);
+      return out;
+    }
+  }
+  out.error = sample_error(sample, all.values, truth, &all.weights);
   return out;
 }
 

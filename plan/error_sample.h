@@ -50,6 +50,8 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
+#include <optional>
 #include <vector>
 
 namespace rsibr {
@@ -89,10 +91,15 @@ class ErrorSample {
   cv::Mat mask(int k) const;
   // Texels in all, and the values of a vector over the sample in order (view-major, ascending).
   int count() const;
+  // Views [first, last) with their texels and weights: a sample of its own whose values (direct or
+  // blended) are those of the same views in this one. Throws std::invalid_argument for an empty or
+  // out-of-range interval.
+  ErrorSample views(int first, int last) const;
 
  private:
+  ErrorSample() = default;
   ErrorSample(int views, int texels, int size, std::uint64_t seed, const TexelGuide* guide, double min_cos);
-  int size_;
+  int size_ = 0;
   bool guided_ = false;
   std::vector<Vec3> views_;
   std::vector<Mat3> frames_;
@@ -137,6 +144,25 @@ struct SampledBlend {
 SampledBlend sampled_blend(const Integrator& integrator, const Brdf& brdf, const IntegratorOptions& options,
                            const ViewSet& views, int res, bool normalise_albedo, const ErrorSample& sample,
                            const BlendRule& rule = {});
+
+// The error (sample_error) of the blend that sampled_blend gives, measured `step` views at a time
+// and stopped as soon as it provably exceeds stop_above: the estimate is sqrt(N / D), N and D sums
+// over the texels where the blend has weight, so N over the views so far above stop_above^2 times
+// D over every texel of the sample bounds it from below. Throws what sampled_blend throws and
+// std::invalid_argument for step < 1 or a truth that is not the sample's size.
+struct BlendErrorOptions {
+  double stop_above = std::numeric_limits<double>::infinity();
+  int step = 1;  // views per step
+};
+struct BlendErrorMeasure {
+  std::optional<ErrorEstimate> error;  // measured at every view; nullopt: stopped
+  double at_least = 0;                 // when stopped: the lower bound, > stop_above
+  int views = 0;                       // views measured
+  double seconds = 0;                  // wall time of the integration
+};
+BlendErrorMeasure sampled_blend_error(const Integrator& integrator, const Brdf& brdf, const IntegratorOptions& options,
+                                      const ViewSet& views, int res, bool normalise_albedo, const ErrorSample& sample,
+                                      const std::vector<Vec3>& truth, const BlendErrorOptions& stop);
 
 // The blend of an existing set at every sampled texel (view_set: the set's views).
 SampledBlend sampled_blend(const MapSet& set, const ViewSet& view_set, const ErrorSample& sample,

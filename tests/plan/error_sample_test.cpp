@@ -73,17 +73,21 @@ void expect_footprints_equal_the_whole_set(const std::string& spec, bool normali
   o.res = 24;
   o.integrator.samples = 16;
   o.normalise_albedo = normalise;
-  const MapSet whole = bake_map_set(*brdf, *integrator, views, o);
-  const ErrorSample sample(3, 40, 48, 11);
-  const SampledBlend full = sampled_blend(whole, views, sample);
-  const SampledBlend sparse = sampled_blend(*integrator, *brdf, o.integrator, views, o.res, normalise, sample);
-  ASSERT_EQ(full.values.size(), sparse.values.size());
-  for (std::size_t i = 0; i < full.values.size(); ++i) {
-    EXPECT_EQ(full.values[i], sparse.values[i]) << spec << " texel " << i;
-    EXPECT_EQ(full.weights[i], sparse.weights[i]);
+  // Sizes even and odd, coarser and finer than the sample's; the sample reaches the rim ring.
+  for (int res : {24, 61}) {
+    o.res = res;
+    const MapSet whole = bake_map_set(*brdf, *integrator, views, o);
+    const ErrorSample sample(6, 60, 48, 11);
+    const SampledBlend full = sampled_blend(whole, views, sample);
+    const SampledBlend sparse = sampled_blend(*integrator, *brdf, o.integrator, views, o.res, normalise, sample);
+    ASSERT_EQ(full.values.size(), sparse.values.size());
+    for (std::size_t i = 0; i < full.values.size(); ++i) {
+      EXPECT_EQ(full.values[i], sparse.values[i]) << spec << " size " << res << " texel " << i;
+      EXPECT_EQ(full.weights[i], sparse.weights[i]);
+    }
+    EXPECT_GT(sparse.texels_baked, 0);
+    EXPECT_LT(sparse.texels_baked, 42LL * res * res / 2);  // a fraction of the set
   }
-  EXPECT_GT(sparse.texels_baked, 0);
-  EXPECT_LT(sparse.texels_baked, 42LL * 24 * 24 / 2);  // a fraction of the set
 }
 
 TEST(SampledBlend, FootprintsGiveTheBlendOfTheWholeSetMirrorWarp) {
@@ -98,6 +102,82 @@ TEST(SampledBlend, FootprintsGiveTheBlendOfTheWholeSetNormalWarp) {
 TEST(SampledBlend, FootprintsGiveTheBlendOfTheWholeSetAlbedoNormalised) {
   expect_footprints_equal_the_whole_set("{type: ggx, roughness: 0.4, fresnel: {type: schlick, f0: [0.04, 0.04, 0.04]}}",
                                         true);
+}
+
+// A part of a sample is a sample of its own: its views, texels and weights, and so its blended and
+// direct values, are those of the same views in the whole; empty or out-of-range parts are refused.
+TEST(ErrorSample, APartOfTheViewsGivesTheWholesValuesForThoseViews) {
+  const EnvMap env = sky(Vec3(0.2, 0.9, -0.3));
+  const auto brdf = parse_brdf("{type: ggx, roughness: 0.25, fresnel: {type: schlick, f0: [0.9, 0.8, 0.6]}}");
+  const auto integrator = make_integrator("fis", env);
+  IntegratorOptions o;
+  o.samples = 8;
+  const ErrorSample whole(5, 30, 32, 3, squared_radiance_guide(*integrator, *brdf, o, 16));
+  const ErrorSample part = whole.views(2, 4);
+  ASSERT_EQ(part.view_count(), 2);
+  EXPECT_TRUE(part.guided());
+  std::size_t offset = 0;
+  for (int k = 0; k < 2; ++k) offset += whole.texels(k).size();
+  const ViewSet views = ViewSet::named("42");
+  const SampledBlend bw = sampled_blend(*integrator, *brdf, o, views, 24, false, whole);
+  const SampledBlend bp = sampled_blend(*integrator, *brdf, o, views, 24, false, part);
+  const std::vector<Vec3> dw = direct_values(*integrator, *brdf, o, whole),
+                          dp = direct_values(*integrator, *brdf, o, part);
+  ASSERT_EQ(std::size_t(part.count()), whole.texels(2).size() + whole.texels(3).size());
+  ASSERT_EQ(bp.values.size(), std::size_t(part.count()));
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(part.view(k), whole.view(k + 2));
+    EXPECT_EQ(part.texels(k), whole.texels(k + 2));
+    EXPECT_EQ(part.weights(k), whole.weights(k + 2));
+  }
+  for (std::size_t i = 0; i < bp.values.size(); ++i) {
+    EXPECT_EQ(bp.values[i], bw.values[offset + i]);
+    EXPECT_EQ(bp.weights[i], bw.weights[offset + i]);
+    EXPECT_EQ(dp[i], dw[offset + i]);
+  }
+  EXPECT_THROW(whole.views(3, 3), std::invalid_argument);
+  EXPECT_THROW(whole.views(-1, 2), std::invalid_argument);
+  EXPECT_THROW(whole.views(4, 6), std::invalid_argument);
+}
+
+// Measured a few views at a time, the blend's error is the whole estimate unless it provably
+// exceeds the bound: then the measurement stops with a lower bound between the bound and the whole
+// estimate.
+TEST(SampledBlendError, StopsOnlyWhenTheErrorProvablyExceedsTheBoundAndElseIsTheWholeEstimate) {
+  const EnvMap env = sky(Vec3(-0.3, 0.7, 0.4));
+  const auto brdf = parse_brdf("{type: ggx, roughness: 0.2, fresnel: {type: schlick, f0: [0.9, 0.8, 0.6]}}");
+  const auto fis = make_integrator("fis", env);
+  const auto reference = make_integrator("reference", env);
+  IntegratorOptions o;
+  o.samples = 16;
+  const ErrorSample sample(12, 40, 32, 9, squared_radiance_guide(*fis, *brdf, o, 16));
+  const std::vector<Vec3> truth = direct_values(*reference, *brdf, IntegratorOptions{}, sample);
+  const ViewSet views = ViewSet::named("icosa");
+  const SampledBlend b = sampled_blend(*fis, *brdf, o, views, 16, false, sample);
+  const ErrorEstimate whole = sample_error(sample, b.values, truth, &b.weights);
+  ASSERT_GT(whole.value, 0.01);
+  BlendErrorOptions never;
+  never.step = 5;  // 12 views in steps of 5, 5 and 2
+  const BlendErrorMeasure all = sampled_blend_error(*fis, *brdf, o, views, 16, false, sample, truth, never);
+  ASSERT_TRUE(all.error);
+  EXPECT_EQ(all.error->value, whole.value);
+  EXPECT_EQ(all.error->sigma, whole.sigma);
+  EXPECT_EQ(all.views, 12);
+  BlendErrorOptions above{whole.value * 1.001, 1};
+  const BlendErrorMeasure kept = sampled_blend_error(*fis, *brdf, o, views, 16, false, sample, truth, above);
+  ASSERT_TRUE(kept.error);
+  EXPECT_EQ(kept.error->value, whole.value);
+  BlendErrorOptions half{whole.value / 2, 1};
+  const BlendErrorMeasure stopped = sampled_blend_error(*fis, *brdf, o, views, 16, false, sample, truth, half);
+  ASSERT_FALSE(stopped.error);
+  EXPECT_LT(stopped.views, 12);
+  EXPECT_GT(stopped.at_least, whole.value / 2);
+  EXPECT_LE(stopped.at_least, whole.value);
+  BlendErrorOptions bad{1.0, 0};
+  EXPECT_THROW(sampled_blend_error(*fis, *brdf, o, views, 16, false, sample, truth, bad), std::invalid_argument);
+  const std::vector<Vec3> short_truth(truth.begin(), truth.end() - 1);
+  EXPECT_THROW(sampled_blend_error(*fis, *brdf, o, views, 16, false, sample, short_truth, never),
+               std::invalid_argument);
 }
 
 TEST(SampledBlend, ABlendAtItsOwnViewsIsTheDirectBake) {
