@@ -92,8 +92,9 @@ Runner add_plan(CLI::App& app) {
       "integrator's own error and time per texel at a few hundred random texels of random novel views, and the "
       "warp and blend's error for each view set and map size from blends of maps baked only where the blend reads "
       "them; the root sum of squares of the two screens the candidates in order of predicted time, and each one "
-      "it lets through is blended at 128 further novel views with its own integrator: the first whose measured "
-      "error plus half its standard error is within 90% of the budget is chosen. Candidates: " +
+      "it lets through is blended at 128 further novel views with its own integrator (left as soon as its error "
+      "provably exceeds 1.5 x 90% of the budget): the first whose measured error plus half its standard error is within "
+      "90% of the budget is chosen. Candidates: " +
       candidates_text() +
       ". --views, --res, --method, --samples and --reference-width fix a knob. rsibr bake --max-error plans, bakes "
       "and checks the result.\n"

@@ -116,13 +116,19 @@ struct Pilots {
       // The pilot's texels are a few per view, so their time is mostly each map's per-call
       // overhead and rows the threads cannot share (4x a bake's per-texel time for MIS 64 on 2
       // cores). A bake integrates whole maps: one whole map, the largest of timing_size, its half
-      // and its quarter whose predicted time is at most a quarter of a second, times that.
+      // and its quarter whose predicted time is at most a quarter of a second, times that (repeated
+      // to at least 50 ms: a shorter time is mostly the scheduler's, and the candidates' order by
+      // predicted time would follow it).
       int size = timing_size;
       while (size > 32 && p.seconds_per_texel * double(disc_texel_count(size)) > 0.25) size /= 2;
       if (p.seconds_per_texel * double(disc_texel_count(size)) <= 0.25) {
         const auto t = std::chrono::steady_clock::now();
-        chosen.radiance_map(brdf, sample.view(0), sample.frame(0), size, options_of(s, seed));
-        p.seconds_per_texel = seconds_since(t) / double(disc_texel_count(size));
+        long long texels = 0;
+        do {
+          chosen.radiance_map(brdf, sample.view(0), sample.frame(0), size, options_of(s, seed));
+          texels += disc_texel_count(size);
+        } while (seconds_since(t) < 0.05);
+        p.seconds_per_texel = seconds_since(t) / double(texels);
       }
       integrators.push_back(p);
     }
@@ -142,8 +148,8 @@ std::vector<IntegratorSetting> default_integrator_settings() {
   std::vector<IntegratorSetting> s;
   for (int w : {32, 64, 128, 256}) s.push_back({"reference", 0, w});
   s.push_back({"reference", 0, 0});
-  for (int n : {16, 64, 256, 1024}) s.push_back({"mis", n, 0});
-  for (int n : {8, 32, 128, 512}) s.push_back({"fis", n, 0});
+  for (int n : {16, 32, 64, 128, 256, 512, 1024}) s.push_back({"mis", n, 0});
+  for (int n : {8, 16, 32, 64, 128, 256, 512}) s.push_back({"fis", n, 0});
   s.push_back({"sh", 0, 0});
   return s;
 }
@@ -309,20 +315,46 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
         return true;
     return false;
   };
+  // The confirmations' work is bounded by max_confirmations candidates' worth of confirmation views
+  // (a confirmation stopped early counts the views it measured).
   int confirmations = 0;
-  // A candidate's measurement: its set's blend at the confirmation texels with its own integrator.
-  auto confirm = [&](Candidate& c) {
+  long long views_measured = 0;
+  const long long views_allowed =
+      (long long)options.max_confirmations * (options.confirm_views > 0 ? options.confirm_views : options.pilot_views);
+  // A candidate's measurement: its set's blend at the confirmation texels with its own integrator,
+  // an eighth of the views at a time, stopped (unless it may not stop) once the error provably
+  // exceeds kStopAbove times the planned budget: then it misses whatever its standard error, its
+  // lower bound is kept, and nullopt is returned. Not at the budget itself: a bound just above the
+  // budget would tell the screen's calibration nothing, and a near miss is most of a measurement's
+  // cost anyway.
+  constexpr double kStopAbove = 1.5;
+  auto confirm = [&](Candidate& c, bool may_stop) -> std::optional<ErrorEstimate> {
     PlannedSetting& s = c.planned;
     const auto [confirm_sample, confirm_values_truth] = confirmation();
-    const SampledBlend b =
-        sampled_blend(integrator_for(s.setting.integrator.method), brdf, options_of(s.setting.integrator, options.seed),
-                      view_sets[c.set], s.setting.res, options.normalise_albedo, confirm_sample);
-    const ErrorEstimate e = sample_error(confirm_sample, b.values, confirm_values_truth, &b.weights);
+    BlendErrorOptions stop;
+    if (may_stop && options.stop_early) {
+      stop.stop_above = kStopAbove * budget;
+      stop.step = std::max(1, confirm_sample.view_count() / 8);
+    } else {
+      stop.step = confirm_sample.view_count();
+    }
+    const BlendErrorMeasure m = sampled_blend_error(
+        integrator_for(s.setting.integrator.method), brdf, options_of(s.setting.integrator, options.seed),
+        view_sets[c.set], s.setting.res, options.normalise_albedo, confirm_sample, confirm_values_truth, stop);
+    plan.confirm_seconds += m.seconds;
+    views_measured += m.views;
+    if (!m.error) {
+      s.measured_at_least = m.at_least;
+      s.upper_error = m.at_least;
+      s.meets = false;
+      return std::nullopt;
+    }
+    const ErrorEstimate e = *m.error;
+    s.measured_at_least.reset();
     s.measured_error = e.value;
     s.measured_sigma = e.sigma;
     s.upper_error = e.upper(k);
     s.meets = s.upper_error <= budget;
-    plan.confirm_seconds += b.seconds;
     return e;
   };
   for (Candidate& c : candidates) {
@@ -345,16 +377,19 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
         s.interpolation_screen = interpolation_screen;
         s.mis_screen = mis_screen;
       }
-      if (!plan.chosen && screened <= budget && confirmations < options.max_confirmations) {
+      if (!plan.chosen && screened <= budget && views_measured < views_allowed) {
         ++confirmations;
-        const ErrorEstimate e = confirm(c);
+        // A confirmation stopped early calibrates with its lower bound: the factor it implies is a
+        // lower bound of the one its whole measurement would, and the screen stays optimistic.
+        const std::optional<ErrorEstimate> measured = confirm(c, true);
+        const double m = measured ? measured->value : *s.measured_at_least;
         const double ip = interpolation_screen * interp->value;
         if (ip >= ie && interp->value > 0) {
-          const double a = std::sqrt(std::max(0.0, e.value * e.value - ie * ie)) / interp->value;
+          const double a = std::sqrt(std::max(0.0, m * m - ie * ie)) / interp->value;
           interpolation_screen = calibrated ? std::min(interpolation_screen, a) : a;
           calibrated = true;
         } else if (s.setting.integrator.method == "mis" && s.integration_error > 0) {
-          const double b = std::sqrt(std::max(0.0, e.value * e.value - ip * ip)) / s.integration_error;
+          const double b = std::sqrt(std::max(0.0, m * m - ip * ip)) / s.integration_error;
           mis_screen = mis_calibrated ? std::min(mis_screen, b) : b;
           mis_calibrated = true;
         }
@@ -370,7 +405,7 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   // its measurement integrates the full quadrature at every texel the blend reads (minutes), for a
   // setting that would bake for days, and the most accurate sampled integrator on the same set
   // screens within a hair of it.
-  if (!plan.chosen && confirmations == 0 && options.max_confirmations > 0) {
+  if (!plan.chosen && confirmations == 0 && views_allowed > 0) {
     Candidate* least = nullptr;
     for (Candidate& c : candidates) {
       const PlannedSetting& s = c.planned;
@@ -382,9 +417,22 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
     }
     if (least) {
       ++confirmations;
-      confirm(*least);
+      confirm(*least, false);
       plan.settings[std::size_t(least - candidates.data())] = least->planned;  // settings follow candidates
       if (least->planned.meets) plan.chosen = least->planned;
+    }
+  }
+  // Without a choice, the plan names the closest setting with its error: when every confirmation
+  // stopped early, the one stopped at the least bound is measured at every view.
+  if (!plan.chosen && std::none_of(candidates.begin(), candidates.end(),
+                                   [](const Candidate& c) { return c.planned.measured_error.has_value(); })) {
+    Candidate* least = nullptr;
+    for (Candidate& c : candidates)
+      if (c.planned.measured_at_least && (!least || *c.planned.measured_at_least < *least->planned.measured_at_least))
+        least = &c;
+    if (least) {
+      confirm(*least, false);
+      plan.settings[std::size_t(least - candidates.data())] = least->planned;
     }
   }
   plan.pilot_seconds = seconds_since(t_start);
@@ -404,8 +452,9 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   } else {
     why << "no setting is predicted to meet " << percent(options.max_error) << " (planned to " << percent(budget)
         << "); the most accurate measured ones are listed in the table";
-    if (confirmations >= options.max_confirmations)
-      why << " (the plan stopped after measuring " << confirmations << " candidates that the model let through)";
+    if (views_measured >= views_allowed)
+      why << " (the plan stopped after measuring " << confirmations
+          << " candidates that the model let through, its allowance of confirmation views)";
     why << ".\n";
     if (plan.closest) {
       const PlannedSetting& c = *plan.closest;
@@ -422,6 +471,9 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
     if (s.measured_error)
       why << "measured " << percent(*s.measured_error) << " +- " << percent(*s.measured_sigma) << " (modelled "
           << percent(s.error) << ")";
+    else if (s.measured_at_least)
+      why << "measured over " << percent(*s.measured_at_least) << " (stopped early; modelled " << percent(s.error)
+          << ")";
     else if (s.interpolation_error)
       why << "modelled " << percent(s.error) << ", at most " << percent(s.upper_error) << " (interpolation "
           << percent(*s.interpolation_error) << ", integration " << percent(s.integration_error) << ")";
@@ -449,6 +501,7 @@ nlohmann::json BakePlan::to_json() const {
     j["upper_error"] = s.upper_error;
     j["measured_error"] = s.measured_error ? nlohmann::json(*s.measured_error) : nlohmann::json();
     j["measured_sigma"] = s.measured_sigma ? nlohmann::json(*s.measured_sigma) : nlohmann::json();
+    j["measured_at_least"] = s.measured_at_least ? nlohmann::json(*s.measured_at_least) : nlohmann::json();
     j["integration_error"] = s.integration_error;
     j["interpolation_error"] = s.interpolation_error ? nlohmann::json(*s.interpolation_error) : nlohmann::json();
     j["predicted_seconds"] = s.seconds;

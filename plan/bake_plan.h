@@ -29,9 +29,13 @@
 // the blend, while e_interp measured with FIS maps carries FIS's own error pattern and overstates
 // the blend's (up to 1.6x). So a candidate the model lets through (with mis errors counted at a
 // third and e_interp at half until measurements say by how much to count them: the least factors
-// the candidates measured so far imply) is measured: the set's blend at the confirmation texels (a sample
-// of its own, confirm_views novel views, 4x the pilot's by default), baking only the footprints with
-// its own integrator, against the truth there. It is taken when
+// the candidates measured so far imply) is measured: the set's blend at the confirmation texels (a
+// sample of its own, confirm_views novel views, 4x the pilot's by default), baking only the
+// footprints with its own integrator, against the truth there, an eighth of the views at a time,
+// left as soon as its error provably exceeds 1.5 x margin * budget (plan/error_sample.h,
+// sampled_blend_error: a wide miss costs a fraction of a measurement, and its lower bound
+// calibrates the screen as a measurement would, optimistically).
+// It is taken when
 //
 //   e_measured + k s_measured <= margin * budget        (k = options.sigmas)
 //
@@ -53,10 +57,11 @@
 //
 // The choice: the settings sorted by predicted time; the first that meets the budget. The pilot
 // measures e_interp lazily, only for the (N, r) pairs it reaches and that no measured pair with at
-// least as many views and texels already rules out, unless asked for every pair; it measures at
-// most max_confirmations candidates. When the screen lets none through, the candidate with the least
-// screened error is measured if that is within twice the planned budget, so that the plan can name
-// the closest setting.
+// least as many views and texels already rules out, unless asked for every pair; its confirmations
+// measure at most max_confirmations candidates' worth of views. When the screen lets none through,
+// the candidate with the least screened error is measured if that is within twice the planned
+// budget, and when every confirmation stopped early, the one stopped at the least bound is measured
+// in full, so that the plan can name the closest setting.
 #pragma once
 
 #include "bake/brdf.h"
@@ -82,8 +87,8 @@ struct IntegratorSetting {
   std::string label() const;
 };
 
-// The integrator settings a plan considers by default: reference widths 32-256 and full, mis 16-1024
-// samples, fis 8-512 samples, sh (Lambert only; left out for other BRDFs).
+// The integrator settings a plan considers by default: reference widths 32-256 and full (2x
+// apart), mis 16-1024 and fis 8-512 samples (2x apart), sh (Lambert only; left out for other BRDFs).
 std::vector<IntegratorSetting> default_integrator_settings();
 
 struct BakeSetting {
@@ -95,9 +100,12 @@ struct BakeSetting {
 
 struct BakePlanOptions {
   double max_error = 0.02;  // relative RMS of blends at novel views against direct bakes there
-  // Steps of about 2x in cost: view counts about 2x apart (the geodesic sets and Fibonacci sets
-  // between them), sizes sqrt 2 apart, so the margin below costs at most about one step.
-  std::vector<std::string> view_sets = {"icosa", "fib24", "42", "fib84", "162", "fib324", "642", "fib1284", "fib2562"};
+  // Steps of about sqrt 2 in cost: view counts about sqrt 2 apart (the geodesic sets and Fibonacci
+  // sets between them), sizes sqrt 2 apart (2x in texels: with the view steps, every sqrt 2 in
+  // cost), samples 2x apart; a choice one step past the cheapest that meets the budget costs about
+  // 1.4x it, where 2x steps cost 2x.
+  std::vector<std::string> view_sets = {"icosa",  "fib24",  "fib34",  "42",  "fib59",  "fib84",   "fib115",  "162",
+                                        "fib230", "fib324", "fib460", "642", "fib910", "fib1284", "fib1820", "fib2562"};
   std::vector<int> sizes = {32, 45, 64, 90, 128, 181, 256};
   std::vector<IntegratorSetting> integrators = default_integrator_settings();
   bool normalise_albedo = false;  // plan albedo-normalised maps (core/albedo_normalisation.h)
@@ -114,9 +122,12 @@ struct BakePlanOptions {
   // estimate that decides, at four times the cost of each confirmation.
   int confirm_views = 128;
   double sigmas = 0.5;         // k: jackknife standard errors added to the measured error
-  int max_confirmations = 32;  // candidates measured before the plan gives up
+  int max_confirmations = 32;  // the confirmations' views, in whole candidates, before the plan gives up
   double margin = 0.9;         // a setting is taken when its upper bound <= margin * max_error
   bool every_pair = false;     // measure e_interp for every (views, size) pair, not only those reached
+  // Leave a confirmation once its error provably exceeds the planned budget (plan/error_sample.h,
+  // sampled_blend_error); false: measure every confirmation at all its views (a fuller table).
+  bool stop_early = true;
 };
 
 struct IntegratorPilot {
@@ -146,6 +157,9 @@ struct PlannedSetting {
   double upper_error = 0;                     // measured + k sigma when measured, else from the model's parts
   std::optional<double> measured_error;       // the set's blend at the confirmation texels (screened in)
   std::optional<double> measured_sigma;       // its standard error
+  // A confirmation stopped once its error provably exceeded the planned budget: a lower bound of
+  // the error it would have measured (measured_error stays nullopt).
+  std::optional<double> measured_at_least;
   // The screen's optimistic error, hypot(a e_interp, e_int') with e_int' the integration error (b
   // e_int for mis), and the factors it used: a for interpolation (half) and b for mis (a third),
   // until measurements calibrate them to the least that they imply; nullopt: not screened.

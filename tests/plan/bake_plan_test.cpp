@@ -146,6 +146,11 @@ TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
       if (s.measured_error) {
         EXPECT_GT(*s.measured_error + o.sigmas * *s.measured_sigma, o.margin * o.max_error);
       }
+      // A confirmation stopped early proved the candidate over 1.5x the planned budget.
+      if (s.measured_at_least) {
+        EXPECT_FALSE(s.measured_error);
+        EXPECT_GT(*s.measured_at_least, 1.5 * o.margin * o.max_error);
+      }
       // The screen is optimistic (mis integration error at a third, interpolation at half until
       // measurements calibrate them: the least factors with measured^2 = (a e_interp)^2 + (b
       // e_int)^2 among the candidates measured before it, a from those whose screened interpolation
@@ -158,18 +163,20 @@ TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
       EXPECT_NEAR(s.mis_screen, mis_factor, 1e-12) << s.setting.views << " " << s.setting.res;
       EXPECT_NEAR(*s.screened_error, std::hypot(factor * *s.interpolation_error, ie), 1e-12);
       if (*s.screened_error <= o.margin * o.max_error) {
-        EXPECT_TRUE(s.measured_error) << s.setting.views << " " << s.setting.res << " " << s.setting.integrator.label();
+        EXPECT_TRUE(s.measured_error || s.measured_at_least)
+            << s.setting.views << " " << s.setting.res << " " << s.setting.integrator.label();
       } else {
-        EXPECT_FALSE(s.measured_error) << s.setting.views << " " << s.setting.res;
+        EXPECT_FALSE(s.measured_error || s.measured_at_least) << s.setting.views << " " << s.setting.res;
       }
+      // A stopped measurement calibrates with its lower bound.
       const double ip = factor * *s.interpolation_error;
-      if (s.measured_error && ip >= ie && *s.interpolation_error > 0) {
-        const double m = *s.measured_error;
+      const bool measured = s.measured_error || s.measured_at_least;
+      const double m = s.measured_error ? *s.measured_error : s.measured_at_least.value_or(0.0);
+      if (measured && ip >= ie && *s.interpolation_error > 0) {
         const double a = std::sqrt(std::max(0.0, m * m - ie * ie)) / *s.interpolation_error;
         factor = measured_any ? std::min(factor, a) : a;
         measured_any = true;
-      } else if (s.measured_error && mis && s.integration_error > 0) {
-        const double m = *s.measured_error;
+      } else if (measured && mis && s.integration_error > 0) {
         const double b = std::sqrt(std::max(0.0, m * m - ip * ip)) / s.integration_error;
         mis_factor = mis_measured ? std::min(mis_factor, b) : b;
         mis_measured = true;
@@ -198,6 +205,7 @@ TEST(BakePlan, TheMisScreenTakesTheFactorItsMeasurementsImply) {
   o.view_sets = {"162"};
   o.sizes = {16};
   o.integrators = {{"mis", 4, 0}, {"mis", 16, 0}, {"mis", 64, 0}, {"reference", 0, 0}};
+  o.stop_early = false;  // only whole measurements calibrate
   const BakePlan plan = plan_bake(env, *brdf, o);
   EXPECT_EQ(plan.interpolation_integrator.label(), "fis 64 samples");  // no FIS in the pilot: the default
   std::vector<const PlannedSetting*> mis;
