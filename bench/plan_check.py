@@ -15,9 +15,9 @@ Usage: bench/plan_check.py [--tool build/release/rsibr_plan_check] [--cache cach
 The sweep does not depend on the planner and is most of the time: --sweep-only DIR writes each case's
 sweep alone to DIR, and --sweeps DIR reuses them (the tool re-times only the sweep's best bake), so a
 planner change is checked in a fraction of the time. bench/plan_check_sweeps holds the sweeps of the
-default cases (copper and rubber with --max-sweep-seconds 2000, pearl with 600: a pearl candidate's
-measurement is the slowest; warehouse x pearl is not kept, its sweep finding nothing in the previous
-version): bench/plan_check.py --sweeps bench/plan_check_sweeps --keep DIR reruns the table's plans. A kept sweep is only reused for the same candidates' check (environment, BRDF,
+default cases (copper and rubber with --max-sweep-seconds 2000, pearl with 600, warehouse x pearl
+with 120: a pearl candidate's measurement is the slowest): bench/plan_check.py --sweeps
+bench/plan_check_sweeps --keep DIR reruns the table's plans. A kept sweep is only reused for the same candidates' check (environment, BRDF,
 budget, seeds, check size); a change of the candidate grid needs new sweeps.
 Build first: cmake --build build/release --target rsibr_plan_check. Standard library only.
 """
@@ -254,10 +254,10 @@ def main():
         "value at the confirmation's 128 views): the plan measured the sweep's cheapest (230 views 128^2, MIS "
         "128) at 2.10% ± 0.65%, measured 24 more candidates at 1.6-2.7% and took 1284 views 128^2, MIS 64 "
         "(1.52% ± 0.19%), 7.3x the sweep's cheapest, which checked at 2.02% ± 0.58%. "
-        "`warehouse` with pearl (a coat of roughness 0.05 under a small bright lamp) was not rerun "
-        "with this version (its sweep is the slowest); in the previous one the plan named 2562 views 181^2, "
-        "MIS 1024 (5.9% ± 1.1%) as the closest setting and said that no candidate meets 2%, and the sweep "
-        "found none up to 120 s. "
+        "Under `warehouse` with pearl (a coat of roughness 0.05 under a small bright lamp) the plan's screen lets "
+        "nothing through; it measures the candidate it screens lowest (2562 views 181^2, MIS 1024: 5.9% ± 1.1%), "
+        "names it as the closest and says that no candidate meets 2%, and the sweep (to 120 s: its 637 "
+        "candidates all missed by a wide margin) finds none. "
         "The previous version of this table (candidates 2x apart in cost, 4x in samples, a check of 16 views and "
         "a sweep up to 120 s) chose in 8 of 9 cases, 7 of 9 met the budget when checked and 3 of 9 both "
         "targets. Its sweep's cheapest was the first of many noisy 16-view estimates to fall under the budget, "
