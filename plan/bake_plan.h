@@ -125,7 +125,7 @@ struct BakePlanOptions {
   int max_confirmations = 32;  // the confirmations' views, in whole candidates, before the plan gives up
   double margin = 0.9;         // a setting is taken when its upper bound <= margin * max_error
   bool every_pair = false;     // measure e_interp for every (views, size) pair, not only those reached
-  // Leave a confirmation once its error provably exceeds the planned budget (plan/error_sample.h,
+  // Leave a confirmation once its error provably exceeds 1.5x the planned budget (plan/error_sample.h,
   // sampled_blend_error); false: measure every confirmation at all its views (a fuller table).
   bool stop_early = true;
 };
@@ -157,8 +157,8 @@ struct PlannedSetting {
   double upper_error = 0;                     // measured + k sigma when measured, else from the model's parts
   std::optional<double> measured_error;       // the set's blend at the confirmation texels (screened in)
   std::optional<double> measured_sigma;       // its standard error
-  // A confirmation stopped once its error provably exceeded the planned budget: a lower bound of
-  // the error it would have measured (measured_error stays nullopt).
+  // A confirmation stopped once its error provably exceeded 1.5x the planned budget: a lower bound
+  // of the error it would have measured (measured_error stays nullopt).
   std::optional<double> measured_at_least;
   // The screen's optimistic error, hypot(a e_interp, e_int') with e_int' the integration error (b
   // e_int for mis), and the factors it used: a for interpolation (half) and b for mis (a third),
