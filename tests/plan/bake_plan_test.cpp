@@ -205,7 +205,7 @@ TEST(BakePlan, TheMisScreenTakesTheFactorItsMeasurementsImply) {
   o.view_sets = {"162"};
   o.sizes = {16};
   o.integrators = {{"mis", 4, 0}, {"mis", 16, 0}, {"mis", 64, 0}, {"reference", 0, 0}};
-  o.stop_early = false;  // only whole measurements calibrate
+  o.stop_early = false;  // whole measurements: the factor is what a measured error implies
   const BakePlan plan = plan_bake(env, *brdf, o);
   EXPECT_EQ(plan.interpolation_integrator.label(), "fis 64 samples");  // no FIS in the pilot: the default
   std::vector<const PlannedSetting*> mis;
