@@ -15,6 +15,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <stdexcept>
 
 namespace rsibr {
@@ -271,7 +272,8 @@ SampledBlend sampled_blend(const Integrator& integrator, const Brdf& brdf, const
 
 BlendErrorMeasure sampled_blend_error(const Integrator& integrator, const Brdf& brdf, const IntegratorOptions& options,
                                       const ViewSet& views, int res, bool normalise_albedo, const ErrorSample& sample,
-                                      const std::vector<Vec3>& truth, const BlendErrorOptions& stop) {
+                                      const std::vector<Vec3>& truth, const BlendErrorOptions& stop,
+                                      const ErrorSums& prior) {
   if (stop.step < 1) throw std::invalid_argument("sampled blend error: the step must be at least one view");
   if (truth.size() != std::size_t(sample.count()))
     throw std::invalid_argument("sampled blend error: the truth differs in size from the sample");
@@ -280,10 +282,10 @@ BlendErrorMeasure sampled_blend_error(const Integrator& integrator, const Brdf& 
   std::size_t i = 0;
   for (int v = 0; v < K; ++v)
     for (double w : sample.weights(v)) truth_norm2 += w * truth[i++].squaredNorm();
-  const double bound = stop.stop_above * stop.stop_above * truth_norm2;
+  const double bound = stop.stop_above * stop.stop_above * (prior.denominator() + truth_norm2);
   BlendErrorMeasure out;
   SampledBlend all;
-  double partial = 0;
+  double partial = prior.numerator();
   i = 0;
   while (out.views < K) {
     const int first = out.views, last = std::min(K, first + stop.step);
@@ -303,11 +305,13 @@ BlendErrorMeasure sampled_blend_error(const Integrator& integrator, const Brdf& 
     all.weights.insert(all.weights.end(), b.weights.begin(), b.weights.end());
     out.views = last;
     if (out.views < K && partial > bound) {
-      out.at_least = std::sqrt(partial / truth_norm2);
+      out.at_least = std::sqrt(partial / (prior.denominator() + truth_norm2));
       return out;
     }
   }
-  out.error = sample_error(sample, all.values, truth, &all.weights);
+  out.sums = prior;
+  out.sums.add(sample, all.values, truth, &all.weights);
+  out.error = out.sums.estimate();
   return out;
 }
 
@@ -330,28 +334,36 @@ double relative_rms(const std::vector<Vec3>& values, const std::vector<Vec3>& tr
   return num > 0 ? std::numeric_limits<double>::infinity() : 0.0;
 }
 
-ErrorEstimate sample_error(const ErrorSample& sample, const std::vector<Vec3>& values, const std::vector<Vec3>& truth,
-                           const std::vector<double>* blend_weights) {
+void ErrorSums::add(const ErrorSample& sample, const std::vector<Vec3>& values, const std::vector<Vec3>& truth,
+                    const std::vector<double>* blend_weights) {
   const std::size_t n = std::size_t(sample.count());
   if (values.size() != n || truth.size() != n || (blend_weights && blend_weights->size() != n))
     throw std::invalid_argument("sample_error: the vectors differ in size from the sample");
-  const int K = sample.view_count();
-  std::vector<double> num(std::size_t(K), 0.0), den(std::size_t(K), 0.0);
   std::size_t i = 0;
-  for (int k = 0; k < K; ++k)
+  for (int k = 0; k < sample.view_count(); ++k) {
+    double num = 0, den = 0;
     for (double w : sample.weights(k)) {
       if (!blend_weights || (*blend_weights)[i] > 0) {
-        num[std::size_t(k)] += w * (values[i] - truth[i]).squaredNorm();
-        den[std::size_t(k)] += w * truth[i].squaredNorm();
+        num += w * (values[i] - truth[i]).squaredNorm();
+        den += w * truth[i].squaredNorm();
       }
       ++i;
     }
+    num_.push_back(num);
+    den_.push_back(den);
+  }
+}
+
+double ErrorSums::numerator() const { return std::accumulate(num_.begin(), num_.end(), 0.0); }
+double ErrorSums::denominator() const { return std::accumulate(den_.begin(), den_.end(), 0.0); }
+
+ErrorEstimate ErrorSums::estimate() const {
   auto ratio = [](double a, double b) {
     if (b > 0) return std::sqrt(a / b);
     return a > 0 ? std::numeric_limits<double>::infinity() : 0.0;
   };
-  double N = 0, D = 0;
-  for (int k = 0; k < K; ++k) N += num[std::size_t(k)], D += den[std::size_t(k)];
+  const int K = views();
+  const double N = numerator(), D = denominator();
   ErrorEstimate e;
   e.value = ratio(N, D);
   if (K < 2 || !std::isfinite(e.value)) return e;
@@ -359,7 +371,7 @@ ErrorEstimate sample_error(const ErrorSample& sample, const std::vector<Vec3>& v
   std::vector<double> loo(static_cast<std::size_t>(K));
   double mean = 0;
   for (int k = 0; k < K; ++k) {
-    loo[std::size_t(k)] = ratio(N - num[std::size_t(k)], D - den[std::size_t(k)]);
+    loo[std::size_t(k)] = ratio(N - num_[std::size_t(k)], D - den_[std::size_t(k)]);
     if (!std::isfinite(loo[std::size_t(k)])) {
       e.sigma = std::numeric_limits<double>::infinity();
       return e;
@@ -370,6 +382,13 @@ ErrorEstimate sample_error(const ErrorSample& sample, const std::vector<Vec3>& v
   for (double r : loo) ss += (r - mean) * (r - mean);
   e.sigma = std::sqrt(double(K - 1) / K * ss);
   return e;
+}
+
+ErrorEstimate sample_error(const ErrorSample& sample, const std::vector<Vec3>& values, const std::vector<Vec3>& truth,
+                           const std::vector<double>* blend_weights) {
+  ErrorSums sums;
+  sums.add(sample, values, truth, blend_weights);
+  return sums.estimate();
 }
 
 TexelGuide squared_radiance_guide(const Integrator& integrator, const Brdf& brdf, const IntegratorOptions& options,

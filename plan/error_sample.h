@@ -114,6 +114,25 @@ struct ErrorEstimate {
   double upper(double k = 1.0) const { return value + k * sigma; }
 };
 
+// The ratio estimator's sums, kept per view so that samples of different views pool into one
+// estimate (the views of every sample added, jackknifed together): N_k = sum_p w |B - D|^2 and
+// D_k = sum_p w |D|^2 over view k's texels where the blend has weight.
+class ErrorSums {
+ public:
+  // Appends the sample's views (values, truth and blend_weights as sample_error takes them).
+  // Throws std::invalid_argument when a size differs from the sample's.
+  void add(const ErrorSample& sample, const std::vector<Vec3>& values, const std::vector<Vec3>& truth,
+           const std::vector<double>* blend_weights = nullptr);
+  int views() const { return int(num_.size()); }
+  double numerator() const;
+  double denominator() const;
+  // sqrt(N / D) over every view added, with the jackknife over them (sample_error's conventions).
+  ErrorEstimate estimate() const;
+
+ private:
+  std::vector<double> num_, den_;
+};
+
 // The sample's estimate of the relative RMS of `values` against `truth` (both view-major over the
 // sample, as direct_values and sampled_blend give them), over the texels whose blend weight is > 0
 // (all when blend_weights is null), each weighted by the sample's weight. Same conventions as
@@ -148,21 +167,24 @@ SampledBlend sampled_blend(const Integrator& integrator, const Brdf& brdf, const
 // The error (sample_error) of the blend that sampled_blend gives, measured `step` views at a time
 // and stopped as soon as it provably exceeds stop_above: the estimate is sqrt(N / D), N and D sums
 // over the texels where the blend has weight, so N over the views so far above stop_above^2 times
-// D over every texel of the sample bounds it from below. Throws what sampled_blend throws and
-// std::invalid_argument for step < 1 or a truth that is not the sample's size.
+// D over every texel of the sample bounds it from below. With `prior` (the same blend's sums at
+// other views), the estimate and the bound are those of the pooled views. Throws what sampled_blend
+// throws and std::invalid_argument for step < 1 or a truth that is not the sample's size.
 struct BlendErrorOptions {
   double stop_above = std::numeric_limits<double>::infinity();
   int step = 1;  // views per step
 };
 struct BlendErrorMeasure {
-  std::optional<ErrorEstimate> error;  // measured at every view; nullopt: stopped
+  std::optional<ErrorEstimate> error;  // measured at every view (pooled with the prior); nullopt: stopped
+  ErrorSums sums;                      // when measured at every view: the prior's and the sample's
   double at_least = 0;                 // when stopped: the lower bound, > stop_above
-  int views = 0;                       // views measured
+  int views = 0;                       // views of the sample measured
   double seconds = 0;                  // wall time of the integration
 };
 BlendErrorMeasure sampled_blend_error(const Integrator& integrator, const Brdf& brdf, const IntegratorOptions& options,
                                       const ViewSet& views, int res, bool normalise_albedo, const ErrorSample& sample,
-                                      const std::vector<Vec3>& truth, const BlendErrorOptions& stop);
+                                      const std::vector<Vec3>& truth, const BlendErrorOptions& stop,
+                                      const ErrorSums& prior = {});
 
 // The blend of an existing set at every sampled texel (view_set: the set's views).
 SampledBlend sampled_blend(const MapSet& set, const ViewSet& view_set, const ErrorSample& sample,

@@ -140,9 +140,9 @@ TEST(ErrorSample, APartOfTheViewsGivesTheWholesValuesForThoseViews) {
   EXPECT_THROW(whole.views(4, 6), std::invalid_argument);
 }
 
-// Measured a few views at a time, the blend's error is the whole estimate unless it provably
-// exceeds the bound: then the measurement stops with a lower bound between the bound and the whole
-// estimate.
+// Measured a few views at a time (and pooled with a prior of other views), the blend's error is the
+// whole estimate unless it provably exceeds the bound: then the measurement stops with a lower bound
+// between the bound and the whole estimate.
 TEST(SampledBlendError, StopsOnlyWhenTheErrorProvablyExceedsTheBoundAndElseIsTheWholeEstimate) {
   const EnvMap env = sky(Vec3(-0.3, 0.7, 0.4));
   const auto brdf = parse_brdf("{type: ggx, roughness: 0.2, fresnel: {type: schlick, f0: [0.9, 0.8, 0.6]}}");
@@ -173,6 +173,27 @@ TEST(SampledBlendError, StopsOnlyWhenTheErrorProvablyExceedsTheBoundAndElseIsThe
   EXPECT_LT(stopped.views, 12);
   EXPECT_GT(stopped.at_least, whole.value / 2);
   EXPECT_LE(stopped.at_least, whole.value);
+  // Pooled: the first 7 views' sums as the prior of the last 5 give the whole estimate, and a stop
+  // there bounds the pooled estimate.
+  const ErrorSample head = sample.views(0, 7), tail = sample.views(7, 12);
+  const std::vector<Vec3> head_truth(truth.begin(), truth.begin() + head.count());
+  const std::vector<Vec3> tail_truth(truth.begin() + head.count(), truth.end());
+  const BlendErrorMeasure first = sampled_blend_error(*fis, *brdf, o, views, 16, false, head, head_truth, never);
+  ASSERT_TRUE(first.error);
+  EXPECT_EQ(first.sums.views(), 7);
+  const BlendErrorMeasure pooled =
+      sampled_blend_error(*fis, *brdf, o, views, 16, false, tail, tail_truth, never, first.sums);
+  ASSERT_TRUE(pooled.error);
+  EXPECT_EQ(pooled.views, 5);
+  EXPECT_EQ(pooled.sums.views(), 12);
+  EXPECT_DOUBLE_EQ(pooled.error->value, whole.value);
+  EXPECT_DOUBLE_EQ(pooled.error->sigma, whole.sigma);
+  const BlendErrorMeasure pooled_stop =
+      sampled_blend_error(*fis, *brdf, o, views, 16, false, tail, tail_truth, half, first.sums);
+  ASSERT_FALSE(pooled_stop.error);
+  EXPECT_EQ(pooled_stop.views, 1);  // the prior's numerator counts from the first step
+  EXPECT_GT(pooled_stop.at_least, whole.value / 2);
+  EXPECT_LE(pooled_stop.at_least, whole.value);
   BlendErrorOptions bad{1.0, 0};
   EXPECT_THROW(sampled_blend_error(*fis, *brdf, o, views, 16, false, sample, truth, bad), std::invalid_argument);
   const std::vector<Vec3> short_truth(truth.begin(), truth.end() - 1);
