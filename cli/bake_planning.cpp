@@ -92,7 +92,8 @@ void print_plan(std::ostream& out, const BakePlan& plan) {
       << "), truth: the full reference quadrature, " << std::setprecision(1) << plan.pilot_seconds << " s\n";
   if (o.confirm_views > 0)
     out << "confirmations: " << o.confirm_views << " further novel views x " << o.pilot_texels
-        << " texels, drawn the same way\n";
+        << " texels, drawn the same way; near the budget, fresh views up to "
+        << std::max(o.confirm_views, o.confirm_max_views) << "\n";
   out << "integration error at the pilot texels (+- one standard error), and time per texel:\n";
   for (const IntegratorPilot& p : plan.integrators)
     out << "  " << std::left << std::setw(22) << p.setting.label() << std::right << std::setw(9) << pct(p.error)

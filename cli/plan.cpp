@@ -21,6 +21,7 @@ struct PlanArgs {
   std::string env, brdf, layout, json, max_error, views, method, lobe = "all", normalise = "none";
   int res = 0, samples = 0, reference_width = -1;
   int confirm_views = BakePlanOptions{}.confirm_views;
+  int confirm_max_views = BakePlanOptions{}.confirm_max_views;
   std::uint64_t seed = 0;  // rsibr bake's default: a plan holds for the seed it was made with
   bool sanitize = false, every_pair = false;
 };
@@ -51,6 +52,7 @@ int run_plan(const PlanArgs& a) {
   BakePlanOptions options = bake_plan_options(parse_error_budget(a.max_error), knobs, a.seed);
   options.every_pair = a.every_pair;
   options.confirm_views = a.confirm_views;
+  options.confirm_max_views = a.confirm_max_views;
   if (knobs.views) ViewSet::named(*knobs.views);  // a bad --views is refused before the pilot
   const EnvMap env = read_environment_input(a.env, a.layout, a.sanitize);
   std::shared_ptr<const Brdf> brdf = load_brdf(a.brdf);
@@ -127,6 +129,12 @@ Runner add_plan(CLI::App& app) {
                 "Novel views of the sample the candidates are confirmed at (0: the pilot's own 32); more views "
                 "halve the decision's scatter per 4x, at that much more time per confirmation")
       ->check(CLI::Range(0, 4096))
+      ->capture_default_str();
+  c->add_option("--confirm-max-views", a->confirm_max_views,
+                "Views a confirmation may pool: a candidate within a standard error of the budget, or one that "
+                "passes at its first views, is measured again at fresh views, doubling them up to this many "
+                "(at most --confirm-views: one round)")
+      ->check(CLI::Range(0, 1 << 16))
       ->capture_default_str();
   c->add_option("--layout", a->layout, "Layout of the environment when its header and shape do not tell");
   c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and negative environment values instead of failing");

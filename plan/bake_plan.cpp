@@ -178,6 +178,7 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   if (!(options.sigmas >= 0)) throw std::invalid_argument("plan: the number of standard errors must be >= 0");
   if (options.confirm_views < 0)
     throw std::invalid_argument("plan: the confirmation's views must be >= 0 (0: the pilot's own)");
+  if (options.confirm_max_views < 0) throw std::invalid_argument("plan: the confirmation's most views must be >= 0");
   if (options.guide_size != 0 && options.guide_size < 2)
     throw std::invalid_argument("plan: the guide's size must be 0 (no guide) or at least 2");
   const auto t_start = std::chrono::steady_clock::now();
@@ -201,30 +202,47 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   auto integrator_for = [&](const std::string& method) -> const Integrator& { return pilots.integrator(method); };
   if (plan.integrators.empty()) throw std::invalid_argument("plan: no integrator setting can bake this BRDF");
 
-  // The confirmations' texels: a larger sample of their own (another seed, drawn the same way), with
-  // the truth there; the pilot's own when confirm_views is 0. Made at the first confirmation: a plan
-  // that measures no candidate does not pay for its truth.
-  std::optional<ErrorSample> confirm_own;
-  std::vector<Vec3> confirm_truth;
-  bool confirm_made = false;
-  auto confirmation = [&]() -> std::pair<const ErrorSample&, const std::vector<Vec3>&> {
-    if (!confirm_made && options.confirm_views > 0) {
-      const std::uint64_t confirm_seed = options.seed ^ 0x9e3779b97f4a7c15ull;
-      confirm_own.emplace(
-          options.guide_size > 0
-              ? ErrorSample(
-                    options.confirm_views, options.pilot_texels, options.pilot_size, confirm_seed,
-                    squared_radiance_guide(pilots.integrator(kInterpolationIntegrator.method), brdf,
-                                           options_of(kInterpolationIntegrator, options.seed), options.guide_size))
-              : ErrorSample(options.confirm_views, options.pilot_texels, options.pilot_size, confirm_seed));
-      confirm_truth = direct_values(pilots.integrator("reference"), brdf, options_of({"reference", 0, 0}, options.seed),
-                                    *confirm_own);
-      plan.truth_texels += confirm_own->count();
+  // The confirmations' texels, in rounds: round 0 is a sample of its own (confirm_views novel views,
+  // another seed, drawn the same way), the pilot's own when confirm_views is 0; round j >= 1 adds
+  // confirm_views 2^(j-1) fresh views, so that rounds 0..j pool confirm_views 2^j. Each is made, with
+  // the truth there, when first needed: a plan that measures no candidate does not pay for its truth.
+  struct ConfirmRound {
+    std::optional<ErrorSample> own;
+    std::vector<Vec3> truth;
+  };
+  std::vector<ConfirmRound> rounds;
+  auto confirmation = [&](std::size_t j) -> std::pair<const ErrorSample&, const std::vector<Vec3>&> {
+    while (rounds.size() <= j) {
+      ConfirmRound r;
+      if (options.confirm_views > 0) {
+        const std::size_t n = rounds.size();
+        const int views = n == 0 ? options.confirm_views : options.confirm_views << (n - 1);
+        const std::uint64_t confirm_seed = (options.seed ^ 0x9e3779b97f4a7c15ull) + n;
+        r.own.emplace(options.guide_size > 0
+                          ? ErrorSample(views, options.pilot_texels, options.pilot_size, confirm_seed,
+                                        squared_radiance_guide(pilots.integrator(kInterpolationIntegrator.method), brdf,
+                                                               options_of(kInterpolationIntegrator, options.seed),
+                                                               options.guide_size))
+                          : ErrorSample(views, options.pilot_texels, options.pilot_size, confirm_seed));
+        r.truth =
+            direct_values(pilots.integrator("reference"), brdf, options_of({"reference", 0, 0}, options.seed), *r.own);
+        plan.truth_texels += r.own->count();
+      }
+      rounds.push_back(std::move(r));
     }
-    confirm_made = true;
-    plan.confirm_texels = confirm_own ? confirm_own->count() : sample.count();
-    if (confirm_own) return {*confirm_own, confirm_truth};
+    if (j == 0) plan.confirm_texels = rounds[0].own ? rounds[0].own->count() : sample.count();
+    if (rounds[j].own) return {*rounds[j].own, rounds[j].truth};
     return {sample, pilots.truth};
+  };
+  // Rounds beyond the first: only with a sample of the confirmations' own, up to confirm_max_views.
+  const int first_round_views = options.confirm_views > 0 ? options.confirm_views : options.pilot_views;
+  auto may_extend = [&](int pooled) { return options.confirm_views > 0 && 2 * pooled <= options.confirm_max_views; };
+  // The planned budget at n pooled views: the reserve (1 - margin) of the budget is for the
+  // confirmation's scatter between samples, which falls as 1 / sqrt(n); it is the whole reserve at
+  // the first round's views.
+  auto planned_budget = [&](int pooled) {
+    const double reserve = options.max_error - budget;
+    return options.max_error - reserve * std::sqrt(double(first_round_views) / std::max(pooled, first_round_views));
   };
 
   // e_interp(N, r) with its standard error, measured when first needed: the FIS maps' blend against
@@ -315,47 +333,70 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
         return true;
     return false;
   };
-  // The confirmations' work is bounded by max_confirmations candidates' worth of confirmation views
-  // (a confirmation stopped early counts the views it measured).
+  // The confirmations' work is bounded by max_confirmations candidates' worth of first-round views
+  // (a confirmation stopped early counts the views it measured; its later rounds are not counted, so
+  // that a decision started is finished).
   int confirmations = 0;
   long long views_measured = 0;
   const long long views_allowed =
       (long long)options.max_confirmations * (options.confirm_views > 0 ? options.confirm_views : options.pilot_views);
   // A candidate's measurement: its set's blend at the confirmation texels with its own integrator,
-  // an eighth of the views at a time, stopped (unless it may not stop) once the error provably
-  // exceeds kStopAbove times the planned budget: then it misses whatever its standard error, its
-  // lower bound is kept, and nullopt is returned. Not at the budget itself: a bound just above the
-  // budget would tell the screen's calibration nothing, and a near miss is most of a measurement's
-  // cost anyway.
+  // round by round (below), each round an eighth of its views at a time, stopped (unless it may not
+  // stop) once the pooled error provably exceeds kStopAbove times the planned budget: then it misses
+  // whatever its standard error, its lower bound is kept, and nullopt is returned. Not at the budget
+  // itself: a bound just above the budget would tell the screen's calibration nothing, and a near
+  // miss is most of a measurement's cost anyway.
   constexpr double kStopAbove = 1.5;
+  // The rounds, a sequential test on the pooled estimate e +- s over n views:
+  //   e + k s <= planned_budget(n): taken, once at least two rounds agree (the first round's views are
+  //     the ones every candidate was screened and selected at: the cheapest candidate they pass is
+  //     the one they favour most, and fresh views take that selection's luck out);
+  //   e - s > planned_budget(n): a miss (one standard error over);
+  //   else undecided: a further round doubles n, up to confirm_max_views; undecided there is a miss.
+  // A near miss on a flat error curve is decided by more views, not by a step up the grid, and a
+  // low draw of a heavy-tailed estimate meets fresh views before it is taken.
   auto confirm = [&](Candidate& c, bool may_stop) -> std::optional<ErrorEstimate> {
     PlannedSetting& s = c.planned;
-    const auto [confirm_sample, confirm_values_truth] = confirmation();
-    BlendErrorOptions stop;
-    if (may_stop && options.stop_early) {
-      stop.stop_above = kStopAbove * budget;
-      stop.step = std::max(1, confirm_sample.view_count() / 8);
-    } else {
-      stop.step = confirm_sample.view_count();
+    ErrorSums pooled;
+    for (std::size_t j = 0;; ++j) {
+      const auto [confirm_sample, confirm_values_truth] = confirmation(j);
+      BlendErrorOptions stop;
+      if (may_stop && options.stop_early) {
+        stop.stop_above = kStopAbove * budget;
+        stop.step = std::max(1, std::min(confirm_sample.view_count(), first_round_views) / 8);
+      } else {
+        stop.step = confirm_sample.view_count();
+      }
+      const BlendErrorMeasure m =
+          sampled_blend_error(integrator_for(s.setting.integrator.method), brdf,
+                              options_of(s.setting.integrator, options.seed), view_sets[c.set], s.setting.res,
+                              options.normalise_albedo, confirm_sample, confirm_values_truth, stop, pooled);
+      plan.confirm_seconds += m.seconds;
+      if (j == 0) views_measured += m.views;  // a decision started is finished
+      s.measured_views = pooled.views() + m.views;
+      if (!m.error) {
+        s.measured_error.reset();
+        s.measured_sigma.reset();
+        s.measured_at_least = m.at_least;
+        s.upper_error = m.at_least;
+        s.meets = false;
+        return std::nullopt;
+      }
+      pooled = m.sums;
+      const ErrorEstimate e = *m.error;
+      s.measured_at_least.reset();
+      s.measured_error = e.value;
+      s.measured_sigma = e.sigma;
+      s.upper_error = e.upper(k);
+      const double planned = planned_budget(pooled.views());
+      s.meets = s.upper_error <= planned;
+      const bool extend = may_extend(pooled.views());
+      if (s.meets && (j > 0 || !extend)) return e;
+      if (e.value - e.sigma > planned || !extend) {
+        s.meets = false;
+        return e;
+      }
     }
-    const BlendErrorMeasure m = sampled_blend_error(
-        integrator_for(s.setting.integrator.method), brdf, options_of(s.setting.integrator, options.seed),
-        view_sets[c.set], s.setting.res, options.normalise_albedo, confirm_sample, confirm_values_truth, stop);
-    plan.confirm_seconds += m.seconds;
-    views_measured += m.views;
-    if (!m.error) {
-      s.measured_at_least = m.at_least;
-      s.upper_error = m.at_least;
-      s.meets = false;
-      return std::nullopt;
-    }
-    const ErrorEstimate e = *m.error;
-    s.measured_at_least.reset();
-    s.measured_error = e.value;
-    s.measured_sigma = e.sigma;
-    s.upper_error = e.upper(k);
-    s.meets = s.upper_error <= budget;
-    return e;
   };
   for (Candidate& c : candidates) {
     PlannedSetting& s = c.planned;
@@ -445,10 +486,11 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
   if (plan.chosen) {
     const PlannedSetting& c = *plan.chosen;
     why << "chosen: " << setting_text(c.setting) << ": measured " << percent(*c.measured_error) << " +- "
-        << percent(*c.measured_sigma) << " at the confirmation texels (at most " << percent(c.upper_error) << " with "
-        << k << " standard errors; modelled " << percent(c.error) << ": interpolation "
-        << percent(*c.interpolation_error) << ", integration " << percent(c.integration_error) << "), " << c.seconds
-        << " s; the budget is " << percent(options.max_error) << ", planned to " << percent(budget) << ".\n";
+        << percent(*c.measured_sigma) << " at " << c.measured_views << " confirmation views (at most "
+        << percent(c.upper_error) << " with " << k << " standard errors; modelled " << percent(c.error)
+        << ": interpolation " << percent(*c.interpolation_error) << ", integration " << percent(c.integration_error)
+        << "), " << c.seconds << " s; the budget is " << percent(options.max_error) << ", planned to "
+        << percent(budget) << ".\n";
   } else {
     why << "no setting is predicted to meet " << percent(options.max_error) << " (planned to " << percent(budget)
         << "); the most accurate measured ones are listed in the table";
@@ -459,8 +501,9 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
     if (plan.closest) {
       const PlannedSetting& c = *plan.closest;
       why << "closest: " << setting_text(c.setting) << ": measured " << percent(*c.measured_error) << " +- "
-          << percent(*c.measured_sigma) << " (at most " << percent(c.upper_error) << "), " << c.seconds
-          << " s; it is planned to meet a budget of " << percent(c.upper_error / options.margin) << ".\n";
+          << percent(*c.measured_sigma) << " at " << c.measured_views << " views (at most " << percent(c.upper_error)
+          << "), " << c.seconds << " s; it is planned to meet a budget of " << percent(c.upper_error / options.margin)
+          << ".\n";
     }
   }
   int shown = 0;
@@ -469,8 +512,8 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
     if (shown++ == 3) break;
     why << "cheaper, misses: " << setting_text(s.setting) << ": ";
     if (s.measured_error)
-      why << "measured " << percent(*s.measured_error) << " +- " << percent(*s.measured_sigma) << " (modelled "
-          << percent(s.error) << ")";
+      why << "measured " << percent(*s.measured_error) << " +- " << percent(*s.measured_sigma) << " at "
+          << s.measured_views << " views (modelled " << percent(s.error) << ")";
     else if (s.measured_at_least)
       why << "measured over " << percent(*s.measured_at_least) << " (stopped early; modelled " << percent(s.error)
           << ")";
@@ -502,6 +545,7 @@ nlohmann::json BakePlan::to_json() const {
     j["measured_error"] = s.measured_error ? nlohmann::json(*s.measured_error) : nlohmann::json();
     j["measured_sigma"] = s.measured_sigma ? nlohmann::json(*s.measured_sigma) : nlohmann::json();
     j["measured_at_least"] = s.measured_at_least ? nlohmann::json(*s.measured_at_least) : nlohmann::json();
+    j["measured_views"] = s.measured_views;
     j["integration_error"] = s.integration_error;
     j["interpolation_error"] = s.interpolation_error ? nlohmann::json(*s.interpolation_error) : nlohmann::json();
     j["predicted_seconds"] = s.seconds;
@@ -524,6 +568,7 @@ nlohmann::json BakePlan::to_json() const {
                 {"confirm_seconds", confirm_seconds},
                 {"truth_texels", truth_texels},
                 {"confirm_views", options.confirm_views},
+                {"confirm_max_views", options.confirm_max_views},
                 {"confirm_texels", confirm_texels}};
   j["integrators"] = nlohmann::json::array();
   for (const IntegratorPilot& p : integrators)

@@ -39,15 +39,22 @@
 //
 //   e_measured + k s_measured <= margin * budget        (k = options.sigmas)
 //
-// with s the jackknife standard error over the confirmation's views. The jackknife takes the views
+// with s the jackknife standard error over the confirmation's views, once two rounds of views agree:
+// the confirmation is a sequential test in rounds of fresh views pooled into one estimate (a miss
+// when e - s > margin * budget; undecided in between, when a further round doubles the pooled views,
+// up to confirm_max_views; a pass at the first round is measured once more at fresh views, since
+// those first views selected it among every candidate before it). The reserve, (1 - margin) *
+// budget at the first round's views, shrinks as 1 / sqrt of the views pooled (below: it is for the
+// scatter between samples). The jackknife takes the views
 // as independent draws, but they are an evenly spread lattice, so it overstates the estimate's
 // scatter (1.9x on a synthetic glint, tests/plan/error_sample_test.cpp; about 1.6x between pilot and
 // check on the development environments): k = 0.5 adds about one true standard error. That is not
 // enough on its own: where a low sun's glint reaches the grazing band of a few views, the estimate
 // is heavy-tailed, a sample that misses the tail is low in both its value and its standard error,
 // and the plan takes the first candidate that passes, so a low draw is what it selects. The margin
-// (0.9 by default) plans to 90% of the budget, a reserve about as wide as the confirmation's scatter
-// between seeds (docs/tradeoffs.md, "Planning for an error budget").
+// (0.9 by default) plans to 90% of the budget at the first round's 128 views, a reserve about as
+// wide as the confirmation's scatter between seeds there (docs/tradeoffs.md, "Planning for an error
+// budget"); at 512 pooled views, to 95%.
 //
 // The time of a setting: setup(m) + N * disc_texels(r) * t(m), with setup(m) the integrator's
 // construction (its precomputation from the environment) and t(m) its wall time per texel, both
@@ -121,10 +128,16 @@ struct BakePlanOptions {
   // the same way); 0: the pilot's texels. Four times the pilot's views halve the scatter of the
   // estimate that decides, at four times the cost of each confirmation.
   int confirm_views = 128;
+  // A candidate neither clearly within the planned budget nor one standard error over it, and one
+  // that passes at its first round, is measured at fresh views in further rounds, each doubling the
+  // views it pools, up to this many (bake_plan.cpp, "The rounds"); at most confirm_views: one round.
+  int confirm_max_views = 512;
   double sigmas = 0.5;         // k: jackknife standard errors added to the measured error
   int max_confirmations = 32;  // the confirmations' views, in whole candidates, before the plan gives up
-  double margin = 0.9;         // a setting is taken when its upper bound <= margin * max_error
-  bool every_pair = false;     // measure e_interp for every (views, size) pair, not only those reached
+  // A setting is taken when its upper bound <= margin * max_error at the first round's views; the
+  // reserve (1 - margin) * max_error shrinks as 1 / sqrt of the views pooled (at 4x them, to half).
+  double margin = 0.9;
+  bool every_pair = false;  // measure e_interp for every (views, size) pair, not only those reached
   // Leave a confirmation once its error provably exceeds 1.5x the planned budget (plan/error_sample.h,
   // sampled_blend_error); false: measure every confirmation at all its views (a fuller table).
   bool stop_early = true;
@@ -160,6 +173,7 @@ struct PlannedSetting {
   // A confirmation stopped once its error provably exceeded 1.5x the planned budget: a lower bound
   // of the error it would have measured (measured_error stays nullopt).
   std::optional<double> measured_at_least;
+  int measured_views = 0;  // the confirmation views measured (pooled over its rounds; 0: not measured)
   // The screen's optimistic error, hypot(a e_interp, e_int') with e_int' the integration error (b
   // e_int for mis), and the factors it used: a for interpolation (half) and b for mis (a third),
   // until measurements calibrate them to the least that they imply; nullopt: not screened.
@@ -167,7 +181,7 @@ struct PlannedSetting {
   double interpolation_screen = 0.5;
   double mis_screen = 1.0 / 3.0;
   double seconds = 0;  // predicted bake time
-  bool meets = false;  // measured, and upper_error <= margin * max_error
+  bool meets = false;  // measured, and upper_error <= the planned budget at its measured_views
 };
 
 struct BakePlan {

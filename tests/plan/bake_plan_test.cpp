@@ -113,6 +113,7 @@ TEST(BakePlan, NoCheaperSettingIsPredictedToMeetTheBudget) {
   const auto brdf = parse_brdf("{type: ggx, roughness: 0.5, fresnel: {type: schlick, f0: [0.9, 0.8, 0.6]}}");
   BakePlanOptions o = small(0.15);
   o.every_pair = true;
+  o.confirm_max_views = o.confirm_views;  // one round: the screen is what this test is about
   o.integrators.push_back({"fis", 8, 0});
   o.integrators.push_back({"fis", 128, 0});
   const BakePlan plan = plan_bake(env, *brdf, o);
@@ -420,6 +421,9 @@ TEST(BakePlan, BadBudgetsAndEmptyChoicesAreRefused) {
   o = small(0.05);
   o.confirm_views = -1;
   EXPECT_THROW(plan_bake(env, *brdf, o), std::invalid_argument);
+  o = small(0.05);
+  o.confirm_max_views = -1;
+  EXPECT_THROW(plan_bake(env, *brdf, o), std::invalid_argument);
 }
 
 // Confirming at the pilot's own texels (confirm_views 0) and at a sample of their own both decide by
@@ -434,10 +438,13 @@ TEST(BakePlan, TheConfirmationSampleIsTheOneNamedAndMoreViewsNarrowIt) {
   o.confirm_views = 0;
   const BakePlan own = plan_bake(env, *brdf, o);
   o.confirm_views = 64;
+  o.confirm_max_views = 64;  // one round
   const BakePlan larger = plan_bake(env, *brdf, o);
   ASSERT_EQ(own.settings.size(), 1u);
   ASSERT_EQ(larger.settings.size(), 1u);
   ASSERT_TRUE(own.settings[0].measured_error && larger.settings[0].measured_error) << own.why << larger.why;
+  EXPECT_EQ(own.settings[0].measured_views, o.pilot_views);
+  EXPECT_EQ(larger.settings[0].measured_views, 64);
   EXPECT_EQ(own.confirm_texels, own.truth_texels);  // the pilot's texels: no truth of its own
   EXPECT_EQ(larger.confirm_texels, larger.truth_texels - own.truth_texels);
   EXPECT_LE(larger.confirm_texels, 64 * o.pilot_texels);
@@ -445,6 +452,61 @@ TEST(BakePlan, TheConfirmationSampleIsTheOneNamedAndMoreViewsNarrowIt) {
   EXPECT_NE(*own.settings[0].measured_error, *larger.settings[0].measured_error);
   EXPECT_LT(*larger.settings[0].measured_sigma, *own.settings[0].measured_sigma);
   EXPECT_EQ(larger.to_json()["pilot"]["confirm_texels"].get<long long>(), larger.confirm_texels);
+}
+
+// The confirmation's rounds are a sequential test on the pooled estimate e +- s: a candidate one
+// standard error over the planned budget is left after its first round; one that passes there is
+// taken only once a round of fresh views agrees; one in between takes fresh views, doubling the
+// pooled count, until the rule decides or confirm_max_views is reached.
+TEST(BakePlan, AConfirmationTakesFreshViewsUntilItsRuleDecides) {
+  const EnvMap env = sky(Vec3(0.3, 0.6, 0.5), 64);
+  const auto brdf = parse_brdf("{type: phong, albedo: [0.6, 0.5, 0.4], exponent: 20}");
+  BakePlanOptions o = small(0.5);
+  o.view_sets = {"icosa"};
+  o.sizes = {32};
+  o.integrators = {{"fis", 32, 0}};
+  o.confirm_views = 16;
+  o.confirm_max_views = 16;
+  o.stop_early = false;
+  const BakePlan one = plan_bake(env, *brdf, o);
+  ASSERT_EQ(one.settings.size(), 1u);
+  ASSERT_TRUE(one.settings[0].measured_error) << one.why;
+  const double e0 = *one.settings[0].measured_error, s0 = *one.settings[0].measured_sigma;
+  ASSERT_GT(s0, 0);
+  EXPECT_EQ(one.settings[0].measured_views, 16);
+
+  o.confirm_max_views = 128;
+  auto with_planned_budget = [&](double planned) {
+    BakePlanOptions b = o;
+    b.max_error = planned / b.margin;
+    const BakePlan p = plan_bake(env, *brdf, b);
+    EXPECT_EQ(p.settings.size(), 1u);
+    return p.settings.at(0);
+  };
+  // Within the budget at the first round: one round of fresh views more, which agrees.
+  const PlannedSetting within = with_planned_budget(2 * e0 + 4 * s0);
+  EXPECT_EQ(within.measured_views, 32);
+  EXPECT_TRUE(within.meets);
+  // A clear miss: one round.
+  const PlannedSetting over = with_planned_budget(0.9 * (e0 - s0));
+  EXPECT_EQ(over.measured_views, 16);
+  EXPECT_FALSE(over.meets);
+  EXPECT_EQ(*over.measured_error, e0);
+  // Undecided at the first round (e0 - s0 <= budget < e0 + s0 / 2): pooled further, and where it
+  // stopped the rule decides or the views ran out.
+  const double budget = e0;
+  const PlannedSetting close = with_planned_budget(budget);
+  ASSERT_TRUE(close.measured_error && close.measured_sigma);
+  EXPECT_GE(close.measured_views, 32);
+  EXPECT_LE(close.measured_views, 128);
+  const double e = *close.measured_error, s = *close.measured_sigma;
+  EXPECT_NE(e, e0);
+  EXPECT_LT(s, s0);
+  // The reserve, (1 - margin) of the budget at the first round's 16 views, shrinks as 1 / sqrt(n).
+  const double max_error = budget / o.margin;
+  const double planned = max_error - (max_error - budget) * std::sqrt(16.0 / close.measured_views);
+  EXPECT_EQ(close.meets, e + o.sigmas * s <= planned);
+  if (close.measured_views < 128) EXPECT_TRUE(close.meets || e - s > planned) << e << " +- " << s;
 }
 
 }  // namespace
