@@ -115,10 +115,12 @@ int run_bake(const BakeArgs& given, const CLI::App& command) {
     if (fallback) {
       std::ostringstream m;
       m << std::fixed << std::setprecision(2) << "rsibr bake: warning: no setting clears the plan's reserve ("
-        << std::lround(100 * plan->options.margin) << "% of --max-error " << a.max_error
+        << std::lround(100 * plan->options.margin) << "% of --max-error " << a.max_error << " at "
+        << plan->options.confirm_views << " views, nearer it at more"
         << "); baking the closest measured one, " << planned->setting.view_count << " views x " << planned->setting.res
         << "^2, " << planned->setting.integrator.label() << " (measured " << 100 * *planned->measured_error << "% +- "
-        << 100 * *planned->measured_sigma << "% at the confirmation texels), and checking it\n";
+        << 100 * *planned->measured_sigma << "% at " << planned->measured_views
+        << " confirmation views), and checking it\n";
       std::cerr << m.str();
     }
     const BakeSetting& s = planned->setting;
