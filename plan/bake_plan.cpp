@@ -490,10 +490,13 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
         << percent(c.upper_error) << " with " << k << " standard errors; modelled " << percent(c.error)
         << ": interpolation " << percent(*c.interpolation_error) << ", integration " << percent(c.integration_error)
         << "), " << c.seconds << " s; the budget is " << percent(options.max_error) << ", planned to "
-        << percent(budget) << ".\n";
+        << percent(planned_budget(c.measured_views)) << " at its " << c.measured_views << " views.\n";
   } else {
     why << "no setting is predicted to meet " << percent(options.max_error) << " (planned to " << percent(budget)
-        << "); the most accurate measured ones are listed in the table";
+        << " at " << first_round_views << " views";
+    if (may_extend(first_round_views))
+      why << ", to " << percent(planned_budget(options.confirm_max_views)) << " at " << options.confirm_max_views;
+    why << "); the most accurate measured ones are listed in the table";
     if (views_measured >= views_allowed)
       why << " (the plan stopped after measuring " << confirmations
           << " candidates that the model let through, its allowance of confirmation views)";
@@ -502,8 +505,8 @@ BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& o
       const PlannedSetting& c = *plan.closest;
       why << "closest: " << setting_text(c.setting) << ": measured " << percent(*c.measured_error) << " +- "
           << percent(*c.measured_sigma) << " at " << c.measured_views << " views (at most " << percent(c.upper_error)
-          << "), " << c.seconds << " s; it is planned to meet a budget of " << percent(c.upper_error / options.margin)
-          << ".\n";
+          << "), " << c.seconds << " s; it is planned to meet a budget of "
+          << percent(c.upper_error / (planned_budget(c.measured_views) / options.max_error)) << ".\n";
     }
   }
   int shown = 0;

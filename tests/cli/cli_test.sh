@@ -102,20 +102,22 @@ rule = 'meets' if e + 2 * s <= 0.05 else 'exceeds' if e - 2 * s > 0.05 else 'und
 assert k['verdict'] == rule, k
 assert k['verdict'] != 'undecided' or s <= 0.005 or k['views'] == 64, k
 " "$work/plan.json" "$work/planned.json"
-# Where no setting clears the plan's reserve (90% of the budget) but the closest measured one is within
-# the budget itself (here 18.9% +- 1.4% against 21%), bake --max-error bakes that one, says so and checks
-# it; plan names it and still exits 3 (no choice).
-"$rsibr" bake --env "$work/sky.exr" --brdf "$work/ggx.yaml" --max-error 21% --views 42 --res 16 --method fis \
+# Where no setting clears the plan's reserve (90% of the budget at 128 views, 95% at 512) but the closest
+# measured one is within the budget itself (here 18.9% +- 0.7% over 512 views against 20%), bake
+# --max-error bakes that one, says so and checks it; plan names it and still exits 3 (no choice).
+"$rsibr" bake --env "$work/sky.exr" --brdf "$work/ggx.yaml" --max-error 20% --views 42 --res 16 --method fis \
   --samples 32 --seed 3 -q --json "$work/closest.json" "$work/closest.exr" 2>"$work/closest.err"
 check "bake --max-error without a choice: the closest measured setting, said and checked" python3 -c "
 import json, sys
 b = json.load(open(sys.argv[1]))
 assert b['plan']['chosen'] is None and b['plan']['closest'] is not None, b['plan']
 assert b['check']['planned_from'] == 'closest' and b['views'] == 42 and b['res'] == 16, b['check']
-assert b['plan']['closest']['measured_error'] <= 0.21 < b['plan']['closest']['upper_error'] / 0.9, b['plan']['closest']
+c = b['plan']['closest']
+planned = 0.2 * (1 - 0.1 * (128 / c['measured_views']) ** 0.5)  # the reserve shrinks as 1 / sqrt(views)
+assert c['measured_error'] <= 0.2 and c['upper_error'] > planned, c
 assert 'no setting clears the plan' in open(sys.argv[2]).read()
 " "$work/closest.json" "$work/closest.err"
-"$rsibr" plan --env "$work/sky.exr" --brdf "$work/ggx.yaml" --max-error 21% --views 42 --res 16 --method fis \
+"$rsibr" plan --env "$work/sky.exr" --brdf "$work/ggx.yaml" --max-error 20% --views 42 --res 16 --method fis \
   --samples 32 --seed 3 --json "$work/closest-plan.json" >"$work/closest-plan.txt" 2>&1
 status=$?
 check "plan without a choice: exit 3, the closest setting's bake arguments" python3 -c "
