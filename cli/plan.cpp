@@ -96,7 +96,10 @@ Runner add_plan(CLI::App& app) {
       "them; the root sum of squares of the two screens the candidates in order of predicted time, and each one "
       "it lets through is blended at 128 further novel views with its own integrator (left as soon as its error "
       "provably exceeds 1.5 x 90% of the budget): the first whose measured error plus half its standard error is within "
-      "90% of the budget is chosen. Candidates: " +
+      "90% of the budget is chosen, once 128 fresh views pooled with those agree; one within a standard error of "
+      "that reserve is measured at fresh views, doubling them up to --confirm-max-views, until the rule decides "
+      "(the reserve shrinks as one over the square root of the views pooled: 95% of the budget at 512). "
+      "Candidates: " +
       candidates_text() +
       ". --views, --res, --method, --samples and --reference-width fix a knob. rsibr bake --max-error plans, bakes "
       "and checks the result.\n"
