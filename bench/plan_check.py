@@ -49,6 +49,10 @@ BRDFS = {
     "clearcoat": "{type: clearcoat, coat: {ior: 1.5, roughness: 0.1}, flakes: {coverage: 0.2, roughness: 0.3, "
                  "fresnel: {type: conductor, eta: [1.66, 0.88, 0.52], k: [9.22, 6.27, 4.84]}}, "
                  "base: {albedo: [0.3, 0.35, 0.6]}}",
+    # Spot checks on environments and BRDFs no table has used (forest, studio): --envs forest,studio
+    # --brdfs steel,ceramic.
+    "steel": "{type: ggx, roughness: 0.3, fresnel: {type: conductor, eta: [2.87, 2.92, 2.58], k: [3.19, 2.93, 2.61]}}",
+    "ceramic": "{type: ggx, roughness: 0.1, fresnel: {type: dielectric, ior: 1.5}}",
     # The held-out BRDFs (with sunset, warehouse and city).
     "copper": "{type: ggx, roughness: 0.15, fresnel: {type: conductor, eta: [0.27, 0.68, 1.22], k: [3.61, 2.63, 2.29]}}",
     "rubber": "{type: phong, albedo: [0.08, 0.08, 0.09], exponent: 6}",
