@@ -41,7 +41,7 @@
 //
 // with s the jackknife standard error over the confirmation's views, once two rounds of views agree:
 // the confirmation is a sequential test in rounds of fresh views pooled into one estimate (a miss
-// when e - s > margin * budget; undecided in between, when a further round doubles the pooled views,
+// when e - s exceeds the planned budget; undecided in between, when a further round doubles the pooled views,
 // up to confirm_max_views; a pass at the first round is measured once more at fresh views, since
 // those first views selected it among every candidate before it). The reserve, (1 - margin) *
 // budget at the first round's views, shrinks as 1 / sqrt of the views pooled (below: it is for the

@@ -32,6 +32,15 @@ BakePlanOptions small(double budget) {
   return o;
 }
 
+// A plan of one candidate: the small plan with one view set, size and integrator setting.
+BakePlanOptions one_candidate(double budget, const std::string& views, int res, const IntegratorSetting& integrator) {
+  BakePlanOptions o = small(budget);
+  o.view_sets = {views};
+  o.sizes = {res};
+  o.integrators = {integrator};
+  return o;
+}
+
 MapSet bake(const EnvMap& env, const Brdf& brdf, const BakeSetting& s) {
   const auto integrator = make_integrator(s.integrator.method, env);
   MapSetBakeOptions o;
@@ -332,10 +341,7 @@ TEST(BakePlan, WhenEveryConfirmationStoppedEarlyTheLeastBoundIsMeasuredInFull) {
   const auto brdf = parse_brdf("{type: phong, albedo: [0.6, 0.5, 0.4], exponent: 20}");
   // 12 views interpolate this lobe at about 7%; the screen counts that at half (3.4%), within the
   // planned 3.6%, and the measurement exceeds 1.5x that.
-  BakePlanOptions o = small(0.04);
-  o.view_sets = {"icosa"};
-  o.sizes = {32};
-  o.integrators = {{"fis", 32, 0}};
+  BakePlanOptions o = one_candidate(0.04, "icosa", 32, {"fis", 32, 0});
   const BakePlan plan = plan_bake(env, *brdf, o);
   ASSERT_FALSE(plan.chosen) << plan.why;
   ASSERT_TRUE(plan.closest) << plan.why;
@@ -431,10 +437,8 @@ TEST(BakePlan, BadBudgetsAndEmptyChoicesAreRefused) {
 TEST(BakePlan, TheConfirmationSampleIsTheOneNamedAndMoreViewsNarrowIt) {
   const EnvMap env = sky(Vec3(0.3, 0.6, 0.5), 64);
   const auto brdf = parse_brdf("{type: ggx, roughness: 0.4, fresnel: {type: schlick, f0: [0.9, 0.7, 0.5]}}");
-  BakePlanOptions o = small(0.5);  // a budget the screen lets the one candidate through for
-  o.view_sets = {"162"};
-  o.sizes = {32};
-  o.integrators = {{"reference", 0, 16}};
+  // A budget the screen lets the one candidate through for.
+  BakePlanOptions o = one_candidate(0.5, "162", 32, {"reference", 0, 16});
   o.confirm_views = 0;
   const BakePlan own = plan_bake(env, *brdf, o);
   o.confirm_views = 64;
@@ -461,10 +465,7 @@ TEST(BakePlan, TheConfirmationSampleIsTheOneNamedAndMoreViewsNarrowIt) {
 TEST(BakePlan, AConfirmationTakesFreshViewsUntilItsRuleDecides) {
   const EnvMap env = sky(Vec3(0.3, 0.6, 0.5), 64);
   const auto brdf = parse_brdf("{type: phong, albedo: [0.6, 0.5, 0.4], exponent: 20}");
-  BakePlanOptions o = small(0.5);
-  o.view_sets = {"icosa"};
-  o.sizes = {32};
-  o.integrators = {{"fis", 32, 0}};
+  BakePlanOptions o = one_candidate(0.5, "icosa", 32, {"fis", 32, 0});
   o.confirm_views = 16;
   o.confirm_max_views = 16;
   o.stop_early = false;
