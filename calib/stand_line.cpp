@@ -12,7 +12,6 @@ namespace rsibr {
 
 namespace {
 
-constexpr double kDeg = kPi / 180;
 
 struct LogImage {
   cv::Mat l;  // CV_32FC1, ln(luminance + eps)

@@ -10,7 +10,6 @@ namespace rsibr {
 
 namespace {
 
-constexpr double kDeg = kPi / 180;
 
 struct Solve {
   Vec3 u;

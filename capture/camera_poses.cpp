@@ -10,7 +10,6 @@
 namespace rsibr {
 namespace {
 
-constexpr double kDeg = kPi / 180;
 
 // Look at `at` with world up, turn right by pan about the world's vertical (a rotation of -pan about
 // +Y), by yaw about the camera's y axis (down), then roll about z.

@@ -13,6 +13,7 @@ using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
 
 inline constexpr double kPi = 3.14159265358979323846;
+inline constexpr double kDeg = kPi / 180;  // radians per degree
 
 // Angle between two (not necessarily unit) vectors, accurate for tiny and near-pi angles
 // (acos of a dot product loses half the digits near 0 and pi).

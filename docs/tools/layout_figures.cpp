@@ -30,7 +30,6 @@ using namespace rsibr;
 
 namespace {
 
-constexpr double kDeg = kPi / 180.0;
 constexpr int kShift = 4;  // fixed-point bits for sub-pixel drawing
 const cv::Scalar kWhite(255, 255, 255), kBlack(0, 0, 0), kGrey(90, 90, 90), kLightGrey(200, 200, 200);
 const int kFont = cv::FONT_HERSHEY_SIMPLEX;
