@@ -53,6 +53,7 @@ std::map<std::string, Runner> add_verbs(CLI::App& app) {
   runners["calibrate"] = add_calibrate(app);
   runners["probe"] = add_probe(app);
   runners["orient"] = add_orient(app);
+  runners["balls"] = add_balls(app);
   runners["process"] = add_process(app);
   runners["plan"] = add_plan(app);
   return runners;

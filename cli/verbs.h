@@ -25,6 +25,7 @@ Runner add_extract(CLI::App& app);
 Runner add_calibrate(CLI::App& app);
 Runner add_probe(CLI::App& app);
 Runner add_orient(CLI::App& app);
+Runner add_balls(CLI::App& app);
 Runner add_process(CLI::App& app);
 Runner add_plan(CLI::App& app);
 
