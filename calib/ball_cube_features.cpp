@@ -2,6 +2,7 @@
 
 #include "calib/sphere_map_extraction.h"
 #include "core/parallel.h"
+#include "hdr/merge.h"
 
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -131,7 +132,7 @@ std::vector<CubeFace> ball_cube_faces(const cv::Mat& image, const cv::Mat& flags
         if (!flags.empty()) {
           const unsigned char fl = flags.at<unsigned char>(y0, x0) | flags.at<unsigned char>(y0, x0 + 1) |
                                    flags.at<unsigned char>(y0 + 1, x0) | flags.at<unsigned char>(y0 + 1, x0 + 1);
-          if (fl & clipped_mask) continue;
+          if (fl & (clipped_mask | kOutside)) continue;
         }
         const cv::Vec3f a = image.at<cv::Vec3f>(y0, x0), b = image.at<cv::Vec3f>(y0, x0 + 1);
         const cv::Vec3f c = image.at<cv::Vec3f>(y0 + 1, x0), d = image.at<cv::Vec3f>(y0 + 1, x0 + 1);

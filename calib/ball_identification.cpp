@@ -1,4 +1,6 @@
 #include "calib/ball_identification.h"
+
+#include "calib/far_camera.h"
 #include "core/luminance.h"
 
 #include <Eigen/Dense>
@@ -273,7 +275,14 @@ BallCandidate measure(const cv::Mat& image, const LensModel& lens, const BallLoc
                       const std::vector<Disc>& ex) {
   BallCandidate c;
   c.loc = loc;
-  c.inlier_fraction = loc.outline_px.empty() ? 0 : double(loc.fit.inliers) / double(loc.outline_px.size());
+  // Inliers within the fit's threshold or 0.3% of the radius, whichever is larger: a large ball's
+  // outline in a real photo (JPEG, demosaicing, a limb that reflects what lies behind it) scatters
+  // by a fixed share of its size, not by a fixed pixel count.
+  const double tol = std::max(ConeFitOptions{}.inlier_px, 0.003 * loc.radius_px);
+  int inliers = 0;
+  for (double r : loc.fit.residual_px) inliers += std::abs(r) < tol;
+  c.inlier_fraction = loc.outline_px.empty() ? 0 : double(inliers) / double(loc.outline_px.size());
+  c.outline_support = loc.outline_support(tol);
   c.texture = disc_texture(image, loc.centre_px, loc.radius_px, ex);
   c.rim_texture = disc_rim_texture(image, loc.centre_px, loc.radius_px, ex);
   c.mirror_score = disc_mirror_score(image, loc.centre_px, loc.radius_px, ex);
@@ -295,8 +304,8 @@ BallCandidate measure_ball(const cv::Mat& image, const LensModel& lens, const Ba
 }
 
 bool acceptable_outline(const BallCandidate& c, const BallSearchOptions& o) {
-  return c.inlier_fraction >= o.min_inlier_fraction && c.loc.fit.rms_px <= o.max_rms_px &&
-         c.frame_fraction >= o.min_frame_fraction;
+  return c.inlier_fraction >= o.min_inlier_fraction && c.outline_support >= o.min_outline_support &&
+         c.loc.fit.rms_px <= o.max_rms_px && c.frame_fraction >= o.min_frame_fraction;
 }
 
 std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const LensModel& lens,
@@ -304,8 +313,16 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
   const double m = std::min(lens.width(), lens.height());
   const double rmin = o.min_radius_px > 0 ? o.min_radius_px : std::max(4.0, m / 40);
   const double rmax = o.max_radius_px > 0 ? o.max_radius_px : m / 2;
-  const std::vector<BallGuess> guesses = detect_balls(image, rmin, rmax, 64, o.per_band);
+  std::vector<BallGuess> guesses = detect_balls(image, rmin, rmax, 64, o.per_band);
+  // A photo cropped to the ball (the usual form of chrome-ball data): its outline touches or
+  // leaves the frame, where Hough sees too little of it. The frame-filling circle is one more
+  // guess, tried first; it must earn its place like any other (outline, appearance).
+  if (rmax >= 0.45 * m)
+    guesses.insert(guesses.begin(), BallGuess{Vec2(0.5 * (lens.width() - 1), 0.5 * (lens.height() - 1)), 0.5 * m});
   std::vector<BallCandidate> balls;
+  // The frame-filling circle as located, even where its outline misses the gates: a crop's ball
+  // whose limb shows little contrast still tells that the circles inside it are its reflections.
+  std::optional<BallLocation> frame_circle;
   for (const BallGuess& g : guesses) {
     // A guess on a ball already located is not located again.
     bool known = false;
@@ -325,6 +342,12 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
       // centre in the image.
       if (!(loc.radius_px >= rmin / 1.25 && loc.radius_px <= 1.25 * rmax) || !lens.in_image(loc.centre_px)) continue;
       BallCandidate c = measure_ball(image, lens, loc);
+      // The frame-filling guess: its circle must show an edge along much of its visible outline (a
+      // few edges of a full frame's furniture fit some huge circle too).
+      const bool frame_guess = &g == &guesses.front() && rmax >= 0.45 * m;
+      if (frame_guess && fills_frame(loc.radius_px, lens.width(), lens.height()) && c.outline_support >= 0.3 &&
+          c.inlier_fraction >= 0.4 && c.loc.fit.rms_px <= o.max_rms_px && !frame_circle)
+        frame_circle = loc;
       if (!acceptable_outline(c, o)) continue;
       auto same =
           std::find_if(balls.begin(), balls.end(), [&](const BallCandidate& b) { return same_circle(b.loc, loc); });
@@ -375,6 +398,14 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
         break;
       }
     }
+  }
+  if (frame_circle) {
+    std::vector<BallCandidate> kept;
+    for (const BallCandidate& b : balls)
+      if (same_circle(b.loc, *frame_circle) ||
+          (b.loc.centre_px - frame_circle->centre_px).norm() + 0.5 * b.loc.radius_px > frame_circle->radius_px)
+        kept.push_back(b);
+    balls = std::move(kept);
   }
   std::vector<BallCandidate> out;
   for (std::size_t i = 0; i < balls.size(); ++i) {
@@ -877,6 +908,16 @@ ViewCandidates view_candidates(const cv::Mat& image, const LensModel& lens, cons
   ViewCandidates vc;
   vc.cands = find_ball_candidates(image, lens, search);
   vc.pick = assign_balls_in_view(vc.cands, balls);
+  // A photo cropped to its one listed ball (calib/far_camera.h): the one circle with a clean
+  // outline that fills the frame is that ball whatever its appearance (a chrome ball reflecting a
+  // smooth table over half its disc looks glossy), and the circles inside it are reflections.
+  if (balls.size() == 1) {
+    int fill = -1, n = 0;
+    for (std::size_t k = 0; k < vc.cands.size(); ++k)
+      if (fills_frame(vc.cands[k].loc.radius_px, image.cols, image.rows) && vc.cands[k].outline_support >= 0.5)
+        fill = int(k), ++n;
+    if (n == 1) vc.pick[0] = fill;
+  }
   return vc;
 }
 

@@ -41,7 +41,8 @@ namespace rsibr {
 
 struct BallCandidate {
   BallLocation loc;
-  double inlier_fraction = 0;  // outline points within the cone fit's inlier threshold
+  double inlier_fraction = 0;  // outline points within max(the cone fit's inlier threshold, 0.3% of the radius)
+  double outline_support = 0;  // those inliers per search line inside the image (calib/ball_locator.h)
   double texture = 0;          // mean |ln L| change between neighbouring pixels within 0.8 radii
   double rim_texture =
       0;  // fraction of the pixels between 0.5 and 0.9 radii whose ln L changes by > 0.06 to a neighbour
@@ -57,6 +58,10 @@ struct BallSearchOptions {
   double max_radius_px = 0;  // 0: min(width, height) / 2
   int per_band = 6;          // Hough circles kept per radius band
   double min_inlier_fraction = 0.6;
+  // Inliers per search line inside the image: an edge on the circle along at least half of its
+  // visible outline (a few edges of furniture that happen to lie on one large circle are all
+  // inliers of it, but of few lines).
+  double min_outline_support = 0.5;
   double max_rms_px = 0.8;  // a chrome ball's limb reflects what lies behind it: 0.5 px on low contrast
   double min_frame_fraction = 0.5;
 };

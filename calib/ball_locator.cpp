@@ -93,6 +93,23 @@ std::vector<Edge> find_edges(const cv::Mat& lum, double eps, const Vec2& q, cons
   return out;
 }
 
+// The part [t0', t1'] of [t0, t1] where q + t n lies at least `margin` px inside the image (the
+// pixel-centre box [0, w-1] x [0, h-1]); t1' < t0' when none does.
+std::pair<double, double> inside_part(const cv::Mat& img, const Vec2& q, const Vec2& n, double t0, double t1,
+                                      double margin) {
+  const double lo[2] = {margin, margin}, hi[2] = {img.cols - 1 - margin, img.rows - 1 - margin};
+  for (int a = 0; a < 2; ++a) {
+    if (std::abs(n[a]) < 1e-12) {
+      if (q[a] < lo[a] || q[a] > hi[a]) return {1, 0};
+      continue;
+    }
+    double u = (lo[a] - q[a]) / n[a], v = (hi[a] - q[a]) / n[a];
+    if (u > v) std::swap(u, v);
+    t0 = std::max(t0, u), t1 = std::min(t1, v);
+  }
+  return {t0, t1};
+}
+
 std::string where(const BallGuess& g) {
   std::ostringstream s;
   s.precision(1);
@@ -116,14 +133,17 @@ BallLocation locate_ball(const cv::Mat& image, const LensModel& lens, const Ball
   const int lines = options.lines > 0 ? options.lines : std::max(48, static_cast<int>(2 * kPi * guess.radius_px / 1.5));
 
   // Pass 1: radial lines from the guessed centre, up to 3 edge candidates each (RANSAC finds the
-  // ones on one cone among reflections, the stand and the background).
+  // ones on one cone among reflections, the stand and the background). A line that leaves the
+  // image is searched over its part inside (a ball that fills a crop shows its outline only near
+  // the corners; the frame's own border is no edge, the line just stops there).
   std::vector<Vec3> rays;
   const double band = std::max(4.0, options.search_fraction * guess.radius_px);
   for (int k = 0; k < lines; ++k) {
     const double phi = 2 * kPi * (k + 0.5) / lines;
     const Vec2 n(std::cos(phi), std::sin(phi));
-    for (const Edge& e : find_edges(lum, eps, guess.centre_px, n, guess.radius_px - band, guess.radius_px + band,
-                                    options.min_log_contrast, 3))
+    const auto [t0, t1] = inside_part(lum, guess.centre_px, n, guess.radius_px - band, guess.radius_px + band, 2.5);
+    if (!(t1 - t0 >= 4)) continue;
+    for (const Edge& e : find_edges(lum, eps, guess.centre_px, n, t0, t1, options.min_log_contrast, 3))
       rays.push_back(lens.unproject(e.px));
   }
   if (rays.size() < 8)
@@ -150,6 +170,10 @@ BallLocation locate_ball(const cv::Mat& image, const LensModel& lens, const Ball
       if (!(n.norm() > 0)) continue;
       n.normalize();
       if (n.dot(q - c) < 0) n = -n;  // outward
+      if (pass == 1) {
+        const auto [t0, t1] = inside_part(lum, q, n, -options.refine_px, options.refine_px, 2.0);
+        loc.lines_inside += t0 <= -options.refine_px && t1 >= options.refine_px;
+      }
       // Of the edges at least 0.3 times as strong as the strongest, the one nearest the fitted
       // outline (a reflection's edge just inside a chrome ball's rim can be the stronger one).
       const auto edges = find_edges(lum, eps, q, n, -options.refine_px, options.refine_px, options.min_log_contrast, 3);
@@ -180,6 +204,12 @@ BallLocation locate_ball(const cv::Mat& image, const LensModel& lens, const Ball
   for (const Vec2& q : outline) sum += (q - loc.centre_px).norm();
   loc.radius_px = sum / outline.size();
   return loc;
+}
+
+double BallLocation::outline_support(double tol_px) const {
+  int in = 0;
+  for (double r : fit.residual_px) in += std::abs(r) < tol_px;
+  return lines_inside > 0 ? double(in) / double(lines_inside) : 0.0;
 }
 
 std::vector<BallGuess> detect_balls(const cv::Mat& image, double min_radius_px, double max_radius_px, int max_count,

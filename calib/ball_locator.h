@@ -39,6 +39,11 @@ struct BallLocation {
   Vec2 centre_px;                // lens.project(axis): the ball centre's pixel
   double radius_px = 0;          // mean distance of the fitted outline from centre_px
   std::vector<Vec2> outline_px;  // the second pass's outline points (inliers and outliers)
+  int lines_inside = 0;          // the second pass's search lines inside the image (with or without an edge)
+  // Inliers (within `tol_px` of the fitted outline) per search line inside the image: how much of
+  // the visible outline shows an edge on the circle (a few edges that happen to lie on a huge
+  // circle are all inliers, but of few lines).
+  double outline_support(double tol_px) const;
 };
 
 // `image` CV_32FC3 (RGB) or CV_32FC1, linear, the lens's size. Throws std::invalid_argument

@@ -1,6 +1,7 @@
 #include "calib/sphere_map_extraction.h"
 
 #include "core/parallel.h"
+#include "hdr/merge.h"
 #include "core/sphere_map.h"
 #include "core/luminance.h"
 
@@ -138,6 +139,10 @@ MapView extract_sphere_map(const cv::Mat& image, const cv::Mat& flags, const Len
     if (options.indexing == SphereIndexing::orthographic) reflected = 2 * cos_i * n - w;
     const Vec2 px = lens.project(p);
     if (!px.allFinite() || !lens.in_image(px, 0.5)) return false;
+    if (!flags.empty() && (flags.at<unsigned char>(std::clamp(int(std::lround(px.y())), 0, flags.rows - 1),
+                                                   std::clamp(int(std::lround(px.x())), 0, flags.cols - 1)) &
+                           kOutside))
+      return false;  // beyond the photo on a view's canvas: not seen
     *out = {n, reflected, px, cos_i};
     return true;
   };

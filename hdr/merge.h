@@ -38,7 +38,8 @@
 
 namespace rsibr {
 
-enum MergeFlag : unsigned char { kClipped = 1, kBlack = 2, kGhost = 4 };
+// kOutside: no photo there (a view placed on a larger canvas, calib/far_camera.h); never written.
+enum MergeFlag : unsigned char { kClipped = 1, kBlack = 2, kGhost = 4, kOutside = 8 };
 
 struct MergeOptions {
   int saturation_code = -1;   // every channel's; -1: the curve's per-channel saturation codes

@@ -23,6 +23,7 @@ BallCandidate candidate(const Vec3& centre_m, double radius_m, double rim_textur
   c.loc.centre_px = Vec2(500 + 1000 * centre_m.x() / centre_m.z(), 400 + 1000 * centre_m.y() / centre_m.z());
   c.loc.radius_px = 1000 * radius_m / centre_m.z();
   c.inlier_fraction = 0.95;
+  c.outline_support = 0.95;
   c.frame_fraction = 1;
   c.texture = 0.05;
   c.rim_texture = rim_texture;
