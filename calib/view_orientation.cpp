@@ -201,6 +201,10 @@ PoseSet orient_views(const std::vector<std::string>& all_names, const std::vecto
     std::string why = "orient: a chrome ball was found in " + std::to_string(names.size()) + " of " +
                       std::to_string(all_views.size()) + " views, need at least " + (single ? "1" : "2");
     if (!rep.left_out.empty()) why += " (" + rep.left_out.front() + ")";
+    // The one hint a failed search needs: where the ball is (rsibr balls lists what was seen).
+    why +=
+        "; give it by hand (rsibr process --ball VIEW:BALL=X,Y,R; rsibr balls hdr/VIEW.exr --picture FILE.png "
+        "shows the candidates)";
     throw std::invalid_argument(why);
   }
   if (names.empty()) throw std::invalid_argument("orient: " + rep.left_out.front());

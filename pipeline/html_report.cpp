@@ -284,7 +284,14 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
   if (rec.count("lens")) {
     // The lens step (pipeline/lens_step.h): a metadata lens's focal length from the balls' outlines.
     const auto& s = rec["lens"].summary;
-    if (s.value("refined", false) && s.value("source", "") == "outlines") {
+    if (s.value("far_camera", false)) {
+      h << "<p><b>Crops of the ball: the far-camera model.</b> Every view's ball fills its frame, so the photos "
+        << "are crops and their metadata's focal length belongs to the uncropped frame: the lens is a distant, "
+        << "near-orthographic pinhole (f = " << num(s.value("focal_px", 0.0), 4) << " px on a "
+        << jnum(s["canvas"][0]) << "x" << jnum(s["canvas"][1]) << " canvas; the ball's half-angle "
+        << num(s.value("ball_half_angle_deg", 0.0), 2) << " degrees). The perspective a crop cannot tell (about "
+        << "the ball's radius over its distance, across the ball) is left out.</p>";
+    } else if (s.value("refined", false) && s.value("source", "") == "outlines") {
       h << "<p>Focal length measured from " << jnum(s["balls_used"]) << " ball outline(s) (" << jnum(s["points"])
         << " points, RMS " << num(s.value("outline_rms_px", 0.0), 3) << " px): f = <b>"
         << num(s.value("focal_px", 0.0), 5) << " &plusmn; " << num(s.value("sigma_px", 0.0), 3) << " px</b>.";

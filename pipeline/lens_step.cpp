@@ -1,5 +1,6 @@
 #include "pipeline/lens_step.h"
 
+#include "calib/far_camera.h"
 #include "calib/outline_focal.h"
 #include "calib/view_image.h"
 
@@ -10,7 +11,7 @@ namespace rsibr {
 nlohmann::json run_lens_step(const LensStep& s) {
   const LensModel lens = LensModel::read(s.calibrated);
   const double f0 = lens.intrinsics().at(0);
-  nlohmann::json j = {{"source", s.source}, {"prior_focal_px", f0}};
+  nlohmann::json j = {{"source", s.source}, {"prior_focal_px", f0}, {"far_camera", false}};
   auto keep = [&](const std::string& why) {
     lens.write(s.out);
     j.update({{"refined", false}, {"why", why}, {"focal_px", f0}});
@@ -20,24 +21,54 @@ nlohmann::json run_lens_step(const LensStep& s) {
   const bool outlines_only = s.source == "outlines";
   auto unknown = [&](const std::string& why) -> nlohmann::json {
     throw std::invalid_argument("lens: the photos' metadata has no focal length and " + why +
-                                "; give the lens with --lens FILE (a .cameramodel, e.g. from rsibr calibrate)");
+                                "; give the lens with --lens FILE (a .cameramodel, e.g. from rsibr calibrate), or "
+                                "the ball with --ball VIEW:BALL=X,Y,R where it was not found (rsibr balls "
+                                "hdr/VIEW.exr --picture shows the candidates)");
   };
-  if (!s.refine)
-    return outlines_only ? unknown("--no-self-calibration keeps the balls from measuring it")
-                         : keep("off (--no-self-calibration)");
-  if (s.source != "exif" && s.source != "lensfun" && !outlines_only)
+  if (s.source != "exif" && s.source != "lensfun" && !outlines_only) {
+    for (std::size_t v = 0; v < s.views.size(); ++v) {
+      const ViewImage image = read_view_image(s.merged[v].string());
+      if (image.radiance.cols != lens.width() || image.radiance.rows != lens.height())
+        throw std::invalid_argument("lens: view " + s.views[v] + " is " + std::to_string(image.radiance.cols) + "x" +
+                                    std::to_string(image.radiance.rows) + " but the lens (" + s.source + ") is " +
+                                    std::to_string(lens.width()) + "x" + std::to_string(lens.height()));
+    }
     return keep("the lens was measured (" + s.source + ")");
-  if (!outlines_only && !(s.prior_sigma_relative > 0)) return keep("the calibrate step states no uncertainty");
-  const double s0 = outlines_only ? 0.0 : s.prior_sigma_relative * f0;
-  if (!outlines_only) j["prior_sigma_px"] = s0;
+  }
 
-  // The listed balls of every view, located with the metadata's lens; cut balls and points off
-  // their robust cone are left out (calib/outline_focal.h drops the rest).
+  // The listed balls of every view, located with the metadata's lens (a pinhole of the view's
+  // diagonal where the view's size differs from it: crops); cut balls and points off their robust
+  // cone are left out (calib/outline_focal.h drops the rest).
   std::vector<std::vector<Vec2>> outlines;
-  nlohmann::json found = nlohmann::json::array();
+  nlohmann::json found = nlohmann::json::array(), sizes_json = nlohmann::json::array();
+  std::vector<std::pair<int, int>> sizes;
+  bool same_size = true, crops = true;
+  std::string crop_note;
   for (std::size_t v = 0; v < s.views.size(); ++v) {
     const ViewImage image = read_view_image(s.merged[v].string());
-    const ViewCandidates vc = view_candidates(image.radiance, lens, s.balls);
+    const int w = image.radiance.cols, h = image.radiance.rows;
+    sizes.push_back({w, h});
+    const bool fits = w == lens.width() && h == lens.height();
+    same_size = same_size && fits;
+    const LensModel view_lens = fits ? lens : LensModel::pinhole(std::hypot(double(w), double(h)), w, h);
+    ViewCandidates vc = view_candidates(image.radiance, view_lens, s.balls);
+    for (std::size_t b = 0; b < s.balls.size() && v < s.given.size(); ++b)
+      if (b < s.given[v].size() && s.given[v][b]) {
+        vc.cands.push_back(given_ball(image.radiance, view_lens, *s.given[v][b]));
+        vc.pick[b] = int(vc.cands.size()) - 1;
+      }
+    // The view's crop evidence: its first listed chrome ball, else its largest ball found.
+    double radius = -1;
+    for (std::size_t b = 0; b < s.balls.size(); ++b)
+      if (vc.pick[b] >= 0 && (radius < 0 || s.balls[b].kind == BallKind::chrome))
+        radius = std::max(s.balls[b].kind == BallKind::chrome ? 0.0 : radius,
+                          vc.cands[std::size_t(vc.pick[b])].loc.radius_px);
+    const bool fills = radius > 0 && fills_frame(radius, w, h);
+    crops = crops && fills;
+    sizes_json.push_back({{"view", s.views[v]}, {"size", {w, h}}, {"ball_radius_px", radius}, {"fills_frame", fills}});
+    if (!fills && crop_note.empty())
+      crop_note = s.views[v] + (radius > 0 ? "'s ball does not fill its frame" : ": no ball found");
+    if (!fits) continue;
     for (std::size_t b = 0; b < s.balls.size(); ++b) {
       const int pick = vc.pick[b];
       if (pick < 0) continue;
@@ -53,6 +84,42 @@ nlohmann::json run_lens_step(const LensStep& s) {
                        {"radius_px", cand.loc.radius_px}});
     }
   }
+  j["views"] = sizes_json;
+  if (crops) {
+    // Crops of the ball (calib/far_camera.h): the metadata's focal length is the uncropped frame's.
+    const LensModel far = far_camera_lens(sizes);
+    far.write(s.out);
+    double alpha = 0;
+    for (const auto& vj : sizes_json)
+      alpha = std::max(alpha, std::asin(std::min(1.0, vj["ball_radius_px"].get<double>() / far.intrinsics().at(0))));
+    j.update(
+        {{"far_camera", true},
+         {"refined", false},
+         {"focal_px", far.intrinsics().at(0)},
+         {"model", far.name()},
+         {"canvas", {far.width(), far.height()}},
+         {"ball_half_angle_deg", alpha / kDeg},
+         {"why", "every view's ball fills its frame (diameter >= " + std::to_string(int(100 * kCropFillFraction)) +
+                     "% of the shorter side): the photos are crops of the ball, so the far-camera model (a distant, "
+                     "near-orthographic camera; the metadata's focal length belongs to the uncropped frame)"}});
+    return j;
+  }
+  if (!same_size) {
+    std::string list;
+    for (std::size_t v = 0; v < sizes.size(); ++v)
+      list +=
+          (v ? ", " : "") + s.views[v] + " " + std::to_string(sizes[v].first) + "x" + std::to_string(sizes[v].second);
+    throw std::invalid_argument("lens: the views differ in size (" + list + ") but are not crops of the ball (" +
+                                crop_note +
+                                "); one lens serves views of one size: give each view's photos at the same size, or "
+                                "the chrome ball with --ball VIEW:BALL=X,Y,R where it was not found");
+  }
+  if (!s.refine)
+    return outlines_only ? unknown("--no-self-calibration keeps the balls from measuring it")
+                         : keep("off (--no-self-calibration)");
+  if (!outlines_only && !(s.prior_sigma_relative > 0)) return keep("the calibrate step states no uncertainty");
+  const double s0 = outlines_only ? 0.0 : s.prior_sigma_relative * f0;
+  if (!outlines_only) j["prior_sigma_px"] = s0;
   if (outlines.empty())
     return outlines_only ? unknown("no ball outline was found to measure it with")
                          : keep("no ball outline found to refine the focal length with");

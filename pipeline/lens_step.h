@@ -11,7 +11,9 @@
 // the calibrate step's guess; when they cannot, the step is an error that asks for --lens. A
 // measured lens (chessboards,
 // --lens, the photo set's model) passes through unchanged. DIR/lens.cameramodel is the lens every
-// later step uses.
+// later step uses. Views that are crops of the ball (every view's chrome ball fills its frame)
+// get the far-camera model instead (calib/far_camera.h), whatever the metadata says: their EXIF
+// focal length belongs to the uncropped frame; views of different sizes are an error otherwise.
 #pragma once
 
 #include "calib/ball_identification.h"
@@ -20,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,8 +35,11 @@ struct LensStep {
   std::vector<std::string> views;             // view names
   std::vector<std::filesystem::path> merged;  // their merged images (same order)
   std::vector<ListedBall> balls;              // the photo set's balls
-  bool refine = true;                         // false: the calibrated lens unchanged
-  std::filesystem::path out;                  // lens.cameramodel
+  // Per view (empty: none given), per listed ball: the ball given by hand (--ball), used instead of
+  // the detection.
+  std::vector<std::vector<std::optional<BallGuess>>> given;
+  bool refine = true;         // false: the calibrated lens unchanged
+  std::filesystem::path out;  // lens.cameramodel
 };
 
 // Writes `out` atomically and returns the step's summary.

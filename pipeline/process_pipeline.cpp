@@ -6,6 +6,7 @@
 #include "plan/bake_plan.h"
 #include "calib/ball_identification.h"
 #include "calib/ball_locator.h"
+#include "calib/far_camera.h"
 #include "calib/intrinsics.h"
 #include "calib/photo_optics.h"
 #include "calib/lambert_consensus.h"
@@ -408,18 +409,43 @@ void step_lens(Context& c) {
   s.refine = c.o.self_calibrate;
   s.balls = listed_balls(c.set);
   s.out = c.dir / "lens.cameramodel";
+  const std::vector<BallOverride> overrides = parse_ball_overrides(c.o.ball_overrides, c.set);
+  nlohmann::json given = nlohmann::json::array();
   for (const PhotoView& v : c.set.views) {
     s.views.push_back(v.name);
     s.merged.push_back(merged_path(c, v.name));
+    s.given.emplace_back();
+    for (const ListedBall& b : s.balls) {
+      s.given.back().push_back(find_override(overrides, v.name, b.name));
+      if (const auto& g = s.given.back().back())
+        given.push_back({v.name, b.name, g->centre_px.x(), g->centre_px.y(), g->radius_px});
+    }
   }
   nlohmann::json balls = nlohmann::json::array();
   for (const ListedBall& b : s.balls) balls.push_back({b.name, to_string(b.kind)});
   const nlohmann::json settings = {
-      {"refine", s.refine}, {"source", s.source}, {"prior_sigma_relative", s.prior_sigma_relative}, {"balls", balls}};
+      {"refine", s.refine}, {"source", s.source},    {"prior_sigma_relative", s.prior_sigma_relative},
+      {"balls", balls},     {"crops", "far camera"}, {"given", given}};
   run_step(c, "lens", settings, inputs, [&](StepRecord& r) {
     r.summary = run_lens_step(s);
     r.outputs = {s.out};
   });
+}
+
+// A view's merged image as the later steps read it: on the lens's canvas when the lens step chose
+// the far camera for crops of the ball (calib/far_camera.h), else of the lens's size exactly.
+ViewImage read_merged_view(const Context& c, const PhotoView& v, const LensModel& lens) {
+  const std::string file = merged_path(c, v.name).string();
+  ViewImage img = read_view_image(file);
+  const nlohmann::json& step = c.result.summary.at("lens");
+  if (!step.contains("far_camera"))
+    throw std::runtime_error("lens: its record has no far_camera field; rerun with --force lens");
+  if (step["far_camera"].get<bool>()) return on_lens_canvas(std::move(img), lens, file);
+  if (img.radiance.cols != lens.width() || img.radiance.rows != lens.height())
+    throw std::invalid_argument(file + ": " + std::to_string(img.radiance.cols) + "x" +
+                                std::to_string(img.radiance.rows) + " but the lens model is " +
+                                std::to_string(lens.width()) + "x" + std::to_string(lens.height()));
+  return img;
 }
 
 // ---- orient: world_from_cam per view, solved from the chrome ball's reflected features
@@ -474,7 +500,7 @@ void step_orient(Context& c) {
     auto load_images = [&] {
       for (const PhotoView& v : c.set.views) {
         names.push_back(v.name);
-        images.push_back(read_view_image(merged_path(c, v.name).string()));
+        images.push_back(read_merged_view(c, v, lens));
       }
     };
     ViewOrientationOptions vo;
@@ -601,15 +627,7 @@ void step_extract(Context& c) {
     const double chrome_radius_m = chrome_index >= 0 && listed[std::size_t(chrome_index)].diameter_m
                                        ? 0.5 * *listed[std::size_t(chrome_index)].diameter_m
                                        : 0.05;
-    auto read_view = [&](const PhotoView& v) {
-      const std::string file = merged_path(c, v.name).string();
-      ViewImage img = read_view_image(file);
-      if (img.radiance.cols != lens.width() || img.radiance.rows != lens.height())
-        throw std::invalid_argument(file + ": " + std::to_string(img.radiance.cols) + "x" +
-                                    std::to_string(img.radiance.rows) + " but the lens model is " +
-                                    std::to_string(lens.width()) + "x" + std::to_string(lens.height()));
-      return img;
-    };
+    auto read_view = [&](const PhotoView& v) { return read_merged_view(c, v, lens); };
     // Pass 1: every view's candidates and its chrome ball (the anchor).
     std::vector<ViewBalls> vb;
     std::vector<const PhotoView*> used;
@@ -963,6 +981,13 @@ void step_probe(Context& c) {
     const auto fresnel = chrome_fresnel_from_spec(c.o.chrome_fresnel, "--chrome-fresnel");
     po.fresnel = fresnel.get();
     Probe p = assemble_probe(all, po);
+    // A chrome ball sees most of the sphere from one view (all but the cone behind it); a probe
+    // that saw almost nothing means a lens or a ball that is wrong, never a usable probe.
+    if (!(p.covered_fraction >= 0.1))
+      throw std::runtime_error(
+          "the chrome maps saw " + std::to_string(100 * p.covered_fraction).substr(0, 4) +
+          "% of the sphere (a chrome ball sees most of it): the lens (lens.cameramodel, see the lens step) or the "
+          "chrome ball is wrong; give the lens with --lens FILE or the ball with --ball VIEW:BALL=X,Y,R");
     p.env.attributes["views"] = std::to_string(all.views.size());
     p.env.attributes["producer"] = "rsibr process (probe step)";
     p.env.attributes["version"] = RSIBR_VERSION;
