@@ -2,6 +2,8 @@
 
 #include "core/lensfun_lens.h"
 
+#include "hdr/photo_exif.h"
+
 #include <exiv2/exiv2.hpp>
 #include <lensfun/lensfun.h>
 #include <libraw/libraw.h>
@@ -39,9 +41,7 @@ PhotoOptics read_photo_optics(const std::filesystem::path& image) {
   PhotoOptics o;
   bool exif_read = false;
   try {
-    auto img = Exiv2::ImageFactory::open(image.string());
-    img->readMetadata();
-    const Exiv2::ExifData& exif = img->exifData();
+    const Exiv2::ExifData exif = read_photo_exif(image.string());
     o.make = text(exif, "Exif.Image.Make");
     o.model = text(exif, "Exif.Image.Model");
     o.lens = text(exif, "Exif.Photo.LensModel");

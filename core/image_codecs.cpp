@@ -1,6 +1,9 @@
 #include "core/image_codecs.h"
 
+#include "core/heif_image.h"
 #include "core/lazy_library.h"
+
+#include <opencv2/imgproc.hpp>
 
 #include <type_traits>
 
@@ -29,6 +32,15 @@ static_assert(std::is_same_v<decltype(static_cast<DecodeFn>(&cv::imdecode)), Dec
 }  // namespace
 
 cv::Mat read_image(const std::string& path, int flags) {
+  if (is_heif_file(path)) {
+    // libheif (core/heif_image.h), converted as imread converts: 8 bits unless ANYDEPTH, grey
+    // when asked.
+    cv::Mat m = read_heif_image(path);
+    if (flags != cv::IMREAD_UNCHANGED && !(flags & cv::IMREAD_ANYDEPTH) && m.depth() == CV_16U)
+      m.convertTo(m, CV_8U, 1.0 / 257);
+    if (flags == cv::IMREAD_GRAYSCALE) cv::cvtColor(m, m, cv::COLOR_BGR2GRAY);
+    return m;
+  }
   static const auto f =
       codecs().function<ReadFn>("_ZN2cv6imreadERKNSt7__cxx1112basic_stringIcSt11char_traitsIcESaIcEEEi");
   return f(path, flags);

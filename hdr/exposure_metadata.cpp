@@ -1,5 +1,7 @@
 #include "hdr/exposure_metadata.h"
 
+#include "hdr/photo_exif.h"
+
 #include <exiv2/exiv2.hpp>
 
 #include <cmath>
@@ -29,9 +31,7 @@ std::optional<double> exif_number(const Exiv2::ExifData& exif, const char* key, 
 ExifExposure read_exif(const std::string& file) {
   ExifExposure out;
   try {
-    auto image = Exiv2::ImageFactory::open(file);
-    image->readMetadata();
-    const Exiv2::ExifData& exif = image->exifData();
+    const Exiv2::ExifData exif = read_photo_exif(file);
     // The EXIF IFD, else IFD 0 (TIFF/EP and some RAW formats keep them there).
     auto either = [&](const char* photo, const char* image) {
       const auto v = exif_number(exif, photo, file);
