@@ -20,7 +20,9 @@ nlohmann::json run_lens_step(const LensStep& s) {
   // No focal length in the metadata: the outlines alone must give it, over a wide range.
   const bool outlines_only = s.source == "outlines";
   auto unknown = [&](const std::string& why) -> nlohmann::json {
-    throw std::invalid_argument("lens: the photos' metadata has no focal length and " + why +
+    throw std::invalid_argument("lens: the photos' metadata gives no focal length in pixels (" +
+                                (s.metadata_note.empty() ? std::string("none found") : s.metadata_note) + ") and " +
+                                why +
                                 "; give the lens with --lens FILE (a .cameramodel, e.g. from rsibr calibrate), or "
                                 "the ball with --ball VIEW:BALL=X,Y,R where it was not found (rsibr balls "
                                 "hdr/VIEW.exr --picture shows the candidates)");

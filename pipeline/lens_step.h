@@ -32,6 +32,7 @@ struct LensStep {
   std::filesystem::path calibrated;           // the calibrate step's camera.cameramodel
   std::string source;                         // its source: "exif" and "lensfun" are refined, "outlines" measured
   double prior_sigma_relative = 0;            // its focal length's stated 1 sigma (relative)
+  std::string metadata_note;                  // source "outlines": what the metadata lacked (for the error)
   std::vector<std::string> views;             // view names
   std::vector<std::filesystem::path> merged;  // their merged images (same order)
   std::vector<ListedBall> balls;              // the photo set's balls

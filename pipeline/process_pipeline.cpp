@@ -187,7 +187,15 @@ void step_calibrate(Context& c) {
       // lensfun's profile of the lens the EXIF names (distortion included), else a pinhole.
       const std::optional<MetadataLens> meta = metadata_lens(inputs.front(), b.cols(), b.rows());
       const PhotoOptics optics = meta ? meta->optics : read_photo_optics(inputs.front());
-      const std::string lensfun_why = meta ? meta->lensfun_why : "the photo's metadata has no usable focal length";
+      // Why no focal length in pixels: what the EXIF held and what was missing to convert it.
+      std::string lensfun_why = meta ? meta->lensfun_why : "the photo's metadata has no FocalLength";
+      if (!meta && optics.focal_mm) {
+        char mm[32];
+        std::snprintf(mm, sizeof mm, "%.3g mm", *optics.focal_mm);
+        lensfun_why = "FocalLength " + std::string(mm) +
+                      " but no FocalLengthIn35mmFilm, and lensfun knows no crop factor of the camera '" + optics.make +
+                      " " + optics.model + "' (its sensor size)";
+      }
       const bool from_lensfun = meta && meta->source == "lensfun";
       const std::optional<OpticsLens> guess = meta ? std::optional<OpticsLens>(meta->lens) : std::nullopt;
       if (!guess) {
@@ -318,7 +326,9 @@ void step_hdr(Context& c) {
              for (const PhotoView& v : c.set.views) all.push_back(&v);
              const PhotoSetResponse psr = recover_photo_set_response(all, RecoveryOptions{}, Alignment::automatic);
              const ResponseRecovery& rec = psr.recovery;
-             const std::string from = std::to_string(psr.from.size()) + " views (all with brackets)";
+             const std::string from = psr.from.empty()
+                                          ? std::string("none: one exposure per view, the sRGB response stated")
+                                          : std::to_string(psr.from.size()) + " views (all with brackets)";
              const ResponseCurve& curve = rec.curve;
              nlohmann::json cands = nlohmann::json::array();
              for (const auto& k : rec.candidates)
@@ -406,6 +416,7 @@ void step_lens(Context& c) {
   s.calibrated = c.dir / "camera.cameramodel";
   s.source = cal.value("source", "");
   s.prior_sigma_relative = cal.value("focal_sigma_relative", 0.0);
+  if (s.source == "outlines") s.metadata_note = cal.value("lensfun", "");
   s.refine = c.o.self_calibrate;
   s.balls = listed_balls(c.set);
   s.out = c.dir / "lens.cameramodel";
