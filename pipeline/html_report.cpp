@@ -287,8 +287,8 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
     if (s.value("far_camera", false)) {
       h << "<p><b>Crops of the ball: the far-camera model.</b> Every view's ball fills its frame, so the photos "
         << "are crops and their metadata's focal length belongs to the uncropped frame: the lens is a distant, "
-        << "near-orthographic pinhole (f = " << num(s.value("focal_px", 0.0), 4) << " px on a "
-        << jnum(s["canvas"][0]) << "x" << jnum(s["canvas"][1]) << " canvas; the ball's half-angle "
+        << "near-orthographic pinhole (f = " << num(s.value("focal_px", 0.0), 4) << " px on a " << jnum(s["canvas"][0])
+        << "x" << jnum(s["canvas"][1]) << " canvas; the ball's half-angle "
         << num(s.value("ball_half_angle_deg", 0.0), 2) << " degrees). The perspective a crop cannot tell (about "
         << "the ball's radius over its distance, across the ball) is left out.</p>";
     } else if (s.value("refined", false) && s.value("source", "") == "outlines") {
