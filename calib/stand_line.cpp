@@ -12,7 +12,6 @@ namespace rsibr {
 
 namespace {
 
-
 struct LogImage {
   cv::Mat l;  // CV_32FC1, ln(luminance + eps)
   bool inside(const Vec2& p) const { return p.x() >= 0 && p.y() >= 0 && p.x() <= l.cols - 1 && p.y() <= l.rows - 1; }

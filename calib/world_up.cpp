@@ -10,7 +10,6 @@ namespace rsibr {
 
 namespace {
 
-
 struct Solve {
   Vec3 u;
   Eigen::Matrix2d information;

@@ -10,7 +10,6 @@
 namespace rsibr {
 namespace {
 
-
 // Look at `at` with world up, turn right by pan about the world's vertical (a rotation of -pan about
 // +Y), by yaw about the camera's y axis (down), then roll about z.
 Mat3 aim(const Vec3& eye, const Vec3& at, double roll_deg, double yaw_deg, double pan_deg = 0) {

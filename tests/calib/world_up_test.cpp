@@ -16,7 +16,6 @@
 namespace rsibr {
 namespace {
 
-
 SynthScene handheld(int count, double elevation_deg, double jitter_deg, std::uint64_t seed, double jitter_m = 0.02) {
   const std::string text = "rsibr_synth: 1\nseed: " + std::to_string(seed) + R"(
 environment: {pattern: sun_and_sky}
