@@ -308,8 +308,8 @@ bool acceptable_outline(const BallCandidate& c, const BallSearchOptions& o) {
          c.loc.fit.rms_px <= o.max_rms_px && c.frame_fraction >= o.min_frame_fraction;
 }
 
-std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const LensModel& lens,
-                                                const BallSearchOptions& o) {
+std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const LensModel& lens, const BallSearchOptions& o,
+                                                std::optional<BallLocation>* frame_out) {
   const double m = std::min(lens.width(), lens.height());
   const double rmin = o.min_radius_px > 0 ? o.min_radius_px : std::max(4.0, m / 40);
   const double rmax = o.max_radius_px > 0 ? o.max_radius_px : m / 2;
@@ -320,8 +320,8 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
   if (rmax >= 0.45 * m)
     guesses.insert(guesses.begin(), BallGuess{Vec2(0.5 * (lens.width() - 1), 0.5 * (lens.height() - 1)), 0.5 * m});
   std::vector<BallCandidate> balls;
-  // The frame-filling circle as located, even where its outline misses the gates: a crop's ball
-  // whose limb shows little contrast still tells that the circles inside it are its reflections.
+  // The frame-filling circle as located, even where its outline misses the gates (for
+  // view_candidates: a crop's ball whose limb shows little contrast).
   std::optional<BallLocation> frame_circle;
   for (const BallGuess& g : guesses) {
     // A guess on a ball already located is not located again.
@@ -399,14 +399,6 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
       }
     }
   }
-  if (frame_circle) {
-    std::vector<BallCandidate> kept;
-    for (const BallCandidate& b : balls)
-      if (same_circle(b.loc, *frame_circle) ||
-          (b.loc.centre_px - frame_circle->centre_px).norm() + 0.5 * b.loc.radius_px > frame_circle->radius_px)
-        kept.push_back(b);
-    balls = std::move(kept);
-  }
   std::vector<BallCandidate> out;
   for (std::size_t i = 0; i < balls.size(); ++i) {
     bool inside = false;
@@ -427,6 +419,7 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
     out[i].texture = m.texture, out[i].rim_texture = m.rim_texture, out[i].mirror_score = m.mirror_score;
     out[i].diffuse_residual = m.diffuse_residual, out[i].shading_texture = m.shading_texture;
   }
+  if (frame_out) *frame_out = frame_circle;
   std::stable_sort(out.begin(), out.end(), [](const BallCandidate& a, const BallCandidate& b) {
     return a.loc.fit.inliers > b.loc.fit.inliers;
   });
@@ -906,7 +899,19 @@ std::vector<BallFinding> identify_view_balls(const ViewBalls& view, const std::v
 ViewCandidates view_candidates(const cv::Mat& image, const LensModel& lens, const std::vector<ListedBall>& balls,
                                const BallSearchOptions& search) {
   ViewCandidates vc;
-  vc.cands = find_ball_candidates(image, lens, search);
+  std::optional<BallLocation> frame_circle;
+  vc.cands = find_ball_candidates(image, lens, search, balls.size() == 1 ? &frame_circle : nullptr);
+  // A photo of one listed ball whose frame a circle fills, even with a weak outline: the circles
+  // inside it are what that ball reflects (a crop's chrome ball whose limb shows little contrast
+  // against a table), never the ball.
+  if (frame_circle) {
+    std::vector<BallCandidate> kept;
+    for (const BallCandidate& b : vc.cands)
+      if (same_circle(b.loc, *frame_circle) ||
+          (b.loc.centre_px - frame_circle->centre_px).norm() + 0.5 * b.loc.radius_px > frame_circle->radius_px)
+        kept.push_back(b);
+    vc.cands = std::move(kept);
+  }
   vc.pick = assign_balls_in_view(vc.cands, balls);
   // A photo cropped to its one listed ball (calib/far_camera.h): the one circle with a clean
   // outline that fills the frame is that ball whatever its appearance (a chrome ball reflecting a

@@ -75,8 +75,11 @@ bool acceptable_outline(const BallCandidate& c, const BallSearchOptions& options
 // Candidates passing the gates, one per ball (fits within half a radius of each other merged,
 // the one with the most inliers kept; a circle inside a chrome-like candidate's disc dropped: a
 // reflection), strongest outline first.
+// `frame_circle`, when given, receives the frame-filling circle as located when its outline is
+// weak but not absent (support >= 0.3, inliers >= 0.4), whether or not it passed the gates.
 std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const LensModel& lens,
-                                                const BallSearchOptions& options = {});
+                                                const BallSearchOptions& options = {},
+                                                std::optional<BallLocation>* frame_circle = nullptr);
 
 // What the photo set says about a ball.
 struct ListedBall {
@@ -95,7 +98,9 @@ bool looks_like(const BallCandidate& c, BallKind kind);
 std::vector<int> assign_balls_in_view(const std::vector<BallCandidate>& candidates,
                                       const std::vector<ListedBall>& balls);
 
-// One view's candidates and the listed balls assign_balls_in_view matched them to.
+// One view's candidates and the listed balls assign_balls_in_view matched them to. With one listed
+// ball (a crop of it, calib/far_camera.h): the one clean circle that fills the frame is that ball
+// whatever its appearance, and circles inside a frame-filling circle are its reflections.
 struct ViewCandidates {
   std::vector<BallCandidate> cands;
   std::vector<int> pick;  // per listed ball, candidate index or -1

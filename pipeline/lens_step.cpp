@@ -44,7 +44,7 @@ nlohmann::json run_lens_step(const LensStep& s) {
   std::vector<std::vector<Vec2>> outlines;
   nlohmann::json found = nlohmann::json::array(), sizes_json = nlohmann::json::array();
   std::vector<std::pair<int, int>> sizes;
-  bool same_size = true, crops = true;
+  bool same_size = true, crops = !s.views.empty();
   std::string crop_note;
   for (std::size_t v = 0; v < s.views.size(); ++v) {
     const ViewImage image = read_view_image(s.merged[v].string());
