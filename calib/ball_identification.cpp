@@ -330,11 +330,14 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
       known |= (b.loc.centre_px - g.centre_px).norm() < 0.3 * b.loc.radius_px &&
                std::abs(b.loc.radius_px - g.radius_px) < 0.3 * b.loc.radius_px;
     if (known) continue;
+    const bool frame_guess = &g == &guesses.front() && rmax >= 0.45 * m;  // inserted first above
     // Hough radii in a textured scene are rough: the guess, then 0.8 and 1.25 times it.
     for (double scale : {1.0, 0.8, 1.25}) {
       BallLocation loc;
       try {
-        loc = locate_ball(image, lens, {g.centre_px, g.radius_px * scale});
+        BallLocateOptions lo;
+        lo.clip_lines = frame_guess;  // its lines all reach the frame
+        loc = locate_ball(image, lens, {g.centre_px, g.radius_px * scale}, lo);
       } catch (const std::invalid_argument&) {
         continue;
       }
@@ -342,12 +345,13 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
       // centre in the image.
       if (!(loc.radius_px >= rmin / 1.25 && loc.radius_px <= 1.25 * rmax) || !lens.in_image(loc.centre_px)) continue;
       BallCandidate c = measure_ball(image, lens, loc);
-      // The frame-filling guess: its circle must show an edge along much of its visible outline (a
-      // few edges of a full frame's furniture fit some huge circle too).
-      const bool frame_guess = &g == &guesses.front() && rmax >= 0.45 * m;
+      // The frame-filling guess's circle, kept for view_candidates when its outline is weak.
       if (frame_guess && fills_frame(loc.radius_px, lens.width(), lens.height()) && c.outline_support >= 0.3 &&
           c.inlier_fraction >= 0.4 && c.loc.fit.rms_px <= o.max_rms_px && !frame_circle)
         frame_circle = loc;
+      // The frame-filling guess stands for a crop's ball: a circle it finds that does not fill the
+      // frame is left to the Hough guesses (their own starts locate it better).
+      if (frame_guess && !fills_frame(loc.radius_px, lens.width(), lens.height())) continue;
       if (!acceptable_outline(c, o)) continue;
       auto same =
           std::find_if(balls.begin(), balls.end(), [&](const BallCandidate& b) { return same_circle(b.loc, loc); });

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 namespace rsibr {
 
@@ -133,16 +134,19 @@ BallLocation locate_ball(const cv::Mat& image, const LensModel& lens, const Ball
   const int lines = options.lines > 0 ? options.lines : std::max(48, static_cast<int>(2 * kPi * guess.radius_px / 1.5));
 
   // Pass 1: radial lines from the guessed centre, up to 3 edge candidates each (RANSAC finds the
-  // ones on one cone among reflections, the stand and the background). A line that leaves the
-  // image is skipped: searched over its part inside, the lines toward a frame that cuts the ball
-  // find only the ball's own shading there, and the start suffers.
+  // ones on one cone among reflections, the stand and the background); a line that leaves the
+  // image is skipped, or with clip_lines searched over its part inside.
   std::vector<Vec3> rays;
   const double band = std::max(4.0, options.search_fraction * guess.radius_px);
   for (int k = 0; k < lines; ++k) {
     const double phi = 2 * kPi * (k + 0.5) / lines;
     const Vec2 n(std::cos(phi), std::sin(phi));
-    for (const Edge& e : find_edges(lum, eps, guess.centre_px, n, guess.radius_px - band, guess.radius_px + band,
-                                    options.min_log_contrast, 3))
+    double t0 = guess.radius_px - band, t1 = guess.radius_px + band;
+    if (options.clip_lines) {
+      std::tie(t0, t1) = inside_part(lum, guess.centre_px, n, t0, t1, 2.5);
+      if (!(t1 - t0 >= 4)) continue;
+    }
+    for (const Edge& e : find_edges(lum, eps, guess.centre_px, n, t0, t1, options.min_log_contrast, 3))
       rays.push_back(lens.unproject(e.px));
   }
   if (rays.size() < 8)

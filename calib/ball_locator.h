@@ -31,6 +31,10 @@ struct BallLocateOptions {
   double search_fraction = 0.25;   // first pass: search radius_px * (1 +- this)
   double refine_px = 3;            // second pass: +- this across the fitted outline
   double min_log_contrast = 0.05;  // edges weaker than this (natural log) are skipped
+  // First pass: search a line that leaves the image over its part inside (for a guess that fills a
+  // crop, whose lines all reach the frame); false: skip it (a ball the frame cuts: the lines toward
+  // the cut would find only the ball's own shading).
+  bool clip_lines = false;
   ConeFitOptions fit;
 };
 
