@@ -3,6 +3,7 @@
 #include "calib/far_camera.h"
 #include "calib/outline_focal.h"
 #include "calib/view_image.h"
+#include "hdr/merge.h"
 
 #include <cmath>
 
@@ -54,17 +55,42 @@ nlohmann::json run_lens_step(const LensStep& s) {
     same_size = same_size && fits;
     const LensModel view_lens = fits ? lens : LensModel::pinhole(std::hypot(double(w), double(h)), w, h);
     ViewCandidates vc = view_candidates(image.radiance, view_lens, s.balls);
+    bool ball_is_chrome = false;
     for (std::size_t b = 0; b < s.balls.size() && v < s.given.size(); ++b)
       if (b < s.given[v].size() && s.given[v][b]) {
         vc.cands.push_back(given_ball(image.radiance, view_lens, *s.given[v][b]));
         vc.pick[b] = int(vc.cands.size()) - 1;
       }
-    // The view's crop evidence: its first listed chrome ball, else its largest ball found.
-    double radius = -1;
-    for (std::size_t b = 0; b < s.balls.size(); ++b)
-      if (vc.pick[b] >= 0 && (radius < 0 || s.balls[b].kind == BallKind::chrome))
-        radius = std::max(s.balls[b].kind == BallKind::chrome ? 0.0 : radius,
-                          vc.cands[std::size_t(vc.pick[b])].loc.radius_px);
+    // The view's evidence: its first listed chrome ball found, else its largest ball found.
+    const BallCandidate* ball = nullptr;
+    for (std::size_t b = 0; b < s.balls.size(); ++b) {
+      if (vc.pick[b] < 0) continue;
+      const BallCandidate& cand = vc.cands[std::size_t(vc.pick[b])];
+      const bool chrome = s.balls[b].kind == BallKind::chrome;
+      if (!ball || (chrome && !ball_is_chrome) ||
+          (!chrome && !ball_is_chrome && cand.loc.radius_px > ball->loc.radius_px))
+        ball = &cand, ball_is_chrome = ball_is_chrome || chrome;
+    }
+    const double radius = ball ? ball->loc.radius_px : -1.0;
+    // A ball whose pixels the brackets disagree on (hdr/merge.h kGhost: a bracket taken from
+    // another place, or cropped elsewhere) has a ghost outline in the merge: found there, it would
+    // be found wrong. More than 2% of its disc ghosted stops the run (a well registered shoot has
+    // under 0.1%).
+    if (ball && !image.flags.empty()) {
+      const Vec2 c = ball->loc.centre_px;
+      long disc = 0, ghost = 0;
+      for (int y = std::max(0, int(c.y() - radius)); y <= std::min(h - 1, int(c.y() + radius)); ++y)
+        for (int x = std::max(0, int(c.x() - radius)); x <= std::min(w - 1, int(c.x() + radius)); ++x)
+          if ((Vec2(x, y) - c).squaredNorm() <= radius * radius) {
+            ++disc;
+            ghost += (image.flags.at<unsigned char>(y, x) & kGhost) != 0;
+          }
+      const double share = disc > 0 ? double(ghost) / double(disc) : 0.0;
+      if (share > 0.02)
+        throw std::invalid_argument("lens: view " + s.views[v] + ": " + std::to_string(int(std::lround(100 * share))) +
+                                    "% of its ball's pixels disagree between brackets (a ghost: a bracket taken from "
+                                    "another place, or cropped elsewhere); leave that bracket out of photoset.yaml");
+    }
     const bool fills = radius > 0 && fills_frame(radius, w, h);
     crops = crops && fills;
     sizes_json.push_back({{"view", s.views[v]}, {"size", {w, h}}, {"ball_radius_px", radius}, {"fills_frame", fills}});
