@@ -484,6 +484,15 @@ assert v[0]['sigma_deg'] == 0 and all(0 < x['sigma_deg'] < 2 for x in v[1:]) and
   "$rsibr" extract "$ov/view01_radiance.exr" --lens "$olens" --poses "$work/poses1.yaml" --out "$work/ext-poses.exr" --size 32 --json "$work/ext-poses.json" -q
   check "extract --poses takes the entry named like the image" python3 -c "
 import json; j = json.load(open('$work/ext-poses.json')); assert j['pose_from_file'] == 'view01' and not j['pose_from_header'], j"
+  "$rsibr" balls "$ov/view00_radiance.exr" --lens "$olens" --picture "$work/balls.png" --json "$work/balls.json" \
+    >"$work/balls.txt"
+  check "balls: the chrome ball is a numbered candidate and taken; the picture is a PNG" python3 -c "
+import json; j = json.load(open('$work/balls.json')); k = j['picks'][0]['candidate']
+assert k >= 0 and j['picks'][0]['kind'] == 'chrome' and 'chrome' in j['candidates'][k]['looks_like'], j
+assert open('$work/balls.png', 'rb').read(4) == b'\\x89PNG'"
+  check "balls: the listing names the candidate the chrome ball takes" grep -q "^chrome: candidate" "$work/balls.txt"
+  expect_error "balls: an unknown kind" "--kinds" balls "$ov/view00_radiance.exr" --kinds chrome,wood
+  expect_error "balls: a malformed --at" "--at" balls "$ov/view00_radiance.exr" --at 1,2
   expect_error "orient: one view" "need at least 2" orient "$ov/view00_radiance.exr" --lens "$olens" --out "$work/or-e1.yaml"
   expect_error "orient: bad --up" "--up" orient "$ov/view00_radiance.exr" "$ov/view01_radiance.exr" --lens "$olens" --out "$work/or-e2.yaml" --up 0,0
   expect_error "orient: two images of one view" "view name 'view00' is already taken" orient "$ov/view00_radiance.exr" "$ov/view00_scene.exr" --lens "$olens" --out "$work/or-e3.yaml"
