@@ -94,6 +94,7 @@ nlohmann::json run_lens_step(const LensStep& s) {
     const bool fills = radius > 0 && fills_frame(radius, w, h);
     crops = crops && fills;
     sizes_json.push_back({{"view", s.views[v]}, {"size", {w, h}}, {"ball_radius_px", radius}, {"fills_frame", fills}});
+    if (ball) sizes_json.back()["ball_centre_px"] = {ball->loc.centre_px.x(), ball->loc.centre_px.y()};
     if (!fills && crop_note.empty())
       crop_note = s.views[v] + (radius > 0 ? "'s ball does not fill its frame" : ": no ball found");
     if (!fits) continue;
