@@ -1,5 +1,7 @@
 #include "capture/camera_response.h"
 
+#include "core/srgb_curve.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -11,9 +13,6 @@ struct NakaRushton {
   double g, a;
 };
 constexpr NakaRushton kMeasured[3] = {{0.62, 0.35}, {0.58, 0.30}, {0.66, 0.42}};
-
-double srgb_encode(double x) { return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055; }
-double srgb_decode(double f) { return f <= 0.04045 ? f / 12.92 : std::pow((f + 0.055) / 1.055, 2.4); }
 
 // The filmic contrast curve on the encoded value u in [0,1] (see the header).
 constexpr double kFilmicW = 0.5, kFilmicA = 1.6;

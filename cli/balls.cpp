@@ -12,13 +12,13 @@
 #include "core/image_codecs.h"
 #include "core/lens_model.h"
 #include "core/output_plan.h"
+#include "core/srgb_curve.h"
 
 #include <opencv2/imgproc.hpp>
 
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 
@@ -67,7 +67,7 @@ int run_balls(const BallsArgs& a) {
     bgr.convertTo(f, CV_32FC3, bgr.depth() == CV_16U ? 1.0 / 65535 : 1.0 / 255);
     cv::cvtColor(f, f, cv::COLOR_BGR2RGB);
     f.forEach<cv::Vec3f>([](cv::Vec3f& p, const int*) {
-      for (int k = 0; k < 3; ++k) p[k] = p[k] <= 0.04045f ? p[k] / 12.92f : std::pow((p[k] + 0.055f) / 1.055f, 2.4f);
+      for (int k = 0; k < 3; ++k) p[k] = float(srgb_decode(p[k]));
     });
     view.radiance = f;
   }
@@ -131,12 +131,10 @@ int run_balls(const BallsArgs& a) {
     if (p >= 0) chosen.push_back(p);
   }
   if (!picture.empty()) {
-    std::vector<unsigned char> bytes;
-    if (!encode_image(".png", ball_candidates_picture(view.radiance, vc.cands, chosen), bytes))
-      throw std::runtime_error(a.picture + ": cannot encode the PNG");
-    std::ofstream f(picture, std::ios::binary);
-    f.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-    if (!f.flush()) throw std::runtime_error(a.picture + ": cannot write");
+    const cv::Mat shown = ball_candidates_picture(view.radiance, vc.cands, chosen);
+    write_atomically(picture, [&](const std::string& tmp) {
+      if (!write_image(tmp, shown)) throw std::runtime_error(a.picture + ": cannot write the PNG image");
+    });
   }
   write_summary(json, {{"image", a.image}, {"width", w}, {"height", h}, {"candidates", cands}, {"picks", picks}});
   outputs.commit();

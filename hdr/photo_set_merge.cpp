@@ -3,6 +3,8 @@
 #include "hdr/alignment.h"
 #include "hdr/bracket_statistics.h"
 
+#include "core/srgb_curve.h"
+
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -48,12 +50,10 @@ PhotoSetResponse recover_photo_set_response(const std::vector<const PhotoView*>&
     r.recovery.margin_sigmas = std::numeric_limits<double>::infinity();
   } else if (r.from.empty() && options.model == "auto") {
     // One exposure per view: no response can be recovered from one photo, so the one photos are
-    // encoded with is stated (IEC 61966-2-1 sRGB, the default of JPEG, HEIF and PNG writers):
-    //   X = u / 12.92 (u <= 0.04045),   X = ((u + 0.055) / 1.055)^2.4 otherwise,   u = z / max_code.
-    // Pixels at the top code stay clipped, merged as lower bounds.
-    r.recovery.curve = ResponseCurve::sampled(
-        "srgb", stats.max_code, stats.max_code == 255 ? 256 : 1024,
-        [](int, double u) { return u <= 0.04045 ? u / 12.92 : std::pow((u + 0.055) / 1.055, 2.4); });
+    // encoded with is stated (sRGB, core/srgb_curve.h, the default of JPEG, HEIF and PNG writers),
+    // at u = z / max_code. Pixels at the top code stay clipped, merged as lower bounds.
+    r.recovery.curve = ResponseCurve::sampled("srgb", stats.max_code, stats.max_code == 255 ? 256 : 1024,
+                                              [](int, double u) { return srgb_decode(u); });
     r.recovery.curve.validate();
     r.recovery.chosen = "sRGB (stated: one exposure per view, nothing to recover a response from)";
     r.recovery.saturation.code = {r.recovery.curve.saturation_code(0), r.recovery.curve.saturation_code(1),
