@@ -1,9 +1,14 @@
 // The lens step (pipeline/lens_step.h) on the cases that need no ball: a measured lens passes
 // through byte for byte in its intrinsics, a metadata lens with nothing to refine it keeps its
-// focal length and says why, and a lens with no focal length at all is an error naming --lens.
+// focal length and says why, and a lens with no focal length at all is an error naming --lens;
+// crops of a rendered ball (the far camera, views of other sizes, a ghosted ball).
 #include "pipeline/lens_step.h"
 
+#include "calib/calib_cases.h"
+#include "calib/far_camera.h"
 #include "core/test_data.h"
+#include "hdr/merge.h"
+#include "hdr/merged_exr.h"
 
 #include <gtest/gtest.h>
 
@@ -59,6 +64,99 @@ TEST(LensStep, NoFocalLengthAndNoOutlineIsAnErrorNamingTheWayOut) {
       EXPECT_NE(std::string(e.what()).find("--lens FILE"), std::string::npos) << e.what();
       EXPECT_NE(std::string(e.what()).find("no focal length"), std::string::npos) << e.what();
     }
+  }
+}
+
+// Crops of one rendered chrome ball (the far-camera model, calib/far_camera.h): views of different
+// sizes whose ball fills the frame get one far pinhole on the largest view's canvas, whatever the
+// metadata said; views of different sizes whose ball does not fill the frame are an error naming
+// their sizes; a ball whose pixels the brackets disagree on stops the step.
+namespace crops {
+
+struct Shoot {
+  cv::Mat radiance;  // the whole rendered frame
+  Vec2 centre;       // the chrome ball's centre pixel in it
+  double radius = 0;
+};
+
+const Shoot& shoot() {
+  static const Shoot s = [] {
+    const LensModel full = LensModel::pinhole(1200, 480, 360);
+    const testing::RenderedView rv = testing::render_view(testing::rig_scene(full, 1.0, false));
+    const Vec3 c = testing::ball_centre_cam(rv, 0);
+    return Shoot{rv.radiance, full.project(c), 1200 * std::tan(std::asin(0.05 / c.norm()))};
+  }();
+  return s;
+}
+
+// A square window of `side` px centred on the ball, written as a merged view with a share `ghost`
+// of the ball's disc flagged kGhost (spread evenly over it).
+std::filesystem::path view(const testing::TempDir& dir, const std::string& name, int side, double ghost = 0) {
+  const Shoot& s = shoot();
+  const int x0 = int(std::lround(s.centre.x() - side / 2.0)), y0 = int(std::lround(s.centre.y() - side / 2.0));
+  MergedImage m;
+  m.radiance = s.radiance(cv::Rect(x0, y0, side, side)).clone();
+  m.variance = cv::Mat::zeros(side, side, CV_32FC3);
+  m.flags = cv::Mat::zeros(side, side, CV_8UC1);
+  const Vec2 c = s.centre - Vec2(x0, y0);
+  for (int y = 0; y < side; ++y)
+    for (int x = 0; x < side; ++x)
+      if ((Vec2(x, y) - c).norm() < s.radius && (x + 7 * y) % 100 < 100 * ghost) m.flags.at<uchar>(y, x) = kGhost;
+  const std::filesystem::path p = dir.path() / (name + ".exr");
+  write_merged_exr(p.string(), m, {{"view", name}});
+  return p;
+}
+
+LensStep two_views(const testing::TempDir& dir, int side_a, int side_b, double ghost = 0) {
+  LensStep s = step_with(dir, "exif", 0.036);
+  s.balls = {{"chrome", BallKind::chrome, 0.1}};
+  s.views = {"a", "b"};
+  s.merged = {view(dir, "a", side_a, ghost), view(dir, "b", side_b)};
+  return s;
+}
+
+}  // namespace crops
+
+TEST(LensStep, CropsOfTheBallGetTheFarCameraOnTheLargestViewsCanvas) {
+  testing::TempDir dir;
+  const double r = crops::shoot().radius;
+  const int a = int(std::lround(2 * r / 0.9)), b = a + 7;  // the ball fills 90% and 88% of the frames
+  const LensStep s = crops::two_views(dir, a, b);
+  const nlohmann::json j = run_lens_step(s);
+  EXPECT_TRUE(j["far_camera"].get<bool>()) << j.dump();
+  const LensModel lens = LensModel::read(s.out);
+  EXPECT_EQ(lens.name(), "LENSMODEL_PINHOLE");
+  EXPECT_EQ(lens.width(), b);
+  EXPECT_EQ(lens.height(), b);
+  EXPECT_DOUBLE_EQ(lens.intrinsics().at(0), kFarCameraFocalPerSide * b);
+  EXPECT_LT(j["ball_half_angle_deg"].get<double>(), 0.29);
+  for (const auto& v : j["views"]) EXPECT_NEAR(v["ball_radius_px"].get<double>(), r, 0.02 * r) << v.dump();
+}
+
+TEST(LensStep, ViewsOfDifferentSizesThatAreNotCropsAreAnErrorNamingThem) {
+  testing::TempDir dir;
+  const int a = int(std::lround(crops::shoot().radius * 3.5));  // the ball fills 57%: no crop
+  const LensStep s = crops::two_views(dir, a, a + 1);
+  try {
+    run_lens_step(s);
+    FAIL() << "views of two sizes were given one lens";
+  } catch (const std::invalid_argument& e) {
+    const std::string want = "the views differ in size (a " + std::to_string(a) + "x" + std::to_string(a) + ", b " +
+                             std::to_string(a + 1) + "x" + std::to_string(a + 1) + ")";
+    EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+  }
+}
+
+TEST(LensStep, ABallTheBracketsDisagreeOnStopsTheStepButAFewGhostPixelsDoNot) {
+  testing::TempDir dir;
+  const int a = int(std::lround(2 * crops::shoot().radius / 0.9));
+  EXPECT_NO_THROW(run_lens_step(crops::two_views(dir, a, a, 0.01)));  // 1% of the disc: kept
+  try {
+    run_lens_step(crops::two_views(dir, a, a, 0.05));
+    FAIL() << "a ghosted ball was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("view a: "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("disagree between brackets"), std::string::npos) << e.what();
   }
 }
 
