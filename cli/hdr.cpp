@@ -304,9 +304,9 @@ int run_hdr(const HdrArgs& a) {
           {"radianceUnit", "X/e: signal over saturation per relative exposure t*iso/100/N^2"},
           {"colourSpace", working},
           {"inputColourSpace", from.empty() ? working : from},
-          {"alignment", alignment == Alignment::off
-                            ? "none"
-                            : std::string("MTB (") + to_string(alignment) + "), shifts " + shift_text},
+          {"alignment", alignment == Alignment::off ? "none"
+                                                    : std::string("median threshold bitmaps, coarse to fine (") +
+                                                          to_string(alignment) + "), shifts " + shift_text},
           {"ghosts", a.deghost ? "flagged; longest usable bracket alone" : "flagged; merged as usual"},
           {"flags",
            "clipped: lower bound (saturated in every bracket); black: nothing recorded; ghost: brackets disagree"}};
@@ -369,6 +369,8 @@ int run_hdr(const HdrArgs& a) {
                            {"found", fj},
                            {"mismatch_before", vm.alignment.mismatch_before},
                            {"mismatch_after", vm.alignment.mismatch_after},
+                           {"rotations_deg", vm.alignment.rotation_deg},
+                           {"beyond_search", vm.alignment.beyond_search},
                            {"file_sizes", sizes},
                            {"sizes_fitted", b.fitted_sizes}};
         vj["alignment_shifts"] = sj;

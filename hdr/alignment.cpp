@@ -3,6 +3,8 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/photo.hpp>
 
+#include "core/vec.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -39,6 +41,119 @@ cv::Mat shifted(const cv::Mat& m, cv::Point s, int border, const cv::Scalar& fil
   return out;
 }
 
+// The motion that moves a bracket onto the middle one: a rotation by `deg` about the image centre,
+// then the shift (pixels, x right, y down).
+cv::Mat motion_matrix(cv::Size size, cv::Point2d shift, double deg) {
+  cv::Mat M =
+      cv::getRotationMatrix2D(cv::Point2f(0.5f * float(size.width - 1), 0.5f * float(size.height - 1)), deg, 1.0);
+  M.at<double>(0, 2) += shift.x;
+  M.at<double>(1, 2) += shift.y;
+  return M;
+}
+
+cv::Mat moved(const cv::Mat& m, cv::Point shift, double deg, int border, const cv::Scalar& fill = cv::Scalar()) {
+  if (deg == 0) return shifted(m, shift, border, fill);
+  cv::Mat out;
+  cv::warpAffine(m, out, motion_matrix(m.size(), shift, deg), m.size(), cv::INTER_NEAREST, border, fill);
+  return out;
+}
+
+// One level of the search: the threshold and exclusion bitmaps (0 / 255) of both images.
+struct Level {
+  cv::Mat tb_a, eb_a, tb_b, eb_b;
+};
+
+// Disagreement of b moved by (shift, deg) with a: the disagreeing fraction of the compared pixels
+// (-1 when fewer than `min_compared` of the frame are compared). An integer shift is compared on
+// the overlap directly; a rotation warps b's bitmaps.
+double level_mismatch(const Level& l, cv::Point shift, double deg, double min_compared) {
+  const int W = l.tb_a.cols, H = l.tb_a.rows;
+  long n = 0, d = 0;
+  if (deg == 0) {
+    const int x0 = std::max(0, shift.x), x1 = std::min(W, W + shift.x), y0 = std::max(0, shift.y),
+              y1 = std::min(H, H + shift.y);
+    if (x1 <= x0 || y1 <= y0) return -1;
+    const cv::Rect ra(x0, y0, x1 - x0, y1 - y0), rb = ra - shift;
+    const cv::Mat both = l.eb_a(ra) & l.eb_b(rb);
+    n = cv::countNonZero(both);
+    d = cv::countNonZero((l.tb_a(ra) ^ l.tb_b(rb)) & both);
+  } else {
+    const cv::Mat M = motion_matrix(l.tb_b.size(), shift, deg);
+    cv::Mat tb, eb;
+    cv::warpAffine(l.tb_b, tb, M, l.tb_b.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(0));
+    cv::warpAffine(l.eb_b, eb, M, l.eb_b.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(0));
+    const cv::Mat both = eb & l.eb_a;
+    n = cv::countNonZero(both);
+    d = cv::countNonZero((tb ^ l.tb_a) & both);
+  }
+  if (double(n) < min_compared * double(W) * double(H)) return -1;
+  return double(d) / double(n);
+}
+
+// The motion of b onto a, coarse to fine (see alignment.h). `at_edge`: the coarse search's best
+// shift lies on the edge of its window (the true one may lie beyond it).
+struct Motion {
+  cv::Point shift;
+  double deg = 0;
+  bool at_edge = false;
+};
+
+Motion search_motion(const std::vector<Level>& levels) {
+  const Level& top = levels.back();
+  const int W = top.tb_a.cols, H = top.tb_a.rows;
+  // Exhaustive over a quarter of the frame's shorter side at the coarsest level; the nearer of two
+  // equal shifts wins (a repeated pattern must not pull the bracket a period away).
+  const int R = std::max(2, (std::min(W, H) + 3) / 4);
+  Motion m;
+  double best = 2;
+  for (int dy = -R; dy <= R; ++dy)
+    for (int dx = -R; dx <= R; ++dx) {
+      const double e = level_mismatch(top, {dx, dy}, 0, 0.25);
+      if (e < 0) continue;
+      const double cost = e + 1e-4 * std::hypot(dx, dy);
+      if (cost < best) best = cost, m.shift = {dx, dy};
+    }
+  if (best > 1) return m;
+  m.at_edge = std::abs(m.shift.x) == R || std::abs(m.shift.y) == R;
+  // Small rotations (a handheld camera rolls a little between shots): the step turns the frame's
+  // corners by about a pixel; kept only when it lowers the disagreement by 5% or more.
+  constexpr double kMaxDeg = 3;
+  auto step_deg = [](const Level& l) { return std::atan(1.0 / (0.5 * std::hypot(l.tb_a.cols, l.tb_a.rows))) / kDeg; };
+  {
+    const double step = step_deg(top), flat = level_mismatch(top, m.shift, 0, 0.25);
+    double best_rot = flat;
+    Motion r = m;
+    for (double deg = -kMaxDeg; deg <= kMaxDeg + 1e-9; deg += step) {
+      if (std::abs(deg) < 0.5 * step) continue;
+      for (int dy = -2; dy <= 2; ++dy)
+        for (int dx = -2; dx <= 2; ++dx) {
+          const double e = level_mismatch(top, m.shift + cv::Point(dx, dy), deg, 0.25);
+          if (e >= 0 && e < best_rot) best_rot = e, r.shift = m.shift + cv::Point(dx, dy), r.deg = deg;
+        }
+    }
+    if (best_rot < 0.95 * flat) m.shift = r.shift, m.deg = r.deg;
+  }
+  // Finer levels: the shift doubled, then the best of its neighbours within 2 pixels (a coarse
+  // level's smooth bitmaps can misjudge by one of its pixels, two of the next level's), or within 1
+  // and one angle step either way when it turns (each a warp of the whole level).
+  for (std::size_t k = levels.size() - 1; k-- > 0;) {
+    const Level& l = levels[k];
+    m.shift *= 2;
+    const double step = m.deg == 0 ? 0 : step_deg(l);
+    const int reach = m.deg == 0 ? 2 : 1;
+    Motion b = m;
+    double be = 2;
+    for (int a = m.deg == 0 ? 0 : -1; a <= (m.deg == 0 ? 0 : 1); ++a)
+      for (int dy = -reach; dy <= reach; ++dy)
+        for (int dx = -reach; dx <= reach; ++dx) {
+          const double e = level_mismatch(l, m.shift + cv::Point(dx, dy), m.deg + a * step, 0.25);
+          if (e >= 0 && e < be) be = e, b.shift = m.shift + cv::Point(dx, dy), b.deg = m.deg + a * step;
+        }
+    m.shift = b.shift, m.deg = b.deg;
+  }
+  return m;
+}
+
 }  // namespace
 
 const char* to_string(Alignment a) {
@@ -62,6 +177,8 @@ AlignmentResult align_brackets(BracketSet& b, Alignment mode, int max_bits) {
   AlignmentResult res;
   res.shifts.assign(P, cv::Point(0, 0));
   res.found.assign(P, cv::Point(0, 0));
+  res.rotation_deg.assign(P, 0.0);
+  res.beyond_search.assign(P, false);
   res.mismatch_before.assign(P, 0.0);
   res.mismatch_after.assign(P, 0.0);
   if (P < 2 || mode == Alignment::off) return res;
@@ -73,43 +190,70 @@ AlignmentResult align_brackets(BracketSet& b, Alignment mode, int max_bits) {
     cv::cvtColor(eight, grey[j], cv::COLOR_RGB2GRAY);
   }
   const std::size_t mid = P / 2;
-  // Each pyramid level halves the image; keep the coarsest level at least 16 pixels across.
-  int bits = 0;
-  while (bits < max_bits && (std::min(b.rows(), b.cols()) >> (bits + 1)) >= 16) ++bits;
-  // Under 32 px a side there is no pyramid to search (and OpenCV's MTB crashes without one).
-  if (bits == 0) return res;
-  auto mtb = cv::createAlignMTB(bits, 4, true);
-  std::vector<cv::Mat> tb(P), eb(P);
+  // Levels: each halves the image, down to a coarsest level of at most 128 pixels on its shorter
+  // side (and at least 16).
+  int levels = 1;
+  while ((std::min(b.rows(), b.cols()) >> (levels - 1)) > 128 && (std::min(b.rows(), b.cols()) >> levels) >= 16)
+    ++levels;
+  // Under 32 px a side there is nothing to search.
+  if (std::min(b.rows(), b.cols()) < 32) return res;
+  auto mtb = cv::createAlignMTB(max_bits, 4, true);
+  // Per bracket, per level: grey image and coverage, halved with area averaging.
+  std::vector<std::vector<cv::Mat>> tb(P), eb(P);
   for (std::size_t j = 0; j < P; ++j) {
-    mtb->computeBitmaps(grey[j], tb[j], eb[j]);
-    if (j < b.covered.size() && !b.covered[j].empty()) eb[j] &= b.covered[j];  // padding is no evidence
+    cv::Mat g = grey[j], cov;
+    if (j < b.covered.size() && !b.covered[j].empty()) cov = b.covered[j];
+    for (int k = 0; k < levels; ++k) {
+      if (k > 0) {
+        cv::resize(g, g, cv::Size((g.cols + 1) / 2, (g.rows + 1) / 2), 0, 0, cv::INTER_AREA);
+        if (!cov.empty()) cv::resize(cov, cov, g.size(), 0, 0, cv::INTER_NEAREST);
+      }
+      cv::Mat t, e;
+      mtb->computeBitmaps(g, t, e);
+      if (!cov.empty()) e &= cov;  // padding is no evidence
+      tb[j].push_back(t), eb[j].push_back(e);
+    }
   }
   for (std::size_t j = 0; j < P; ++j) {
     if (j == mid) continue;
-    // calculateShift(img0, img1) is the shift that moves img1 onto img0.
-    const cv::Point s = mtb->calculateShift(grey[mid], grey[j]);
+    std::vector<Level> pyr;
+    for (std::size_t k = 0; k < std::size_t(levels); ++k) pyr.push_back({tb[mid][k], eb[mid][k], tb[j][k], eb[j][k]});
+    const Motion found = search_motion(pyr);
+    const cv::Point s = found.shift;
     res.found[j] = s;
     int n0 = 0, n1 = 0;
-    res.mismatch_before[j] = mismatch(tb[mid], eb[mid], tb[j], eb[j], cv::Point(0, 0), &n0);
-    res.mismatch_after[j] =
-        s == cv::Point(0, 0) ? res.mismatch_before[j] : mismatch(tb[mid], eb[mid], tb[j], eb[j], s, &n1);
-    if (s == cv::Point(0, 0)) continue;
+    res.mismatch_before[j] = mismatch(tb[mid][0], eb[mid][0], tb[j][0], eb[j][0], cv::Point(0, 0), &n0);
+    if (s == cv::Point(0, 0) && found.deg == 0) {
+      res.mismatch_after[j] = res.mismatch_before[j];
+      continue;
+    }
+    {
+      const cv::Mat t = moved(tb[j][0], s, found.deg, cv::BORDER_CONSTANT),
+                    e = moved(eb[j][0], s, found.deg, cv::BORDER_CONSTANT);
+      res.mismatch_after[j] = mismatch(tb[mid][0], eb[mid][0], t, e, cv::Point(0, 0), &n1);
+    }
+    // A best shift on the edge of the search window may be short of the true one: not applied.
+    if (found.at_edge) {
+      res.beyond_search[j] = true;
+      continue;
+    }
     const double enough = kMinCompared * double(b.rows()) * double(b.cols());
     // Disagreeing pixels before and after: the drop must also stand out of their counting noise
-    // (small or mostly white frames give a few dozen, and MTB picks the shift that happens to
-    // lower them).
+    // (small or mostly white frames give a few dozen, and the search picks the shift that happens
+    // to lower them).
     const double d0 = res.mismatch_before[j] * n0, d1 = res.mismatch_after[j] * n1;
     const bool better = double(n0) >= enough && double(n1) >= enough && res.mismatch_before[j] > 0 &&
                         res.mismatch_after[j] <= kAcceptRatio * res.mismatch_before[j] &&
                         d0 - d1 > 4.0 * std::sqrt(d0 + d1) + 20.0;
     if (mode == Alignment::automatic && !b.fitted_sizes && !better) continue;
     res.shifts[j] = s;
-    b.codes[j] = shifted(b.codes[j], s, cv::BORDER_REPLICATE);
+    res.rotation_deg[j] = found.deg;
+    b.codes[j] = moved(b.codes[j], s, found.deg, cv::BORDER_REPLICATE);
     if (j < b.saturated.size() && !b.saturated[j].empty())
-      b.saturated[j] = shifted(b.saturated[j], s, cv::BORDER_REPLICATE);
+      b.saturated[j] = moved(b.saturated[j], s, found.deg, cv::BORDER_REPLICATE);
     if (b.covered.size() < P) b.covered.resize(P);
     const cv::Mat cov = b.covered[j].empty() ? cv::Mat(b.codes[j].size(), CV_8UC1, cv::Scalar(255)) : b.covered[j];
-    b.covered[j] = shifted(cov, s, cv::BORDER_CONSTANT, cv::Scalar(0));
+    b.covered[j] = moved(cov, s, found.deg, cv::BORDER_CONSTANT, cv::Scalar(0));
   }
   return res;
 }

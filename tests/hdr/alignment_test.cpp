@@ -111,6 +111,72 @@ TEST(Alignment, AHandheldShiftIsUndoneAutomaticallyAndItsUncoveredEdgeLeftOut) {
   }
 }
 
+// A larger scene without repeats (smoothed random blobs), three brackets through a gamma camera.
+TexturedShoot blob_shoot(int rows, int cols, unsigned seed = 7) {
+  TexturedShoot s;
+  cv::Mat noise(rows, cols, CV_64FC1);
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
+  cv::GaussianBlur(noise, noise, cv::Size(0, 0), 2.5);
+  cv::normalize(noise, noise, 0.2, 2.0, cv::NORM_MINMAX);
+  s.L.create(rows, cols, CV_64FC3);
+  for (int r = 0; r < rows; ++r)
+    for (int x = 0; x < cols; ++x) {
+      const double v = noise.at<double>(r, x);
+      s.L.at<cv::Vec3d>(r, x) = cv::Vec3d(v, 0.9 * v, 0.8 * v);
+    }
+  testing::BracketCamera cam;
+  cam.max_code = 255;
+  cam.response = [](int, double X) { return std::pow(X, 1 / 2.2); };
+  s.images = testing::synthesize(s.L, s.e, cam, seed);
+  return s;
+}
+
+// A handheld bracket moved by a sixth of the frame, beyond what six levels of MTB reach (63 px):
+// the coarse search finds it and the merge has no ghost left but at the uncovered edge.
+TEST(Alignment, AShiftOfASixthOfTheFrameIsUndone) {
+  TexturedShoot s = blob_shoot(480, 640);
+  s.images[0] = moved(s.images[0], 110, -80);
+  const BracketSet unaligned = make_brackets(s.images, s.e);
+  BracketSet b = make_brackets(s.images, s.e);
+  const AlignmentResult r = align_brackets(b, Alignment::automatic);
+  EXPECT_EQ(r.shifts[0], cv::Point(-110, 80));
+  EXPECT_EQ(r.rotation_deg[0], 0.0);
+  EXPECT_FALSE(r.beyond_search[0]);
+  const double px = 480.0 * 640;
+  EXPECT_GT(ghosts(unaligned) / px, 0.05);
+  EXPECT_LT(ghosts(b) / px, 0.005);
+}
+
+// A handheld camera rolls too: a bracket turned by 1.5 degrees and moved is registered with the
+// rotation, and its ghosts go with it.
+TEST(Alignment, ASmallRollIsUndone) {
+  TexturedShoot s = blob_shoot(480, 640, 9);
+  cv::Mat M = cv::getRotationMatrix2D(cv::Point2f(319.5f, 239.5f), 1.5, 1.0);
+  M.at<double>(0, 2) += 12, M.at<double>(1, 2) -= 7;
+  cv::warpAffine(s.images[2], s.images[2], M, s.images[2].size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  const BracketSet unaligned = make_brackets(s.images, s.e);
+  BracketSet b = make_brackets(s.images, s.e);
+  const AlignmentResult r = align_brackets(b, Alignment::automatic);
+  EXPECT_NEAR(r.rotation_deg[2], -1.5, 0.3);  // two angle steps of the finest level (a pixel at the corners each)
+  EXPECT_LT(r.mismatch_after[2], 0.3 * r.mismatch_before[2]);
+  const double px = 480.0 * 640;
+  EXPECT_GT(ghosts(unaligned) / px, 0.05);
+  EXPECT_LT(ghosts(b) / px, 0.01);
+  EXPECT_EQ(r.rotation_deg[0], 0.0);  // the other bracket was not turned
+}
+
+// A bracket of another scene entirely (shot elsewhere): no motion makes it agree, so the
+// automatic mode leaves it where it is (the merge flags it as ghost).
+TEST(Alignment, ABracketOfAnotherSceneIsNotMoved) {
+  TexturedShoot s = blob_shoot(240, 320, 11);
+  s.images[0] = blob_shoot(240, 320, 12).images[0];
+  BracketSet b = make_brackets(s.images, s.e);
+  const AlignmentResult r = align_brackets(b, Alignment::automatic);
+  EXPECT_EQ(r.shifts[0], cv::Point(0, 0));
+  EXPECT_EQ(r.rotation_deg[0], 0.0);
+}
+
 // A smooth, noisy scene: the threshold bitmaps are mostly noise and MTB may report a shift, but
 // it does not make them agree better, so the automatic mode keeps the frame.
 // Brackets white almost everywhere (the long end of a sunny bracket set): no bitmap to compare,
