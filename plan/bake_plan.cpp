@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -117,18 +118,24 @@ struct Pilots {
       // overhead and rows the threads cannot share (4x a bake's per-texel time for MIS 64 on 2
       // cores). A bake integrates whole maps: one whole map, the largest of timing_size, its half
       // and its quarter whose predicted time is at most a quarter of a second, times that (repeated
-      // to at least 50 ms: a shorter time is mostly the scheduler's, and the candidates' order by
-      // predicted time would follow it).
+      // to at least 25 ms: a shorter time is mostly the scheduler's), the fastest of three such
+      // windows (a window where other processes took the cores is slower, never faster: without
+      // the minimum, the candidates' order by predicted time followed the machine's load, and two
+      // runs of one plan chose differently on a busy machine).
       int size = timing_size;
       while (size > 32 && p.seconds_per_texel * double(disc_texel_count(size)) > 0.25) size /= 2;
       if (p.seconds_per_texel * double(disc_texel_count(size)) <= 0.25) {
-        const auto t = std::chrono::steady_clock::now();
-        long long texels = 0;
-        do {
-          chosen.radiance_map(brdf, sample.view(0), sample.frame(0), size, options_of(s, seed));
-          texels += disc_texel_count(size);
-        } while (seconds_since(t) < 0.05);
-        p.seconds_per_texel = seconds_since(t) / double(texels);
+        double fastest = std::numeric_limits<double>::infinity();
+        for (int window = 0; window < 3; ++window) {
+          const auto t = std::chrono::steady_clock::now();
+          long long texels = 0;
+          do {
+            chosen.radiance_map(brdf, sample.view(0), sample.frame(0), size, options_of(s, seed));
+            texels += disc_texel_count(size);
+          } while (seconds_since(t) < 0.025);
+          fastest = std::min(fastest, seconds_since(t) / double(texels));
+        }
+        p.seconds_per_texel = fastest;
       }
       integrators.push_back(p);
     }
