@@ -1,5 +1,6 @@
 #include "calib/probe.h"
 
+#include "core/exr_io.h"
 #include "core/parallel.h"
 #include "core/sphere_map.h"
 #include "core/luminance.h"
@@ -184,6 +185,12 @@ Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
   probe.covered_fraction = a > 0 ? c / a : 0;
   probe.clipped_fraction = a > 0 ? cl / a : 0;
   return probe;
+}
+
+void write_probe(const std::string& path, const EnvMap& env, const cv::Mat& confidence, const cv::Mat& flags) {
+  cv::Mat f;
+  flags.convertTo(f, CV_32F);
+  write_environment(path, env, {}, {{"confidence", confidence}, {"flags", f}});
 }
 
 }  // namespace rsibr

@@ -34,6 +34,15 @@ namespace rsibr {
 // --chrome-fresnel): a conductor with chromium-like optical constants, n = 2.9 / 2.9 / 2.6 and
 // k = 3.4 / 3.4 / 3.2 (R / G / B), about 57% at normal incidence and rising to 1 at grazing, as
 // chrome-plated steel balls measure (55-65% across the visible). "none" keeps F L in the probe.
+// What a texel of a finished probe (DIR/probe.exr) is, in its `flags` channel; its `confidence`
+// channel is the summed confidence of the views' trusted lookups (Probe::weight), 0 unless measured.
+//   kProbeLowerBound  clipped in every view that saw it and not recovered: the largest clipped
+//                     value (Probe::lower_bound); the light there is at least this
+//   kProbeSource      clipped, and a light source recovered from the grey balls lies there
+//   kProbeFilled      no view saw it (behind the ball, the stand, the masked camera): filled from
+//                     the seen surroundings (calib/probe_fill.h), no measurement
+enum ProbeFlag : unsigned char { kProbeLowerBound = 1, kProbeSource = 2, kProbeFilled = 4 };
+
 inline constexpr const char* kDefaultChromeFresnel = "{type: conductor, eta: [2.9, 2.9, 2.6], k: [3.4, 3.4, 3.2]}";
 
 struct ProbeOptions {
@@ -53,5 +62,9 @@ struct Probe {
 
 // Throws std::invalid_argument when the set is empty or has no confidence channel (not captured).
 Probe assemble_probe(const MapSet& chrome, const ProbeOptions& options = {});
+
+// Writes a finished probe atomically: R, G, B and the `confidence` and `flags` channels (CV_32FC1
+// and CV_8UC1 of the map's size; ProbeFlag bits). Throws FileError(path, problem).
+void write_probe(const std::string& path, const EnvMap& env, const cv::Mat& confidence, const cv::Mat& flags);
 
 }  // namespace rsibr

@@ -24,7 +24,7 @@ struct ProbeArgs {
   std::string out, fresnel = kDefaultChromeFresnel, json, glossy_brdf;
   double grey_albedo = 0.18;
   int width = 512;
-  bool quiet = false, sanitize = false;
+  bool quiet = false, sanitize = false, fill = true;
 };
 
 // Captured normal-warp map sets (grey or glossy balls) for the source recovery.
@@ -101,15 +101,18 @@ int run_probe(const ProbeArgs& a) {
   RecoveredProbe rp =
       recover_probe_sources(all, o, grey, glossy, SourceRecoveryOptions{}, !grey.empty() || !glossy.empty());
   const Probe& p = rp.measured;
+  const double filled = a.fill ? fill_unseen_directions(rp, o.min_weight) : 0.0;
   rp.env.attributes["views"] = std::to_string(all.views.size());
+  if (a.fill) rp.env.attributes["filled"] = "push-pull of log radiance (flags channel: 4)";
   if (fresnel) rp.env.attributes["fresnel"] = fresnel->spec();
-  write_environment(exr, rp.env);
+  write_recovered_probe(exr, rp, o.min_weight);
   nlohmann::json j;
   j["maps"] = a.maps;
   j["out"] = a.out;
   j["views"] = all.views.size();
   j["width"] = a.width;
   j["covered_fraction"] = p.covered_fraction;
+  j["filled_fraction"] = filled;
   j["values_sanitized"] = sanitized;
   j["fresnel"] = fresnel ? fresnel->spec() : "none";
   j["light_sources"] = rp.summary;
@@ -137,10 +140,14 @@ Runner add_probe(CLI::App& app) {
       "rsibr bake; default: chrome, '" +
       std::string(kDefaultChromeFresnel) +
       "', about 57% at normal incidence; "
-      "'none' keeps F L). Directions no view saw are 0. Directions clipped in every bracket of every view that saw "
-      "them (a sun) are light the probe lacks: with --grey (a grey ball's captured maps in the same world frame) "
-      "each such region is recovered as a compact source from the grey ball's shading (and a glossy ball's with "
-      "--glossy and --glossy-brdf) and written into the probe, listed in its header (rsibr.lightSources) and --json.\n"
+      "'none' keeps F L). Directions no view saw (behind the ball, the masked camera) are filled from their "
+      "surroundings (a push-pull of log radiance; --no-fill leaves them 0). Directions clipped in every bracket of "
+      "every view that saw them (a sun) keep the largest clipped value, a lower bound: with --grey (a grey ball's "
+      "captured maps in the same world frame) each such region is recovered as a compact source from the grey "
+      "ball's shading (and a glossy ball's with --glossy and --glossy-brdf) and written into the probe, listed in "
+      "its header (rsibr.lightSources) and --json. The output's `confidence` channel is the views' summed "
+      "confidence (0 where nothing was measured) and its `flags` channel 1 for a lower bound, 2 for a recovered "
+      "source, 4 for a filled texel.\n"
       "Example: rsibr probe north.exr south.exr east.exr --out probe.exr --fresnel '{type: schlick, f0: [0.6, 0.6, 0.6]}'");
   c->add_option("maps", a->maps, "Captured map sets (chrome)")->required();
   c->add_option("--out", a->out, "Output lat-long EXR")->required();
@@ -158,6 +165,7 @@ Runner add_probe(CLI::App& app) {
   c->add_flag("--sanitize", a->sanitize,
               "Zero NaN, Inf and absurd (> 1e30) values of the map sets (and clamp their "
               "confidences to [0, 1]) instead of failing; the JSON counts them");
+  c->add_flag("!--no-fill", a->fill, "Leave the directions no view saw at 0 (with confidence 0, flags 0)");
   c->add_flag("-q,--quiet", a->quiet, "No report line");
   return [a] { return run_probe(*a); };
 }

@@ -137,13 +137,19 @@ EnvMap read_environment(const std::string& path, std::optional<LayoutKind> hint,
   return map;
 }
 
-void write_environment(const std::string& path, const EnvMap& map, const ExrWriteOptions& options) {
+void write_environment(const std::string& path, const EnvMap& map, const ExrWriteOptions& options,
+                       const ExrExtraChannels& extra_channels) {
   const int W = map.pixels.cols, H = map.pixels.rows, ch = map.pixels.channels();
   if (map.pixels.depth() != CV_32F || (ch != 1 && ch != 3 && ch != 4))
     refuse(path, "internal: pixels must be float with 1, 3 or 4 channels");
   if (W != map.layout.width() || H != map.layout.height()) refuse(path, "internal: pixels do not match the layout");
   ExrPartOut part;
   for (int k = 0; k < ch; ++k) part.channels.push_back({ch == 1 ? "Y" : std::string(1, "RGBA"[k]), map.pixels, k});
+  for (const auto& [name, m] : extra_channels) {
+    if (m.type() != CV_32FC1 || m.cols != W || m.rows != H)
+      refuse(path, "internal: channel " + name + " must be float, one channel, of the map's size");
+    part.channels.push_back({name, m, 0});
+  }
   part.half = options.half;
   if (map.layout.kind() == LayoutKind::LatLong) part.envmap = ExrEnvmap::LatLong;
   if (map.layout.kind() == LayoutKind::Cube) part.envmap = ExrEnvmap::Cube;

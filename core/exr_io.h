@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace rsibr {
 
@@ -33,9 +34,14 @@ struct ExrWriteOptions {
   bool half = false;  // half float output; values beyond +-65504 are an error, never a silent Inf
 };
 
+// More channels beside the pixels: (name, CV_32FC1 of the map's size), stored like them (e.g. a
+// probe's confidence and flags). read_environment reads R, G, B (or Y) and ignores them.
+using ExrExtraChannels = std::vector<std::pair<std::string, cv::Mat>>;
+
 // Writes atomically (temporary name, then rename). Writes `envmap` for lat-long and cube,
 // `rsibr.layout` always, Rec.709 `chromaticities`, and map.attributes as string attributes
 // (names must stay under 32 characters). Throws FileError(path, problem).
-void write_environment(const std::string& path, const EnvMap& map, const ExrWriteOptions& options = {});
+void write_environment(const std::string& path, const EnvMap& map, const ExrWriteOptions& options = {},
+                       const ExrExtraChannels& extra_channels = {});
 
 }  // namespace rsibr

@@ -1,6 +1,7 @@
 #include "lights/recovered_probe.h"
 
 #include "bake/brdf_spec.h"
+#include "calib/probe_fill.h"
 #include "core/yaml_spec.h"
 #include "lights/probe_sources.h"
 
@@ -69,6 +70,20 @@ RecoveredProbe recover_probe_sources(const MapSet& chrome, const ProbeOptions& p
   for (const LightSource& s : out.recovery.sources) recovered += s.power, recovered_var += s.power_sigma.cwiseAbs2();
   std::set<int> done;
   for (const LightSource& s : out.recovery.sources) done.insert(s.region);
+  // Texels of a region nothing recovered keep the light measured there: at least the lower bound.
+  out.flags = cv::Mat(measured.env.pixels.size(), CV_8UC1, cv::Scalar(0));
+  for (std::size_t i = 0; i < out.regions.size(); ++i)
+    for (const long t : out.regions[i].texels) {
+      const int y = int(t / out.flags.cols), x = int(t % out.flags.cols);
+      if (done.count(int(i))) {
+        out.flags.at<uchar>(y, x) = kProbeSource;
+        continue;
+      }
+      out.flags.at<uchar>(y, x) = kProbeLowerBound;
+      cv::Vec3f& p = out.env.pixels.at<cv::Vec3f>(y, x);
+      const cv::Vec3f b = measured.lower_bound.at<cv::Vec3f>(y, x);
+      for (int k = 0; k < 3; ++k) p[k] = std::max(p[k], b[k]);
+    }
   nlohmann::json regions = nlohmann::json::array();
   for (std::size_t i = 0; i < out.regions.size(); ++i) {
     const ClippedRegion& g = out.regions[i];
@@ -90,7 +105,7 @@ RecoveredProbe recover_probe_sources(const MapSet& chrome, const ProbeOptions& p
     if (i >= 0 && std::size_t(i) < regions.size()) regions[std::size_t(i)]["note"] = out.recovery.notes[k];
   }
   if (!recover)
-    for (auto& r : regions) r["note"] = "recovery off: the probe keeps it clipped";
+    for (auto& r : regions) r["note"] = "recovery off: the probe keeps its lower bound";
   nlohmann::json residuals = nlohmann::json::array();
   for (const BallResidual& b : out.recovery.residuals) {
     nlohmann::json views = nlohmann::json::array();
@@ -121,6 +136,20 @@ RecoveredProbe recover_probe_sources(const MapSet& chrome, const ProbeOptions& p
   return out;
 }
 
+double fill_unseen_directions(RecoveredProbe& probe, double min_weight) {
+  const cv::Mat trusted = probe.measured.weight >= min_weight;
+  const cv::Mat unseen = (trusted == 0) & (probe.flags == 0);
+  const double filled = fill_unseen(probe.env, trusted, unseen);
+  probe.flags.setTo(kProbeFilled, unseen);
+  return filled;
+}
+
+void write_recovered_probe(const std::string& path, const RecoveredProbe& probe, double min_weight) {
+  cv::Mat confidence = probe.measured.weight.clone();
+  confidence.setTo(0, probe.measured.weight < min_weight);
+  write_probe(path, probe.env, confidence, probe.flags);
+}
+
 std::string light_sources_line(const nlohmann::json& s) {
   if (!s.contains("regions") || s["regions"].empty()) return "";
   const std::size_t regions = s["regions"].size(), sources = s.value("sources", nlohmann::json::array()).size();
@@ -143,9 +172,11 @@ std::string light_sources_line(const nlohmann::json& s) {
     o << "recovered " << sources << " from " << (from.empty() ? "-" : from) << ": " << pct(s["missing_fraction"])
       << " of the probe's light";
     if (sources < regions)
-      o << "; " << regions - sources << " not recovered (at least " << pct(s["lower_bound_fraction"]) << " missing)";
+      o << "; " << regions - sources << " not recovered (kept at their lower bounds, " << pct(s["lower_bound_fraction"])
+        << " of the light)";
   } else {
-    o << "none recovered: at least " << pct(s["lower_bound_fraction"]) << " of the light is missing from the probe";
+    o << "none recovered: " << pct(s["lower_bound_fraction"])
+      << " of the probe's light is only a lower bound (clipped in every bracket; it may be far brighter)";
   }
   return o.str();
 }

@@ -12,8 +12,8 @@
 //   recovered_power      sum of the sources' powers (RGB), and its sigma (root sum of squares)
 //   missing_fraction     recovered / (measured + recovered) per channel: the share of the final
 //                        probe's light that the measured one lacked
-//   lower_bound_fraction the regions' lower bounds / (measured + lower bounds): at least this much
-//                        is missing where nothing was recovered
+//   lower_bound_fraction the unrecovered regions' lower bounds / (measured + lower bounds): the
+//                        share of the probe's light that is only a lower bound (they are in it)
 //   residuals[]          per ball: relative RMS of captured vs computed from the probe, before and
 //                        after (lights/source_recovery.h BallResidual), per view too
 #pragma once
@@ -30,7 +30,8 @@ namespace rsibr {
 
 struct RecoveredProbe {
   Probe measured;  // the chrome maps' blend (calib/probe.h)
-  EnvMap env;      // the probe with the sources added (a copy when none)
+  EnvMap env;      // the probe with the sources added, and the lower bounds where none was recovered
+  cv::Mat flags;   // CV_8UC1: kProbeLowerBound, kProbeSource (calib/probe.h)
   std::vector<ClippedRegion> regions;
   SourceRecovery recovery;
   nlohmann::json summary;
@@ -42,10 +43,20 @@ std::shared_ptr<const Fresnel> chrome_fresnel_from_spec(const std::string& spec,
 
 // The chrome maps are blended (assemble_probe with `probe`), and once more without each view for
 // the jackknife's folds (lights/source_recovery.h). `recover` false: the regions are found and
-// summarised, nothing is added (today's probe).
+// summarised, no source is added. A region with no source keeps its lower bound (Probe::lower_bound)
+// in `env`, flagged kProbeLowerBound.
 RecoveredProbe recover_probe_sources(const MapSet& chrome, const ProbeOptions& probe,
                                      const std::vector<GreyBallMaps>& grey, const std::vector<GlossyBallMaps>& glossy,
                                      const SourceRecoveryOptions& options, bool recover = true);
+
+// Directions no view saw (neither trusted nor clipped) filled from the trusted ones
+// (calib/probe_fill.h) and flagged kProbeFilled, so a renderer can use the probe. Returns the filled
+// solid-angle fraction.
+double fill_unseen_directions(RecoveredProbe& probe, double min_weight);
+
+// Writes `env` with its `confidence` (the trusted texels' summed weight, 0 elsewhere) and `flags`
+// channels (calib/probe.h, write_probe). Throws FileError(path, problem).
+void write_recovered_probe(const std::string& path, const RecoveredProbe& probe, double min_weight);
 
 // One line for a terminal or a report: "2 clipped light sources; recovered 61% / 59% / 47% (R/G/B)
 // of the probe's light from grey", or "" when nothing was clipped.

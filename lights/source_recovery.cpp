@@ -471,7 +471,7 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
                                : "the grey and glossy balls have " + std::to_string(lit) +
                                      " trusted texel(s) it lights (at least " + std::to_string(options.min_lit_texels) +
                                      " needed: the ball is missing, clipped or hidden there)") +
-                          "; the probe keeps it clipped");
+                          "; the probe keeps its lower bound");
       continue;
     }
     chosen.push_back(int(ri));
@@ -666,7 +666,7 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
     if (!finite) {
       out.unrecovered.push_back(src.region);
       out.notes.push_back(describe(g) +
-                          ": not recovered: the solve did not give finite values; the probe keeps it clipped");
+                          ": not recovered: the solve did not give finite values; the probe keeps its lower bound");
       continue;
     }
     out.sources.push_back(src);

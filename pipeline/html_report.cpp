@@ -361,6 +361,21 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
       h << ", " << num(100 * s["well_seen_fraction"].get<double>(), 3) << "% seen well (summed confidence at least 1/2"
         << (s.value("views", 0) == 1 ? "; one view: behind the ball only its stretched rim, low confidence" : "")
         << ")";
+    if (rec.count("sources")) {
+      const auto& src = rec["sources"].summary;
+      if (src.value("filled_fraction", 0.0) > 0)
+        h << "; " << num(100 * src["filled_fraction"].get<double>(), 3)
+          << "% no view saw, filled from the surroundings (no measurement there: the probe's confidence is 0)";
+      if (src.contains("lower_bound_fraction") && !src.value("regions", nlohmann::json::array()).empty()) {
+        const auto& f = src["lower_bound_fraction"];
+        double largest = 0;
+        for (const auto& v : f) largest = std::max(largest, v.get<double>());
+        if (largest > 0)
+          h << "; " << num(100 * f[0].get<double>(), 3) << "% / " << num(100 * f[1].get<double>(), 3) << "% / "
+            << num(100 * f[2].get<double>(), 3) << "% (R / G / B) of its light is only a lower bound (clipped in every "
+            << "bracket, nothing recovered it)";
+      }
+    }
     h << " (lat-long, tone-mapped";
     const bool sources =
         rec.count("sources") && !rec["sources"].summary.value("sources", nlohmann::json::array()).empty();

@@ -103,9 +103,10 @@ std::string light_sources_warning(const nlohmann::json& s) {
       << " sr) was not recovered: " << html_escape(r.value("note", std::string("-"))) << ". ";
   }
   if (sources.size() < s["regions"].size())
-    h << "At least " << rgb(s.value("lower_bound_fraction", nlohmann::json::array({0, 0, 0})), true)
-      << " (R / G / B) of the light is missing from the probe there (the clipped values are lower bounds), so the "
-         "computed maps are too dark on the side it lights; shoot shorter brackets, add a grey ball, or an ND filter.";
+    h << rgb(s.value("lower_bound_fraction", nlohmann::json::array({0, 0, 0})), true)
+      << " (R / G / B) of the probe's light is only a lower bound there (the probe keeps the clipped values; the "
+         "light may be far brighter), so the computed maps are too dark on the side it lights; shoot shorter "
+         "brackets, add a grey ball, or an ND filter.";
   h << "</p>";
   return h.str();
 }

@@ -44,11 +44,17 @@ nlohmann::json run_light_sources_step(const LightSourcesStep& s) {
   SourceRecoveryOptions ro;
   ro.seed = s.seed;
   RecoveredProbe r = recover_probe_sources(chrome, po, grey, glossy, ro, s.recover);
+  // Directions no view saw, filled so a renderer can use the probe (calib/probe_fill.h); they keep
+  // zero confidence and the kProbeFilled flag.
+  const double filled = s.fill ? fill_unseen_directions(r, po.min_weight) : 0.0;
   r.env.attributes["views"] = std::to_string(chrome.views.size());
   r.env.attributes["producer"] = "rsibr process (sources step)";
   r.env.attributes["version"] = RSIBR_VERSION;
+  r.env.attributes["filled"] = s.fill ? "push-pull of log radiance (flags channel: 4)" : "none (0)";
   if (fresnel) r.env.attributes["fresnel"] = fresnel->spec();
-  write_environment(s.out.string(), r.env);
+  write_recovered_probe(s.out.string(), r, po.min_weight);
+  r.summary["filled_fraction"] = filled;
+  r.summary["fill"] = s.fill ? "push-pull" : "none";
   r.summary["glossy_used"] = !glossy.empty();
   if (!s.glossy.empty() && s.glossy_brdf.empty())
     r.summary["notes"].push_back("glossy ball(s) not used: their BRDF is not known (--glossy-brdf)");

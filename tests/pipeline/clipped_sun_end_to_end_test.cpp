@@ -132,15 +132,19 @@ TEST_P(ClippedSun, TheProbeGetsTheSunBackAndCapturedMatchesComputed) {
   ASSERT_TRUE(probe.attributes.count("lightSources"));
   EXPECT_EQ(nlohmann::json::parse(probe.attributes.at("lightSources")).size(), 1u);
 
-  // --no-sources: the measured probe, the report says recovery was off, and the grey ball is far off.
+  // --no-sources: the measured probe with the sun at its lower bound (far below the truth), the
+  // report says recovery was off, and the grey ball is far off.
   o.recover_sources = false;
   const ProcessResult off = run_process(o);
   const Vec3 unrecovered = integral3(read_environment((o.out / "probe.exr").string()));
-  for (int k = 0; k < 3; ++k) EXPECT_NEAR(unrecovered[k], before[k], 1e-6 * before[k]) << k;
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_GE(unrecovered[k], before[k] * (1 - 1e-6)) << k;
+    EXPECT_LT(unrecovered[k] / truth[k], 0.7) << k;
+  }
   EXPECT_GT(off.summary["compare"]["balls"][0]["overall"]["after"]["relative_rms"].get<double>(), 3 * vs_captured);
   const std::string html_off = text_of(off.report);
   EXPECT_NE(html_off.find("Recovery was off"), std::string::npos);
-  EXPECT_NE(html_off.find("missing from the probe"), std::string::npos);
+  EXPECT_NE(html_off.find("only a lower bound"), std::string::npos);
   fs::remove_all(root);
 }
 

@@ -6,6 +6,8 @@
 #include "pipeline/light_sources_report.h"
 #include "pipeline/light_sources_step.h"
 
+#include "calib/probe.h"
+#include "core/exr_file.h"
 #include "lights/clipped_shoot.h"
 
 #include <gtest/gtest.h>
@@ -17,13 +19,26 @@ namespace {
 
 namespace fs = std::filesystem;
 
+struct ProbeChannels {
+  cv::Mat rgb, confidence, flags;
+};
+
+ProbeChannels read_probe_channels(const fs::path& path) {
+  const ExrFileIn file(path.string());
+  ProbeChannels p;
+  p.rgb = file.read(0, {"R", "G", "B"});
+  p.confidence = file.read(0, {"confidence"});
+  p.flags = file.read(0, {"flags"});
+  return p;
+}
+
 struct StepRun {
   nlohmann::json summary;
   fs::path dir;
 };
 
-StepRun run_step_on(const EnvMap& env, double clip, const std::string& name, bool recover = true) {
-  const testing::ClippedShoot shoot = testing::clipped_shoot(env, clip, 4, 10, 15, 0.005, 32);
+StepRun run_step_on(const EnvMap& env, double clip, const std::string& name, bool recover = true, int views = 4) {
+  const testing::ClippedShoot shoot = testing::clipped_shoot(env, clip, views, 10, 15, 0.005, 32);
   const fs::path dir = fs::temp_directory_path() / ("rsibr-sources-step-" + name + "-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
@@ -95,8 +110,47 @@ TEST(LightSourcesStep, WithRecoveryOffTheReportSaysWhatIsMissing) {
   EXPECT_TRUE(r.summary["sources"].empty());
   const std::string warning = light_sources_warning(r.summary);
   EXPECT_NE(warning.find("was not recovered"), std::string::npos) << warning;
-  EXPECT_NE(warning.find("missing from the probe"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("only a lower bound"), std::string::npos) << warning;
   EXPECT_NE(light_sources_section(r.dir, r.summary).find("Recovery was off"), std::string::npos);
+  // The sun's texels keep their lower bound, flagged, with no confidence: the probe holds more
+  // light than the trusted texels alone.
+  const ProbeChannels p = read_probe_channels(r.dir / "probe.exr");
+  int bound = 0;
+  for (int y = 0; y < p.flags.rows; ++y)
+    for (int x = 0; x < p.flags.cols; ++x)
+      if (int(p.flags.at<float>(y, x)) == kProbeLowerBound) {
+        ++bound;
+        EXPECT_EQ(p.confidence.at<float>(y, x), 0.0f);
+        EXPECT_GT(p.rgb.at<cv::Vec3f>(y, x)[1], 40.0f);  // at least the clip level, Fresnel divided out
+      }
+  EXPECT_GT(bound, 0);
+  const std::vector<double> before = integral(read_environment((r.dir / "probe-measured.exr").string()));
+  const std::vector<double> after = integral(read_environment((r.dir / "probe.exr").string()));
+  for (int k = 0; k < 3; ++k) EXPECT_GT(after[std::size_t(k)], 1.05 * before[std::size_t(k)]) << k;
+  fs::remove_all(r.dir);
+}
+
+TEST(LightSourcesStep, DirectionsNoViewSawAreFilledFlaggedAndWithoutConfidence) {
+  const EnvMap env =
+      testing::environment_with(std::nullopt, {{testing::direction_at(30, 40), 0.5, Vec3(2e4, 2e4, 1.8e4)}}, 128);
+  const StepRun r = run_step_on(env, 1e12, "fill", true, 1);  // one view: the cone behind the ball is unseen
+  EXPECT_GT(r.summary["filled_fraction"].get<double>(), 0.005);
+  const ProbeChannels p = read_probe_channels(r.dir / "probe.exr");
+  const EnvMap measured = read_environment((r.dir / "probe-measured.exr").string());
+  int filled = 0;
+  for (int y = 0; y < p.flags.rows; ++y)
+    for (int x = 0; x < p.flags.cols; ++x) {
+      const cv::Vec3f v = p.rgb.at<cv::Vec3f>(y, x);
+      if (int(p.flags.at<float>(y, x)) == kProbeFilled) {
+        ++filled;
+        ASSERT_EQ(p.confidence.at<float>(y, x), 0.0f);
+        for (int k = 0; k < 3; ++k) ASSERT_TRUE(std::isfinite(v[k]) && v[k] > 0) << y << " " << x;
+      } else if (p.confidence.at<float>(y, x) > 0) {
+        const cv::Vec3f m = measured.pixels.at<cv::Vec3f>(y, x);  // what was seen stays as seen
+        for (int k = 0; k < 3; ++k) ASSERT_NEAR(v[k], m[k], 1e-5 * (1 + m[k])) << y << " " << x;
+      }
+    }
+  EXPECT_GT(filled, 0);
   fs::remove_all(r.dir);
 }
 
