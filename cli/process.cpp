@@ -113,8 +113,12 @@ Runner add_process(CLI::App& app) {
   c->add_option("--probe", a->o.probe_file, "Use this environment as the probe instead of the chrome maps' blend");
   c->add_option("--mesh", a->o.mesh, "Mesh for the turntable (.glb, .gltf, .obj; default: a torus)");
   c->add_option("--force", a->o.force, "Re-run this step even if up to date (repeatable; 'all')");
-  c->add_option("--map-size", a->o.map_size, "Sphere maps' size in texels")->check(CLI::Range(8, 2048));
-  c->add_option("--probe-width", a->o.probe_width, "Lat-long probe width")->check(CLI::Range(8, 16384));
+  c->add_option("--map-size", a->o.map_size,
+                "Sphere maps' size in texels (default: from each ball's pixel radius, pipeline/default_sizes.h)")
+      ->check(CLI::Range(8, 2048));
+  c->add_option("--probe-width", a->o.probe_width,
+                "Lat-long probe width (default: as sharp as the sharpest chrome map, pipeline/default_sizes.h)")
+      ->check(CLI::Range(8, 16384));
   c->add_option("--chrome-fresnel", a->o.chrome_fresnel,
                 "The chrome ball's Fresnel spec, divided out of the probe ('none': the probe holds F L)")
       ->capture_default_str();
@@ -124,6 +128,9 @@ Runner add_process(CLI::App& app) {
   c->add_flag(
       "--no-sources", a->no_sources,
       "Do not recover light clipped in every chrome view from the grey and glossy balls (probe.exr is the measured probe)");
+  c->add_flag("!--no-fill", a->o.fill_unseen,
+              "Leave the directions no view saw at 0 in probe.exr instead of filling them from their surroundings "
+              "(confidence 0, flags 0)");
   c->add_option("--glossy-brdf", a->o.glossy_brdf,
                 "The glossy balls' BRDF spec (YAML text): they then constrain the recovered sources");
   c->add_option("--grey-albedo", a->o.grey_albedo, "The grey ball's albedo")->check(CLI::Range(0.001, 1.0));

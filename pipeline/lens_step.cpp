@@ -1,8 +1,11 @@
 #include "pipeline/lens_step.h"
 
+#include "calib/ball_candidates_picture.h"
 #include "calib/far_camera.h"
 #include "calib/outline_focal.h"
 #include "calib/view_image.h"
+#include "core/atomic_file.h"
+#include "core/image_codecs.h"
 #include "hdr/merge.h"
 
 #include <cmath>
@@ -20,13 +23,19 @@ nlohmann::json run_lens_step(const LensStep& s) {
   };
   // No focal length in the metadata: the outlines alone must give it, over a wide range.
   const bool outlines_only = s.source == "outlines";
+  // Where the candidates are shown, for the errors that ask for --ball.
+  auto candidates_hint = [&] {
+    return s.pictures.empty()
+               ? std::string("rsibr balls hdr/VIEW.exr --picture shows the candidates")
+               : "the candidates are circled and numbered in " + s.pictures.filename().string() + "/VIEW.png";
+  };
   auto unknown = [&](const std::string& why) -> nlohmann::json {
     throw std::invalid_argument("lens: the photos' metadata gives no focal length in pixels (" +
                                 (s.metadata_note.empty() ? std::string("none found") : s.metadata_note) + ") and " +
                                 why +
                                 "; give the lens with --lens FILE (a .cameramodel, e.g. from rsibr calibrate), or "
-                                "the ball with --ball VIEW:BALL=X,Y,R where it was not found (rsibr balls "
-                                "hdr/VIEW.exr --picture shows the candidates)");
+                                "the ball with --ball VIEW:BALL=X,Y,R where it was not found (" +
+                                candidates_hint() + ")");
   };
   if (s.source != "exif" && s.source != "lensfun" && !outlines_only) {
     for (std::size_t v = 0; v < s.views.size(); ++v) {
@@ -47,6 +56,7 @@ nlohmann::json run_lens_step(const LensStep& s) {
   std::vector<std::pair<int, int>> sizes;
   bool same_size = true, crops = !s.views.empty();
   std::string crop_note;
+  nlohmann::json pictures = nlohmann::json::array();
   for (std::size_t v = 0; v < s.views.size(); ++v) {
     const ViewImage image = read_view_image(s.merged[v].string());
     const int w = image.radiance.cols, h = image.radiance.rows;
@@ -61,6 +71,18 @@ nlohmann::json run_lens_step(const LensStep& s) {
         vc.cands.push_back(given_ball(image.radiance, view_lens, *s.given[v][b]));
         vc.pick[b] = int(vc.cands.size()) - 1;
       }
+    if (!s.pictures.empty()) {
+      std::vector<int> chosen;
+      for (const int p : vc.pick)
+        if (p >= 0) chosen.push_back(p);
+      const cv::Mat shown = ball_candidates_picture(image.radiance, vc.cands, chosen);
+      const std::filesystem::path png = s.pictures / (s.views[v] + ".png");
+      std::filesystem::create_directories(s.pictures);
+      write_atomically(png, [&](const std::string& tmp) {
+        if (!write_image(tmp, shown)) throw std::runtime_error(png.string() + ": cannot write the PNG image");
+      });
+      pictures.push_back(png.filename().string());
+    }
     // The view's evidence: its first listed chrome ball found, else its largest ball found.
     const BallCandidate* ball = nullptr;
     for (std::size_t b = 0; b < s.balls.size(); ++b) {
@@ -86,10 +108,14 @@ nlohmann::json run_lens_step(const LensStep& s) {
             ghost += (image.flags.at<unsigned char>(y, x) & kGhost) != 0;
           }
       const double share = disc > 0 ? double(ghost) / double(disc) : 0.0;
-      if (share > 0.02)
-        throw std::invalid_argument("lens: view " + s.views[v] + ": " + std::to_string(int(std::lround(100 * share))) +
-                                    "% of its ball's pixels disagree between brackets (a ghost: a bracket taken from "
-                                    "another place, or cropped elsewhere); leave that bracket out of photoset.yaml");
+      if (share > 0.02) {
+        const std::string suspect = v < s.suspect_bracket.size() ? s.suspect_bracket[v] : "";
+        throw std::invalid_argument(
+            "lens: view " + s.views[v] + ": " + std::to_string(int(std::lround(100 * share))) +
+            "% of its ball's pixels disagree between brackets (a ghost: a bracket taken from another place, or cropped "
+            "elsewhere); leave that bracket out of photoset.yaml" +
+            (suspect.empty() ? "" : " (the one registration left furthest off: " + suspect + ")"));
+      }
     }
     const bool fills = radius > 0 && fills_frame(radius, w, h);
     crops = crops && fills;
@@ -114,6 +140,7 @@ nlohmann::json run_lens_step(const LensStep& s) {
     }
   }
   j["views"] = sizes_json;
+  if (!s.pictures.empty()) j["candidates_pictures"] = pictures;
   if (crops) {
     // Crops of the ball (calib/far_camera.h): the metadata's focal length is the uncropped frame's.
     const LensModel far = far_camera_lens(sizes);
@@ -141,7 +168,8 @@ nlohmann::json run_lens_step(const LensStep& s) {
     throw std::invalid_argument("lens: the views differ in size (" + list + ") but are not crops of the ball (" +
                                 crop_note +
                                 "); one lens serves views of one size: give each view's photos at the same size, or "
-                                "the chrome ball with --ball VIEW:BALL=X,Y,R where it was not found");
+                                "the chrome ball with --ball VIEW:BALL=X,Y,R where it was not found (" +
+                                candidates_hint() + ")");
   }
   if (!s.refine)
     return outlines_only ? unknown("--no-self-calibration keeps the balls from measuring it")

@@ -35,12 +35,18 @@ struct LensStep {
   std::string metadata_note;                  // source "outlines": what the metadata lacked (for the error)
   std::vector<std::string> views;             // view names
   std::vector<std::filesystem::path> merged;  // their merged images (same order)
-  std::vector<ListedBall> balls;              // the photo set's balls
+  // Per view: the bracket its registration left furthest off (for a ghost's error), or "".
+  std::vector<std::string> suspect_bracket;
+  std::vector<ListedBall> balls;  // the photo set's balls
   // Per view (empty: none given), per listed ball: the ball given by hand (--ball), used instead of
   // the detection.
   std::vector<std::vector<std::optional<BallGuess>>> given;
   bool refine = true;         // false: the calibrated lens unchanged
   std::filesystem::path out;  // lens.cameramodel
+  // Where each view's candidates picture goes (calib/ball_candidates_picture.h: every circle the
+  // finder located, numbered, the picks in green), <view>.png, so a user whose ball was missed or
+  // mistaken can give it with --ball; empty: none written.
+  std::filesystem::path pictures;
 };
 
 // Writes `out` atomically and returns the step's summary.

@@ -44,6 +44,7 @@
 #include "lights/recovered_probe.h"
 #include "pipeline/ball_override.h"
 #include "pipeline/chessboard_problem.h"
+#include "pipeline/default_sizes.h"
 #include "pipeline/html_report.h"
 #include "pipeline/lens_step.h"
 #include "pipeline/light_sources_step.h"
@@ -377,8 +378,9 @@ void step_hdr(Context& c) {
                                  {"producer", "rsibr process (hdr step)"}});
                r.outputs.push_back(exr);
                const double px = double(m.radiance.total());
-               nlohmann::json shifts = nlohmann::json::array();
+               nlohmann::json shifts = nlohmann::json::array(), bracket_names = nlohmann::json::array();
                for (const cv::Point& s : vm.shifts) shifts.push_back({s.x, s.y});
+               for (const std::string& f : b.files) bracket_names.push_back(fs::path(f).filename().string());
                views.push_back({{"name", v.name},
                                 {"brackets", b.size()},
                                 {"clipped_fraction", m.clipped / px},
@@ -387,6 +389,10 @@ void step_hdr(Context& c) {
                                 {"noise_read", noise.read},
                                 {"noise_shot", noise.shot},
                                 {"alignment_shifts", shifts},
+                                {"alignment_rotations_deg", vm.alignment.rotation_deg},
+                                {"alignment_beyond_search", vm.alignment.beyond_search},
+                                {"alignment_mismatch_after", vm.alignment.mismatch_after},
+                                {"bracket_files", bracket_names},
                                 {"sizes_fitted", b.fitted_sizes}});
                bar.update(double(i + 1) / double(c.set.views.size()));
              }
@@ -405,6 +411,32 @@ void step_hdr(Context& c) {
            });
 }
 
+// The bracket of a view that its registration left furthest from the middle one (the largest
+// disagreement of the threshold bitmaps after it), for an error about a ghost: "FILE (moved X,Y px;
+// P% of its bitmap disagrees)", or "" when the hdr step's summary does not tell.
+std::string suspect_bracket(const PhotoView& v, const nlohmann::json& hdr) {
+  if (!hdr.is_object() || !hdr.contains("views")) return "";
+  for (const auto& vj : hdr["views"]) {
+    if (vj.value("name", "") != v.name || !vj.contains("alignment_mismatch_after")) continue;
+    // In the merge's order (by exposure), the middle one the reference.
+    const auto& m = vj["alignment_mismatch_after"];
+    const auto& shifts = vj["alignment_shifts"];
+    const auto& files = vj.value("bracket_files", nlohmann::json::array());
+    const std::size_t n = std::min(m.size(), files.size());
+    std::size_t worst = n;
+    for (std::size_t j = 0; j < n; ++j)
+      if (j != n / 2 && (worst == n || m[j].get<double>() > m[worst].get<double>())) worst = j;
+    if (worst == n) return "";
+    std::string text = files[worst].get<std::string>();
+    if (worst < shifts.size())
+      text += " (moved " + std::to_string(shifts[worst][0].get<int>()) + "," +
+              std::to_string(shifts[worst][1].get<int>()) + " px; " +
+              std::to_string(int(std::lround(100 * m[worst].get<double>()))) + "% of its bitmap disagrees)";
+    return text;
+  }
+  return "";
+}
+
 // ---- lens: the calibrated lens, its focal length refined from the balls' outlines when it came
 // from the photos' metadata (pipeline/lens_step.h) -> DIR/lens.cameramodel, the lens of every
 // later step.
@@ -420,11 +452,14 @@ void step_lens(Context& c) {
   s.refine = c.o.self_calibrate;
   s.balls = listed_balls(c.set);
   s.out = c.dir / "lens.cameramodel";
+  s.pictures = c.dir / "balls";
   const std::vector<BallOverride> overrides = parse_ball_overrides(c.o.ball_overrides, c.set);
   nlohmann::json given = nlohmann::json::array();
+  const nlohmann::json& hdr = c.result.summary["hdr"];
   for (const PhotoView& v : c.set.views) {
     s.views.push_back(v.name);
     s.merged.push_back(merged_path(c, v.name));
+    s.suspect_bracket.push_back(suspect_bracket(v, hdr));
     s.given.emplace_back();
     for (const ListedBall& b : s.balls) {
       s.given.back().push_back(find_override(overrides, v.name, b.name));
@@ -440,6 +475,8 @@ void step_lens(Context& c) {
   run_step(c, "lens", settings, inputs, [&](StepRecord& r) {
     r.summary = run_lens_step(s);
     r.outputs = {s.out};
+    for (const auto& name : r.summary.value("candidates_pictures", nlohmann::json::array()))
+      r.outputs.push_back(s.pictures / name.get<std::string>());
   });
 }
 
@@ -684,6 +721,21 @@ void step_extract(Context& c) {
     int anchored = 0;
     for (const ViewBalls& v : vb) anchored += v.chrome.has_value();
     const bool trust_views = anchored < 2;  // one view: nothing to check it against
+    // Map sizes (pipeline/default_sizes.h): from the chrome ball's largest pixel radius over the
+    // views, scaled by the rig's radius ratio for the other balls (they are decided view by view
+    // below, after the size is needed); a size the user gives wins.
+    double chrome_px = 0;
+    for (const ViewBalls& v : vb)
+      if (v.chrome) chrome_px = std::max(chrome_px, ball_pixel_radius(*v.chrome, lens));
+    std::vector<int> map_size(listed.size(), c.o.map_size);
+    for (std::size_t b = 0; b < listed.size(); ++b)
+      if (c.o.map_size <= 0) {
+        const double scale = rig.size() == listed.size() && rig[b].known && rig[b].scale > 0 ? rig[b].scale : 1.0;
+        map_size[b] = default_map_size(listed[b].kind, chrome_px * scale);
+      }
+    const int probe_width = c.o.probe_width > 0
+                                ? c.o.probe_width
+                                : default_probe_width(chrome_index >= 0 ? map_size[std::size_t(chrome_index)] : 64);
     // Pass 2: each view's balls decided, extracted; the chrome maps masked.
     std::vector<MapSet> sets(listed.size());
     FolderContents masks;
@@ -739,7 +791,7 @@ void step_extract(Context& c) {
         }
         const BallCone cone = found[b].ball->loc.fit.cone;
         ExtractOptions eo;
-        eo.size = c.o.map_size;
+        eo.size = map_size[b];
         eo.mirror = ball.kind == BallKind::chrome;
         eo.indexing = eo.mirror ? SphereIndexing::reflection : SphereIndexing::orthographic;
         eo.camera_mask_deg = eo.mirror ? 12.0 : 0.0;
@@ -786,7 +838,7 @@ void step_extract(Context& c) {
         mv.attributes["frame"] = "world (poses.yaml)";
         mv.attributes["identified"] = found[b].status;
         const cv::Mat& conf = mv.confidence;
-        bj["confident_fraction"] = cv::countNonZero(conf > 0.5) / (kPiD / 4 * c.o.map_size * c.o.map_size);
+        bj["confident_fraction"] = cv::countNonZero(conf > 0.5) / (kPiD / 4 * eo.size * eo.size);
         nlohmann::json occ = nlohmann::json::array();
         for (const Occluder& o : eo.occluders) occ.push_back(o.what);
         for (const Occluder& o : eo.in_front) occ.push_back(o.what);
@@ -840,7 +892,7 @@ void step_extract(Context& c) {
     if (!grey_scenes.empty() && !sets[std::size_t(chrome_index)].views.empty()) {
       const auto fresnel = chrome_fresnel_from_spec(c.o.chrome_fresnel, "--chrome-fresnel");
       ProbeOptions po;
-      po.width = c.o.probe_width;
+      po.width = probe_width;
       po.fresnel = fresnel.get();
       std::vector<GreyBallMaps> grey_maps;
       for (std::size_t b = 0; b < listed.size(); ++b)
@@ -863,7 +915,7 @@ void step_extract(Context& c) {
         for (int x = 0; x < seen_weight.cols; ++x)
           if (probe.measured.clipped.at<float>(y, x) > 0)
             seen_weight.at<float>(y, x) = std::max(seen_weight.at<float>(y, x), 1.0f);
-      const OpenLight light = open_light(probe.env, seen_weight, fresnel.get(), std::min(64, c.o.probe_width));
+      const OpenLight light = open_light(probe.env, seen_weight, fresnel.get(), std::min(64, probe_width));
       for (const GreyScene& g : grey_scenes) {
         auto of_view = [&](std::vector<MapView>& maps) -> MapView* {
           for (MapView& mv : maps)
@@ -900,8 +952,7 @@ void step_extract(Context& c) {
         if (bj) {
           (*bj)["consensus"] = {
               {"judged", cons[k].judged}, {"masked", cons[k].masked}, {"median_stops", cons[k].median_stops}};
-          (*bj)["confident_fraction"] =
-              cv::countNonZero(mv.confidence > 0.5) / (kPiD / 4 * c.o.map_size * c.o.map_size);
+          (*bj)["confident_fraction"] = cv::countNonZero(mv.confidence > 0.5) / (kPiD / 4 * mv.rgb.cols * mv.rgb.rows);
         }
         if (cons[k].left_out) {
           if (bj) {
@@ -952,9 +1003,21 @@ void step_extract(Context& c) {
                     {"views_agreeing", m.support},
                     {"rms_radii", m.rms}});
     }
+    nlohmann::json sizes = nlohmann::json::object();
+    std::size_t bytes = 0;
+    for (std::size_t b = 0; b < listed.size(); ++b) {
+      sizes[listed[b].name] = map_size[b];
+      bytes += map_set_bytes(map_size[b], sets[b].views.size());
+    }
     r.summary = {
         {"views", views},
-        {"map_size", c.o.map_size},
+        {"map_size", sizes},
+        {"map_size_source",
+         c.o.map_size > 0 ? "--map-size"
+                          : "the balls' pixel radii (chrome: " + std::to_string(int(std::lround(chrome_px))) + " px)"},
+        {"probe_width", probe_width},
+        {"probe_width_source", c.o.probe_width > 0 ? "--probe-width" : "the chrome map's size"},
+        {"maps_memory_mb", double(bytes) / (1 << 20)},
         {"rig", rj},
         {"chrome_radius_m", chrome_radius_m},
         {"chrome_radius_source",
@@ -962,8 +1025,16 @@ void step_extract(Context& c) {
   });
 }
 
+// The probe's width: the user's, else the one the extract step chose (pipeline/default_sizes.h).
+int probe_width(const Context& c) {
+  if (c.o.probe_width > 0) return c.o.probe_width;
+  const nlohmann::json& e = c.result.summary.contains("extract") ? c.result.summary.at("extract") : nlohmann::json();
+  return e.is_object() && e.contains("probe_width") ? e.at("probe_width").get<int>() : 256;
+}
+
 // ---- probe: the chrome maps blended.
 void step_probe(Context& c) {
+  const int width = probe_width(c);
   const auto chrome = balls_of(c, BallKind::chrome);
   if (chrome.empty()) throw std::invalid_argument(c.o.photoset + ": balls: no chrome ball (the probe needs one)");
   std::vector<fs::path> inputs;
@@ -971,24 +1042,22 @@ void step_probe(Context& c) {
   if (!c.o.probe_file.empty()) {
     // The stage swapped for a given environment (the truth, for the error budget): resampled
     // (area-weighted, core/resample.h) to the probe's lat-long size.
-    run_step(c, "probe", {{"width", c.o.probe_width}, {"given", c.o.probe_file}}, {c.o.probe_file}, [&](StepRecord& r) {
-      EnvMap env =
-          resample(read_environment(c.o.probe_file), Layout(LayoutKind::LatLong, c.o.probe_width, c.o.probe_width / 2));
+    run_step(c, "probe", {{"width", width}, {"given", c.o.probe_file}}, {c.o.probe_file}, [&](StepRecord& r) {
+      EnvMap env = resample(read_environment(c.o.probe_file), Layout(LayoutKind::LatLong, width, width / 2));
       env.attributes["producer"] = "rsibr process (given probe " + fs::path(c.o.probe_file).filename().string() + ")";
       const fs::path out = c.dir / "probe-measured.exr";
       write_environment(out.string(), env);
       r.outputs = {out};
-      r.summary = {
-          {"views", 0}, {"width", c.o.probe_width}, {"covered_fraction", 1.0}, {"fresnel", "given: " + c.o.probe_file}};
+      r.summary = {{"views", 0}, {"width", width}, {"covered_fraction", 1.0}, {"fresnel", "given: " + c.o.probe_file}};
     });
     return;
   }
-  run_step(c, "probe", {{"width", c.o.probe_width}, {"fresnel", c.o.chrome_fresnel}}, inputs, [&](StepRecord& r) {
+  run_step(c, "probe", {{"width", width}, {"fresnel", c.o.chrome_fresnel}}, inputs, [&](StepRecord& r) {
     MapSet all;
     for (const fs::path& p : inputs)
       for (MapView& v : read_map_set(p.string()).views) all.views.push_back(std::move(v));
     ProbeOptions po;
-    po.width = c.o.probe_width;
+    po.width = width;
     const auto fresnel = chrome_fresnel_from_spec(c.o.chrome_fresnel, "--chrome-fresnel");
     po.fresnel = fresnel.get();
     Probe p = assemble_probe(all, po);
@@ -1017,7 +1086,8 @@ void step_probe(Context& c) {
       }
     }
     r.summary = {{"views", all.views.size()},
-                 {"width", c.o.probe_width},
+                 {"width", width},
+                 {"memory_mb", double(probe_bytes(width)) / (1 << 20)},
                  {"covered_fraction", p.covered_fraction},
                  {"well_seen_fraction", all_sa > 0 ? well / all_sa : 0.0},
                  {"clipped_fraction", p.clipped_fraction},
@@ -1045,16 +1115,14 @@ void step_sources(Context& c) {
   s.glossy_brdf = c.o.glossy_brdf;
   s.measured = c.dir / "probe-measured.exr";
   s.out = c.dir / "probe.exr";
-  s.probe_width = c.o.probe_width;
+  s.probe_width = probe_width(c);
   s.chrome_fresnel = c.o.chrome_fresnel;
   s.grey_albedo = c.o.grey_albedo;
   s.recover = c.o.recover_sources;
+  s.fill = c.o.fill_unseen;
   s.seed = c.o.seed;
-  nlohmann::json settings = {{"recover", s.recover},
-                             {"width", s.probe_width},
-                             {"fresnel", s.chrome_fresnel},
-                             {"given", s.given_probe},
-                             {"clipped", clipped}};
+  nlohmann::json settings = {{"recover", s.recover},        {"fill", s.fill},         {"width", s.probe_width},
+                             {"fresnel", s.chrome_fresnel}, {"given", s.given_probe}, {"clipped", clipped}};
   if (clipped) settings.update({{"albedo", s.grey_albedo}, {"glossy_brdf", s.glossy_brdf}, {"seed", s.seed}});
   run_step(c, "sources", settings, inputs, [&](StepRecord& r) {
     r.summary = run_light_sources_step(s);
@@ -1226,7 +1294,16 @@ void step_render(Context& c) {
   run_step(c, "render", settings, inputs, [&](StepRecord& r) {
     const EnvMap probe = read_environment((c.dir / "probe.exr").string());
     const auto brdf = parse_brdf(c.o.render_brdf);
-    const auto integrator = make_integrator("fis", probe);
+    // The render's maps are render_views_res texels of a glossy lobe: a probe wider than 512 adds
+    // nothing to them but the integrator's MIP pyramid (7 s of 9 for a 1472-wide probe on 2 cores).
+    // Area sampling keeps the energy; the full probe stays the background.
+    std::optional<EnvMap> smaller;
+    if (probe.layout.width() > 512) {
+      ResampleOptions rs;
+      rs.supersampling = 1;
+      smaller = resample(probe, Layout(LayoutKind::LatLong, 512, 256), rs);
+    }
+    const auto integrator = make_integrator("fis", smaller ? *smaller : probe);
     MapSetBakeOptions bo;
     bo.res = c.o.render_views_res;
     bo.integrator.samples = 32;

@@ -66,11 +66,12 @@ struct ProcessOptions {
   std::string probe_file;          // probe: this environment (resampled) instead of the chrome maps' blend
   std::string mesh;                // render: .glb/.gltf/.obj; empty: a built-in torus
   std::vector<std::string> force;  // steps to re-run ("all" for every step)
-  int map_size = 64;               // extracted and computed sphere maps (texels a side)
-  int probe_width = 256;           // lat-long probe width
+  int map_size = 0;                // extracted and computed sphere maps (texels a side); 0: pipeline/default_sizes.h
+  int probe_width = 0;             // lat-long probe width; 0: pipeline/default_sizes.h
   // The chrome ball's Fresnel spec (YAML text), divided out of the probe; "" or "none": none (F L).
   std::string chrome_fresnel = kDefaultChromeFresnel;
-  bool recover_sources = true;  // sources step: false writes the measured probe unchanged
+  bool recover_sources = true;  // sources step: false writes the measured probe (lower bounds where clipped)
+  bool fill_unseen = true;      // sources step: directions no view saw filled (calib/probe_fill.h); false: 0
   std::string glossy_brdf;      // the glossy balls' BRDF spec (YAML text); empty: they are not used
   double grey_albedo = 0.18;    // the grey ball's Lambert albedo (compare fits a gain anyway)
   // extract: the light the photographer takes from each grey ball restored (calib/occluded_light.h),

@@ -133,6 +133,10 @@ refused "blend: a folder" "folder.exr" blend "$in/folder.exr" "$out/bl.exr"
 refused "blend: a FIFO" "fifo.exr" blend "$in/fifo.exr" "$out/bl.exr"
 refused "extract: a FIFO" "fifo.exr" extract "$in/fifo.exr" --lens "$in/lens.cameramodel" --out "$out/e.exr"
 refused "extract: a truncated lens" "truncated.cameramodel" extract "$in/shoot-hdr/north.exr" --lens "$in/truncated.cameramodel" --out "$out/e.exr"
+for f in empty text folder fifo; do
+  refused "balls: $f" "$f.exr" balls "$in/$f.exr" --picture "$out/balls.png"
+done
+refused "balls: a truncated lens" "truncated.cameramodel" balls "$in/shoot-hdr/north.exr" --lens "$in/truncated.cameramodel"
 refused "orient: a FIFO" "fifo.exr" orient "$in/fifo.exr" "$in/shoot-hdr/north.exr" --lens "$in/lens.cameramodel" --out "$out/p.yaml"
 refused "render: a truncated glb" "truncated.glb" render --maps "$in/maps-good.exr" --mesh "$in/truncated.glb" "$out/r.png" --size 16x16
 refused "render: an OBJ face past the vertices" "bad-index.obj" render --maps "$in/maps-good.exr" --mesh "$in/bad-index.obj" "$out/r.png" --size 16x16

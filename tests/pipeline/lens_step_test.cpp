@@ -6,6 +6,7 @@
 
 #include "calib/calib_cases.h"
 #include "calib/far_camera.h"
+#include "core/image_codecs.h"
 #include "core/test_data.h"
 #include "hdr/merge.h"
 #include "hdr/merged_exr.h"
@@ -136,7 +137,8 @@ TEST(LensStep, CropsOfTheBallGetTheFarCameraOnTheLargestViewsCanvas) {
 TEST(LensStep, ViewsOfDifferentSizesThatAreNotCropsAreAnErrorNamingThem) {
   testing::TempDir dir;
   const int a = int(std::lround(crops::shoot().radius * 3.5));  // the ball fills 57%: no crop
-  const LensStep s = crops::two_views(dir, a, a + 1);
+  LensStep s = crops::two_views(dir, a, a + 1);
+  s.pictures = dir.path() / "balls";
   try {
     run_lens_step(s);
     FAIL() << "views of two sizes were given one lens";
@@ -144,6 +146,12 @@ TEST(LensStep, ViewsOfDifferentSizesThatAreNotCropsAreAnErrorNamingThem) {
     const std::string want = "the views differ in size (a " + std::to_string(a) + "x" + std::to_string(a) + ", b " +
                              std::to_string(a + 1) + "x" + std::to_string(a + 1) + ")";
     EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+    // The error points at the pictures of the candidates, which a failed step leaves behind.
+    EXPECT_NE(std::string(e.what()).find("circled and numbered in balls/VIEW.png"), std::string::npos) << e.what();
+  }
+  for (const char* view : {"a", "b"}) {
+    const cv::Mat png = read_image((s.pictures / (std::string(view) + ".png")).string());
+    EXPECT_FALSE(png.empty()) << view;
   }
 }
 
