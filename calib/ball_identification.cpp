@@ -323,6 +323,7 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
   // The frame-filling circle as located, even where its outline misses the gates (for
   // view_candidates: a crop's ball whose limb shows little contrast).
   std::optional<BallLocation> frame_circle;
+  double frame_support = 0;
   for (const BallGuess& g : guesses) {
     // A guess on a ball already located is not located again.
     bool known = false;
@@ -331,24 +332,42 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
                std::abs(b.loc.radius_px - g.radius_px) < 0.3 * b.loc.radius_px;
     if (known) continue;
     const bool frame_guess = &g == &guesses.front() && rmax >= 0.45 * m;  // inserted first above
-    // Hough radii in a textured scene are rough: the guess, then 0.8 and 1.25 times it.
-    for (double scale : {1.0, 0.8, 1.25}) {
-      BallLocation loc;
-      try {
-        BallLocateOptions lo;
-        lo.clip_lines = frame_guess;  // its lines all reach the frame
-        loc = locate_ball(image, lens, {g.centre_px, g.radius_px * scale}, lo);
-      } catch (const std::invalid_argument&) {
-        continue;
+    // Hough radii in a textured scene are rough: the guess, then 0.8 and 1.25 times it. The frame's
+    // circle is only where a crop's ball usually is: 0.9 times it too (a ball filling 80-95% of the
+    // frame, off centre, is 5-10% from it, where the outline search can lock onto the horizon the
+    // ball reflects).
+    const std::vector<double> scales =
+        frame_guess ? std::vector<double>{1.0, 0.9, 0.8, 1.25} : std::vector<double>{1.0, 0.8, 1.25};
+    for (double scale : scales) {
+      // The frame's circle searches its lines up to the frame (a crop's ball leaves it) and, in
+      // case the ball's outline runs along the frame's edge, where that clipped search finds only
+      // what the ball reflects, also skipping the lines that leave it; the better outline wins.
+      std::optional<BallLocation> best;
+      std::optional<BallCandidate> best_c;
+      for (const bool clip : frame_guess ? std::vector<bool>{true, false} : std::vector<bool>{false}) {
+        BallLocation l;
+        try {
+          BallLocateOptions lo;
+          lo.clip_lines = clip;
+          l = locate_ball(image, lens, {g.centre_px, g.radius_px * scale}, lo);
+        } catch (const std::invalid_argument&) {
+          continue;
+        }
+        // A straight edge fits a huge circle: the radius must stay near the detection range and the
+        // centre in the image.
+        if (!(l.radius_px >= rmin / 1.25 && l.radius_px <= 1.25 * rmax) || !lens.in_image(l.centre_px)) continue;
+        BallCandidate lc = measure_ball(image, lens, l);
+        if (!best_c || lc.outline_support > best_c->outline_support) best = l, best_c = lc;
       }
-      // A straight edge fits a huge circle: the radius must stay near the detection range and the
-      // centre in the image.
-      if (!(loc.radius_px >= rmin / 1.25 && loc.radius_px <= 1.25 * rmax) || !lens.in_image(loc.centre_px)) continue;
-      BallCandidate c = measure_ball(image, lens, loc);
-      // The frame-filling guess's circle, kept for view_candidates when its outline is weak.
+      if (!best) continue;
+      const BallLocation loc = *best;
+      BallCandidate c = *best_c;
+      // The frame-filling guess's circle, kept for view_candidates when its outline is weak: the
+      // best supported of its scales.
       if (frame_guess && fills_frame(loc.radius_px, lens.width(), lens.height()) && c.outline_support >= 0.3 &&
-          c.inlier_fraction >= 0.4 && c.loc.fit.rms_px <= o.max_rms_px && !frame_circle)
-        frame_circle = loc;
+          c.inlier_fraction >= 0.4 && c.loc.fit.rms_px <= o.max_rms_px &&
+          (!frame_circle || c.outline_support > frame_support))
+        frame_circle = loc, frame_support = c.outline_support;
       // The frame-filling guess stands for a crop's ball: a circle it finds that does not fill the
       // frame is left to the Hough guesses (their own starts locate it better).
       if (frame_guess && !fills_frame(loc.radius_px, lens.width(), lens.height())) continue;
@@ -915,6 +934,16 @@ ViewCandidates view_candidates(const cv::Mat& image, const LensModel& lens, cons
           (b.loc.centre_px - frame_circle->centre_px).norm() + 0.5 * b.loc.radius_px > frame_circle->radius_px)
         kept.push_back(b);
     vc.cands = std::move(kept);
+    // Its outline supported along half its length or more, but with too few inliers among all
+    // its lines to pass the search's gate (an edge-on-edge limb against a table): still the one
+    // ball of a crop, taken below as any clean frame-filling circle is.
+    const bool listed = std::any_of(vc.cands.begin(), vc.cands.end(),
+                                    [&](const BallCandidate& b) { return same_circle(b.loc, *frame_circle); });
+    if (!listed) {
+      const BallCandidate fc = measure_ball(image, lens, *frame_circle);
+      if (fc.outline_support >= search.min_outline_support && fc.loc.fit.rms_px <= search.max_rms_px)
+        vc.cands.insert(vc.cands.begin(), fc);
+    }
   }
   vc.pick = assign_balls_in_view(vc.cands, balls);
   // A photo cropped to its one listed ball (calib/far_camera.h): the one circle with a clean

@@ -43,12 +43,13 @@ struct TexturedShoot {
   std::vector<cv::Mat> images;
 };
 
-TexturedShoot textured_shoot(unsigned seed = 30) {
+// A scene of level v (CV_64FC1), tinted (v, 0.9 v, 0.8 v), through a gamma camera with noise.
+TexturedShoot shoot_of(const cv::Mat& level, unsigned seed) {
   TexturedShoot s;
-  s.L.create(128, 160, CV_64FC3);
-  for (int r = 0; r < s.L.rows; ++r)
-    for (int x = 0; x < s.L.cols; ++x) {
-      const double v = 1.0 + 0.8 * std::sin(x * 0.21) * std::cos(r * 0.17) + 0.5 * ((x / 16 + r / 16) % 2);
+  s.L.create(level.rows, level.cols, CV_64FC3);
+  for (int r = 0; r < level.rows; ++r)
+    for (int x = 0; x < level.cols; ++x) {
+      const double v = level.at<double>(r, x);
       s.L.at<cv::Vec3d>(r, x) = cv::Vec3d(v, 0.9 * v, 0.8 * v);
     }
   testing::BracketCamera cam;
@@ -56,6 +57,14 @@ TexturedShoot textured_shoot(unsigned seed = 30) {
   cam.response = [](int, double X) { return std::pow(X, 1 / 2.2); };
   s.images = testing::synthesize(s.L, s.e, cam, seed);
   return s;
+}
+
+TexturedShoot textured_shoot(unsigned seed = 30) {
+  cv::Mat level(128, 160, CV_64FC1);
+  for (int r = 0; r < level.rows; ++r)
+    for (int x = 0; x < level.cols; ++x)
+      level.at<double>(r, x) = 1.0 + 0.8 * std::sin(x * 0.21) * std::cos(r * 0.17) + 0.5 * ((x / 16 + r / 16) % 2);
+  return shoot_of(level, seed);
 }
 
 ResponseCurve gamma_curve() {
@@ -113,23 +122,12 @@ TEST(Alignment, AHandheldShiftIsUndoneAutomaticallyAndItsUncoveredEdgeLeftOut) {
 
 // A larger scene without repeats (smoothed random blobs), three brackets through a gamma camera.
 TexturedShoot blob_shoot(int rows, int cols, unsigned seed = 7) {
-  TexturedShoot s;
   cv::Mat noise(rows, cols, CV_64FC1);
   cv::RNG rng(seed);
   rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
   cv::GaussianBlur(noise, noise, cv::Size(0, 0), 2.5);
   cv::normalize(noise, noise, 0.2, 2.0, cv::NORM_MINMAX);
-  s.L.create(rows, cols, CV_64FC3);
-  for (int r = 0; r < rows; ++r)
-    for (int x = 0; x < cols; ++x) {
-      const double v = noise.at<double>(r, x);
-      s.L.at<cv::Vec3d>(r, x) = cv::Vec3d(v, 0.9 * v, 0.8 * v);
-    }
-  testing::BracketCamera cam;
-  cam.max_code = 255;
-  cam.response = [](int, double X) { return std::pow(X, 1 / 2.2); };
-  s.images = testing::synthesize(s.L, s.e, cam, seed);
-  return s;
+  return shoot_of(noise, seed);
 }
 
 // A handheld bracket moved by a sixth of the frame, beyond what six levels of MTB reach (63 px):
