@@ -117,6 +117,8 @@ def run_set(rsibr, set_dir, out_root, timeout):
                                               " (lens step)" if got[3] == "lens step" else ""))
     probe = step_summary(run_dir, "probe") or {}
     coverage = probe.get("covered_fraction")
+    sources = step_summary(run_dir, "sources") or {}
+    bound = sources.get("lower_bound_fraction")
     worst = max(errors) if errors else None
     if rc == 0:
         wrong = (worst is None or worst > TOLERANCE or len(errors) < len(ann.get("views", [])) or
@@ -134,18 +136,24 @@ def run_set(rsibr, set_dir, out_root, timeout):
         "ball_notes": "; ".join(notes),
         "lens": lens_text(run_dir),
         "coverage": coverage,
+        "probe_width": probe.get("width"),
+        "filled": sources.get("filled_fraction"),
+        "lower_bound": max(bound) if bound else None,
         "seconds": seconds,
     }
 
 
 def table(rows):
-    lines = ["| set | camera | result | chrome ball: centre / radius error (% of r) | lens | probe coverage | time |",
+    lines = ["| set | camera | result | chrome ball: centre / radius error (% of r) | lens | probe: width, seen, "
+             "filled, light only a lower bound | time |",
              "|---|---|---|---|---|---|---|"]
+    pct = lambda v: "-" if v is None else "%.0f%%" % (100 * v)  # noqa: E731
     for r in rows:
         result = r["verdict"] if r["exit"] == 0 else "%s (exit %s): %s" % (r["verdict"], r["exit"], r["error_line"])
-        cov = "-" if r["coverage"] is None else "%.0f%%" % (100 * r["coverage"])
+        probe = "-" if r["coverage"] is None else "%s, %s seen, %s filled, %s" % (
+            r["probe_width"] or "-", pct(r["coverage"]), pct(r["filled"]), pct(r["lower_bound"]))
         lines.append("| %s | %s | %s | %s | %s | %s | %.0f s |" % (
-            r["set"], r["camera"], result.replace("|", "/"), r["ball_notes"] or "-", r["lens"], cov, r["seconds"]))
+            r["set"], r["camera"], result.replace("|", "/"), r["ball_notes"] or "-", r["lens"], probe, r["seconds"]))
     return "\n".join(lines)
 
 
@@ -185,7 +193,10 @@ def main():
             "README). The ball found in each view's reference frame is compared with the circle measured by "
             "hand: centre distance and radius difference in % of the annotated radius. A run either completes "
             "with the ball within " + str(round(100 * TOLERANCE)) + "% and a probe that saw light, or stops with "
-            "one line naming the option to give; WRONG marks an exit 0 that does neither. Times on 2 shared "
+            "one line naming the option to give; WRONG marks an exit 0 that does neither. The probe: its width "
+            "(from the ball's pixel radius by default), the share of the sphere the chrome views saw, the share "
+            "no view saw (filled from the surroundings), and the largest channel's share of the probe's light "
+            "that is only a lower bound (clipped in every bracket, nothing recovered it). Times on 2 shared "
             "cores.\n\nRegenerate: `/usr/bin/python3 bench/real_photos.py` (needs ../shared/real-photos).\n\n" + text)
     replace_section(os.path.join(ROOT, "docs", "tradeoffs.md"), "Real photo sets", body)
     return 1 if wrong else 0
