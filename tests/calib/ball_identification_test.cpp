@@ -5,6 +5,7 @@
 // by the frame's edge. Checked against the
 // renderer's truth: every ball found where it is, nothing else taken for one.
 #include "calib/ball_identification.h"
+#include "calib/ball_locator.h"
 
 #include "calib_cases.h"
 
@@ -208,6 +209,32 @@ TEST(BallIdentification, DrawnBallsAreMeasuredAndMatchedByAppearanceAndSize) {
   EXPECT_TRUE(looks_like(c[std::size_t(pick[0])], BallKind::chrome));
   EXPECT_TRUE(looks_like(c[std::size_t(pick[1])], BallKind::grey));
   EXPECT_FALSE(c[std::size_t(pick[1])].cut);
+}
+
+// The same mirror world drawn on a ball of 64 and of 256 pixels (its features scale with the ball):
+// the rim texture, the chrome test's evidence, is the same, so a chrome ball photographed large in a
+// phone frame is as chrome as one in a small crop.
+TEST(BallIdentification, TheRimTextureDoesNotDependOnTheBallsSizeInPixels) {
+  std::vector<double> rim;
+  for (const double r : {64.0, 256.0}) {
+    const int side = int(2.6 * r);
+    const LensModel lens = LensModel::pinhole(100.0 * side, side, side);
+    cv::Mat img(side, side, CV_32FC3, cv::Scalar::all(0.3));
+    const Vec2 c(0.5 * (side - 1), 0.5 * (side - 1));
+    for (int y = 0; y < side; ++y)
+      for (int x = 0; x < side; ++x) {
+        const Vec2 d = (Vec2(x, y) - c) / r;
+        if (d.squaredNorm() > 1) continue;
+        // A world of bands a tenth of the radius wide, compressed toward the rim as a mirror shows it.
+        const double s = d.norm(), phi = std::atan2(d.y(), d.x());
+        const float v = float(std::exp(1.2 * std::sin(10 * kPi * s * s) * std::cos(7 * phi)));
+        img.at<cv::Vec3f>(y, x) = cv::Vec3f(v, 0.9f * v, 0.8f * v);
+      }
+    const BallCandidate b = measure_ball(img, lens, locate_ball(img, lens, {c, r}));
+    rim.push_back(b.rim_texture);
+  }
+  EXPECT_GT(rim[0], 0.25);  // a mirror by the chrome test
+  EXPECT_NEAR(rim[1], rim[0], 0.1);
 }
 
 // A grey ball lit by a sun 50 times its sky, from the front, the side and behind (a lit crescent
