@@ -61,12 +61,13 @@ def replace_section(path, title, body):
     """Replaces (or appends) the section '## title' of a markdown file."""
     text = open(path).read() if os.path.exists(path) else "# Trade-offs: error against time for every knob\n"
     start = text.find(f"## {title}\n")
-    section = f"## {title}\n\n{body}\n"
+    section = f"## {title}\n\n{body.rstrip(chr(10))}\n"
     if start < 0:
         text = text.rstrip("\n") + "\n\n" + section
     else:
         end = text.find("\n## ", start + 1)
-        text = text[:start] + section + (text[end + 1:] if end >= 0 else "")
+        # A blank line before the next section, whether the body ended with one or not.
+        text = text[:start] + section + ("\n" + text[end + 1:] if end >= 0 else "")
     tmp = path + ".tmp"
     with open(tmp, "w") as f:
         f.write(text)
