@@ -1,12 +1,15 @@
 #include "calib/ball_candidates_picture.h"
 
+#include "core/atomic_file.h"
 #include "core/colour.h"
+#include "core/image_codecs.h"
 #include "core/preview_exposure.h"
 
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 namespace rsibr {
@@ -35,6 +38,16 @@ cv::Mat ball_candidates_picture(const cv::Mat& image, const std::vector<BallCand
     cv::putText(shown, label, at, cv::FONT_HERSHEY_SIMPLEX, font, colour, thick + 1, cv::LINE_AA);
   }
   return shown;
+}
+
+void write_ball_candidates_picture(const std::filesystem::path& png, const cv::Mat& image, const ViewCandidates& vc) {
+  std::vector<int> chosen;
+  for (const int p : vc.pick)
+    if (p >= 0) chosen.push_back(p);
+  const cv::Mat shown = ball_candidates_picture(image, vc.cands, chosen);
+  write_atomically(png, [&](const std::string& tmp) {
+    if (!write_image(tmp, shown)) throw std::runtime_error(png.string() + ": cannot write the PNG image");
+  });
 }
 
 }  // namespace rsibr

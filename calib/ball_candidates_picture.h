@@ -9,6 +9,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <filesystem>
 #include <vector>
 
 namespace rsibr {
@@ -16,5 +17,9 @@ namespace rsibr {
 // `image` CV_32FC3 RGB linear; `chosen` holds indices into `candidates`.
 cv::Mat ball_candidates_picture(const cv::Mat& image, const std::vector<BallCandidate>& candidates,
                                 const std::vector<int>& chosen = {}, int max_side = 1600);
+
+// A view's candidates and picks (view_candidates) drawn as above and written atomically as a PNG.
+// Throws std::runtime_error("<png>: ...") when it cannot be written.
+void write_ball_candidates_picture(const std::filesystem::path& png, const cv::Mat& image, const ViewCandidates& vc);
 
 }  // namespace rsibr

@@ -8,7 +8,6 @@
 #include "calib/ball_candidates_picture.h"
 #include "calib/ball_identification.h"
 #include "calib/view_image.h"
-#include "core/atomic_file.h"
 #include "core/image_codecs.h"
 #include "core/lens_model.h"
 #include "core/output_plan.h"
@@ -122,20 +121,13 @@ int run_balls(const BallsArgs& a) {
                      {"diffuse_residual", std::isfinite(c.diffuse_residual) ? c.diffuse_residual : -1.0},
                      {"looks_like", looks}});
   }
-  std::vector<int> chosen;
   for (std::size_t b = 0; b < listed.size(); ++b) {
     const int p = vc.pick[b];
     std::cout << to_string(listed[b].kind) << ": " << (p < 0 ? std::string("none") : "candidate " + std::to_string(p))
               << "\n";
     picks.push_back({{"kind", to_string(listed[b].kind)}, {"candidate", p}});
-    if (p >= 0) chosen.push_back(p);
   }
-  if (!picture.empty()) {
-    const cv::Mat shown = ball_candidates_picture(view.radiance, vc.cands, chosen);
-    write_atomically(picture, [&](const std::string& tmp) {
-      if (!write_image(tmp, shown)) throw std::runtime_error(a.picture + ": cannot write the PNG image");
-    });
-  }
+  if (!picture.empty()) write_ball_candidates_picture(picture, view.radiance, vc);
   write_summary(json, {{"image", a.image}, {"width", w}, {"height", h}, {"candidates", cands}, {"picks", picks}});
   outputs.commit();
   return 0;

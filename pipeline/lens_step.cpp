@@ -4,8 +4,6 @@
 #include "calib/far_camera.h"
 #include "calib/outline_focal.h"
 #include "calib/view_image.h"
-#include "core/atomic_file.h"
-#include "core/image_codecs.h"
 #include "hdr/merge.h"
 
 #include <cmath>
@@ -72,16 +70,9 @@ nlohmann::json run_lens_step(const LensStep& s) {
         vc.pick[b] = int(vc.cands.size()) - 1;
       }
     if (!s.pictures.empty()) {
-      std::vector<int> chosen;
-      for (const int p : vc.pick)
-        if (p >= 0) chosen.push_back(p);
-      const cv::Mat shown = ball_candidates_picture(image.radiance, vc.cands, chosen);
-      const std::filesystem::path png = s.pictures / (s.views[v] + ".png");
       std::filesystem::create_directories(s.pictures);
-      write_atomically(png, [&](const std::string& tmp) {
-        if (!write_image(tmp, shown)) throw std::runtime_error(png.string() + ": cannot write the PNG image");
-      });
-      pictures.push_back(png.filename().string());
+      write_ball_candidates_picture(s.pictures / (s.views[v] + ".png"), image.radiance, vc);
+      pictures.push_back(s.views[v] + ".png");
     }
     // The view's evidence: its first listed chrome ball found, else its largest ball found.
     const BallCandidate* ball = nullptr;
