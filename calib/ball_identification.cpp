@@ -752,7 +752,24 @@ BallLocation refit_outline_excluding(const BallLocation& ball, const LensModel& 
 }
 
 BallCandidate given_ball(const cv::Mat& image, const LensModel& lens, const BallGuess& guess) {
-  return measure_ball(image, lens, locate_ball(image, lens, guess));
+  // A circle given by hand is usually within a few percent; the locator's default band (25% of the
+  // radius) also holds the circles of reflections inside a chrome ball, which win where the limb
+  // barely differs from what lies behind it. Of the bands that find an outline, the one whose
+  // circle shows the most of its outline wins (the narrowest on a tie).
+  std::optional<BallCandidate> best;
+  std::string why;
+  for (double band : {0.06, 0.12, 0.25}) {
+    BallLocateOptions o;
+    o.search_fraction = band;
+    try {
+      BallCandidate c = measure_ball(image, lens, locate_ball(image, lens, guess, o));
+      if (!best || c.outline_support > best->outline_support) best = std::move(c);
+    } catch (const std::invalid_argument& e) {
+      if (why.empty()) why = e.what();
+    }
+  }
+  if (!best) throw std::invalid_argument(why);
+  return *best;
 }
 
 std::optional<AnchorFromRig> anchor_from_rig(const ViewBalls& view, const std::vector<RigMember>& rig,

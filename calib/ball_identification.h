@@ -214,7 +214,9 @@ BallCone predicted_cone(const BallCone& chrome, const Mat3& world_from_cam, cons
 BallLocation refit_outline_excluding(const BallLocation& ball, const LensModel& lens,
                                      const std::vector<BallLocation>& others);
 
-// A ball given by hand: located at the guess (calib/ball_locator.h) and measured.
+// A ball given by hand: located at the guess (calib/ball_locator.h) within 6%, 12% and 25% of its
+// radius, the outline that shows most of itself kept, and measured. Throws std::invalid_argument
+// when no band finds an outline.
 BallCandidate given_ball(const cv::Mat& image, const LensModel& lens, const BallGuess& guess);
 
 }  // namespace rsibr
