@@ -1,13 +1,16 @@
 #include "calib/ball_features.h"
 
+#include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <optional>
+#include <stdexcept>
 
 namespace rsibr {
 
@@ -82,7 +85,11 @@ BallFeatures ball_features(const cv::Mat& image, const LensModel& lens, const Ba
 }
 
 std::vector<DirectionObservation> match_ball_features(const std::vector<BallFeatures>& views, int* features,
-                                                      double ratio) {
+                                                      double ratio, const MatchGuess& guess,
+                                                      std::vector<PairMatches>* pairs) {
+  if (!guess.world_from_cam.empty() && guess.world_from_cam.size() != views.size())
+    throw std::invalid_argument("match_ball_features: a rotation guess must be given for every view or none");
+  if (pairs) pairs->clear();
   // Union-find over (view, index).
   std::vector<int> offset(views.size() + 1, 0);
   for (std::size_t v = 0; v < views.size(); ++v)
@@ -96,16 +103,68 @@ std::vector<DirectionObservation> match_ball_features(const std::vector<BallFeat
   cv::BFMatcher matcher(cv::NORM_L2);
   for (std::size_t a = 0; a < views.size(); ++a)
     for (std::size_t b = a + 1; b < views.size(); ++b) {
-      if (views[a].descriptors.rows < 2 || views[b].descriptors.rows < 2) continue;
-      std::vector<std::vector<cv::DMatch>> ab, ba;
-      matcher.knnMatch(views[a].descriptors, views[b].descriptors, ab, 2);
-      matcher.knnMatch(views[b].descriptors, views[a].descriptors, ba, 2);
-      std::vector<int> best_ba(views[b].descriptors.rows, -1);
-      for (const auto& m : ba)
-        if (m.size() == 2 && m[0].distance < ratio * m[1].distance) best_ba[m[0].queryIdx] = m[0].trainIdx;
-      for (const auto& m : ab)
-        if (m.size() == 2 && m[0].distance < ratio * m[1].distance && best_ba[m[0].trainIdx] == m[0].queryIdx)
-          parent[find(offset[a] + m[0].queryIdx)] = find(offset[b] + m[0].trainIdx);
+      PairMatches pm{int(a), int(b), views[a].descriptors.rows, views[b].descriptors.rows, 0, false};
+      const bool gated = !guess.world_from_cam.empty() && guess.world_from_cam[a] && guess.world_from_cam[b];
+      if (views[a].descriptors.rows < (gated ? 1 : 2) || views[b].descriptors.rows < (gated ? 1 : 2)) {
+        if (pairs) pairs->push_back(pm);
+        continue;
+      }
+      pm.gated = gated;
+      std::vector<std::pair<int, int>> kept;  // (index in a, index in b)
+      if (gated) {
+        // Under the guess: a's feature i and b's feature j pair when each is the other's nearest
+        // descriptor inside the gate, gated_ratio times nearer than the second nearest there (a
+        // lone candidate passes).
+        const Mat3 b_from_a = guess.world_from_cam[b]->transpose() * *guess.world_from_cam[a];
+        const double cos_gate = std::cos(guess.gate_deg * kPi / 180);
+        cv::Mat dist;
+        cv::batchDistance(views[a].descriptors, views[b].descriptors, dist, CV_32F, cv::noArray(), cv::NORM_L2);
+        const int na = dist.rows, nb = dist.cols;
+        constexpr float kNone = std::numeric_limits<float>::max();
+        std::vector<int> best_a(na, -1), best_b(nb, -1);
+        std::vector<float> d1a(na, kNone), d2a(na, kNone), d1b(nb, kNone), d2b(nb, kNone);
+        auto offer = [](float x, int k, int& best, float& d1, float& d2) {
+          if (x < d1)
+            d2 = d1, d1 = x, best = k;
+          else if (x < d2)
+            d2 = x;
+        };
+        for (int i = 0; i < na; ++i) {
+          const Vec3 d = b_from_a * views[a].directions[std::size_t(i)];
+          for (int j = 0; j < nb; ++j)
+            if (d.dot(views[b].directions[std::size_t(j)]) > cos_gate) {
+              const float x = dist.at<float>(i, j);
+              offer(x, j, best_a[i], d1a[i], d2a[i]);
+              offer(x, i, best_b[j], d1b[j], d2b[j]);
+            }
+        }
+        const float gr = static_cast<float>(guess.gated_ratio);
+        for (int i = 0; i < na; ++i) {
+          const int j = best_a[i];
+          if (j >= 0 && best_b[j] == i && (d2a[i] == kNone || d1a[i] < gr * d2a[i]) &&
+              (d2b[j] == kNone || d1b[j] < gr * d2b[j]))
+            kept.push_back({i, j});
+        }
+      }
+      // Unguided: the mutual nearest descriptors over the whole sphere that pass the ratio test;
+      // under a guess, those the gate did not already pair (a wrong guess keeps them).
+      if (views[a].descriptors.rows >= 2 && views[b].descriptors.rows >= 2) {
+        std::vector<char> used_a(views[a].descriptors.rows, 0), used_b(views[b].descriptors.rows, 0);
+        for (const auto& [i, j] : kept) used_a[i] = used_b[j] = 1;
+        std::vector<std::vector<cv::DMatch>> ab, ba;
+        matcher.knnMatch(views[a].descriptors, views[b].descriptors, ab, 2);
+        matcher.knnMatch(views[b].descriptors, views[a].descriptors, ba, 2);
+        std::vector<int> best_ba(views[b].descriptors.rows, -1);
+        for (const auto& m : ba)
+          if (m.size() == 2 && m[0].distance < ratio * m[1].distance) best_ba[m[0].queryIdx] = m[0].trainIdx;
+        for (const auto& m : ab)
+          if (m.size() == 2 && m[0].distance < ratio * m[1].distance && best_ba[m[0].trainIdx] == m[0].queryIdx &&
+              !used_a[m[0].queryIdx] && !used_b[m[0].trainIdx])
+            kept.push_back({m[0].queryIdx, m[0].trainIdx});
+      }
+      for (const auto& [i, j] : kept) parent[find(offset[a] + i)] = find(offset[b] + j);
+      pm.matched = static_cast<int>(kept.size());
+      if (pairs) pairs->push_back(pm);
     }
   // Tracks: roots seen by >= 2 views, numbered in order of first appearance.
   std::map<int, std::vector<std::pair<int, int>>> tracks;

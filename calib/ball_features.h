@@ -16,6 +16,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <optional>
 #include <vector>
 
 namespace rsibr {
@@ -40,9 +41,32 @@ struct BallFeatures {
 BallFeatures ball_features(const cv::Mat& image, const LensModel& lens, const BallCone& cone,
                            const BallFeatureOptions& options = {});
 
+// Per pair of views: the features each had, and the mutual matches kept.
+struct PairMatches {
+  int a = 0, b = 0;  // view indices, a < b
+  int features_a = 0, features_b = 0;
+  int matched = 0;
+  bool gated = false;  // matched under a rotation guess
+};
+
+// Matching under a guess of each view's rotation (world_from_cam, or nullopt): in a pair whose
+// views both have one, features i and j match when their world directions agree within gate_deg
+// and each is the other's nearest descriptor inside that gate, gated_ratio times nearer than the
+// second nearest there (a lone candidate passes). The gate keeps look-alikes elsewhere on the
+// sphere from failing a true match. Chance pairs inside the gate agree with the guess and so with
+// each other: their consensus is no evidence (orient_views tests it against chance). The unguided
+// matches the gate did not pair are kept too, so a wrong guess loses nothing.
+struct MatchGuess {
+  std::vector<std::optional<Mat3>> world_from_cam;  // per view, or empty: no guess
+  double gate_deg = 4;
+  double gated_ratio = 0.9;
+};
+
 // Observations for solve_orientations; *features gets the number of tracks. Tracks seen by one view
-// only are dropped; a track with two features of one view keeps the first.
+// only are dropped; a track with two features of one view keeps the first. `pairs`, when given,
+// gets one entry per pair of views.
 std::vector<DirectionObservation> match_ball_features(const std::vector<BallFeatures>& views, int* features,
-                                                      double ratio = 0.75);
+                                                      double ratio = 0.75, const MatchGuess& guess = {},
+                                                      std::vector<PairMatches>* pairs = nullptr);
 
 }  // namespace rsibr

@@ -21,9 +21,12 @@
 #include "calib/ball_identification.h"
 #include "calib/ball_locator.h"
 #include "calib/orientation_solve.h"
+#include "calib/point_pairs.h"
 #include "calib/pose_file.h"
+#include "calib/rotation_search.h"
 #include "calib/stand_line.h"
 #include "calib/track_refinement.h"
+#include "calib/view_agreement.h"
 #include "calib/view_image.h"
 #include "calib/world_up.h"
 #include "core/lens_model.h"
@@ -79,6 +82,44 @@ struct ViewOrientationOptions {
   bool rig_check = true;
   RigSuspectOptions rig_suspect;
   OrientationOptions solve;  // its first_world_from_cam is set from the gauge
+  // When the features matched over the whole sphere leave a view unplaced: every pair's rotation
+  // searched by correlating the balls' panoramas (calib/rotation_search.h); pairs scoring at least
+  // min_search_score form a spanning tree (best scores first) whose chained rotations gate a second
+  // matching (MatchGuess). Real views far apart share too few features that pass an unguided
+  // ratio test over the whole sphere. Only then, so a shoot the features orient is not changed.
+  bool search_rotations = true;
+  PanoramaOptions panorama;
+  RotationSearchOptions rotation_search;
+  double min_search_score = 0.5;
+  double gate_deg = 4;  // the search's error plus a room's parallax a few metres away
+  // A view's matched pairs must agree within consensus_deg beyond chance (a pair inside the gate
+  // agrees by chance with up to (consensus_deg / gate_deg)^2, one matched over the whole sphere
+  // with the share of the sphere a consensus cap covers): the Poisson tail of its agreeing count
+  // at most max_chance; otherwise it is left out.
+  // Points picked by hand (calib/point_pairs.h): one more track each; a view they tie in is not
+  // tested against chance. match_features false: the picked points alone.
+  PointPairs points;
+  bool match_features = true;
+  double consensus_deg = 2;
+  double max_chance = 1e-3;
+};
+
+// One pair of oriented views, for reports: the rotation search, the matches and, after the solve,
+// the inliers.
+struct PairOrientation {
+  std::string a, b;
+  int features_a = 0, features_b = 0;
+  int matched = 0;  // mutual matches (gated: under the search's rotations)
+  bool gated = false;
+  int shared_tracks = 0;  // tracks observed by both
+  int inliers = 0;        // of those: both observations within the solve's inlier_deg of each other
+  // What chance would give under the search's gate: shared_tracks (inlier_deg / gate_deg)^2 (0 ungated).
+  double chance_inliers = 0;
+  double search_score = -1, search_runner_up = -1, search_overlap = 0;
+  double search_angle_deg = 0;  // the searched relative rotation's angle
+  // Angle between the solved relative rotation and the searched one (-1 without a search).
+  double solved_vs_search_deg = -1;
+  ViewAgreement agreement;  // at the solved rotations (calib/view_agreement.h); samples 0 if unsolved
 };
 
 // What orient_views saw, for reports (--json).
@@ -98,6 +139,7 @@ struct ViewOrientationReport {
   // whether that makes it a view left out of the world-up estimate (ViewOrientationOptions::rig_check).
   std::vector<double> rig_disagreement;
   std::vector<char> rig_suspect;
+  std::vector<PairOrientation> pairs;  // every pair of views oriented
 };
 
 // The world_from_cam of the first view for the gauge (identity without `up`). Throws

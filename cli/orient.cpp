@@ -3,6 +3,7 @@
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
+#include "calib/point_pairs.h"
 #include "calib/pose_file.h"
 #include "calib/view_orientation.h"
 #include "core/atomic_file.h"
@@ -10,6 +11,7 @@
 #include "core/output_plan.h"
 #include "core/progress.h"
 #include "core/safe_name.h"
+#include "pipeline/orientation_json.h"
 
 #include <algorithm>
 #include <cmath>
@@ -23,9 +25,23 @@ namespace {
 
 struct OrientArgs {
   std::vector<std::string> images;
-  std::string lens, out, up, json;
+  std::string lens, out, up, json, points;
+  std::vector<std::string> balls;  // VIEW=X,Y,R
   bool quiet = false;
 };
+
+// "VIEW=X,Y,R": the chrome ball of that view, roughly (within ~20%).
+std::pair<std::string, BallGuess> parse_chrome_ball(const std::string& text) {
+  const auto eq = text.find('=');
+  std::istringstream in(eq == std::string::npos ? std::string() : text.substr(eq + 1));
+  double x = 0, y = 0, r = 0;
+  char c1 = 0, c2 = 0;
+  if (eq == std::string::npos || eq == 0 || !(in >> x >> c1 >> y >> c2 >> r) || c1 != ',' || c2 != ',' ||
+      !(in >> std::ws).eof() || !std::isfinite(x) || !std::isfinite(y) || !(r > 1 && std::isfinite(r)))
+    throw std::invalid_argument("--ball '" + text +
+                                "': expected VIEW=X,Y,R (the chrome ball's centre and radius, pixels)");
+  return {text.substr(0, eq), BallGuess{Vec2(x, y), r}};
+}
 
 Vec3 parse_up(const std::string& text) {
   std::istringstream in(text);
@@ -67,11 +83,36 @@ int run_orient(const OrientArgs& a) {
       bar.update(double(i + 1) / a.images.size());
     }
   }
+  if (!a.points.empty()) o.points = read_point_pairs(a.points);
+  if (!a.balls.empty()) {
+    o.given_chrome.assign(names.size(), std::nullopt);
+    for (const std::string& text : a.balls) {
+      const auto [view, guess] = parse_chrome_ball(text);
+      const auto it = std::find(names.begin(), names.end(), view);
+      if (it == names.end())
+        throw std::invalid_argument("--ball '" + text + "': no view '" + view + "' among the images");
+      if (o.given_chrome[std::size_t(it - names.begin())])
+        throw std::invalid_argument("--ball '" + text + "': view '" + view + "' is given twice");
+      o.given_chrome[std::size_t(it - names.begin())] = guess;
+    }
+  }
   ViewOrientationReport rep;
   PoseSet poses;
   try {
     poses = orient_views(names, views, lens, o, &rep);
-  } catch (const std::invalid_argument& e) {
+  } catch (const std::exception& e) {
+    // What was found before it stopped, when a summary was asked for (no pose file is written).
+    if (!a.json.empty()) {
+      nlohmann::json f = {{"images", a.images},
+                          {"lens", a.lens},
+                          {"error", e.what()},
+                          {"left_out", rep.left_out},
+                          {"notes", rep.notes},
+                          {"features", rep.features},
+                          {"pairs", pair_orientation_json(rep.pairs)}};
+      write_summary(a.json, f);
+    }
+    if (!dynamic_cast<const std::invalid_argument*>(&e)) throw;
     // "<name>: ..." -> the image's path, so the line names the file.
     const std::string what = e.what();
     for (std::size_t i = 0; i < names.size(); ++i)
@@ -89,6 +130,7 @@ int run_orient(const OrientArgs& a) {
   j["observations"] = rep.observations;
   j["inliers"] = rep.inliers;
   j["rms_sigmas"] = rep.rms_sigmas;
+  j["pairs"] = pair_orientation_json(rep.pairs);
   j["tracks_relocated"] = {{"tracks", rep.track_refinement.tracks_refined},
                            {"observations", rep.track_refinement.observations_refined},
                            {"dropped", rep.track_refinement.observations_dropped},
@@ -152,7 +194,14 @@ Runner add_orient(CLI::App& app) {
   c->add_option("--up", a->up,
                 "World up X,Y,Z in the first camera's frame, or 'auto' (estimated from the views; "
                 "default: world = first camera)");
-  c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
+  c->add_option("--ball", a->balls,
+                "VIEW=X,Y,R: the chrome ball of that view is at pixel (X, Y) with radius R (roughly), instead of "
+                "the detection (repeatable)");
+  c->add_option("--points", a->points,
+                "YAML of points picked by hand in two or more views' chrome balls (see the guide): they tie the "
+                "views together where the features cannot");
+  c->add_option("--json", a->json,
+                "Write a JSON summary to FILE ('-' for stdout); when the orientation fails, what it found and why");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or report line");
   return [a] { return run_orient(*a); };
 }

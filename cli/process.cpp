@@ -98,6 +98,9 @@ Runner add_process(CLI::App& app) {
                 "X,Y,Z in the first camera's frame (0,-1,0 for a levelled camera), or 'none' (world = "
                 "first camera)")
       ->capture_default_str();
+  c->add_option("--points", a->o.points,
+                "YAML of points picked by hand in two or more views' chrome balls (see the guide): they tie the "
+                "views together where the features cannot");
   c->add_option("--ball", a->o.ball_overrides,
                 "VIEW:BALL=X,Y,R: that ball of that view is at pixel (X, Y) with radius R "
                 "(roughly), instead of the detection (repeatable)");

@@ -49,6 +49,7 @@
 #include "pipeline/lens_step.h"
 #include "pipeline/light_sources_step.h"
 #include "pipeline/mask_picture.h"
+#include "pipeline/orientation_json.h"
 #include "pipeline/pose_input.h"
 #include "pipeline/step_record.h"
 #include "pipeline/torus_mesh.h"
@@ -119,17 +120,29 @@ void run_step(Context& c, const std::string& step, const nlohmann::json& setting
   r.step = step;
   r.settings = settings;
   r.inputs = inputs;
+  // A step that stops leaves what it found and why (steps/STEP.failed.json), never its record.
+  auto failed = [&](const std::string& why) {
+    try {
+      write_failed_step_record(c.dir, r, why);
+    } catch (const std::exception&) {
+      // The step's own error is the one to report.
+    }
+  };
   try {
     body(r);
-  } catch (const std::invalid_argument&) {
+  } catch (const std::invalid_argument& e) {
+    failed(e.what());
     throw;
   } catch (const FileError& e) {
+    failed(e.what());
     throw e.in_step(step);
   } catch (const std::exception& e) {
+    failed(e.what());
     throw std::runtime_error(step + ": " + e.what());
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   write_step_record(c.dir, r, roots);
+  remove_failed_step_record(c.dir, step);
   outcome.ran = true;
   outcome.reason = reason;
   outcome.seconds = outcome.recorded_seconds = r.seconds;
@@ -513,6 +526,10 @@ nlohmann::json world_up_json(const WorldUp& w) {
 void step_orient(Context& c) {
   std::vector<fs::path> inputs = hdr_files(c);
   inputs.push_back(c.dir / "lens.cameramodel");
+  if (!c.o.points.empty()) {
+    if (!c.o.poses.empty()) throw std::invalid_argument("--points: not with --poses (the poses are given)");
+    inputs.push_back(c.o.points);
+  }
   if (!c.o.poses.empty()) {
     inputs.push_back(c.o.poses);
     const PoseSet given = read_given_poses(c.o.poses);
@@ -554,6 +571,7 @@ void step_orient(Context& c) {
     ViewOrientationOptions vo;
     vo.listed = listed;
     vo.given_chrome = given_chrome;
+    if (!c.o.points.empty()) vo.points = read_point_pairs(c.o.points);
     ViewOrientationReport report;
     if (!c.o.poses.empty()) {
       poses = read_given_poses(c.o.poses);
@@ -583,7 +601,15 @@ void step_orient(Context& c) {
       load_images();
       vo.up = c.o.up;
       vo.estimate_up = c.o.estimate_up;
-      poses = orient_views(names, images, lens, vo, &report);
+      try {
+        poses = orient_views(names, images, lens, vo, &report);
+      } catch (const std::exception&) {
+        // What the solve saw before it stopped, for steps/orient.failed.json.
+        r.summary = {{"left_out", report.left_out},
+                     {"notes", report.notes},
+                     {"solve", {{"features", report.features}, {"pairs", pair_orientation_json(report.pairs)}}}};
+        throw;
+      }
       source = "solved (chrome-ball features)";
       solve = {{"tracks", report.tracks},
                {"observations", report.observations},
@@ -591,7 +617,8 @@ void step_orient(Context& c) {
                {"rms_sigmas", report.rms_sigmas},
                {"features", report.features},
                {"tracks_relocated", report.track_refinement.tracks_refined},
-               {"rig_disagreement_radii", report.rig_disagreement}};
+               {"rig_disagreement_radii", report.rig_disagreement},
+               {"pairs", pair_orientation_json(report.pairs)}};
       std::vector<std::string> suspects;
       for (std::size_t v = 0; v < report.rig_suspect.size(); ++v)
         if (report.rig_suspect[v]) suspects.push_back(report.names[v]);

@@ -53,6 +53,7 @@ struct ProcessOptions {
   std::string lens;            // given .cameramodel (skips the chessboards)
   bool self_calibrate = true;  // lens step: refine a metadata lens's focal length from the balls' outlines
   std::string poses;           // given poses (pipeline/pose_input.h); empty: the orientation solve
+  std::string points;          // points picked by hand for the solve (calib/point_pairs.h); empty: none
   std::optional<Vec3> up;      // world up in the first camera's frame (e.g. 0,-1,0 for a levelled camera)
   bool estimate_up = true;     // without `up`: estimated from the views (calib/world_up.h); false: first-view gauge
   std::vector<std::string>

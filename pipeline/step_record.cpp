@@ -187,4 +187,25 @@ void write_step_record(const fs::path& dir, const StepRecord& r, const RecordRoo
                         j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
+fs::path failed_step_record_path(const fs::path& dir, const std::string& step) {
+  return dir / "steps" / (step + ".failed.json");
+}
+
+void write_failed_step_record(const fs::path& dir, const StepRecord& r, const std::string& error) {
+  nlohmann::json j;
+  j["step"] = r.step;
+  j["status"] = "failed";
+  j["error"] = error;
+  j["settings"] = r.settings;
+  j["summary"] = r.summary;
+  fs::create_directories(dir / "steps");
+  write_text_atomically(failed_step_record_path(dir, r.step),
+                        j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+}
+
+void remove_failed_step_record(const fs::path& dir, const std::string& step) {
+  std::error_code ec;
+  fs::remove(failed_step_record_path(dir, step), ec);
+}
+
 }  // namespace rsibr

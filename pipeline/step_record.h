@@ -55,6 +55,13 @@ std::string step_stale_reason(const std::filesystem::path& dir, const std::strin
 void write_step_record(const std::filesystem::path& dir, const StepRecord& record, const RecordRoots& roots = {});
 
 // Reads a record; throws std::runtime_error("<file>: ...") when missing or malformed.
+// A step that stopped: DIR/steps/STEP.failed.json with the step, the one-line error, the settings
+// and what the step had found (its summary so far), so a failed run can be read. It is never
+// taken for the step's record; remove_failed_step_record removes it once the step succeeds.
+std::filesystem::path failed_step_record_path(const std::filesystem::path& dir, const std::string& step);
+void write_failed_step_record(const std::filesystem::path& dir, const StepRecord& record, const std::string& error);
+void remove_failed_step_record(const std::filesystem::path& dir, const std::string& step);
+
 StepRecord read_step_record(const std::filesystem::path& dir, const std::string& step, const RecordRoots& roots = {});
 
 }  // namespace rsibr

@@ -135,6 +135,27 @@ TEST_F(StepRecordTest, ACopiedRunFolderWithMovedPhotosIsUpToDate) {
             (run2 / "lens2.cameramodel").string() + " changed");
 }
 
+TEST_F(StepRecordTest, AFailedStepLeavesItsErrorAndFindingsButNoRecordUntilItSucceeds) {
+  write(dir / "in.txt", "input");
+  write(dir / "out.txt", "output");
+  const StepRecord r = record({{"k", 1}});
+  write_failed_step_record(dir, r, "bake: the map is empty");
+  const fs::path failed = failed_step_record_path(dir, "bake");
+  ASSERT_TRUE(fs::exists(failed));
+  std::ifstream in(failed);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["status"], "failed");
+  EXPECT_EQ(j["error"], "bake: the map is empty");
+  EXPECT_EQ(j["summary"]["views"], 3);
+  // Never taken for the step's record.
+  EXPECT_EQ(step_stale_reason(dir, "bake", {{"k", 1}}, r.inputs), "no record");
+  write_step_record(dir, r);
+  remove_failed_step_record(dir, "bake");
+  EXPECT_FALSE(fs::exists(failed));
+  EXPECT_EQ(step_stale_reason(dir, "bake", {{"k", 1}}, r.inputs), "");
+  remove_failed_step_record(dir, "bake");  // none there: nothing happens
+}
+
 TEST_F(StepRecordTest, Sha256OfAKnownTextIsTheStandardDigest) {
   write(dir / "abc.txt", "abc");
   EXPECT_EQ(file_sha256(dir / "abc.txt"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
