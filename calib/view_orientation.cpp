@@ -254,13 +254,19 @@ std::vector<DirectionObservation> picked_observations(const PointPairs& points, 
   return out;
 }
 
-std::vector<PairOrientation> pair_report(const std::vector<std::string>& names, const std::vector<PairMatches>& matches,
-                                         const PairSearches& searches, const OrientationSolution& s,
-                                         const std::vector<DirectionObservation>& obs, double inlier_deg,
-                                         double gate_deg) {
+std::vector<PairOrientation> pair_report(const std::vector<std::string>& names, const std::vector<BallFeatures>& feats,
+                                         const std::vector<PairMatches>& matches, const PairSearches& searches,
+                                         const OrientationSolution& s, const std::vector<DirectionObservation>& obs,
+                                         double inlier_deg, double gate_deg) {
   // Per track: its observation in each view.
-  std::map<int, std::map<int, Vec3>> tracks;
-  for (const DirectionObservation& o : obs) tracks[o.feature][o.view] = o.direction;
+  std::map<int, std::map<int, const DirectionObservation*>> tracks;
+  for (const DirectionObservation& o : obs) tracks[o.feature][o.view] = &o;
+  const auto pixel = [&](const DirectionObservation& o) -> std::optional<Vec2> {
+    if (o.index < 0 || std::size_t(o.view) >= feats.size() ||
+        std::size_t(o.index) >= feats[std::size_t(o.view)].pixels.size())
+      return std::nullopt;
+    return feats[std::size_t(o.view)].pixels[std::size_t(o.index)];
+  };
   std::vector<PairOrientation> out;
   for (const PairMatches& m : matches) {
     if (std::size_t(m.b) >= names.size()) continue;
@@ -275,9 +281,12 @@ std::vector<PairOrientation> pair_report(const std::vector<std::string>& names, 
       const auto ia = seen.find(m.a), ib = seen.find(m.b);
       if (ia == seen.end() || ib == seen.end()) continue;
       ++p.shared_tracks;
-      if (solved && angle_between(s.world_from_cam[std::size_t(m.a)] * ia->second,
-                                  s.world_from_cam[std::size_t(m.b)] * ib->second) < inlier_deg * kPi / 180)
-        ++p.inliers;
+      const bool inlier =
+          solved && angle_between(s.world_from_cam[std::size_t(m.a)] * ia->second->direction,
+                                  s.world_from_cam[std::size_t(m.b)] * ib->second->direction) < inlier_deg * kPi / 180;
+      p.inliers += inlier;
+      const auto pa = pixel(*ia->second), pb = pixel(*ib->second);
+      if (pa && pb) p.matches_px.push_back({*pa, *pb}), p.match_inlier.push_back(inlier);
     }
     if (m.gated) p.chance_inliers = p.shared_tracks * std::min(1.0, std::pow(inlier_deg / gate_deg, 2));
     if (auto it = searches.find({p.a, p.b}); it != searches.end()) {
@@ -475,8 +484,8 @@ PoseSet orient_views_reporting(const std::vector<std::string>& all_names, const 
     } catch (const OrientationError& e) {
       throw named(e, names);
     }
-    rep.pairs =
-        pair_report(names, pair_matches, searches, first, obs, so.inlier_deg, options.gate_deg);  // kept if it stops
+    rep.pairs = pair_report(names, feats, pair_matches, searches, first, obs, so.inlier_deg,
+                            options.gate_deg);  // kept if it stops
     std::vector<char> keep = first.oriented;
     // Under searched rotations, a view whose matches agree no better than chance is not placed.
     const std::vector<ChanceTest> chance =
@@ -558,7 +567,7 @@ PoseSet orient_views_reporting(const std::vector<std::string>& all_names, const 
   for (std::size_t v = 0; v < n; ++v)
     if (!std::isfinite(s.sigma_deg[v]))
       throw std::runtime_error("orient: the orientations are not determined by the features (singular covariance)");
-  rep.pairs = pair_report(names, pair_matches, searches, s, obs_used, so.inlier_deg, options.gate_deg);
+  rep.pairs = pair_report(names, feats, pair_matches, searches, s, obs_used, so.inlier_deg, options.gate_deg);
   // Where both views of a pair see the same direction, how well their radiances agree.
   for (PairOrientation& p : rep.pairs) {
     const auto view = [&](const std::string& name) {

@@ -120,6 +120,9 @@ struct PairOrientation {
   // Angle between the solved relative rotation and the searched one (-1 without a search).
   double solved_vs_search_deg = -1;
   ViewAgreement agreement;  // at the solved rotations (calib/view_agreement.h); samples 0 if unsolved
+  // The shared tracks' features: their pixels in a and in b, and whether they are inliers.
+  std::vector<std::pair<Vec2, Vec2>> matches_px;
+  std::vector<char> match_inlier;
 };
 
 // What orient_views saw, for reports (--json).

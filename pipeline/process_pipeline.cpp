@@ -16,6 +16,7 @@
 #include "calib/sphere_map_extraction.h"
 #include "calib/view_image.h"
 #include "calib/view_orientation.h"
+#include "calib/pair_matches_picture.h"
 #include "calib/pose_file.h"
 #include "core/atomic_file.h"
 #include "core/atomic_folder.h"
@@ -601,14 +602,37 @@ void step_orient(Context& c) {
       load_images();
       vo.up = c.o.up;
       vo.estimate_up = c.o.estimate_up;
+      // Per pair, the features that tied the views (or failed to): DIR/orient/A--B.png.
+      const auto pair_pictures = [&] {
+        std::vector<fs::path> files;
+        for (const PairOrientation& p : report.pairs) {
+          const auto image = [&](const std::string& name) -> const cv::Mat& {
+            return images[std::size_t(std::find(names.begin(), names.end(), name) - names.begin())].radiance;
+          };
+          fs::create_directories(c.dir / "orient");
+          files.push_back(file_in_folder(c.dir / "orient", p.a + "--" + p.b + ".png"));
+          write_pair_matches_picture(files.back(), image(p.a), image(p.b), p);
+        }
+        return files;
+      };
       try {
         poses = orient_views(names, images, lens, vo, &report);
       } catch (const std::exception&) {
-        // What the solve saw before it stopped, for steps/orient.failed.json.
+        // What the solve saw before it stopped, for steps/orient.failed.json and the pictures.
+        nlohmann::json pictures = nlohmann::json::array();
+        for (const fs::path& f : pair_pictures()) pictures.push_back(fs::relative(f, c.dir).string());
         r.summary = {{"left_out", report.left_out},
                      {"notes", report.notes},
-                     {"solve", {{"features", report.features}, {"pairs", pair_orientation_json(report.pairs)}}}};
+                     {"solve",
+                      {{"features", report.features},
+                       {"pairs", pair_orientation_json(report.pairs)},
+                       {"pair_pictures", pictures}}}};
         throw;
+      }
+      nlohmann::json pictures = nlohmann::json::array();
+      for (const fs::path& f : pair_pictures()) {
+        r.outputs.push_back(f);
+        pictures.push_back(fs::relative(f, c.dir).string());
       }
       source = "solved (chrome-ball features)";
       solve = {{"tracks", report.tracks},
@@ -618,7 +642,8 @@ void step_orient(Context& c) {
                {"features", report.features},
                {"tracks_relocated", report.track_refinement.tracks_refined},
                {"rig_disagreement_radii", report.rig_disagreement},
-               {"pairs", pair_orientation_json(report.pairs)}};
+               {"pairs", pair_orientation_json(report.pairs)},
+               {"pair_pictures", pictures}};
       std::vector<std::string> suspects;
       for (std::size_t v = 0; v < report.rig_suspect.size(); ++v)
         if (report.rig_suspect[v]) suspects.push_back(report.names[v]);
@@ -645,7 +670,7 @@ void step_orient(Context& c) {
       }
       views.push_back(vj);
     }
-    r.outputs = {out};
+    r.outputs.push_back(out);
     r.summary = {{"source", source},     {"gauge", ordered.gauge}, {"views", views}, {"solve", solve},
                  {"left_out", left_out}, {"notes", notes},         {"world_up", up}};
   });
