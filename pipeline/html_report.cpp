@@ -143,6 +143,35 @@ void write_orientation_notes(std::ostringstream& h, const nlohmann::json& s) {
   }
 }
 
+// Orient: per pair of views, what tied them (the rotation search, the matches, the inliers against
+// chance, how the views agree) and the picture of the matches.
+void write_orientation_pairs(std::ostringstream& h, const nlohmann::json& s, const fs::path& dir) {
+  if (!s.contains("solve") || !s["solve"].is_object() || !s["solve"].contains("pairs")) return;
+  const nlohmann::json& solve = s["solve"];
+  if (solve["pairs"].empty()) return;
+  h << "<h3>Pairs of views</h3><p>Inliers: shared tracks whose directions agree within 2 degrees at the solved "
+       "rotations (in brackets, what chance gives when the matching was gated by the rotation search). Offset "
+       "and mismatch: the median log2 ratio of the two views' luminance where both see a direction, and the "
+       "median deviation around it (stops).</p><table><tr><th>views</th><th>search score (runner-up)</th>"
+       "<th>matches</th><th>inliers</th><th>offset</th><th>mismatch</th></tr>";
+  for (const auto& p : solve["pairs"]) {
+    h << "<tr><td>" << html_escape(p["views"][0].get<std::string>() + " - " + p["views"][1].get<std::string>())
+      << "</td><td>";
+    if (p.contains("search")) h << jnum(p["search"]["score"], 3) << " (" << jnum(p["search"]["runner_up"], 3) << ")";
+    h << "</td><td>" << jnum(p["matched"]) << "</td><td>" << jnum(p["inliers"]);
+    if (p.value("matched_under_search", false)) h << " (" << jnum(p["inliers_by_chance"], 3) << ")";
+    h << "</td><td>";
+    if (p.contains("agreement")) h << jnum(p["agreement"]["median_log2_ratio"], 3);
+    h << "</td><td>";
+    if (p.contains("agreement")) h << jnum(p["agreement"]["mismatch_stops"], 3);
+    h << "</td></tr>";
+  }
+  h << "</table>";
+  for (const auto& f : solve.value("pair_pictures", nlohmann::json::array()))
+    h << "<p>" << html_escape(f.get<std::string>()) << " (green: tracks the solve took; red: the others)<br>"
+      << img_tag(read_bytes(dir, dir / f.get<std::string>()), f.get<std::string>(), "max-width:100%") << "</p>";
+}
+
 // Extract: every ball of every view as identified, and each chrome view's mask.
 void write_balls_section(std::ostringstream& h, const nlohmann::json& s, const fs::path& dir) {
   h << "<h2>Balls</h2><p>Each listed ball of each view, identified by its outline, its appearance and the rig's "
@@ -345,6 +374,7 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
         << "</td></tr>";
     h << "</table>";
     write_orientation_notes(h, s);
+    write_orientation_pairs(h, s, dir);
   }
 
   if (rec.count("extract")) write_balls_section(h, rec["extract"].summary, dir);
