@@ -347,7 +347,13 @@ PoseSet orient_views_reporting(const std::vector<std::string>& all_names, const 
   std::vector<BallFeatures> feats;
   std::vector<CubeFeatureSet> sets;  // cube domain, for re-locating the tracks
   std::vector<BallCone> detected_cones;
-  std::vector<ReflectionPanorama> panoramas;  // per view placed, with search_rotations
+  // Per view placed, with search_rotations: what its panorama is made from (made only if needed).
+  struct PanoramaSource {
+    std::size_t image;
+    cv::Mat flags;
+    BallCone cone;
+  };
+  std::vector<PanoramaSource> panoramas;
   std::vector<std::string> names;
   std::vector<Mat3> known;
   for (std::size_t v = 0; v < all_views.size(); ++v) {
@@ -395,8 +401,7 @@ PoseSet orient_views_reporting(const std::vector<std::string>& all_names, const 
     const BallLocation& loc = found->loc;
     const cv::Mat flags =
         overlapping.empty() ? all_views[v].flags : masked_flags(all_views[v].flags, img.size(), overlapping);
-    if (options.search_rotations && options.known_world_from_cam.empty())
-      panoramas.push_back(reflection_panorama(img, flags, lens, loc.fit.cone, options.panorama));
+    if (options.search_rotations && options.known_world_from_cam.empty()) panoramas.push_back({v, flags, loc.fit.cone});
     if (options.domain == FeatureDomain::cube) {
       sets.push_back(ball_cube_feature_set(img, flags, lens, loc.fit.cone, options.features, options.cube));
       feats.push_back(sets.back().features);
@@ -446,6 +451,16 @@ PoseSet orient_views_reporting(const std::vector<std::string>& all_names, const 
   // anyone is left out, the features are matched once more under the rotations the panoramas
   // give (every pair searched, by name: views left out later keep theirs).
   PairSearches searches;
+  std::map<std::size_t, ReflectionPanorama> made;  // by image index
+  const auto panorama_of = [&](std::size_t v) -> const ReflectionPanorama& {
+    const PanoramaSource& src = panoramas[v];
+    auto it = made.find(src.image);
+    if (it == made.end())
+      it = made.emplace(src.image,
+                        reflection_panorama(all_views[src.image].radiance, src.flags, lens, src.cone, options.panorama))
+               .first;
+    return it->second;
+  };
   bool gated = false;
   int tracks = 0;
   std::vector<DirectionObservation> obs;
@@ -457,7 +472,7 @@ PoseSet orient_views_reporting(const std::vector<std::string>& all_names, const 
       for (std::size_t i = 0; i < names.size(); ++i)
         for (std::size_t j = i + 1; j < names.size(); ++j)
           if (!searches.count({names[i], names[j]}))
-            searches[{names[i], names[j]}] = search_rotation(panoramas[i], panoramas[j], options.rotation_search);
+            searches[{names[i], names[j]}] = search_rotation(panorama_of(i), panorama_of(j), options.rotation_search);
       guess.world_from_cam = chained_rotations(names, searches, options.min_search_score);
       guess.gate_deg = options.gate_deg;
     }
