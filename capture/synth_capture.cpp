@@ -13,6 +13,8 @@
 #include "core/truth_image.h"
 #include "core/atomic_file.h"
 #include "core/atomic_folder.h"
+#include "core/texel_audit.h"
+#include "core/written_file_check.h"
 #include "core/exr_io.h"
 #include "core/patterns.h"
 #include "core/image_codecs.h"
@@ -28,6 +30,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace rsibr {
@@ -40,7 +43,9 @@ double secs(Clock::duration d) { return std::chrono::duration<double>(d).count()
 void write_bytes(const fs::path& file, const std::vector<uchar>& bytes) {
   std::ofstream out(file, std::ios::binary);
   out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  out.close();
   if (!out) throw std::runtime_error(file.string() + ": cannot write");
+  check_written_file(file, file);
 }
 
 // Codes (CV_16UC1/3, RGB) -> an encoded image file of the camera's format.
@@ -212,23 +217,23 @@ EnvMap synth_environment(const SynthScene& scene) {
       cv::cvtColor(env.pixels, rgb, cv::COLOR_RGBA2RGB);
       env.pixels = rgb;
     }
-    long bad = 0;
-    for (int y = 0; y < env.pixels.rows; ++y) {
-      float* p = env.pixels.ptr<float>(y);
-      for (int i = 0; i < env.pixels.cols * env.channels(); ++i)
-        if (!(std::isfinite(p[i]) && p[i] >= 0)) {
-          ++bad;
-          p[i] = 0;
-        }
-    }
+    const TexelAudit audit = audit_texels(env.pixels);
+    const long bad = audit.nan + audit.inf + audit.huge + audit.negative;
     if (bad && !e.sanitize)
       throw std::invalid_argument(e.file->string() + ": " + std::to_string(bad) +
-                                  " NaN, Inf or negative values (set environment.sanitize: true to zero them)");
+                                  " NaN, Inf, huge or negative values (set environment.sanitize: true to remove them)");
+    if (bad) sanitize_texels(env.pixels);  // negatives folded into their neighbours, energy kept
   } else {
     env = render_pattern(
         patterns::sun_and_sky(e.sun_direction, e.sun_radius_deg * kPi / 180, e.sun_rgb, e.zenith_rgb, e.horizon_rgb),
         Layout::with_size(LayoutKind::LatLong, e.size), 4);
   }
+  double brightest = 0;
+  cv::minMaxLoc(env.pixels.reshape(1), nullptr, &brightest);
+  if (!(brightest * e.scale <= kMaxSceneRadiance))
+    throw std::invalid_argument("environment: its brightest value times scale is " +
+                                std::to_string(brightest * e.scale) + ", beyond " + std::to_string(kMaxSceneRadiance) +
+                                " (the camera's float arithmetic would overflow)");
   if (e.scale != 1.0) env.pixels *= e.scale;
   return env;
 }
@@ -499,11 +504,11 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
         write_codes(photos / "chessboards" / (std::string(name) + board_ext), codes, cam.format);
       }
       cs.files.push_back(photos / "chessboards" / (std::string(name) + board_ext));
-      std::ofstream corners(truth / "chessboards" / (std::string(name) + ".txt"));
+      std::ostringstream corners;
       corners.precision(10);
       corners << "# true pixel positions of the inner corners, row-major (j outer, i inner); mrcal pixel convention\n";
       for (const Vec2& p : shot.corners) corners << p.x() << " " << p.y() << "\n";
-      if (!corners) throw std::runtime_error((truth / "chessboards" / name).string() + ".txt: cannot write");
+      write_text_atomically(truth / "chessboards" / (std::string(name) + ".txt"), corners.str());
       YAML::Node tb;
       tb["file"] = std::string("chessboards/") + name + board_ext;
       tb["corners"] = std::string("chessboards/") + name + ".txt";
@@ -519,21 +524,22 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
   ty["camera"] = tc;
   cam.lens.write(truth / "camera.cameramodel");
   {
-    std::ofstream csv(truth / "response.csv");
+    std::ostringstream csv;
     csv.precision(17);
     csv << "code,R,G,B\n";
     const CameraResponse written(cam.format == "dng" ? "linear" : cam.response);
     for (const auto& row : written.table(max_code))
       csv << row[0] << "," << row[1] << "," << row[2] << "," << row[3] << "\n";
-    if (!csv) throw std::runtime_error((truth / "response.csv").string() + ": cannot write");
+    write_text_atomically(truth / "response.csv", csv.str());
   }
   {
     YAML::Emitter em;
     em.SetDoublePrecision(17);
     em << ty;
-    std::ofstream f(truth / "truth.yaml");
-    f << "# Ground truth of a synthetic capture (rsibr synth); see capture/synth_capture.h.\n" << em.c_str() << "\n";
-    if (!f) throw std::runtime_error((truth / "truth.yaml").string() + ": cannot write");
+    write_text_atomically(
+        truth / "truth.yaml",
+        std::string("# Ground truth of a synthetic capture (rsibr synth); see capture/synth_capture.h.\n") +
+            em.c_str() + "\n");
   }
   save_photo_set(set);
 

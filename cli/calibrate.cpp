@@ -45,9 +45,7 @@ void write_with_comment(const LensModel& lens, const std::string& out, const std
   std::stringstream text;
   text << in.rdbuf();
   in.close();
-  std::ofstream o(out, std::ios::binary | std::ios::trunc);
-  o << comment << text.str();
-  if (!o) throw std::runtime_error(out + ": cannot write");
+  write_text_atomically(out, comment + text.str());  // renamed over the model: never half a file
 }
 
 // No chessboards: the lens from the first photo's metadata (calib/photo_optics.h metadata_lens),
@@ -241,7 +239,18 @@ Runner add_calibrate(CLI::App& app) {
   c->add_option("photoset", a->photoset, "photoset.yaml or the folder holding it")->required();
   c->add_option("--out", a->out, "Output .cameramodel")->required();
   c->add_option("--model", a->models,
-                "Candidate mrcal models, simplest first (repeatable; 'splined' for the automatic spline)");
+                "Candidate mrcal models, simplest first (repeatable; 'splined' for the automatic spline)")
+      ->check(CLI::Validator(
+          [](std::string& name) -> std::string {
+            if (name == "splined") return "";
+            try {
+              LensModel::check_name(name);  // before any work, and before mrcal could assert on it
+            } catch (const std::invalid_argument& e) {
+              return e.what();
+            }
+            return "";
+          },
+          ""));
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or report line");
   return [a] { return run_calibrate(*a); };

@@ -1,5 +1,7 @@
 #include "core/atomic_file.h"
 
+#include "core/written_file_check.h"
+
 #include <unistd.h>
 
 #include <atomic>
@@ -10,7 +12,10 @@
 
 namespace rsibr {
 
-void write_atomically(const std::filesystem::path& target, const std::function<void(const std::string&)>& writer) {
+namespace {
+
+void write_checked(const std::filesystem::path& target, const std::function<void(const std::string&)>& writer,
+                   bool empty_allowed) {
   static std::atomic<int> counter{0};
   // Keep the extension last so format-sniffing writers (OpenCV) still see it.
   std::filesystem::path tmp = target;
@@ -18,7 +23,9 @@ void write_atomically(const std::filesystem::path& target, const std::function<v
                        std::to_string(counter++) + target.extension().string());
   try {
     writer(tmp.string());
+    check_written_file(tmp, target, empty_allowed);
     std::filesystem::rename(tmp, target);
+    note_checked_file(target);
   } catch (...) {
     std::error_code ec;
     std::filesystem::remove(tmp, ec);
@@ -26,13 +33,22 @@ void write_atomically(const std::filesystem::path& target, const std::function<v
   }
 }
 
+}  // namespace
+
+void write_atomically(const std::filesystem::path& target, const std::function<void(const std::string&)>& writer) {
+  write_checked(target, writer, false);
+}
+
 void write_text_atomically(const std::filesystem::path& target, const std::string& text) {
-  write_atomically(target, [&](const std::string& tmp) {
-    std::ofstream f(tmp, std::ios::binary);
-    f.write(text.data(), std::streamsize(text.size()));
-    f.close();
-    if (!f) throw std::runtime_error(target.string() + ": cannot write: " + std::strerror(errno));
-  });
+  write_checked(
+      target,
+      [&](const std::string& tmp) {
+        std::ofstream f(tmp, std::ios::binary);
+        f.write(text.data(), std::streamsize(text.size()));
+        f.close();
+        if (!f) throw std::runtime_error(target.string() + ": cannot write: " + std::strerror(errno));
+      },
+      text.empty());
 }
 
 void check_not_same_file(const std::filesystem::path& input, const std::filesystem::path& output) {

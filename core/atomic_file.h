@@ -1,6 +1,7 @@
 // Writes that never leave a partial file: the writer fills a temporary name next to the target,
-// which is renamed over the target only when the writer returns; on an exception the temporary
-// is removed and the exception propagates. The target's folder must exist.
+// which is renamed over the target only when the writer returns and the file passes
+// core/written_file_check.h (a full disk that the writer did not notice is caught there); on an
+// exception the temporary is removed and the exception propagates. The target's folder must exist.
 #pragma once
 
 #include <filesystem>

@@ -1,5 +1,7 @@
 #include "core/atomic_folder.h"
 
+#include "core/written_file_check.h"
+
 #include "core/text.h"
 
 #include <unistd.h>
@@ -69,6 +71,7 @@ void write_folder_atomically(const std::filesystem::path& folder, const FolderCo
       out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
       out.close();
       if (!out) throw std::runtime_error((target / name).string() + ": cannot write");
+      check_written_file(staging / name, target / name, bytes.empty());
     }
     if (!existed) {
       fs::rename(staging, target);

@@ -312,7 +312,36 @@ void write_exr(const std::string& path, const std::vector<ExrPartOut>& parts) {
         what.erase(at, name.size());
     for (char& c : what)
       if (c == '\n') c = ' ';
+    if (what.rfind(path + ": ", 0) == 0) what.erase(0, path.size() + 2);  // the file check names it already
     fail_output(path, what);
+  }
+}
+
+bool exr_reads_back(const std::string& path) noexcept {
+  try {
+    Imf::MultiPartInputFile in(path.c_str());
+    for (int p = 0; p < in.parts(); ++p) {
+      if (!in.partComplete(p)) return false;
+      const Imf::Header& h = in.header(p);
+      if (h.hasType() && h.type() != Imf::SCANLINEIMAGE) continue;  // rsibr writes scan lines only
+      const auto first = h.channels().begin();
+      if (first == h.channels().end()) continue;
+      // One channel into a scratch buffer is enough to make OpenEXR read and decode every chunk.
+      const Imath::Box2i dw = h.dataWindow();
+      const std::ptrdiff_t w = dw.max.x - dw.min.x + 1, rows = dw.max.y - dw.min.y + 1;
+      std::vector<float> scratch(std::size_t(w * rows));
+      char* origin = reinterpret_cast<char*>(scratch.data()) -
+                     (std::ptrdiff_t(dw.min.x) + std::ptrdiff_t(dw.min.y) * w) * std::ptrdiff_t(sizeof(float));
+      Imf::FrameBuffer fb;
+      fb.insert(first.name(), Imf::Slice(Imf::FLOAT, origin, sizeof(float), sizeof(float) * std::size_t(w),
+                                         first.channel().xSampling, first.channel().ySampling));
+      Imf::InputPart part(in, p);
+      part.setFrameBuffer(fb);
+      part.readPixels(dw.min.y, dw.max.y);
+    }
+    return true;
+  } catch (...) {
+    return false;
   }
 }
 

@@ -81,6 +81,10 @@ struct ExrPartIn {
 };
 
 // An EXR file opened for reading: every part's header up front, pixels on request.
+// Whether every part of the EXR file at `path` opens and all its scan lines decode (the read-back
+// of core/written_file_check.h). Never throws.
+bool exr_reads_back(const std::string& path) noexcept;
+
 class ExrFileIn {
  public:
   explicit ExrFileIn(const std::string& path);  // a regular file, checked before OpenEXR opens it

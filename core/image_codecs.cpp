@@ -5,6 +5,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <filesystem>
+#include <fstream>
 #include <type_traits>
 
 namespace rsibr {
@@ -21,11 +23,9 @@ static_assert(_GLIBCXX_USE_CXX11_ABI, "core/image_codecs.cpp: the mangled names 
 // Each signature is spelled once here; the static_cast makes the compiler check it against
 // OpenCV's header (a mismatch with the mangled name below would be a crash, not an error).
 using ReadFn = cv::Mat (*)(const cv::String&, int);
-using WriteFn = bool (*)(const cv::String&, cv::InputArray, const std::vector<int>&);
 using EncodeFn = bool (*)(const cv::String&, cv::InputArray, std::vector<uchar>&, const std::vector<int>&);
 using DecodeFn = cv::Mat (*)(cv::InputArray, int);
 static_assert(std::is_same_v<decltype(static_cast<ReadFn>(&cv::imread)), ReadFn>);
-static_assert(std::is_same_v<decltype(static_cast<WriteFn>(&cv::imwrite)), WriteFn>);
 static_assert(std::is_same_v<decltype(static_cast<EncodeFn>(&cv::imencode)), EncodeFn>);
 static_assert(std::is_same_v<decltype(static_cast<DecodeFn>(&cv::imdecode)), DecodeFn>);
 
@@ -46,10 +46,16 @@ cv::Mat read_image(const std::string& path, int flags) {
   return f(path, flags);
 }
 
+// Encoded in memory, then written: the codec never sees the file, so a full disk is this
+// function's `false`, not a codec's message on stderr (libpng prints its own).
 bool write_image(const std::string& path, const cv::Mat& image, const std::vector<int>& params) {
-  static const auto f = codecs().function<WriteFn>(
-      "_ZN2cv7imwriteERKNSt7__cxx1112basic_stringIcSt11char_traitsIcESaIcEEERKNS_11_InputArrayERKSt6vectorIiSaIiEE");
-  return f(path, image, params);
+  std::vector<unsigned char> bytes;
+  const std::string extension = std::filesystem::path(path).extension().string();
+  if (extension.empty() || !encode_image(extension, image, bytes, params)) return false;
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  out.close();
+  return bool(out);
 }
 
 bool encode_image(const std::string& extension, const cv::Mat& image, std::vector<unsigned char>& bytes,

@@ -1,5 +1,7 @@
 #include "core/output_plan.h"
 
+#include "core/written_file_check.h"
+
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -116,6 +118,7 @@ void OutputPlan::commit() {
   std::error_code ec;
   for (const auto& [tmp, target] : staged_)
     if (!fs::exists(tmp, ec)) throw std::logic_error(target.string() + ": the output was never written");
+  for (const auto& [tmp, target] : staged_) check_written_file(tmp, target);
   for (const auto& [tmp, target] : staged_) {
     fs::rename(tmp, target, ec);
     if (ec) throw std::runtime_error(target.string() + ": cannot put the output in place: " + ec.message());

@@ -39,8 +39,10 @@ class OutputPlan {
   // (core/atomic_folder.h); the plan only keeps file outputs from colliding with it.
   void folder(const std::string& path);
 
-  // Renames every temporary onto its target, in the order the files were added. A temporary that
-  // was never written is a std::logic_error (a verb that registers an output must write it).
+  // Renames every temporary onto its target, in the order the files were added, after every one
+  // has passed core/written_file_check.h (std::runtime_error naming the target; nothing renamed).
+  // A temporary that was never written is a std::logic_error (a verb that registers an output
+  // must write it).
   void commit();
 
   // `message` with every temporary this process's plans handed out replaced by its target: an

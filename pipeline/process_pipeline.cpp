@@ -363,11 +363,7 @@ void step_hdr(Context& c) {
              const Vignetting vig = photo_set_vignetting(c.set, c.o.vignetting, curve,
                                                          LensModel::read(c.dir / "camera.cameramodel"), &vignetting);
              const fs::path vfile = c.dir / "hdr" / "vignetting.json";
-             write_atomically(vfile, [&](const std::string& tmp) {
-               std::ofstream f(tmp);
-               f << vignetting["model"].dump(2) << "\n";
-               if (!f) throw std::runtime_error(tmp + ": cannot write");
-             });
+             write_text_atomically(vfile, vignetting["model"].dump(2) + "\n");
              r.outputs.push_back(vfile);
              nlohmann::json views = nlohmann::json::array();
              Progress bar("hdr", c.o.progress);

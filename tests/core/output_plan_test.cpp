@@ -41,17 +41,35 @@ class OutputPlanTest : public ::testing::Test {
 TEST_F(OutputPlanTest, CommittedOutputsAppearTogetherAndNothingElseRemains) {
   {
     OutputPlan plan({dir_ / "in.exr"});
-    const std::string a = plan.file((dir_ / "out.exr").string()), j = plan.file((dir_ / "out.json").string());
+    const std::string a = plan.file((dir_ / "out.txt").string()), j = plan.file((dir_ / "out.json").string());
     EXPECT_EQ(fs::path(a).parent_path(), dir_);
-    EXPECT_EQ(fs::path(a).extension(), ".exr") << "writers that pick the format by the extension still can";
+    EXPECT_EQ(fs::path(a).extension(), ".txt") << "writers that pick the format by the extension still can";
     std::ofstream(a) << "map";
     std::ofstream(j) << "{}";
-    EXPECT_FALSE(fs::exists(dir_ / "out.exr")) << "nothing is in place before the commit";
+    EXPECT_FALSE(fs::exists(dir_ / "out.txt")) << "nothing is in place before the commit";
     plan.commit();
   }
-  EXPECT_EQ(contents_of(dir_ / "out.exr"), "map");
+  EXPECT_EQ(contents_of(dir_ / "out.txt"), "map");
   EXPECT_EQ(contents_of(dir_ / "out.json"), "{}");
-  EXPECT_EQ(entries(), 4u) << "in.exr, sub, out.exr, out.json and no temporary";
+  EXPECT_EQ(entries(), 4u) << "in.exr, sub, out.txt, out.json and no temporary";
+}
+
+// What a full disk leaves when the writer did not notice: an empty or broken file. The commit
+// checks every output first (core/written_file_check.h) and renames none of them.
+TEST_F(OutputPlanTest, ACommitWithABrokenOutputRenamesNothingAndNamesTheTarget) {
+  {
+    OutputPlan plan;
+    std::ofstream(plan.file((dir_ / "fine.json").string())) << "{}";
+    std::ofstream(plan.file((dir_ / "half.exr").string())) << "not an EXR";
+    std::string e;
+    try {
+      plan.commit();
+    } catch (const std::runtime_error& x) {
+      e = x.what();
+    }
+    EXPECT_NE(e.find((dir_ / "half.exr").string() + ": cannot write"), std::string::npos) << e;
+  }
+  EXPECT_EQ(entries(), 2u) << "in.exr and sub only";
 }
 
 TEST_F(OutputPlanTest, AFailureBeforeTheCommitLeavesNothing) {
