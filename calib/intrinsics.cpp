@@ -54,6 +54,7 @@ void check(const IntrinsicsProblem& p, const std::vector<int>& subset) {
 }
 
 mrcal_lensmodel_t lensmodel(const std::string& name) {
+  LensModel::check_name(name);  // splines mrcal would assert on
   mrcal_lensmodel_t m;
   if (!mrcal_lensmodel_from_name(&m, name.c_str()) || !mrcal_lensmodel_type_is_valid(m.type))
     throw std::invalid_argument("intrinsics: unknown lens model '" + name + "'");

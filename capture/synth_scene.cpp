@@ -17,7 +17,7 @@ namespace {
 Vec3 vec3_in(const YamlMap& m, const std::string& key, double lo, bool lo_open) {
   const Vec3 v = m.vec3(key);
   for (int i = 0; i < 3; ++i)
-    spec_in_range(v[i], m.at(key) + "[" + std::to_string(i) + "]", lo, lo_open, INFINITY, true);
+    spec_in_range(v[i], m.at(key) + "[" + std::to_string(i) + "]", lo, lo_open, kMaxSceneRadiance, false);
   return v;
 }
 
@@ -48,7 +48,7 @@ SynthEnvironment parse_environment(const YAML::Node& node, const std::string& pa
     if (m.has("zenith_rgb")) e.zenith_rgb = vec3_in(m, "zenith_rgb", 0, false);
     if (m.has("horizon_rgb")) e.horizon_rgb = vec3_in(m, "horizon_rgb", 0, false);
   }
-  if (m.has("scale")) e.scale = m.positive("scale");
+  if (m.has("scale")) e.scale = m.number_in("scale", 0, true, kMaxSceneRadiance, false);
   return e;
 }
 
@@ -118,7 +118,8 @@ LensModel parse_lens(const YAML::Node& node, const std::string& path, int width,
     if (m.has("focal_px") || m.has("distortion")) spec_fail(m.at("intrinsics"), "give intrinsics or focal_px");
     intr = m.numbers("intrinsics");
   } else {
-    const double f = m.positive("focal_px");
+    // Under 1 px a pinhole's pixels span most of a half-space: no camera, and no ray table.
+    const double f = m.number_in("focal_px", 1, false, 1e7, false);
     intr = {f, f, 0.5 * (width - 1), 0.5 * (height - 1)};
     if (m.has("distortion"))
       for (double d : m.numbers("distortion")) intr.push_back(d);

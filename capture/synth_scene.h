@@ -19,6 +19,10 @@
 
 namespace rsibr {
 
+// The brightest radiance a scene may hold (environment values, times scale): a sun 10^9 times its
+// shadows fits many times over; beyond it, exposure, gains and supersampling sums in float overflow.
+inline constexpr double kMaxSceneRadiance = 1e12;
+
 struct SynthEnvironment {
   // Either a file (EXR or .hdr, path absolute after loading) ...
   std::optional<std::filesystem::path> file;

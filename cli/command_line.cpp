@@ -1,5 +1,6 @@
 #include "cli/command_line.h"
 
+#include "cli/option_checks.h"
 #include "cli/verbs.h"
 #include "cluster/session.h"
 #include "core/file_error.h"
@@ -93,6 +94,7 @@ CommandResult run_command_line(const std::vector<std::string>& args) {
     return parse_failure + "\n";
   });
   std::map<std::string, Runner> runners = add_verbs(app);
+  require_finite_numbers(app);
   // A first word that is neither an option nor a verb: say so (CLI11 would ask for "a subcommand").
   if (!args.empty() && !args[0].empty() && args[0][0] != '-' && !runners.count(args[0])) {
     std::string verbs;

@@ -1,4 +1,5 @@
 // rsibr pattern: analytic test environments (known integrals) in any layout.
+#include "cli/option_checks.h"
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
@@ -7,6 +8,7 @@
 #include "core/map_set.h"
 #include "core/output_plan.h"
 #include "core/patterns.h"
+#include "core/texel_audit.h"
 
 #include <cmath>
 #include <iostream>
@@ -107,7 +109,9 @@ Runner add_pattern(CLI::App& app) {
   c->add_option("--to", a->to, "Layout: latlong, cube, octahedral or sphere");
   c->add_option("--size", a->size, "Layout size (lat-long width, cube face, square side)")->check(CLI::Range(2, 16384));
   c->add_option("--subsamples", a->subsamples, "n x n points per texel")->check(CLI::Range(1, 64));
-  c->add_option("--sun-intensity", a->sun_intensity, "sun-sky: sun radiance");
+  c->add_option("--sun-intensity", a->sun_intensity,
+                "sun-sky: sun radiance (up to 1e30, the largest value a map may hold)")
+      ->check(number_from_to(0.0, double(kMaxRadiance)));
   c->add_option("--sun-radius", a->sun_radius_deg, "sun-sky: sun angular radius in degrees")
       ->check(CLI::Range(1e-4, 90.0));
   c->add_option("--sun-dir", a->sun_dir, "sun-sky: direction toward the sun (world, +Y up)")->expected(3);

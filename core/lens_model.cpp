@@ -130,6 +130,16 @@ mrcal_lensmodel_t lensmodel_of(const std::string& name) {
   mrcal_lensmodel_t m;
   if (!mrcal_lensmodel_from_name(&m, name.c_str()) || !mrcal_lensmodel_type_is_valid(m.type))
     throw std::invalid_argument("unknown or unconfigured mrcal lens model '" + name + "'");
+  // mrcal asserts (aborts) on splines it cannot build; refused here with the reason instead.
+  if (m.type == MRCAL_LENSMODEL_SPLINED_STEREOGRAPHIC) {
+    const auto& c = m.LENSMODEL_SPLINED_STEREOGRAPHIC__config;
+    if (c.order != 2 && c.order != 3)
+      throw std::invalid_argument("mrcal lens model '" + name + "': a spline's order is 2 or 3");
+    if (c.Nx < 4 || c.Ny < 4)
+      throw std::invalid_argument("mrcal lens model '" + name + "': a spline needs a grid of at least 4x4 knots");
+    if (c.fov_x_deg < 1 || c.fov_x_deg > 359)
+      throw std::invalid_argument("mrcal lens model '" + name + "': fov_x_deg must be 1 to 359 degrees");
+  }
   return m;
 }
 
@@ -155,8 +165,14 @@ LensModel::LensModel(const std::string& name, std::vector<double> intrinsics, in
                                 std::to_string(intrinsics_.size()));
   for (double v : intrinsics_)
     if (!std::isfinite(v)) throw std::invalid_argument(name_ + ": intrinsics must be finite");
+  // Every mrcal model with a core starts with fx, fy, cx, cy: a focal length that is not positive
+  // maps every pixel to the same ray (or none), which no later step survives.
+  if (mrcal_lensmodel_metadata(&m).has_core && !(intrinsics_[0] > 0 && intrinsics_[1] > 0))
+    throw std::invalid_argument(name_ + ": the focal lengths (fx, fy) must be positive");
   if (width <= 0 || height <= 0) throw std::invalid_argument(name_ + ": the image size must be positive");
 }
+
+void LensModel::check_name(const std::string& name) { lensmodel_of(name); }
 
 LensModel LensModel::pinhole(double f, int width, int height) {
   return LensModel("LENSMODEL_PINHOLE", {f, f, 0.5 * (width - 1), 0.5 * (height - 1)}, width, height);

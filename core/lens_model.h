@@ -24,8 +24,13 @@ class LensModel {
   // `name` is mrcal's configured model name, e.g. "LENSMODEL_OPENCV8" or
   // "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=100". Throws
   // std::invalid_argument for an unknown name, an intrinsics vector of the wrong length, a
-  // non-finite value or a non-positive image size.
+  // non-finite value, a focal length that is not positive, a spline mrcal cannot build (order 2
+  // or 3, at least 4x4 knots, fov_x_deg 1 to 359) or a non-positive image size.
   LensModel(const std::string& name, std::vector<double> intrinsics, int width, int height);
+
+  // Throws std::invalid_argument("mrcal lens model '<name>': <problem>") for a name the
+  // constructor would refuse (the model's configuration, before mrcal is asked to use it).
+  static void check_name(const std::string& name);
 
   // A pinhole model with focal length f (pixels) and the principal point at the image centre.
   static LensModel pinhole(double f, int width, int height);

@@ -221,6 +221,36 @@ refused "plan: --max-error 150%" "--max-error" plan --env "$in/env-good.exr" --b
 refused "plan: --max-error two" "--max-error" plan --env "$in/env-good.exr" --brdf "$in/ggx.yaml" --max-error two
 refused "plan: --samples without --method" "--method" plan --env "$in/env-good.exr" --brdf "$in/ggx.yaml" --max-error 2% --samples 64
 refused "bake: --max-error under a fixed --samples alone" "--method" bake --env "$in/env-good.exr" --brdf "$in/ggx.yaml" --max-error 2% --samples 64 "$out/b.exr"
+# NaN and Inf for every kind of floating-point option (CLI11 reads them as numbers and its range
+# checks let NaN through): refused naming the option, by the check every FLOAT option gets.
+for v in nan inf -inf 1e999; do
+  refused "blend: --rim-fade $v" "--rim-fade" blend "$in/maps-good.exr" "$out/bl.exr" --rim-fade "$v"
+  refused "extract: --camera-mask-deg $v" "--camera-mask-deg" extract "$in/shoot-hdr/north.exr" --lens "$in/lens.cameramodel" --out "$out/e.exr" --camera-mask-deg "$v"
+  refused "extract: --stand-mask-deg $v" "--stand-mask-deg" extract "$in/shoot-hdr/north.exr" --lens "$in/lens.cameramodel" --out "$out/e.exr" --stand-mask-deg "$v"
+  refused "hdr: --ghost-sigmas $v" "--ghost-sigmas" hdr "$in/shoot" --out "$out/h" --ghost-sigmas "$v"
+  refused "compare: --fail-above $v" "--fail-above" compare "$in/maps-good.exr" "$in/maps-good.exr" --fail-above "$v"
+  refused "compare: --heat-max $v" "--heat-max" compare "$in/maps-good.exr" "$in/maps-good.exr" --heat-max "$v"
+  refused "pattern: --sun-intensity $v" "--sun-intensity" pattern sun-sky "$out/pt.exr" --to latlong --size 8 --sun-intensity "$v"
+done
+refused "pattern: a sun beyond what a float map holds" "--sun-intensity" pattern sun-sky "$out/pt.exr" --to latlong --size 8 --sun-intensity 1e300
+# (made files go to $made: $in is checked byte-identical at the end)
+made="$work/made"
+mkdir -p "$made"
+# Library preconditions checked before the call: no mrcal assertion, no division by a zero focal.
+refused "calibrate: a spline of 1x1 knots" "4x4 knots" calibrate "$in/shoot" --out "$out/cam.cameramodel" --model LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=1_Ny=1_fov_x_deg=0
+sed 's/100, 100, 47.5/0, 0, 47.5/' "$in/lens.cameramodel" >"$made/zero-focal.cameramodel"
+refused "extract: a lens of zero focal length" "zero-focal.cameramodel" extract "$in/shoot-hdr/north.exr" --lens "$made/zero-focal.cameramodel" --out "$out/e.exr"
+# Scenes whose radiance overflows the camera's float arithmetic: refused naming the key.
+sed 's/sun_rgb: \[20000, 19000, 17000\]/sun_rgb: [1e300, 1e300, 1e300]/' "$in/minimal.yaml" >"$made/sun-1e300.yaml"
+refused "synth: a sun of 1e300" "sun_rgb" synth "$made/sun-1e300.yaml" --out "$out/s"
+sed 's/focal_px: 700/focal_px: 1e-30/' "$in/minimal.yaml" >"$made/tiny-focal.yaml"
+refused "synth: a focal length of 1e-30 px" "focal_px" synth "$made/tiny-focal.yaml" --out "$out/s"
+sed 's/^  pattern: sun_and_sky$/&\n  scale: 1e30/' "$in/minimal.yaml" >"$made/huge-scale.yaml"
+refused "synth: an environment scale of 1e30" "scale" synth "$made/huge-scale.yaml" --out "$out/s"
+# Lossy-compression ringing (negative values) is folded into its neighbours by default (a warning
+# says how many; core/texel_audit.h): the bake runs and its values are finite.
+accepted "bake: an environment with negative ringing" bake --env "$in/env-negative.exr" --brdf "$in/lambert.yaml" --res 8 -q "$out/b-neg.exr"
+finite_output "bake: an environment with negative ringing" "$out/b-neg.exr"
 
 # ---- outputs: checked together before any work, distinct from the inputs and each other
 # Each line: verb | one of its inputs | its arguments.
