@@ -259,7 +259,9 @@ Runner add_bake(CLI::App& app) {
                 "reference: integrate over the MIP level at most this wide (0: the full environment)")
       ->check(CLI::Range(0, 1 << 20));
   c->add_option("--layout", a->layout, "Layout of the environment when its header and shape do not tell");
-  c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and negative environment values instead of failing");
+  c->add_flag(
+      "--sanitize", a->sanitize,
+      "Zero NaN, Inf and absurd environment values instead of failing (negative values are always folded into their positive neighbours, energy kept)");
   c->add_flag("-q,--quiet", a->quiet, "No progress bar or summary line");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   c->add_option("--max-error", a->max_error,

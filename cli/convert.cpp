@@ -65,6 +65,11 @@ int run_convert(const ConvertArgs& a) {
   if (report.texels.bad() && !a.sanitize)
     throw std::runtime_error(a.input + ": " + report.texels.describe() + "; pass --sanitize to zero them");
   const long sanitized = a.sanitize ? sanitize_texels(src.pixels) : 0;
+  // A converter keeps values as they are unless asked; negative ones are said out loud.
+  if (!a.sanitize && report.texels.negative > 0)
+    std::cerr << "rsibr convert: warning: " << a.input << ": " << report.texels.negative
+              << " negative values (lossy-compression ringing) kept; --sanitize folds them into their positive "
+                 "neighbours, energy kept\n";
   const auto t1 = std::chrono::steady_clock::now();
 
   const int size = a.size > 0 ? a.size : matching_size(to, src.layout.texel_count());
@@ -141,7 +146,9 @@ Runner add_convert(CLI::App& app) {
   c->add_option("--input-colorspace", a->input_colour_space,
                 "OpenColorIO colour space of the input pixels (default: the file's chromaticities; $OCIO honoured)");
   c->add_flag("--half", a->half, "Write half floats (an error if a value exceeds 65504)");
-  c->add_flag("--sanitize", a->sanitize, "Replace NaN, Inf and negative input values (lossy-compression ringing) by 0");
+  c->add_flag("--sanitize", a->sanitize,
+              "Zero NaN, Inf and absurd input values; fold negative ones (lossy-compression ringing) into their "
+              "positive neighbours, the integral kept");
   c->add_option("--supersampling", a->supersampling,
                 "Taps per source texel across an output texel's footprint (1: area sampling; default 4 keeps a "
                 "one-texel sun's energy to ~1e-3)")

@@ -140,7 +140,9 @@ Runner add_plan(CLI::App& app) {
       ->check(CLI::Range(0, 1 << 16))
       ->capture_default_str();
   c->add_option("--layout", a->layout, "Layout of the environment when its header and shape do not tell");
-  c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and negative environment values instead of failing");
+  c->add_flag(
+      "--sanitize", a->sanitize,
+      "Zero NaN, Inf and absurd environment values instead of failing (negative values are always folded into their positive neighbours, energy kept)");
   c->add_option("--json", a->json, "Write the plan as JSON to FILE ('-' for stdout)");
   return [a] { return run_plan(*a); };
 }

@@ -194,7 +194,9 @@ Runner add_reference(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::IsMember({"env", "black"}));
   c->add_option("--layout", a->layout, "Layout of the environment when its header and shape do not tell");
-  c->add_flag("--sanitize", a->sanitize, "Zero NaN, Inf and negative environment values instead of failing");
+  c->add_flag(
+      "--sanitize", a->sanitize,
+      "Zero NaN, Inf and absurd environment values instead of failing (negative values are always folded into their positive neighbours, energy kept)");
   c->add_option("--preview", a->preview, "Also write a display-encoded PNG (OCIO; numbered with --turntable)");
   c->add_option("--preview-exposure", a->preview_exposure,
                 "Exposure of the preview in stops (default: the first frame's median luminance at mid-grey)");

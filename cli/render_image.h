@@ -14,7 +14,9 @@ namespace rsibr::cli {
 
 // Reads an environment (layout: a --layout value or empty). NaN, Inf or absurd values
 // (core/texel_audit.h) are an error naming the file, the counts and the first texel unless
-// `sanitize`, which zeroes them and negative values (lossy-compression ringing).
+// `sanitize`, which zeroes them. Negative values (lossy-compression ringing) are always folded
+// into their positive neighbours (remove_negative_ringing: the integral kept), with a warning
+// line on stderr giving the count and the integral's change.
 EnvMap read_environment_input(const std::string& path, const std::string& layout, bool sanitize);
 
 // rgba: CV_32FC4 (R, G, B, A). ZIP, Rec.709 chromaticities, the camera as rsibr.eye (V3f),

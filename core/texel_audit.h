@@ -24,7 +24,18 @@ struct TexelAudit {
 // m: a float image (CV_32F, any channel count), rows in order.
 TexelAudit audit_texels(const cv::Mat& m);
 
-// Zeroes every NaN, Inf, huge and negative value of m (CV_32F) and returns how many it changed.
+// Negative values of m (CV_32F, any channel count, finite) removed without changing the sum of
+// each channel: the ringing a lossy codec leaves around a bright source is a negative lobe beside
+// a positive one, so zeroing the negatives adds the lobe's energy (14% on a CC0 sky with a sun).
+// Each negative value's deficit is taken from the positive values near it instead, in proportion
+// to them, over square windows of radius 1, 2, 4, ... texels until none is left (or the window
+// spans the image; what no positive value can absorb is then zeroed). Texel solid angles differ
+// little within a window, so an environment's integral moves by the variation of solid angle
+// across the ringing's width, not by the ringing's energy. Returns how many values were negative.
+long remove_negative_ringing(cv::Mat& m);
+
+// NaN, Inf and huge values of m (CV_32F) zeroed, then its negatives removed by
+// remove_negative_ringing; returns how many values it changed.
 long sanitize_texels(cv::Mat& m);
 
 }  // namespace rsibr
