@@ -138,6 +138,8 @@ int run_hdr(const HdrArgs& a) {
         std::find_if(set.views.begin(), set.views.end(), [&](const PhotoView& v) { return v.name == name; });
     if (it == set.views.end())
       throw std::invalid_argument(a.photoset + ": no view named '" + quoted_for_message(name) + "'");
+    if (std::find(views.begin(), views.end(), &*it) != views.end())
+      throw std::invalid_argument("--view: '" + quoted_for_message(name) + "' is given twice");
     views.push_back(&*it);
   }
   std::optional<NoiseModel> given_noise;

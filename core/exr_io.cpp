@@ -60,6 +60,11 @@ EnvMap read_exr(const std::string& path, std::optional<LayoutKind> hint, EnvRead
   } else if (hint) {
     kind = *hint;
     report.layout_source = "--layout";
+    // rsibr writes non-square sphere maps with their layout attribute; a bare image said to be one
+    // is a square crop of a mirror ball, or a mistake (a lat-long read as a ball).
+    if (kind == LayoutKind::Sphere && h.width != h.height)
+      refuse(path, "a " + std::to_string(h.width) + "x" + std::to_string(h.height) +
+                       " image cannot be a mirror-ball (sphere) map: it must be square");
   } else {
     kind = layout_from_shape(path, h.width, h.height);
     report.layout_source = "shape";
@@ -114,6 +119,9 @@ EnvMap read_hdr(const std::string& path, std::optional<LayoutKind> hint, EnvRead
   report.compression = "rle";
   const LayoutKind kind = hint ? *hint : layout_from_shape(path, bgr.cols, bgr.rows);
   report.layout_source = hint ? "--layout" : "shape";
+  if (kind == LayoutKind::Sphere && bgr.cols != bgr.rows)
+    refuse(path, "a " + std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows) +
+                     " image cannot be a mirror-ball (sphere) map: it must be square");
   try {
     map.layout = Layout(kind, bgr.cols, bgr.rows);
   } catch (const std::exception& e) {

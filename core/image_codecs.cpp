@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <type_traits>
 
 namespace rsibr {
@@ -64,6 +65,31 @@ bool encode_image(const std::string& extension, const cv::Mat& image, std::vecto
       "_ZN2cv8imencodeERKNSt7__cxx1112basic_stringIcSt11char_traitsIcESaIcEEERKNS_11_InputArrayERSt6vectorIhSaIhEERKSB_"
       "IiSaIiEE");
   return f(extension, image, bytes, params);
+}
+
+bool jpeg_is_complete(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::vector<unsigned char> b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (b.size() < 4 || b[0] != 0xFF || b[1] != 0xD8) return false;
+  std::size_t at = 2;
+  while (at + 1 < b.size()) {
+    if (b[at] != 0xFF) return false;              // segments follow each other without gaps
+    while (at < b.size() && b[at] == 0xFF) ++at;  // fill bytes
+    if (at >= b.size()) return false;
+    const unsigned char marker = b[at++];
+    if (marker == 0xD9) return false;                                    // the end before any scan
+    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) continue;  // no length
+    if (at + 1 >= b.size()) return false;
+    const std::size_t length = std::size_t(b[at]) << 8 | b[at + 1];
+    if (length < 2) return false;
+    if (marker == 0xDA) {
+      for (std::size_t i = at + length; i + 1 < b.size(); ++i)
+        if (b[i] == 0xFF && b[i + 1] == 0xD9) return true;
+      return false;
+    }
+    at += length;
+  }
+  return false;
 }
 
 cv::Mat decode_image(const std::vector<unsigned char>& bytes, int flags) {

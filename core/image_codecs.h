@@ -19,4 +19,12 @@ bool encode_image(const std::string& extension, const cv::Mat& image, std::vecto
                   const std::vector<int>& params = {});
 cv::Mat decode_image(const std::vector<unsigned char>& bytes, int flags);
 
+// Whether the JPEG file at `path` holds its image data to the end-of-image marker. libjpeg decodes
+// a truncated file without failing (grey rows where the data stopped, a warning on stderr), so a
+// photo cut short by a copy would be merged as if it were whole. The segments are walked from the
+// start of image to the first start of scan; an end-of-image marker must follow it (the entropy-
+// coded data cannot hold one: 0xFF is stuffed there). Bytes after it (a phone's trailer) are
+// allowed. False for a file that does not start as a JPEG or cannot be read.
+bool jpeg_is_complete(const std::string& path);
+
 }  // namespace rsibr

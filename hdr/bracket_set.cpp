@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <fstream>
 #include <cmath>
 #include <numeric>
 #include <optional>
@@ -34,6 +35,14 @@ int to_codes(const cv::Mat& in, cv::Mat& out, const std::string& name, bool bgr)
   }
   rgb.convertTo(out, CV_16UC3);
   return in.depth() == CV_8U ? 255 : 65535;
+}
+
+// By content, not by name: a JPEG starts with its start-of-image marker.
+bool is_jpeg_file(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  unsigned char head[2] = {0, 0};
+  in.read(reinterpret_cast<char*>(head), 2);
+  return in && head[0] == 0xFF && head[1] == 0xD8;
 }
 
 std::string size_text(const cv::Mat& m) { return std::to_string(m.cols) + "x" + std::to_string(m.rows); }
@@ -144,6 +153,8 @@ BracketSet load_brackets(const PhotoView& view, bool fit_sizes) {
       ++raw_count;
     } else {
       metadata.push_back(resolve_exposure(b));
+      if (is_jpeg_file(b.file) && !jpeg_is_complete(name))
+        throw std::invalid_argument(name + ": a truncated JPEG (its image data stops before the end-of-image marker)");
       ranges.push_back(to_codes(read_image(name, cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH), c, name, true));
       raw_info.emplace_back();
       raw_saturated.emplace_back();

@@ -192,6 +192,13 @@ refused "hdr: a missing photo" "3.png" hdr "$in/missing-photo" --out "$out/h"
 refused "hdr: brackets of different sizes" "4.png" hdr "$in/resized" --out "$out/h"
 refused "hdr: an unknown key" "photoset.colour" hdr "$in/unknown-key" --out "$out/h"
 refused "hdr: an alias bomb" "photoset.yaml" hdr "$in/bomb-set" --out "$out/h"
+refused "hdr: one view given twice" "--view" hdr "$in/shoot" --out "$out/h" --view north --view north
+# A JPEG cut short decodes without an error in libjpeg (grey rows): refused by its missing end.
+sed 's/format: png/format: jpeg/' "$in/minimal.yaml" >"$work/jpeg-spec.yaml"
+"$rsibr" synth "$work/jpeg-spec.yaml" --out "$work/jpeg-shoot" -q
+jpg=$(ls "$work"/jpeg-shoot/photos/view00/*.jpg | head -1)
+head -c $(($(stat -c %s "$jpg") * 2 / 3)) "$jpg" >"$jpg.cut" && mv "$jpg.cut" "$jpg"
+refused "hdr: a truncated JPEG" "$(basename "$jpg")" hdr "$work/jpeg-shoot/photos" --out "$out/h"
 # process keeps the steps that finished (a re-run resumes from them): only its run folder may change.
 mkdir -p "$out/pr"
 touch "$out/pr/.keep"

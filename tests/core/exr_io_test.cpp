@@ -160,6 +160,15 @@ TEST(ExrIo, LayoutComesFromEnvmapAttributeThenRsibrLayoutThenHintThenShape) {
     EXPECT_EQ(report.layout_source, "shape");
     EXPECT_EQ(read_environment(cube, LayoutKind::LatLong, &report).layout.kind(), LayoutKind::LatLong);
     EXPECT_EQ(report.layout_source, "--layout");
+    // ... but a bare image that is not square is no mirror ball, whatever the hint says.
+    try {
+      read_environment(ll, LayoutKind::Sphere, &report);
+      ADD_FAILURE() << "a 16x8 image was read as a sphere map";
+    } catch (const std::runtime_error& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind(ll, 0), 0u) << msg;
+      EXPECT_NE(msg.find("must be square"), std::string::npos) << msg;
+    }
   }
   // envmap beats rsibr.layout; rsibr.layout beats the hint and the shape.
   {
