@@ -91,7 +91,7 @@ void bind_environment(py::module_& m) {
 
   m.def(
       "read_environment",
-      [](const std::string& path, const std::optional<std::string>& layout, bool sanitize) {
+      [](const std::string& path, const std::optional<std::string>& layout, bool sanitize, bool fold_ringing) {
         check_input_file(path);
         const std::optional<LayoutKind> hint =
             layout ? std::optional<LayoutKind>(parse_layout_kind(*layout)) : std::nullopt;
@@ -104,13 +104,24 @@ void bind_environment(py::module_& m) {
         if (report.texels.bad() && !sanitize)
           throw std::runtime_error(path + ": " + report.texels.describe() + "; pass sanitize=True to zero them");
         if (sanitize) sanitize_texels(env.pixels);
+        // The rule of the command line's environment inputs (cli/render_image.h): lossy-codec
+        // ringing folded into its neighbours, energy kept, and said.
+        if (fold_ringing && report.texels.negative > 0) {
+          if (!sanitize) remove_negative_ringing(env.pixels);
+          const std::string warning = path + ": " + std::to_string(report.texels.negative) +
+                                      " negative values (lossy-compression ringing) folded into their positive "
+                                      "neighbours";
+          if (PyErr_WarnEx(PyExc_UserWarning, warning.c_str(), 1) != 0) throw py::error_already_set();
+        }
         return env;
       },
-      py::arg("path"), py::arg("layout") = py::none(), py::arg("sanitize") = false,
+      py::arg("path"), py::arg("layout") = py::none(), py::arg("sanitize") = false, py::arg("fold_ringing") = true,
       "Reads an OpenEXR or Radiance .hdr environment. Layout: the file's envmap or rsibr.layout attribute, else "
       "`layout` (a name), else the shape (2:1 lat-long, 1:6 cube). Pixels are converted to the working space. "
-      "NaN, Inf and absurd values are a RuntimeError naming the file unless sanitize=True, which zeroes them and "
-      "negative values. RuntimeError for unreadable files, FileNotFoundError for missing ones.");
+      "NaN, Inf and absurd values are a RuntimeError naming the file unless sanitize=True, which zeroes them. "
+      "Negative values (lossy-compression ringing) are folded into their positive neighbours, the integral kept, "
+      "with a UserWarning giving the count (as the command line does), unless fold_ringing=False. RuntimeError "
+      "for unreadable files, FileNotFoundError for missing ones.");
   m.def(
       "write_environment",
       [](const std::string& path, const EnvMap& env, bool half) {

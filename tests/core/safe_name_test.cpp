@@ -132,9 +132,9 @@ TEST_F(FileInFolderTest, NamesWithFoldersOrFolderReferencesAreRefused) {
 TEST_F(FileInFolderTest, AnExistingLinkOfThatNameIsReplacedByTheWriteNotFollowed) {
   // The contract of every writer: a finished temporary renamed onto the path replaces the link.
   std::ofstream(dir_ / "elsewhere" / "victim") << "keep";
-  fs::create_symlink(dir_ / "elsewhere" / "victim", dir_ / "out" / "north.exr");
-  const fs::path p = file_in_folder(dir_ / "out", "north.exr");
-  write_folder_atomically(dir_ / "out", {{"north.exr", {'n', 'e', 'w'}}});
+  fs::create_symlink(dir_ / "elsewhere" / "victim", dir_ / "out" / "north.txt");
+  const fs::path p = file_in_folder(dir_ / "out", "north.txt");
+  write_folder_atomically(dir_ / "out", {{"north.txt", {'n', 'e', 'w'}}});
   std::ifstream victim(dir_ / "elsewhere" / "victim");
   std::string text;
   victim >> text;
