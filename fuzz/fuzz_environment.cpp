@@ -1,8 +1,9 @@
 // libFuzzer target: the environment reader (OpenEXR lat-long / cube / octahedral / sphere, and
-// Radiance .hdr through OpenCV), then a resample of what it read. The first byte picks the
-// extension the reader sees.
+// Radiance .hdr through OpenCV), then a resample of what it read and its negative values folded
+// (core/texel_audit.h). The first byte picks the extension the reader sees.
 #include "core/exr_io.h"
 #include "core/resample.h"
+#include "core/texel_audit.h"
 #include "fuzz/fuzz_input.h"
 
 #include <exception>
@@ -17,6 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       rsibr::ResampleOptions o;
       o.max_subsamples = 2;
       (void)rsibr::resample(env, rsibr::Layout::with_size(rsibr::LayoutKind::Octahedral, 8), o);
+      (void)rsibr::remove_negative_ringing(env.pixels);
     }
   } catch (const std::exception&) {
   }
