@@ -1,4 +1,5 @@
 #include "calib/ball_candidates_picture.h"
+#include "core/file_error.h"
 
 #include "core/atomic_file.h"
 #include "core/colour.h"
@@ -46,7 +47,7 @@ void write_ball_candidates_picture(const std::filesystem::path& png, const cv::M
     if (p >= 0) chosen.push_back(p);
   const cv::Mat shown = ball_candidates_picture(image, vc.cands, chosen);
   write_atomically(png, [&](const std::string& tmp) {
-    if (!write_image(tmp, shown)) throw std::runtime_error(png.string() + ": cannot write the PNG image");
+    if (!write_image(tmp, shown)) throw FileError(png.string(), "cannot write the PNG image", {}, FileRole::Output);
   });
 }
 

@@ -1,4 +1,5 @@
 #include "calib/pair_matches_picture.h"
+#include "core/file_error.h"
 
 #include "core/atomic_file.h"
 #include "core/colour.h"
@@ -43,7 +44,7 @@ void write_pair_matches_picture(const std::filesystem::path& png, const cv::Mat&
                                 const PairOrientation& pair) {
   const cv::Mat shown = pair_matches_picture(a, b, pair);
   write_atomically(png, [&](const std::string& tmp) {
-    if (!write_image(tmp, shown)) throw std::runtime_error(png.string() + ": cannot write the PNG image");
+    if (!write_image(tmp, shown)) throw FileError(png.string(), "cannot write the PNG image", {}, FileRole::Output);
   });
 }
 

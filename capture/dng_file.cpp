@@ -1,4 +1,5 @@
 #include "capture/dng_file.h"
+#include "core/file_error.h"
 
 #include "core/atomic_file.h"
 
@@ -122,9 +123,9 @@ void write_dng(const std::filesystem::path& file, const cv::Mat& mosaic, const D
     for (int y = 0; y < mosaic.rows; ++y) {
       row = mosaic.row(y).clone();
       if (TIFFWriteScanline(t, row.ptr<std::uint16_t>(), std::uint32_t(y), 0) < 0)
-        throw std::runtime_error(file.string() + ": cannot write row " + std::to_string(y));
+        throw FileError(file.string(), std::string("cannot write row ") + std::to_string(y), {}, FileRole::Output);
     }
-    if (!TIFFWriteDirectory(t)) throw std::runtime_error(file.string() + ": cannot write the directory");
+    if (!TIFFWriteDirectory(t)) throw FileError(file.string(), "cannot write the directory", {}, FileRole::Output);
   });
 }
 

@@ -1,4 +1,5 @@
 #include "capture/synth_capture.h"
+#include "core/file_error.h"
 
 #include "capture/camera_poses.h"
 #include "capture/camera_processing.h"
@@ -44,7 +45,7 @@ void write_bytes(const fs::path& file, const std::vector<uchar>& bytes) {
   std::ofstream out(file, std::ios::binary);
   out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
   out.close();
-  if (!out) throw std::runtime_error(file.string() + ": cannot write");
+  if (!out) throw FileError(file.string(), "cannot write", {}, FileRole::Output);
   check_written_file(file, file);
 }
 
@@ -89,7 +90,7 @@ void write_photo_exif(const fs::path& file, const SynthCamera& cam, double t, co
     }
     image->writeMetadata();
   } catch (const Exiv2::Error& e) {
-    throw std::runtime_error(file.string() + ": cannot write EXIF: " + e.what());
+    throw FileError(file.string(), std::string("cannot write EXIF: ") + e.what(), {}, FileRole::Output);
   }
 }
 
@@ -238,24 +239,11 @@ EnvMap synth_environment(const SynthScene& scene) {
   return env;
 }
 
-SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir,
-                                const std::function<void(double)>& progress) {
-  const auto t0 = Clock::now();
-  const fs::path out = fs::absolute(out_dir).lexically_normal();
-  if (fs::exists(out) && !(fs::is_directory(out) && fs::is_empty(out)))
-    throw std::invalid_argument(out_dir.string() + ": exists and is not an empty folder");
-  if (!fs::is_directory(out.parent_path()))
-    throw std::invalid_argument(out_dir.string() + ": the folder it goes in does not exist");
-  const fs::path tmp = out.parent_path() / ("." + out.filename().string() + ".partial-" + std::to_string(::getpid()));
-  fs::remove_all(tmp);
-  struct Cleanup {
-    fs::path p;
-    bool keep = false;
-    ~Cleanup() {
-      std::error_code ec;
-      if (!keep) fs::remove_all(p, ec);
-    }
-  } cleanup{tmp};
+namespace {
+
+// The capture's files written into `tmp` (the staging folder write_synth_capture renames).
+SynthReport fill_synth_folder(const SynthScene& scene, const fs::path& tmp,
+                              const std::function<void(double)>& progress) {
   const fs::path photos = tmp / "photos", truth = tmp / "truth";
   for (const fs::path& d : {photos / "chessboards", truth / "views", truth / "maps", truth / "chessboards"})
     fs::create_directories(d);
@@ -542,14 +530,44 @@ SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir
             em.c_str() + "\n");
   }
   save_photo_set(set);
-
-  if (fs::exists(out)) fs::remove(out);  // an empty folder (checked above)
-  fs::rename(tmp, out);
-  cleanup.keep = true;
   report.views = int(poses.size());
-  report.seconds_total = secs(Clock::now() - t0);
-  if (progress) progress(1.0);
   return report;
+}
+
+}  // namespace
+
+SynthReport write_synth_capture(const SynthScene& scene, const fs::path& out_dir,
+                                const std::function<void(double)>& progress) {
+  const auto t0 = Clock::now();
+  const fs::path out = fs::absolute(out_dir).lexically_normal();
+  if (fs::exists(out) && !(fs::is_directory(out) && fs::is_empty(out)))
+    throw std::invalid_argument(out_dir.string() + ": exists and is not an empty folder");
+  if (!fs::is_directory(out.parent_path()))
+    throw std::invalid_argument(out_dir.string() + ": the folder it goes in does not exist");
+  const fs::path tmp = out.parent_path() / ("." + out.filename().string() + ".partial-" + std::to_string(::getpid()));
+  fs::remove_all(tmp);
+  struct Cleanup {
+    fs::path p;
+    bool keep = false;
+    ~Cleanup() {
+      std::error_code ec;
+      if (!keep) fs::remove_all(p, ec);
+    }
+  } cleanup{tmp};
+  try {
+    SynthReport report = fill_synth_folder(scene, tmp, progress);
+    if (fs::exists(out)) fs::remove(out);  // an empty folder (checked above)
+    fs::rename(tmp, out);
+    cleanup.keep = true;
+    report.seconds_total = secs(Clock::now() - t0);
+    if (progress) progress(1.0);
+    return report;
+  } catch (const FileError& e) {
+    // Name the file where it would have been, not in the staging folder that is removed.
+    std::string file = e.file();
+    if (file.rfind(tmp.string(), 0) == 0) file = out.string() + file.substr(tmp.string().size());
+    throw FileError(file, e.problem(), e.where(), e.role(), e.step());
+  }
 }
 
 }  // namespace rsibr

@@ -1,6 +1,7 @@
 // rsibr blend: the radiance map for any view from a map set (the runtime's warp and blend), written
 // as a one-view map set whose confidence channel is the blend's total weight.
 #include "cli/bake_planning.h"
+#include "core/file_error.h"
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
@@ -96,7 +97,7 @@ int run_blend(const BlendArgs& a) {
   write_map_set(exr, out);
   if (!preview.empty() &&
       !write_image(preview, display_encode(r.rgb, a.preview_exposure ? *a.preview_exposure : preview_exposure(r.rgb))))
-    throw std::runtime_error(a.preview + ": cannot write the preview image");
+    throw FileError(a.preview, "cannot write the preview image", {}, FileRole::Output);
   nlohmann::json j;
   j["maps"] = a.maps;
   j["output"] = a.output;

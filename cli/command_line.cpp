@@ -6,6 +6,7 @@
 #include "core/file_error.h"
 #include "core/output_plan.h"
 
+#include <opencv2/core.hpp>
 #include <tbb/global_control.h>
 
 #include <exception>
@@ -122,16 +123,26 @@ CommandResult run_command_line(const std::vector<std::string>& args) {
     if (session.size() > 1 && name != "bake" && name != "batch")
       return fail(2, "rsibr " + name + ": error: runs as one process, not over " + std::to_string(session.size()) +
                          " MPI ranks (only bake and batch are split over ranks; run it without mpirun)");
-    // Exit status: 2 when the command is refused (the command line, or an input that is missing,
-    // unreadable or inconsistent: the caller's to fix), 1 when the work failed (an output that
-    // cannot be written, a solve that does not converge, anything else).
+    // Exit status (docs/user-guide.md, Common behaviour): 2 the command is refused (the command
+    // line, or an input that is missing, unreadable or inconsistent: the caller's to fix); 1 the
+    // work failed (a solve that does not converge, a ball not found, anything else); 4 an output
+    // could not be written (a full disk, a folder gone); 70 an internal error (a broken invariant
+    // or a library's own assertion: a bug to report, never the input's fault).
     const std::string who = "rsibr " + name + ": error: ";
     try {
       return {run(), ""};
     } catch (const FileError& e) {
-      return fail(e.role() == FileRole::Input ? 2 : 1, who + OutputPlan::naming_targets(e.what()));
+      return fail(e.role() == FileRole::Input ? 2 : 4, who + OutputPlan::naming_targets(e.what()));
     } catch (const std::invalid_argument& e) {
       return fail(2, who + OutputPlan::naming_targets(e.what()));
+    } catch (const std::out_of_range& e) {  // std::stod on a user's 1e999 as well as a bad .at()
+      return fail(1, who + OutputPlan::naming_targets(e.what()));
+    } catch (const std::length_error& e) {
+      return fail(1, who + OutputPlan::naming_targets(e.what()));
+    } catch (const std::logic_error& e) {
+      return fail(70, who + "internal error (please report it): " + OutputPlan::naming_targets(e.what()));
+    } catch (const cv::Exception& e) {
+      return fail(70, who + "internal error (please report it): OpenCV's " + e.func + " refused its input: " + e.err);
     } catch (const std::exception& e) {
       return fail(1, who + OutputPlan::naming_targets(e.what()));
     }

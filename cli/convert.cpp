@@ -1,5 +1,6 @@
 // rsibr convert: an environment map from one layout and size to another.
 #include "cli/summary.h"
+#include "core/file_error.h"
 #include "cli/verbs.h"
 
 #include "core/atomic_file.h"
@@ -93,7 +94,7 @@ int run_convert(const ConvertArgs& a) {
   if (!preview.empty() &&
       !write_image(preview,
                    display_encode(out.pixels, a.preview_exposure ? *a.preview_exposure : preview_exposure(out.pixels))))
-    throw std::runtime_error(a.preview + ": cannot write the preview image");
+    throw FileError(a.preview, "cannot write the preview image", {}, FileRole::Output);
   const auto t3 = std::chrono::steady_clock::now();
 
   const std::vector<double> in_int = integral(src), out_int = integral(out);

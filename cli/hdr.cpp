@@ -3,6 +3,7 @@
 // a shot + read noise model, the inverse-variance merge with variance, clipped, black and ghost
 // channels, conversion to the working colour space, EXR + PNG preview per view.
 #include "cli/summary.h"
+#include "core/file_error.h"
 #include "cli/verbs.h"
 
 #include "core/atomic_file.h"
@@ -318,7 +319,8 @@ int run_hdr(const HdrArgs& a) {
       if (!a.no_preview) {
         const cv::Mat png = display_encode(m.radiance, stops);
         const fs::path p = file_in_folder(stage, v.name + ".png");
-        if (!write_image(p.string(), png)) throw std::runtime_error(p.string() + ": cannot write the preview");
+        if (!write_image(p.string(), png))
+          throw FileError(p.string(), "cannot write the preview", {}, FileRole::Output);
         staged.push_back({p, file_in_folder(out_dir, v.name + ".png")});
       }
       const auto t3 = std::chrono::steady_clock::now();

@@ -1,6 +1,7 @@
 // rsibr reference: the ground-truth render of a mesh with a BRDF under an environment, seen by a
 // perspective camera (bake/reference_renderer.h for what a pixel holds).
 #include "cli/camera_options.h"
+#include "core/file_error.h"
 #include "cli/option_checks.h"
 #include "cli/render_image.h"
 #include "cli/summary.h"
@@ -109,7 +110,8 @@ int run_reference(const ReferenceArgs& a) {
     write_render(exr_tmp[std::size_t(k)], im, cam, strings, o);
     if (!a.preview.empty() && !write_image(png_tmp[std::size_t(k)],
                                            display_encode(im.rgb, *(stops = stops ? stops : preview_exposure(im.rgb)))))
-      throw std::runtime_error(frame_path(a.preview, a.camera.turntable, k) + ": cannot write the preview image");
+      throw FileError(frame_path(a.preview, a.camera.turntable, k), "cannot write the preview image", {},
+                      FileRole::Output);
     const auto r2 = std::chrono::steady_clock::now();
     render_s += std::chrono::duration<double>(r1 - r0).count();
     write_s += std::chrono::duration<double>(r2 - r1).count();

@@ -1,4 +1,5 @@
 #include "cli/rgba_png.h"
+#include "core/file_error.h"
 
 #include "core/atomic_file.h"
 #include "core/colour.h"
@@ -35,7 +36,7 @@ void write_rgba_png(const std::string& path, const cv::Mat& rgba, float exposure
   }
   write_atomically(path, [&](const std::string& tmp) {
     if (!write_image(tmp, bgra, {cv::IMWRITE_PNG_COMPRESSION, 3}))
-      throw std::runtime_error(path + ": cannot write the PNG image");
+      throw FileError(path, "cannot write the PNG image", {}, FileRole::Output);
   });
 }
 

@@ -1,5 +1,6 @@
 #include "core/atomic_file.h"
 
+#include "core/file_error.h"
 #include "core/written_file_check.h"
 
 #include <unistd.h>
@@ -46,7 +47,8 @@ void write_text_atomically(const std::filesystem::path& target, const std::strin
         std::ofstream f(tmp, std::ios::binary);
         f.write(text.data(), std::streamsize(text.size()));
         f.close();
-        if (!f) throw std::runtime_error(target.string() + ": cannot write: " + std::strerror(errno));
+        if (!f)
+          throw FileError(target.string(), std::string("cannot write: ") + std::strerror(errno), {}, FileRole::Output);
       },
       text.empty());
 }

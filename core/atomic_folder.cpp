@@ -1,5 +1,6 @@
 #include "core/atomic_folder.h"
 
+#include "core/file_error.h"
 #include "core/written_file_check.h"
 
 #include "core/text.h"
@@ -70,7 +71,7 @@ void write_folder_atomically(const std::filesystem::path& folder, const FolderCo
       std::ofstream out(staging / name, std::ios::binary);
       out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
       out.close();
-      if (!out) throw std::runtime_error((target / name).string() + ": cannot write");
+      if (!out) throw FileError((target / name).string(), "cannot write", {}, FileRole::Output);
       check_written_file(staging / name, target / name, bytes.empty());
     }
     if (!existed) {
@@ -81,7 +82,7 @@ void write_folder_atomically(const std::filesystem::path& folder, const FolderCo
     }
   } catch (const fs::filesystem_error& e) {
     fs::remove_all(staging, ec);
-    throw std::runtime_error(folder.string() + ": " + e.code().message());
+    throw FileError(folder.string(), e.code().message(), {}, FileRole::Output);
   } catch (...) {
     fs::remove_all(staging, ec);
     throw;

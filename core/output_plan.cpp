@@ -1,5 +1,6 @@
 #include "core/output_plan.h"
 
+#include "core/file_error.h"
 #include "core/written_file_check.h"
 
 #include <sys/stat.h>
@@ -121,7 +122,7 @@ void OutputPlan::commit() {
   for (const auto& [tmp, target] : staged_) check_written_file(tmp, target);
   for (const auto& [tmp, target] : staged_) {
     fs::rename(tmp, target, ec);
-    if (ec) throw std::runtime_error(target.string() + ": cannot put the output in place: " + ec.message());
+    if (ec) throw FileError(target.string(), "cannot put the output in place: " + ec.message(), {}, FileRole::Output);
   }
   committed_ = true;
 }

@@ -1,6 +1,8 @@
 #include "core/written_file_check.h"
 
 #include "core/exr_file.h"
+#include "core/file_error.h"
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -23,7 +25,7 @@ namespace fs = std::filesystem;
 namespace {
 
 [[noreturn]] void refuse(const fs::path& shown, const std::string& why) {
-  throw std::runtime_error(shown.string() + ": cannot write: " + why);
+  throw FileError(shown.string(), "cannot write: " + why, {}, FileRole::Output);
 }
 
 void sync_to_disk(const fs::path& file, const fs::path& shown) {

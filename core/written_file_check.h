@@ -14,7 +14,8 @@
 
 namespace rsibr {
 
-// Throws std::runtime_error("<shown_as>: cannot write: <reason>") where `file` fails a check;
+// Throws FileError(shown_as, "cannot write: <reason>", output role; what() = "<shown_as>: cannot
+// write: <reason>") where `file` fails a check;
 // `shown_as` is the name the user gave (the target of a temporary). The format is taken from
 // `shown_as`'s extension.
 void check_written_file(const std::filesystem::path& file, const std::filesystem::path& shown_as,

@@ -689,7 +689,7 @@ status_is "probe: missing input" 2 "rsibr probe: error: $gone: no such file" pro
 status_is "render: missing input" 2 "rsibr render: error: $gone: no such file" render --maps "$gone" --mesh "$work/cube.obj" "$work/s5.png"
 status_is "bake: a value out of range" 2 "rsibr bake: error: --res: expected a value from 1 to 8192, got '0' (see --help)" bake --env "$work/sky.exr" --brdf "$work/ggx.yaml" --res 0 "$work/s6.exr"
 "$rsibr" convert "$work/sky.exr" "$work/half-probe.exr" --to cube --half >/dev/null 2>"$work/err"
-check "convert: an output that cannot be written is exit 1" test $? -eq 1
+check "convert: an output that cannot be written is exit 4" test $? -eq 4
 check "no outputs after refused commands" bash -c "! ls '$work'/s[1-6].* 2>/dev/null | grep -q ."
 
 finish cli

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Every verb that writes, onto a full file system (a small tmpfs): a non-zero exit, one line on
+# Every verb that writes, onto a full file system (a small tmpfs): exit status 4, one line on
 # stderr naming the output, and nothing left on the full file system but its filler. Two levels:
 # no space at all, and a few KiB (headers fit, pixels do not). Needs root (mount); skipped with a
 # message (exit 77) where mounting a tmpfs is not allowed.
@@ -51,7 +51,8 @@ complete_outputs() {
 }
 # on_full_disk LEFT_KIB NAME ARGS...: the whole contract for one verb. KEEP=1 in the environment:
 # the verb's run folder may stay (with whole files only); LINES_OK=N: N lines on stderr;
-# NEEDLE: what the message must name (default: the full file system's path).
+# NEEDLE: what the message must name (default: the full file system's path); STATUS: the exit
+# status wanted (default 4, an output that could not be written).
 on_full_disk() {
   local left=$1 name="$2 ($1 KiB free)" keep=${KEEP:-}; shift 2
   fill "$left"
@@ -64,6 +65,7 @@ on_full_disk() {
   elif [ "$rc" -ge 128 ]; then why="killed by signal $((rc - 128))"
   elif [ "$rc" -eq 0 ] && [ "$left" -eq 0 ]; then why="exit 0"
   elif [ "$rc" -eq 0 ]; then why=$(complete_outputs)  # it fitted: every file must be whole
+  elif [ "$rc" -ne "${STATUS:-4}" ]; then why="exit $rc, not ${STATUS:-4} (an output could not be written)"
   elif [ "$lines" -ne "${LINES_OK:-1}" ]; then why="$lines lines on stderr"
   elif ! grep -q -- "${NEEDLE:-$full}" "$work/err"; then why="the message does not name the output"
   elif [ -n "$keep" ]; then why=$(complete_outputs)  # a run folder keeps what finished
@@ -92,7 +94,7 @@ for left in 0 8; do
   on_full_disk "$left" "balls --picture" balls "$in/hdr/view00.exr" --lens "$in/lens.cameramodel" --picture "$full/balls.png"
   on_full_disk "$left" "probe" probe "$in/chrome0.exr" --out "$full/probe.exr" --width 64 -q
   on_full_disk "$left" "plan --json" plan --env "$in/env-good.exr" --brdf "$in/lambert.yaml" --max-error 20% --views octa --res 8 --json "$full/plan.json"
-  NEEDLE=full/batch.exr LINES_OK=2 on_full_disk "$left" "batch (the job's line and the summary)" batch "$work/batch.yaml" -q
+  STATUS=1 NEEDLE=full/batch.exr LINES_OK=2 on_full_disk "$left" "batch (the job's line and the summary)" batch "$work/batch.yaml" -q
   KEEP=1 on_full_disk "$left" "process" process "$in/syn/photos" --out "$full/run" -q
 done
 finish "full disk"
