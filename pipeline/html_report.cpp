@@ -258,10 +258,48 @@ std::string svg_line_plot(const std::vector<PlotSeries>& series, const std::stri
   return s.str();
 }
 
+// The step that stopped the run (DIR/steps/STEP.failed.json): its error, what it had found, and
+// the pictures a user needs to help it (the pairs' matches, the ball candidates).
+void write_failed_step_section(std::ostringstream& h, const std::string& step, const nlohmann::json& failed,
+                               const fs::path& dir) {
+  h << "<h2>Stopped at " << html_escape(step) << "</h2><p class=\"warn\">"
+    << html_escape(failed.value("error", std::string("(no message)"))) << "</p>";
+  const nlohmann::json summary = failed.value("summary", nlohmann::json::object());
+  if (step == "orient" && summary.is_object()) {
+    write_orientation_notes(h, summary);
+    write_orientation_pairs(h, summary, dir);
+  }
+  if (step == "lens" || step == "orient" || step == "extract") {
+    std::vector<fs::path> pictures;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir / "balls", ec))
+      if (e.path().extension() == ".png") pictures.push_back(e.path());
+    std::sort(pictures.begin(), pictures.end());
+    if (!pictures.empty())
+      h << "<h3>Ball candidates</h3><p>Each view's candidates, numbered; give the right one with "
+           "<code>--ball VIEW:BALL=X,Y,R</code>.</p>";
+    for (const fs::path& f : pictures)
+      h << "<p>" << html_escape(f.filename().string()) << "<br>"
+        << img_tag(read_bytes(dir, f), f.filename().string(), "max-width:100%") << "</p>";
+  }
+}
+
 void write_process_report(const fs::path& dir, const fs::path& out, const std::string& photoset) {
   std::map<std::string, StepRecord> rec;
-  for (const std::string& step : process_steps())
-    if (step != "report" && fs::exists(step_record_path(dir, step))) rec[step] = read_step_record(dir, step);
+  std::map<std::string, nlohmann::json> failed;  // steps that stopped, with no record of their own
+  for (const std::string& step : process_steps()) {
+    if (step == "report") continue;
+    if (fs::exists(step_record_path(dir, step))) {
+      rec[step] = read_step_record(dir, step);
+    } else if (fs::exists(failed_step_record_path(dir, step))) {
+      try {
+        std::ifstream in(failed_step_record_path(dir, step));
+        failed[step] = nlohmann::json::parse(in);
+      } catch (const std::exception&) {
+        failed[step] = {{"error", "its record of the failure cannot be read"}};
+      }
+    }
+  }
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>rsibr process report</title><style>"
        "body{font-family:sans-serif;max-width:1100px;margin:1em auto;padding:0 1em;color:#222}"
@@ -280,10 +318,11 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
       total += rec[step].seconds;
       h << "<tr><td>" << step << "</td><td>" << num(rec[step].seconds, 3) << "</td></tr>";
     } else {
-      h << "<tr><td>" << step << "</td><td>not run</td></tr>";
+      h << "<tr><td>" << step << "</td><td>" << (failed.count(step) ? "<b>failed</b>" : "not run") << "</td></tr>";
     }
   }
   h << "<tr><th>total</th><th>" << num(total, 3) << "</th></tr></table>\n";
+  for (const auto& [step, f] : failed) write_failed_step_section(h, step, f, dir);
 
   if (rec.count("calibrate")) {
     const auto& s = rec["calibrate"].summary;

@@ -28,7 +28,9 @@ struct PlotSeries {
 std::string svg_line_plot(const std::vector<PlotSeries>& series, const std::string& x_label, const std::string& y_label,
                           int width = 480, int height = 300);
 
-// Writes `out` atomically from DIR's records (a step without a record gets "not run").
+// Writes `out` atomically from DIR's records (a step without a record gets "not run"; one that
+// stopped, DIR/steps/STEP.failed.json, gets its error and what it had found: the pairs of views
+// and their pictures, the ball candidates).
 // Throws std::runtime_error("<file>: <problem>") when an output a record lists cannot be read.
 void write_process_report(const std::filesystem::path& dir, const std::filesystem::path& out,
                           const std::string& photoset);

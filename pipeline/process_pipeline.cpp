@@ -1459,16 +1459,26 @@ ProcessResult run_process(const ProcessOptions& o) {
     throw std::invalid_argument(o.out.string() + ": is the photo set's folder; choose another output folder");
   fs::create_directories(c.dir);
 
-  step_calibrate(c);
-  step_hdr(c);
-  step_lens(c);
-  step_orient(c);
-  step_extract(c);
-  step_probe(c);
-  step_sources(c);
-  step_bake(c);
-  step_compare(c);
-  step_render(c);
+  try {
+    step_calibrate(c);
+    step_hdr(c);
+    step_lens(c);
+    step_orient(c);
+    step_extract(c);
+    step_probe(c);
+    step_sources(c);
+    step_bake(c);
+    step_compare(c);
+    step_render(c);
+  } catch (...) {
+    // The report up to the step that stopped, with that step's error and pictures; best effort:
+    // the step's own error is what the user is told.
+    try {
+      write_process_report(c.dir, c.dir / "report.html", c.set.folder.string());
+    } catch (const std::exception&) {
+    }
+    throw;
+  }
 
   // The report reads every record (timings included), so it runs whenever any step did.
   std::vector<fs::path> inputs;

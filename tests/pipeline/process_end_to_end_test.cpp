@@ -23,6 +23,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 namespace rsibr {
@@ -249,7 +250,8 @@ TEST_F(ProcessEndToEnd, ReportIsSelfContained) {
 
 // The orientation solve needs features the views share; the minimal sky has too few for views
 // 120 degrees apart, so without --poses the run stops at the orient step with one message naming
-// the view, rather than inventing poses, and writes no poses and no report.
+// the view, rather than inventing poses, and writes no poses; the report up to that step says
+// where it stopped and why (the error, the steps that ran, the failed step's record).
 TEST_F(ProcessEndToEnd, WithoutSharedFeaturesTheOrientStepFailsClearly) {
   ProcessOptions o = options();
   o.poses.clear();
@@ -264,7 +266,14 @@ TEST_F(ProcessEndToEnd, WithoutSharedFeaturesTheOrientStepFailsClearly) {
     EXPECT_EQ(what.find('\n'), std::string::npos) << what;
   }
   EXPECT_FALSE(fs::exists(o.out / "poses.yaml"));
-  EXPECT_FALSE(fs::exists(o.out / "report.html"));
+  EXPECT_TRUE(fs::exists(o.out / "steps" / "orient.failed.json"));
+  ASSERT_TRUE(fs::exists(o.out / "report.html"));
+  std::ifstream in(o.out / "report.html");
+  const std::string html((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_NE(html.find("Stopped at orient"), std::string::npos);
+  EXPECT_NE(html.find("<b>failed</b>"), std::string::npos);
+  EXPECT_NE(html.find("Camera response"), std::string::npos) << "the steps before it are reported";
+  EXPECT_EQ(html.find("Light probe"), std::string::npos) << "no step after it ran";
   EXPECT_TRUE(fs::exists(o.out / "hdr" / "view00.exr"));  // the steps before stay, for a resumed run
 }
 
