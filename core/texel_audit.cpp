@@ -48,50 +48,63 @@ std::string TexelAudit::describe() const {
 
 namespace {
 
-// One channel (CV_32FC1). The window sums are unnormalised box filters (reflected at the border).
-//   ask_x   = d_x / S_P(x)           the share of its window's positive mass deficit x needs
-//   take_y  = min(P_y, P_y * sum_{x in W(y)} ask_x)
-// and every deficit is then scaled by 1 - (sum take) / (sum of the deficits that had positive mass
-// in their window): the channel's sum is exact, the attribution to windows approximate.
+// One channel (CV_32FC1). With window W of radius r, positive values P and deficits d (-L where
+// L < 0), over unnormalised box sums (reflected at the border, which keeps them symmetric:
+// y in W(x) exactly when x in W(y)):
+//   ask_x = d_x / sum_{y in W(x)} P_y        the share of its window's positive mass x needs
+//   q_y   = sum_{x in W(y)} ask_x            what is asked of y, as a fraction of P_y
+//   h_y   = min(1, 1 / q_y)                  the fraction of the asks y can honour
+//   y gives P_y min(q_y, 1);  x receives ask_x sum_{y in W(x)} P_y h_y
+// so what the positives give equals what the deficits receive, texel by texel of the windows, and
+// each channel's sum is kept. Deficits left over (their window had too little) try the next,
+// doubled radius. Only the deficits' bounding box, grown by 2r, is filtered.
 void remove_negative_ringing_channel(cv::Mat& c) {
   cv::Mat positive = cv::max(c, 0.0), deficit = cv::max(-c, 0.0);
   const int largest = std::max(c.rows, c.cols);
   for (int radius = 1;; radius *= 2) {
-    if (cv::countNonZero(deficit) == 0) break;
+    cv::Mat has_deficit = deficit > 0;
+    if (cv::countNonZero(has_deficit) == 0) break;
+    if (radius > 2 * largest) {  // no positive value anywhere can absorb what is left
+      deficit.setTo(0);
+      break;
+    }
+    const cv::Rect box = cv::boundingRect(has_deficit);
+    const cv::Rect roi =
+        cv::Rect(box.x - 2 * radius, box.y - 2 * radius, box.width + 4 * radius, box.height + 4 * radius) &
+        cv::Rect(0, 0, c.cols, c.rows);
+    cv::Mat p = positive(roi), d = deficit(roi);
     const cv::Size window(2 * radius + 1, 2 * radius + 1);
-    cv::Mat window_positive;
-    cv::boxFilter(positive, window_positive, CV_64F, window, cv::Point(-1, -1), false, cv::BORDER_REFLECT);
-    cv::Mat deficit64;
-    deficit.convertTo(deficit64, CV_64F);
-    cv::Mat ask = cv::Mat::zeros(c.size(), CV_64F);
-    double asked = 0;
-    for (int r = 0; r < c.rows; ++r) {
-      const double* d = deficit64.ptr<double>(r);
-      const double* s = window_positive.ptr<double>(r);
-      double* a = ask.ptr<double>(r);
-      for (int i = 0; i < c.cols; ++i)
-        if (d[i] > 0 && s[i] > 0) a[i] = d[i] / s[i], asked += d[i];
-    }
-    cv::Mat pull;
-    cv::boxFilter(ask, pull, CV_64F, window, cv::Point(-1, -1), false, cv::BORDER_REFLECT);
-    double taken = 0;
-    for (int r = 0; r < c.rows; ++r) {
-      float* p = positive.ptr<float>(r);
-      const double* q = pull.ptr<double>(r);
-      for (int i = 0; i < c.cols; ++i) {
-        const double t = std::min(double(p[i]), double(p[i]) * q[i]);
-        p[i] = float(double(p[i]) - t);
-        taken += t;
+    const auto box_sum = [&](const cv::Mat& in) {
+      cv::Mat out;
+      cv::boxFilter(in, out, CV_64F, window, cv::Point(-1, -1), false, cv::BORDER_REFLECT);
+      return out;
+    };
+    cv::Mat p64, d64;
+    p.convertTo(p64, CV_64F);
+    d.convertTo(d64, CV_64F);
+    const cv::Mat window_positive = box_sum(p64);
+    cv::Mat ask = cv::Mat::zeros(roi.size(), CV_64F);
+    for (int r = 0; r < roi.height; ++r)
+      for (int i = 0; i < roi.width; ++i)
+        if (d64.at<double>(r, i) > 0 && window_positive.at<double>(r, i) > 0)
+          ask.at<double>(r, i) = d64.at<double>(r, i) / window_positive.at<double>(r, i);
+    const cv::Mat asked = box_sum(ask);
+    cv::Mat honoured(roi.size(), CV_64F);  // P_y h_y
+    for (int r = 0; r < roi.height; ++r)
+      for (int i = 0; i < roi.width; ++i) {
+        const double q = asked.at<double>(r, i), pv = p64.at<double>(r, i);
+        honoured.at<double>(r, i) = q > 1 ? pv / q : pv;
+        p.at<float>(r, i) = float(pv - pv * std::min(q, 1.0));
       }
-    }
-    const double kept = asked > 0 ? std::clamp(1.0 - taken / asked, 0.0, 1.0) : 1.0;
-    for (int r = 0; r < c.rows; ++r) {
-      float* d = deficit.ptr<float>(r);
-      const double* a = ask.ptr<double>(r);
-      for (int i = 0; i < c.cols; ++i)
-        if (a[i] > 0) d[i] = kept > 1e-6 ? float(d[i] * kept) : 0.f;
-    }
-    if (radius >= largest) break;  // what is left has no positive mass anywhere: dropped
+    const cv::Mat supply = box_sum(honoured);
+    for (int r = 0; r < roi.height; ++r)
+      for (int i = 0; i < roi.width; ++i) {
+        const double a = ask.at<double>(r, i);
+        if (a <= 0) continue;
+        const double left = d64.at<double>(r, i) - a * supply.at<double>(r, i);
+        // Rounding leaves crumbs of a deficit that was met in full: dropped, not chased.
+        d.at<float>(r, i) = left > 1e-6 * d64.at<double>(r, i) ? float(left) : 0.f;
+      }
   }
   c = positive;
 }

@@ -26,7 +26,7 @@ TexelAudit audit_texels(const cv::Mat& m);
 
 // Negative values of m (CV_32F, any channel count, finite) removed without changing the sum of
 // each channel: the ringing a lossy codec leaves around a bright source is a negative lobe beside
-// a positive one, so zeroing the negatives adds the lobe's energy (14% on a CC0 sky with a sun).
+// a positive one, so zeroing the negatives adds the negative lobe's energy back as light.
 // Each negative value's deficit is taken from the positive values near it instead, in proportion
 // to them, over square windows of radius 1, 2, 4, ... texels until none is left (or the window
 // spans the image; what no positive value can absorb is then zeroed). Texel solid angles differ
