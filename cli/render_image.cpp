@@ -6,11 +6,8 @@
 #include "core/texel_audit.h"
 #include "core/text.h"
 
-#include <algorithm>
 #include <cmath>
-#include <iomanip>
 #include <iostream>
-#include <sstream>
 #include <optional>
 #include <stdexcept>
 
@@ -24,22 +21,9 @@ EnvMap read_environment_input(const std::string& path, const std::string& layout
   if (report.texels.bad() && !sanitize)
     throw std::runtime_error(path + ": " + report.texels.describe() + "; pass --sanitize to zero them");
   if (sanitize) sanitize_texels(env.pixels);
-  if (report.texels.negative > 0) {
-    // Lossy-compression ringing: a negative lobe beside a positive one. Folded into its positive
-    // neighbours (energy kept), never integrated as negative light nor zeroed (energy added).
-    const std::vector<double> before = integral(env);
-    if (!sanitize) remove_negative_ringing(env.pixels);
-    const std::vector<double> after = integral(env);
-    double change = 0;
-    for (std::size_t k = 0; k < before.size() && k < after.size(); ++k)
-      change = std::max(change, std::abs(after[k] - before[k]) / std::max(1e-30, std::abs(before[k])));
-    if (sanitize) change = NAN;  // the NaN/Inf zeroed too: no clean before
-    std::ostringstream line;
-    line << "rsibr: warning: " << path << ": " << report.texels.negative
-         << " negative values (lossy-compression ringing) folded into their positive neighbours";
-    if (std::isfinite(change)) line << " (integral changed by " << std::setprecision(2) << 100 * change << "%)";
-    std::cerr << line.str() << "\n";
-  }
+  // Lossy-compression ringing: never integrated as negative light nor zeroed (energy added).
+  if (const std::string folded = fold_environment_ringing(env, path, report, sanitize); !folded.empty())
+    std::cerr << "rsibr: warning: " << folded << "\n";
   return env;
 }
 

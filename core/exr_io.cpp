@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
@@ -131,6 +132,23 @@ EnvMap read_hdr(const std::string& path, std::optional<LayoutKind> hint, EnvRead
 }
 
 }  // namespace
+
+std::string fold_environment_ringing(EnvMap& env, const std::string& path, const EnvReadReport& report,
+                                     bool already_folded) {
+  if (report.texels.negative <= 0) return "";
+  std::ostringstream line;
+  line << path << ": " << report.texels.negative
+       << " negative values (lossy-compression ringing) folded into their positive neighbours";
+  if (already_folded) return line.str();
+  const std::vector<double> before = integral(env);
+  remove_negative_ringing(env.pixels);
+  const std::vector<double> after = integral(env);
+  double change = 0;
+  for (std::size_t k = 0; k < before.size() && k < after.size(); ++k)
+    change = std::max(change, std::abs(after[k] - before[k]) / std::max(1e-30, std::abs(before[k])));
+  line << " (integral changed by " << std::setprecision(2) << 100 * change << "%)";
+  return line.str();
+}
 
 EnvMap read_environment(const std::string& path, std::optional<LayoutKind> hint, EnvReadReport* report_out) {
   EnvReadReport report;

@@ -30,6 +30,15 @@ struct EnvReadReport {
 EnvMap read_environment(const std::string& path, std::optional<LayoutKind> layout_hint = std::nullopt,
                         EnvReadReport* report = nullptr);
 
+// The rule for an environment a computation reads (bake, reference, plan, render, Python's
+// read_environment): lossy-codec ringing, the negative values `report` counted, folded into their
+// positive neighbours (remove_negative_ringing: energy kept). Returns the warning to show ("" when
+// there was none): "<path>: N negative values (lossy-compression ringing) folded into their
+// positive neighbours (integral changed by X%)". `already_folded`: sanitize_texels ran (it folds
+// too, after zeroing NaN and Inf, so no clean integral before it is known and none is given).
+std::string fold_environment_ringing(EnvMap& env, const std::string& path, const EnvReadReport& report,
+                                     bool already_folded);
+
 struct ExrWriteOptions {
   bool half = false;  // half float output; values beyond +-65504 are an error, never a silent Inf
 };

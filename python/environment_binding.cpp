@@ -104,14 +104,10 @@ void bind_environment(py::module_& m) {
         if (report.texels.bad() && !sanitize)
           throw std::runtime_error(path + ": " + report.texels.describe() + "; pass sanitize=True to zero them");
         if (sanitize) sanitize_texels(env.pixels);
-        // The rule of the command line's environment inputs (cli/render_image.h): lossy-codec
-        // ringing folded into its neighbours, energy kept, and said.
-        if (fold_ringing && report.texels.negative > 0) {
-          if (!sanitize) remove_negative_ringing(env.pixels);
-          const std::string warning = path + ": " + std::to_string(report.texels.negative) +
-                                      " negative values (lossy-compression ringing) folded into their positive "
-                                      "neighbours";
-          if (PyErr_WarnEx(PyExc_UserWarning, warning.c_str(), 1) != 0) throw py::error_already_set();
+        // The rule of the command line's environment inputs (core/exr_io.h).
+        if (fold_ringing) {
+          const std::string folded = fold_environment_ringing(env, path, report, sanitize);
+          if (!folded.empty() && PyErr_WarnEx(PyExc_UserWarning, folded.c_str(), 1) != 0) throw py::error_already_set();
         }
         return env;
       },
