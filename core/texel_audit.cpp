@@ -1,9 +1,12 @@
 #include "core/texel_audit.h"
 
 #include <opencv2/imgproc.hpp>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -57,61 +60,151 @@ namespace {
 //   y gives P_y min(q_y, 1);  x receives ask_x sum_{y in W(x)} P_y h_y
 // so what the positives give equals what the deficits receive, texel by texel of the windows, and
 // each channel's sum is kept. Deficits left over (their window had too little) try the next,
-// doubled radius. Only the deficits' bounding box, grown by 2r, is filtered.
-void remove_negative_ringing_channel(cv::Mat& c) {
-  cv::Mat positive = cv::max(c, 0.0), deficit = cv::max(-c, 0.0);
-  const int largest = std::max(c.rows, c.cols);
-  for (int radius = 1;; radius *= 2) {
-    cv::Mat has_deficit = deficit > 0;
-    if (cv::countNonZero(has_deficit) == 0) break;
-    if (radius > 2 * largest) {  // no positive value anywhere can absorb what is left
-      deficit.setTo(0);
-      break;
+// doubled radius.
+struct Deficit {
+  int row, col;
+  double amount;
+};
+
+// One radius's step over a list of deficits, with the windows' indices reflected as the dense
+// step's box filter reflects them (the same sums, in another order). Costs (2r+1)^2 per deficit
+// wherever the deficits lie, where the dense step costs the deficits' whole bounding box.
+// field: a zeroed buffer of the image's size, handed back zeroed.
+void fold_step_sparse(cv::Mat& positive, std::vector<Deficit>& deficits, int radius, double* field) {
+  const int rows = positive.rows, cols = positive.cols, w = 2 * radius + 1;
+  std::vector<int> window_rows(static_cast<std::size_t>(w)), window_cols(static_cast<std::size_t>(w));
+  const auto window = [&](const Deficit& d) {
+    for (int k = 0; k < w; ++k) {
+      window_rows[std::size_t(k)] = cv::borderInterpolate(d.row - radius + k, rows, cv::BORDER_REFLECT);
+      window_cols[std::size_t(k)] = cv::borderInterpolate(d.col - radius + k, cols, cv::BORDER_REFLECT);
     }
-    const cv::Rect box = cv::boundingRect(has_deficit);
-    const cv::Rect roi =
-        cv::Rect(box.x - 2 * radius, box.y - 2 * radius, box.width + 4 * radius, box.height + 4 * radius) &
-        cv::Rect(0, 0, c.cols, c.rows);
-    cv::Mat p = positive(roi), d = deficit(roi);
-    const cv::Size window(2 * radius + 1, 2 * radius + 1);
-    const auto box_sum = [&](const cv::Mat& in) {
-      cv::Mat out;
-      cv::boxFilter(in, out, CV_64F, window, cv::Point(-1, -1), false, cv::BORDER_REFLECT);
-      return out;
-    };
-    cv::Mat p64, d64;
-    p.convertTo(p64, CV_64F);
-    d.convertTo(d64, CV_64F);
-    const cv::Mat window_positive = box_sum(p64);
-    cv::Mat ask = cv::Mat::zeros(roi.size(), CV_64F);
-    for (int r = 0; r < roi.height; ++r)
-      for (int i = 0; i < roi.width; ++i)
-        if (d64.at<double>(r, i) > 0 && window_positive.at<double>(r, i) > 0)
-          ask.at<double>(r, i) = d64.at<double>(r, i) / window_positive.at<double>(r, i);
-    const cv::Mat asked = box_sum(ask);
-    cv::Mat honoured(roi.size(), CV_64F);  // P_y h_y
-    for (int r = 0; r < roi.height; ++r)
-      for (int i = 0; i < roi.width; ++i) {
-        const double q = asked.at<double>(r, i), pv = p64.at<double>(r, i);
-        honoured.at<double>(r, i) = q > 1 ? pv / q : pv;
-        p.at<float>(r, i) = float(pv - pv * std::min(q, 1.0));
-      }
-    const cv::Mat supply = box_sum(honoured);
-    for (int r = 0; r < roi.height; ++r)
-      for (int i = 0; i < roi.width; ++i) {
-        const double a = ask.at<double>(r, i);
-        if (a <= 0) continue;
-        const double left = d64.at<double>(r, i) - a * supply.at<double>(r, i);
-        // Rounding leaves crumbs of a deficit that was met in full: dropped, not chased.
-        d.at<float>(r, i) = left > 1e-6 * d64.at<double>(r, i) ? float(left) : 0.f;
+  };
+  const auto at = [&](int r, int c) { return std::size_t(r) * std::size_t(cols) + std::size_t(c); };
+  std::vector<double> ask(deficits.size(), 0.0);
+  std::vector<std::size_t> touched;  // indices into field that the asks reached
+  for (std::size_t i = 0; i < deficits.size(); ++i) {
+    window(deficits[i]);
+    double window_positive = 0;
+    for (int rr : window_rows) {
+      const float* p = positive.ptr<float>(rr);
+      for (int cc : window_cols) window_positive += p[cc];
+    }
+    if (!(window_positive > 0)) continue;
+    ask[i] = deficits[i].amount / window_positive;
+    for (int rr : window_rows)
+      for (int cc : window_cols) {
+        double& f = field[at(rr, cc)];
+        if (f == 0) touched.push_back(at(rr, cc));
+        f += ask[i];
       }
   }
-  c = positive;
+  // field: q_y, then P_y h_y; positive loses P_y min(q_y, 1).
+  float* pos = positive.ptr<float>(0);  // continuous: one channel split from the image
+  for (std::size_t t : touched) {
+    float& pv = pos[t];
+    const double q = field[t], p = pv;
+    field[t] = q > 1 ? p / q : p;
+    pv = float(p - p * std::min(q, 1.0));
+  }
+  std::vector<Deficit> left;
+  for (std::size_t i = 0; i < deficits.size(); ++i) {
+    if (ask[i] <= 0) {
+      left.push_back(deficits[i]);
+      continue;
+    }
+    window(deficits[i]);
+    double supply = 0;
+    for (int rr : window_rows)
+      for (int cc : window_cols) supply += field[at(rr, cc)];
+    const double rest = deficits[i].amount - ask[i] * supply;
+    // Rounding leaves crumbs of a deficit that was met in full: dropped, not chased.
+    if (rest > 1e-6 * deficits[i].amount) left.push_back({deficits[i].row, deficits[i].col, rest});
+  }
+  for (std::size_t t : touched) field[t] = 0;
+  deficits = std::move(left);
+}
+
+// The same step by box filters over the deficits' bounding box grown by 2r: linear in that box,
+// whatever the radius, so it serves many deficits at a large radius.
+void fold_step_dense(cv::Mat& positive, std::vector<Deficit>& deficits, int radius) {
+  cv::Rect box(deficits.front().col, deficits.front().row, 1, 1);
+  for (const Deficit& d : deficits) box |= cv::Rect(d.col, d.row, 1, 1);
+  const cv::Rect roi =
+      cv::Rect(box.x - 2 * radius, box.y - 2 * radius, box.width + 4 * radius, box.height + 4 * radius) &
+      cv::Rect(0, 0, positive.cols, positive.rows);
+  cv::Mat p = positive(roi);
+  cv::Mat d64 = cv::Mat::zeros(roi.size(), CV_64F);
+  for (const Deficit& d : deficits) d64.at<double>(d.row - roi.y, d.col - roi.x) = d.amount;
+  const cv::Size window(2 * radius + 1, 2 * radius + 1);
+  const auto box_sum = [&](const cv::Mat& in) {
+    cv::Mat out;
+    cv::boxFilter(in, out, CV_64F, window, cv::Point(-1, -1), false, cv::BORDER_REFLECT);
+    return out;
+  };
+  cv::Mat p64;
+  p.convertTo(p64, CV_64F);
+  const cv::Mat window_positive = box_sum(p64);
+  cv::Mat ask = cv::Mat::zeros(roi.size(), CV_64F);
+  for (const Deficit& d : deficits) {
+    const int r = d.row - roi.y, i = d.col - roi.x;
+    if (window_positive.at<double>(r, i) > 0) ask.at<double>(r, i) = d.amount / window_positive.at<double>(r, i);
+  }
+  const cv::Mat asked = box_sum(ask);
+  cv::Mat honoured(roi.size(), CV_64F);  // P_y h_y
+  for (int r = 0; r < roi.height; ++r)
+    for (int i = 0; i < roi.width; ++i) {
+      const double q = asked.at<double>(r, i), pv = p64.at<double>(r, i);
+      honoured.at<double>(r, i) = q > 1 ? pv / q : pv;
+      p.at<float>(r, i) = float(pv - pv * std::min(q, 1.0));
+    }
+  const cv::Mat supply = box_sum(honoured);
+  std::vector<Deficit> left;
+  for (const Deficit& d : deficits) {
+    const int r = d.row - roi.y, i = d.col - roi.x;
+    const double a = ask.at<double>(r, i);
+    const double rest = a > 0 ? d.amount - a * supply.at<double>(r, i) : d.amount;
+    if (a <= 0 || rest > 1e-6 * d.amount) left.push_back({d.row, d.col, rest});
+  }
+  deficits = std::move(left);
+}
+
+void remove_negative_ringing_channel(cv::Mat& c, FoldMethod method) {
+  if (!c.isContinuous()) c = c.clone();
+  std::vector<Deficit> deficits;
+  for (int r = 0; r < c.rows; ++r) {
+    float* p = c.ptr<float>(r);
+    for (int i = 0; i < c.cols; ++i)
+      if (p[i] < 0) {
+        deficits.push_back({r, i, -double(p[i])});
+        p[i] = 0.f;
+      }
+  }
+  const int largest = std::max(c.rows, c.cols);
+  // Zeroed pages come from the system as they are first touched: only those near deficits cost.
+  const std::unique_ptr<double, decltype(&std::free)> field(
+      static_cast<double*>(std::calloc(std::size_t(c.rows) * std::size_t(c.cols), sizeof(double))), &std::free);
+  if (!field) throw std::bad_alloc();
+  for (int radius = 1; !deficits.empty(); radius *= 2) {
+    if (radius > 2 * largest) break;  // no positive value anywhere can absorb what is left: zeroed
+    long r0 = c.rows, r1 = 0, c0 = c.cols, c1 = 0;
+    for (const Deficit& d : deficits)
+      r0 = std::min<long>(r0, d.row), r1 = std::max<long>(r1, d.row), c0 = std::min<long>(c0, d.col),
+      c1 = std::max<long>(c1, d.col);
+    const double box = double(std::min<long>(c.rows, r1 - r0 + 1 + 4L * radius)) *
+                       double(std::min<long>(c.cols, c1 - c0 + 1 + 4L * radius));
+    const double sparse = 3.0 * double(deficits.size()) * double(2 * radius + 1) * double(2 * radius + 1);
+    // The dense step allocates and converts its whole box in double, so it pays only for many
+    // deficits at large radii; the factor weighs a window texel against a box texel.
+    if (method == FoldMethod::Sparse || (method == FoldMethod::Auto && sparse <= 64.0 * box))
+      fold_step_sparse(c, deficits, radius, field.get());
+    else
+      fold_step_dense(c, deficits, radius);
+  }
 }
 
 }  // namespace
 
-long remove_negative_ringing(cv::Mat& m) {
+long remove_negative_ringing(cv::Mat& m, FoldMethod method) {
   if (m.depth() != CV_32F) throw std::logic_error("remove_negative_ringing: expected a float image");
   long negative = 0;
   for (int r = 0; r < m.rows; ++r) {
@@ -121,7 +214,9 @@ long remove_negative_ringing(cv::Mat& m) {
   if (negative == 0) return 0;
   std::vector<cv::Mat> channels;
   cv::split(m, channels);
-  for (cv::Mat& c : channels) remove_negative_ringing_channel(c);
+  // Channels are independent: one task each.
+  tbb::parallel_for(std::size_t(0), channels.size(),
+                    [&](std::size_t k) { remove_negative_ringing_channel(channels[k], method); });
   cv::merge(channels, m);
   return negative;
 }

@@ -32,7 +32,11 @@ TexelAudit audit_texels(const cv::Mat& m);
 // spans the image; what no positive value can absorb is then zeroed). Texel solid angles differ
 // little within a window, so an environment's integral moves by the variation of solid angle
 // across the ringing's width, not by the ringing's energy. Returns how many values were negative.
-long remove_negative_ringing(cv::Mat& m);
+// The step at each radius runs over the deficits' windows (sparse: cost per deficit) or box
+// filters over their bounding box (dense: cost per texel of the box), whichever costs less; both
+// give the same values up to rounding (Auto). The others force one, for tests.
+enum class FoldMethod { Auto, Sparse, Dense };
+long remove_negative_ringing(cv::Mat& m, FoldMethod method = FoldMethod::Auto);
 
 // NaN, Inf and huge values of m (CV_32F) zeroed, then its negatives removed by
 // remove_negative_ringing; returns how many values it changed.

@@ -55,6 +55,35 @@ TEST(RemoveNegativeRinging, TakesTheDeficitFromTheNeighbourNotFromFarTexels) {
   EXPECT_FLOAT_EQ(m.at<float>(8, 9), 0.f);
 }
 
+// Many deficits, some needing large windows, some at the borders (where the windows reflect).
+cv::Mat crowded_ringing_image() {
+  cv::Mat m(40, 50, CV_32FC3);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  for (int r = 0; r < m.rows; ++r)
+    for (int c = 0; c < m.cols; ++c) {
+      const float v = u(rng) < 0.3f ? -5.f * u(rng) : 10.f * u(rng) * u(rng);
+      m.at<cv::Vec3f>(r, c) = cv::Vec3f(v, 0.5f * v, u(rng) < 0.5f ? 0.5f * v : v);
+    }
+  m(cv::Rect(10, 10, 12, 9)).setTo(cv::Scalar(-3, -1, -2));  // a hole only large windows fill
+  return m;
+}
+
+TEST(RemoveNegativeRinging, SparseAndDenseStepsGiveTheSameValues) {
+  for (cv::Mat base : {ringing_image(3), crowded_ringing_image()}) {
+    cv::Mat sparse = base.clone(), dense = base.clone(), chosen = base.clone();
+    const long n = remove_negative_ringing(sparse, FoldMethod::Sparse);
+    EXPECT_EQ(remove_negative_ringing(dense, FoldMethod::Dense), n);
+    EXPECT_EQ(remove_negative_ringing(chosen), n);
+    double peak = 0;
+    cv::minMaxLoc(cv::Mat(cv::abs(base)).reshape(1), nullptr, &peak);
+    EXPECT_LE(cv::norm(sparse, dense, cv::NORM_INF), 1e-5 * peak);
+    EXPECT_LE(cv::norm(chosen, dense, cv::NORM_INF), 1e-5 * peak);
+    const cv::Scalar before = sums(base), after = sums(sparse);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(after[k], before[k], 1e-5 * std::abs(before[k]) + 1e-3);
+  }
+}
+
 TEST(RemoveNegativeRinging, ZeroesWhatNoPositiveValueCanAbsorb) {
   cv::Mat m(4, 4, CV_32FC1, cv::Scalar(-1.f));
   EXPECT_EQ(remove_negative_ringing(m), 16);
