@@ -1,4 +1,6 @@
 #include "bake/bright_texels.h"
+
+#include "core/parallel.h"
 #include "core/luminance.h"
 
 #include <algorithm>
@@ -26,24 +28,35 @@ EnvironmentSplit split_bright_texels(const EnvMap& env, const BrightTexelOptions
     long texel;
     double lum, omega;
   };
-  std::vector<Candidate> all;
-  all.reserve(std::size_t(w) * std::size_t(h));
-  double power = 0, area = 0;
-  for (int r = 0; r < h; ++r) {
+  // Power and area per row (rows in parallel, summed in row order: the same bits on any threads).
+  std::vector<double> row_power(std::size_t(h), 0.0), row_area(std::size_t(h), 0.0);
+  parallel_for_rows(h, [&](int r) {
     const float* row = env.pixels.ptr<float>(r);
+    const double seam = env.layout.texel_solid_angle(0, r), inner = env.layout.texel_solid_angle(w > 2 ? 1 : 0, r);
+    double p = 0, a = 0;
     for (int c = 0; c < w; ++c) {
-      const double omega = env.layout.texel_solid_angle(c, r);
-      const double lum = texel_luminance(row + c * ch);
-      power += lum * omega;
-      area += omega;
-      all.push_back({long(r) * w + c, lum, omega});
+      const double omega = c == 0 || c == w - 1 ? seam : inner;  // a lat-long row: equal but the seams
+      p += texel_luminance(row + c * ch) * omega;
+      a += omega;
     }
-  }
+    row_power[std::size_t(r)] = p, row_area[std::size_t(r)] = a;
+  });
+  double power = 0, area = 0;
+  for (int r = 0; r < h; ++r) power += row_power[std::size_t(r)], area += row_area[std::size_t(r)];
   if (!(power > 0) || !std::isfinite(power)) return out;
   const double threshold = options.ratio * power / area;
+  std::vector<std::vector<Candidate>> row_bright(static_cast<std::size_t>(h));
+  parallel_for_rows(h, [&](int r) {
+    const float* row = env.pixels.ptr<float>(r);
+    for (int c = 0; c < w; ++c) {
+      const double lum = texel_luminance(row + c * ch);
+      if (!(lum >= threshold)) continue;
+      const double omega = env.layout.texel_solid_angle(c, r);
+      if (omega > 0) row_bright[std::size_t(r)].push_back({long(r) * w + c, lum, omega});
+    }
+  });
   std::vector<Candidate> bright;
-  for (const Candidate& q : all)
-    if (q.lum >= threshold && q.omega > 0) bright.push_back(q);
+  for (const auto& row : row_bright) bright.insert(bright.end(), row.begin(), row.end());
   // Brightest power first; ties by texel index (deterministic).
   std::sort(bright.begin(), bright.end(), [](const Candidate& a, const Candidate& b) {
     const double pa = a.lum * a.omega, pb = b.lum * b.omega;

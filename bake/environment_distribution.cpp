@@ -1,5 +1,6 @@
 #include "bake/environment_distribution.h"
 #include "core/luminance.h"
+#include "core/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -19,7 +20,8 @@ int find_bin(const double* cdf, int n, double u) {
   return i;
 }
 
-// Normalises a CDF in place from the weights; returns the total. All-zero: uniform.
+// Normalises a CDF in place from the weights; returns the total. All-zero: uniform. weight may
+// be cdf + 1 (the weights are read before they are overwritten).
 double build_cdf(const double* weight, int n, double* cdf) {
   cdf[0] = 0;
   for (int i = 0; i < n; ++i) cdf[i + 1] = cdf[i] + weight[i];
@@ -44,34 +46,39 @@ EnvironmentDistribution::EnvironmentDistribution(const EnvMap& env) : layout_(en
   w_ = layout_.width();
   h_ = layout_.height();
   const std::size_t n = std::size_t(w_) * std::size_t(h_);
-  omega_.resize(n);
-  std::vector<double> weight(n);
-  double total = 0;
-  const int ch = env.channels();
-  for (int r = 0; r < h_; ++r) {
-    const float* row = env.pixels.ptr<float>(r);
-    for (int c = 0; c < w_; ++c) {
-      const std::size_t i = std::size_t(r) * w_ + c;
-      omega_[i] = layout_.texel_solid_angle(c, r);
-      const double lum = positive_luminance(row + c * ch);
-      weight[i] = lum * omega_[i];
-      total += weight[i];
-    }
-  }
-  if (!(total > 0) || !std::isfinite(total)) {
-    weight = omega_;  // nothing to follow (or an Inf): uniform on the sphere
-    total = 0;
-    for (double x : weight) total += x;
-  }
-  prob_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) prob_[i] = weight[i] / total;
-  density_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) density_[i] = omega_[i] > 0 ? prob_[i] / omega_[i] : 0.0;
-
-  std::vector<double> row_weight(std::size_t(h_), 0.0);
-  conditional_.resize(std::size_t(h_) * (w_ + 1));
+  // A lat-long texel's solid angle is its row's times its column's share (half at the seams).
+  row_omega_.resize(std::size_t(h_));
   for (int r = 0; r < h_; ++r)
-    row_weight[std::size_t(r)] = build_cdf(&prob_[std::size_t(r) * w_], w_, &conditional_[std::size_t(r) * (w_ + 1)]);
+    row_omega_[std::size_t(r)] = w_ > 2 ? layout_.texel_solid_angle(1, r) : 2 * layout_.texel_solid_angle(0, r);
+  // Per row: the weights L_lum * Omega as the row's CDF (unnormalised first), then the totals in
+  // row order (the same sum whatever the threads).
+  density_.resize(n);
+  conditional_.resize(std::size_t(h_) * (w_ + 1));
+  std::vector<double> row_weight(std::size_t(h_), 0.0);
+  const int ch = env.channels();
+  const auto weigh_rows = [&](bool uniform) {
+    parallel_for_rows(h_, [&](int r) {
+      const float* row = env.pixels.ptr<float>(r);
+      double* cdf = &conditional_[std::size_t(r) * (w_ + 1)];
+      double* density = &density_[std::size_t(r) * w_];
+      for (int c = 0; c < w_; ++c) {
+        density[c] = uniform ? 1.0 : positive_luminance(row + c * ch);  // density, before the total
+        cdf[c + 1] = density[c] * solid_angle(long(r) * w_ + c);
+      }
+      row_weight[std::size_t(r)] = build_cdf(cdf + 1, w_, cdf);
+    });
+    double total = 0;
+    for (double x : row_weight) total += x;
+    return total;
+  };
+  double total = weigh_rows(false);
+  // Nothing to follow (or an Inf): uniform on the sphere.
+  if (!(total > 0) || !std::isfinite(total)) total = weigh_rows(true);
+  // density = prob / Omega = L_lum * Omega / total / Omega.
+  parallel_for_rows(h_, [&](int r) {
+    double* density = &density_[std::size_t(r) * w_];
+    for (int c = 0; c < w_; ++c) density[c] /= total;
+  });
   marginal_.resize(std::size_t(h_) + 1);
   build_cdf(row_weight.data(), h_, marginal_.data());
 }

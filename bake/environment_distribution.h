@@ -40,16 +40,20 @@ class EnvironmentDistribution {
   long texel_of(const Vec3& dir) const;
   // Solid-angle density of sample() anywhere in that texel's cell.
   double texel_pdf(long texel) const { return density_[std::size_t(texel)]; }
-  double probability(long texel) const { return prob_[std::size_t(texel)]; }
-  double solid_angle(long texel) const { return omega_[std::size_t(texel)]; }
+  double probability(long texel) const { return density_[std::size_t(texel)] * solid_angle(texel); }
+  double solid_angle(long texel) const {
+    const long c = texel % w_;
+    return row_omega_[std::size_t(texel / w_)] * (c == 0 || c == w_ - 1 ? 0.5 : 1.0);
+  }
   const Layout& layout() const { return layout_; }
 
  private:
   Layout layout_;
   int w_ = 0, h_ = 0;
-  std::vector<double> prob_, omega_, density_;  // density = prob / omega
-  std::vector<double> marginal_;                // h+1 entries, CDF over rows
-  std::vector<double> conditional_;             // h rows x (w+1) entries, CDF over columns per row
+  std::vector<double> row_omega_;    // a full column's texel solid angle per row
+  std::vector<double> density_;      // per texel: probability / solid angle
+  std::vector<double> marginal_;     // h+1 entries, CDF over rows
+  std::vector<double> conditional_;  // h rows x (w+1) entries, CDF over columns per row
 };
 
 // The cell geometry behind EnvironmentDistribution::cell_direction, for any lat-long layout.

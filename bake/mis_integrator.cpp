@@ -15,13 +15,13 @@ EnvMap as_latlong(const EnvMap& env) {
 
 MisIntegrator::MisIntegrator(const EnvMap& env)
     : env_(as_latlong(env)), split_(split_bright_texels(env_)), dist_(split_.remainder) {
-  const int ch = env_.channels();
-  radiance_.resize(std::size_t(env_.layout.texel_count()));
-  for (int r = 0; r < env_.layout.height(); ++r) {
-    const float* row = split_.remainder.pixels.ptr<float>(r);
-    for (int c = 0; c < env_.layout.width(); ++c)
-      radiance_[std::size_t(r) * env_.layout.width() + c] = Vec3(row[c * ch], row[c * ch + 1], row[c * ch + 2]);
-  }
+  if (!split_.remainder.pixels.isContinuous()) split_.remainder.pixels = split_.remainder.pixels.clone();
+}
+
+Vec3 MisIntegrator::remainder_radiance(long texel) const {
+  const int ch = split_.remainder.channels();
+  const float* p = split_.remainder.pixels.ptr<float>(0) + std::size_t(texel) * std::size_t(ch);
+  return Vec3(p[0], p[1], p[2]);
 }
 
 cv::Mat MisIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Mat3& world_from_view, int size,
@@ -43,7 +43,7 @@ cv::Mat MisIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Ma
           if (b.valid) {
             const long q = dist_.texel_of(frame.to_world(b.wi));
             const double pe = dist_.texel_pdf(q);
-            sum += (b.weight * b.pdf).cwiseProduct(radiance_[std::size_t(q)]) / (b.pdf + pe);
+            sum += (b.weight * b.pdf).cwiseProduct(remainder_radiance(q)) / (b.pdf + pe);
           }
           // Environment sample.
           const EnvironmentDistribution::Sample e = dist_.sample(integrator_detail::rotated_hammersley(i, n, shift_e));
@@ -52,7 +52,7 @@ cv::Mat MisIntegrator::radiance_map(const Brdf& brdf, const Vec3& view, const Ma
             if (wi.z() > 0) {
               double pb = 0;
               const Vec3 f = brdf.eval_pdf(wo, wi, &pb);
-              if (f != Vec3::Zero()) sum += f.cwiseProduct(radiance_[std::size_t(e.texel)]) / (pb + e.pdf);
+              if (f != Vec3::Zero()) sum += f.cwiseProduct(remainder_radiance(e.texel)) / (pb + e.pdf);
             }
           }
         }

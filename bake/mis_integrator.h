@@ -37,7 +37,8 @@ class MisIntegrator final : public Integrator {
   EnvMap env_;  // lat-long
   EnvironmentSplit split_;
   EnvironmentDistribution dist_;  // of split_.remainder
-  std::vector<Vec3> radiance_;    // per texel, RGB
+  // RGB of split_.remainder at a texel (r * width + c), read in place: no copy of the map.
+  Vec3 remainder_radiance(long texel) const;
 };
 
 // The environment in lat-long (itself when it already is).
