@@ -94,6 +94,30 @@ TEST(Resample, ShrinkingIsAreaWeightedAndDoesNotAlias) {
   }
 }
 
+TEST(Resample, InterpolatedTapsAgreeWithExactTapsFromLatLong) {
+  // A sun (the energy rule's exact texels), a seam crossing, the poles and a sphere map's rim.
+  const auto sky = patterns::sun_and_sky(Vec3(-0.05, 0.3, -1).normalized(), 1.0 * kPi / 180, Vec3(3e4, 3e4, 2e4),
+                                         Vec3(0.3, 0.5, 1.0), Vec3(0.8, 0.8, 0.7));
+  const EnvMap src = render_pattern(sky, Layout::with_size(LayoutKind::LatLong, 512), 4);
+  ResampleOptions exact_taps;
+  exact_taps.interpolate_taps = false;
+  for (const Layout& to : targets()) {
+    const EnvMap fast = resample(src, to), exact = resample(src, to, exact_taps);
+    double worst = 0, sum2 = 0, ref2 = 0;
+    for (int r = 0; r < to.height(); ++r)
+      for (int c = 0; c < to.width(); ++c) {
+        const cv::Vec3f a = fast.pixels.at<cv::Vec3f>(r, c), b = exact.pixels.at<cv::Vec3f>(r, c);
+        ASSERT_TRUE(std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]));
+        worst = std::max(worst, double(cv::norm(a - b)) / std::max(1.0, double(cv::norm(b))));
+        sum2 += cv::norm(a - b) * cv::norm(a - b);
+        ref2 += cv::norm(b) * cv::norm(b);
+      }
+    EXPECT_LT(worst, 0.05) << to_string(to.kind());
+    EXPECT_LT(std::sqrt(sum2 / ref2), 2e-3) << to_string(to.kind());
+    EXPECT_LT(max_relative_change(integral(exact), integral(fast)), 1e-4) << to_string(to.kind());
+  }
+}
+
 TEST(Resample, EnlargingIsPlainBilinear) {
   const EnvMap small = render_pattern(patterns::direction_coded(), Layout::with_size(LayoutKind::LatLong, 32), 2);
   const Layout big = Layout::with_size(LayoutKind::LatLong, 256);
