@@ -6,6 +6,7 @@
 #include "core/text.h"
 
 #include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfThreading.h>
 #include <OpenEXR/ImfChromaticitiesAttribute.h>
 #include <OpenEXR/ImfCompression.h>
 #include <OpenEXR/ImfEnvmapAttribute.h>
@@ -25,13 +26,28 @@
 #include <OpenEXR/ImfVecAttribute.h>
 #include <Imath/half.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <mutex>
 #include <sstream>
+#include <thread>
 
 namespace rsibr {
+
+namespace {
+// OpenEXR decodes and encodes a file's chunks on its own thread pool, sized here once to the
+// machine (its default is none: one core for an 8K map's zip chunks).
+void use_exr_threads() {
+  static const bool started = [] {
+    Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency())));
+    return true;
+  }();
+  (void)started;
+}
+}  // namespace
+
 namespace {
 
 [[noreturn]] void fail(const std::string& path, const std::string& what) { throw FileError(path, what); }
@@ -288,6 +304,7 @@ void write_exr(const std::string& path, const std::vector<ExrPartOut>& parts) {
   // window (its size), which is what readers take.
   for (Imf::Header& h : headers) h.displayWindow() = headers.front().displayWindow();
   std::string temporary;
+  use_exr_threads();
   try {
     write_atomically(path, [&](const std::string& tmp) {
       temporary = tmp;
@@ -319,6 +336,7 @@ void write_exr(const std::string& path, const std::vector<ExrPartOut>& parts) {
 
 bool exr_reads_back(const std::string& path) noexcept {
   try {
+    use_exr_threads();
     Imf::MultiPartInputFile in(path.c_str());
     for (int p = 0; p < in.parts(); ++p) {
       if (!in.partComplete(p)) return false;
@@ -346,7 +364,7 @@ bool exr_reads_back(const std::string& path) noexcept {
 }
 
 struct ExrFileIn::Impl {
-  explicit Impl(const std::string& path) : file(path.c_str()) {}
+  explicit Impl(const std::string& path) : file((use_exr_threads(), path.c_str())) {}
   Imf::MultiPartInputFile file;
 };
 
