@@ -1,6 +1,7 @@
 #include "core/mip_pyramid.h"
 
 #include "core/parallel.h"
+#include "core/latlong_area_resize.h"
 #include "core/resample.h"
 
 #include <algorithm>
@@ -136,7 +137,10 @@ MipPyramid::MipPyramid(const EnvMap& base) {
         break;
     }
     if (!next || *next == top) break;
-    levels_.push_back(resample(levels_.back(), *next));
+    // A lat-long resizes exactly (separable overlaps, linear in its texels); others resample.
+    levels_.push_back(top.kind() == LayoutKind::LatLong
+                          ? latlong_area_resize(levels_.back(), next->width(), next->height())
+                          : resample(levels_.back(), *next));
   }
 }
 
