@@ -33,14 +33,16 @@ class ReferenceIntegrator final : public Integrator {
     Vec3 radiance;  // L * Omega (RGB)
   };
   static std::vector<Texel> texels_of(const EnvMap& env);
+  // Appends row r's texels (those with light and solid angle) to out, in column order.
+  static void append_row_texels(const EnvMap& env, int r, std::vector<Texel>& out);
 
  private:
   const std::vector<Texel>& level_for(int width) const;
 
   EnvMap base_;
-  std::vector<Texel> full_;
-  mutable std::unique_ptr<MipPyramid> pyramid_;     // built on first use of reference_width
-  mutable std::vector<std::vector<Texel>> levels_;  // filled lazily (guarded by mutex_)
+  mutable std::unique_ptr<std::vector<Texel>> full_;  // every texel of base_, made by level_for
+  mutable std::unique_ptr<MipPyramid> pyramid_;       // built on first use of reference_width
+  mutable std::vector<std::vector<Texel>> levels_;    // filled lazily (guarded by mutex_)
   mutable std::unique_ptr<std::mutex> mutex_;
 };
 

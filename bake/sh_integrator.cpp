@@ -1,10 +1,13 @@
 #include "bake/sh_integrator.h"
 
 #include "bake/reference_integrator.h"
+#include "core/parallel.h"
 
 #include "bake/lambert.h"
 
+#include <array>
 #include <cmath>
+#include <vector>
 #include <stdexcept>
 
 namespace rsibr {
@@ -20,11 +23,22 @@ std::array<double, 9> ShIntegrator::basis(const Vec3& d) {
 
 ShIntegrator::ShIntegrator(const EnvMap& env) {
   // Projection with exact texel solid angles: the reference integrator's (direction, L*Omega) list.
+  // Rows in parallel, each row's sums added in row order (the same bits on any threads).
+  const int h = env.layout.height();
+  std::vector<std::array<Vec3, 9>> rows(static_cast<std::size_t>(h));
+  parallel_for_rows(h, [&](int r) {
+    std::vector<ReferenceIntegrator::Texel> texels;
+    ReferenceIntegrator::append_row_texels(env, r, texels);
+    auto& sums = rows[std::size_t(r)];
+    for (auto& c : sums) c = Vec3::Zero();
+    for (const auto& t : texels) {
+      const auto y = basis(t.dir);
+      for (int k = 0; k < 9; ++k) sums[std::size_t(k)] += t.radiance * y[std::size_t(k)];
+    }
+  });
   for (auto& c : coeffs_) c = Vec3::Zero();
-  for (const auto& t : ReferenceIntegrator::texels_of(env)) {
-    const auto y = basis(t.dir);
-    for (int k = 0; k < 9; ++k) coeffs_[std::size_t(k)] += t.radiance * y[std::size_t(k)];
-  }
+  for (const auto& sums : rows)
+    for (int k = 0; k < 9; ++k) coeffs_[std::size_t(k)] += sums[std::size_t(k)];
 }
 
 Vec3 ShIntegrator::irradiance(const Vec3& n) const {
