@@ -143,26 +143,41 @@ void sample_nearest(const EnvMap& map, const Vec3& dir, float* out) {
   accumulate(map.pixels, &tap, 1, out);
 }
 
+namespace {
+// Row r's texel solid angles into w (width entries): a lat-long row's are equal but for its two
+// seam columns, so two sines per row serve it.
+void row_solid_angles(const Layout& layout, int r, double* w) {
+  const int width = layout.width();
+  if (layout.kind() == LayoutKind::LatLong) {
+    const double seam = layout.texel_solid_angle(0, r), inner = layout.texel_solid_angle(width > 2 ? 1 : 0, r);
+    for (int c = 0; c < width; ++c) w[c] = c == 0 || c == width - 1 ? seam : inner;
+    return;
+  }
+  for (int c = 0; c < width; ++c) w[c] = layout.texel_solid_angle(c, r);
+}
+}  // namespace
+
 cv::Mat texel_solid_angles(const Layout& layout) {
   cv::Mat sa(layout.height(), layout.width(), CV_64FC1);
-  parallel_for_rows(layout.height(), [&](int r) {
-    double* row = sa.ptr<double>(r);
-    for (int c = 0; c < layout.width(); ++c) row[c] = layout.texel_solid_angle(c, r);
-  });
+  parallel_for_rows(layout.height(), [&](int r) { row_solid_angles(layout, r, sa.ptr<double>(r)); });
   return sa;
 }
 
 std::vector<double> integral(const EnvMap& map) {
-  const cv::Mat sa = texel_solid_angles(map.layout);
-  const int ch = map.channels();
-  std::vector<double> total(ch, 0.0);
-  // Rows summed in order so the result does not depend on the thread count.
-  for (int r = 0; r < map.pixels.rows; ++r) {
+  const int ch = map.channels(), rows = map.pixels.rows, cols = map.pixels.cols;
+  // Each row's sums in parallel, then the rows added in order: the same result on any threads.
+  std::vector<double> row_sums(std::size_t(rows) * std::size_t(ch), 0.0);
+  parallel_for_rows(rows, [&](int r) {
+    std::vector<double> w(static_cast<std::size_t>(cols));
+    row_solid_angles(map.layout, r, w.data());
     const float* px = map.pixels.ptr<float>(r);
-    const double* w = sa.ptr<double>(r);
-    for (int c = 0; c < map.pixels.cols; ++c)
-      for (int k = 0; k < ch; ++k) total[k] += double(px[c * ch + k]) * w[c];
-  }
+    double* sum = &row_sums[std::size_t(r) * std::size_t(ch)];
+    for (int c = 0; c < cols; ++c)
+      for (int k = 0; k < ch; ++k) sum[k] += double(px[c * ch + k]) * w[std::size_t(c)];
+  });
+  std::vector<double> total(ch, 0.0);
+  for (int r = 0; r < rows; ++r)
+    for (int k = 0; k < ch; ++k) total[std::size_t(k)] += row_sums[std::size_t(r) * std::size_t(ch) + std::size_t(k)];
   return total;
 }
 

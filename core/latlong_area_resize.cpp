@@ -60,6 +60,10 @@ EnvMap latlong_area_resize(const EnvMap& src, int width, int height) {
     float* o = rows.ptr<float>(r);
     for (int c = 0; c < width; ++c) weighted_row(lon[std::size_t(c)], in, o + std::size_t(c) * ch, ch);
   });
+  if (height == in_h) {  // the rows are the output's
+    out.pixels = rows;
+    return out;
+  }
   // Then latitude: a fraction f of the interval from the north pole is latitude pi/2 - pi f, and
   // the solid angle of [f_a, f_b] is proportional to sin(lat_a) - sin(lat_b).
   const auto lat = overlaps(

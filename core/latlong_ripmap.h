@@ -25,8 +25,9 @@ class LatLongRipmap {
   const cv::Mat& level(int j) const { return levels_.at(std::size_t(j)); }
   int width(int j) const { return levels_[std::size_t(j)].cols; }
   int height() const { return levels_.front().rows; }
-  double latitude_step() const;        // radians between rows
-  double longitude_step(int j) const;  // radians between columns of level j
+  double inverse_scale(int j) const { return inverse_scale_[std::size_t(j)]; }  // level-j per level-0 columns
+  double latitude_step() const;                                                 // radians between rows
+  double longitude_step(int j) const;                                           // radians between columns of level j
 
   // The coarsest level whose texels at latitude phi (radians) are no wider than they are tall.
   int level_for_latitude(double phi) const;

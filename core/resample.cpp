@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <map>
 #include <optional>
 #include <vector>
 
@@ -120,91 +121,214 @@ class PeakPyramid {
   double energy_ = 0, tolerance_ = 0;
 };
 
-// One destination row by interpolated taps from a lat-long source (see resample()). Corners are
-// taken a hair inside the row so that a cube's face is the row's own; the interpolation's
-// parameter across the row allows for that. exact(c, r, px) renders a texel the check refuses.
+// The n x n taps of one texel from ripmap level `level`, for RGB: corner positions x, y (level-0
+// pixels, unwrapped) and densities w in the order top-left, top-right, bottom-left, bottom-right,
+// the corner lines at pixel offsets y_top and y_bottom. The same sums as LatLongRipmap::bilinear
+// per tap, with the level's constants hoisted out of the loop.
+void rgb_taps(const LatLongRipmap& ripmap, int level, int n, const double* x, const double* y, const double* w,
+              double y_top, double y_bottom, float* px) {
+  const cv::Mat& m = ripmap.level(level);
+  const int cols = m.cols, rows = m.rows;
+  const double period = cols - 1, to_level = ripmap.inverse_scale(level), last_row = rows - 1;
+  const std::size_t stride = m.step1();
+  const float* base = m.ptr<float>(0);
+  double r = 0, g = 0, b = 0, wsum = 0;
+  for (int j = 0; j < n; ++j) {
+    const double t = ((j + 0.5) / n - 0.5 - y_top) / (y_bottom - y_top);
+    const double lx = (x[0] + t * (x[2] - x[0])) * to_level, rx = (x[1] + t * (x[3] - x[1])) * to_level;
+    const double ly = y[0] + t * (y[2] - y[0]), ry = y[1] + t * (y[3] - y[1]);
+    const double lw = w[0] + t * (w[2] - w[0]), rw = w[1] + t * (w[3] - w[1]);
+    for (int i = 0; i < n; ++i) {
+      const double s = (i + 0.5) / n;
+      double xx = lx + s * (rx - lx);
+      if (xx < 0 || xx > period) xx -= period * std::floor(xx / period);
+      xx = std::clamp(xx, 0.0, period);
+      const double yy = std::clamp(ly + s * (ry - ly), 0.0, last_row);
+      const int c0 = std::min(int(xx), cols - 2), r0 = std::min(int(yy), rows - 2);
+      const float fx = float(xx - c0), fy = float(yy - r0);
+      const float* a = base + std::size_t(r0) * stride + std::size_t(c0) * 3;
+      const float* d = a + stride;
+      const float w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
+      const double tw = lw + s * (rw - lw);
+      r += tw * (w00 * a[0] + w01 * a[3] + w10 * d[0] + w11 * d[3]);
+      g += tw * (w00 * a[1] + w01 * a[4] + w10 * d[1] + w11 * d[4]);
+      b += tw * (w00 * a[2] + w01 * a[5] + w10 * d[2] + w11 * d[5]);
+      wsum += tw;
+    }
+  }
+  px[0] = float(r / wsum), px[1] = float(g / wsum), px[2] = float(b / wsum);
+}
+
+// The destination's corner points x = c - 1/2 (c = 0..W) on the boundary line y = b - 1/2 between
+// rows b - 1 and b, as row q (b - 1 or b) sees it: a cube's faces are stacked, so on a face
+// boundary the line is taken a hair inside row q's face. Lines are computed once per range of
+// rows and shared by the rows on either side.
+class CornerLines {
+ public:
+  static constexpr double kInset = 1e-3;
+
+  CornerLines(const Layout& dst, const Layout& src) : dst_(dst), src_(src) {}
+
+  bool face_boundary(int b) const { return dst_.kind() == LayoutKind::Cube && b % dst_.width() == 0; }
+  // Rows q and q2 lie on one smooth piece of the destination (a cube: the same face).
+  bool same_piece(int q, int q2) const {
+    return q2 >= 0 && q2 < dst_.height() && (dst_.kind() != LayoutKind::Cube || q / dst_.width() == q2 / dst_.width());
+  }
+  // y of line b as row q sees it, relative to b - 1/2.
+  double offset(int b, int q) const { return face_boundary(b) ? (q == b ? kInset : -kInset) : 0.0; }
+
+  const std::vector<PointSample>& line(int b, int q) {
+    const std::pair<int, int> key(b, face_boundary(b) ? q - b : 0);
+    auto it = cache_.find(key);
+    if (it != cache_.end()) return it->second;
+    std::vector<PointSample> points(std::size_t(dst_.width()) + 1);
+    const double y = b - 0.5 + offset(b, q);
+    for (int c = 0; c <= dst_.width(); ++c) points[std::size_t(c)] = point_sample(dst_, src_, Vec2(c - 0.5, y));
+    return cache_.emplace(key, std::move(points)).first->second;
+  }
+  void forget_above(int b) {
+    while (!cache_.empty() && cache_.begin()->first.first < b) cache_.erase(cache_.begin());
+  }
+
+ private:
+  const Layout& dst_;
+  const Layout& src_;
+  std::map<std::pair<int, int>, std::vector<PointSample>> cache_;
+};
+
+// Destination rows [r0, r1) by interpolated taps from a lat-long source (see resample()).
+// A texel's bilinear interpolation of the source position (and density) between its corners is
+// trusted where the second differences of the corner lines bound its error, (|f_xx| + |f_yy|) / 8,
+// within a fiftieth of a texel of the level read (a thousandth of the density); elsewhere (a pole,
+// a seam's far side, a sphere map's rim) exact(c, r, px) renders the texel.
 template <class Exact>
-void interpolated_row(const EnvMap& src, const Layout& dst, const LatLongRipmap& ripmap, const ResampleOptions& options,
-                      const PeakPyramid& peaks, int r, float* row, const Exact& exact) {
-  constexpr double kInset = 1e-3;
-  // Largest mismatch at the centre between interpolated and exact: source position (texels of
-  // the level read) and relative density.
+void interpolated_rows(const EnvMap& src, const Layout& dst, const LatLongRipmap& ripmap,
+                       const ResampleOptions& options, const PeakPyramid& peaks, int r0, int r1, EnvMap& out,
+                       const Exact& exact) {
   constexpr double kPositionTolerance = 0.02, kDensityTolerance = 1e-3;
   const int width = dst.width(), ch = src.channels(), max_n = std::max(1, options.max_subsamples);
-  std::vector<PointSample> top(std::size_t(width) + 1), bottom(std::size_t(width) + 1);
-  for (int c = 0; c <= width; ++c) {
-    top[std::size_t(c)] = point_sample(dst, src.layout, Vec2(c - 0.5, r - 0.5 + kInset));
-    bottom[std::size_t(c)] = point_sample(dst, src.layout, Vec2(c - 0.5, r + 0.5 - kInset));
-  }
   const double period = src.layout.width() - 1, dlat = ripmap.latitude_step();
+  const double kInset = CornerLines::kInset;
+  CornerLines lines(dst, src.layout);
   double acc[kMaxChannels];
   float tap[kMaxChannels];
-  for (int c = 0; c < width; ++c) {
-    float* px = row + std::size_t(c) * ch;
-    const PointSample* k[4] = {&top[std::size_t(c)], &top[std::size_t(c) + 1], &bottom[std::size_t(c)],
-                               &bottom[std::size_t(c) + 1]};
-    const PointSample centre = point_sample(dst, src.layout, Vec2(c, r));
-    if (!centre.ok || !k[0]->ok || !k[1]->ok || !k[2]->ok || !k[3]->ok) {
-      exact(c, r, px);
-      continue;
+  for (int r = r0; r < r1; ++r) {
+    lines.forget_above(r - 1);
+    const std::vector<PointSample>& top = lines.line(r, r);
+    const std::vector<PointSample>& bottom = lines.line(r + 1, r);
+    // A third line on the same piece, for the second difference across rows.
+    const std::vector<PointSample>* third = nullptr;
+    bool third_below = true;
+    if (lines.same_piece(r, r + 1)) {
+      third = &lines.line(r + 2, r + 1);
+    } else if (lines.same_piece(r, r - 1)) {
+      third = &lines.line(r - 1, r - 1);
+      third_below = false;
     }
-    // Corner columns unwrapped to the centre's side of the seam.
-    double x[4], y[4], w[4];
-    for (int i = 0; i < 4; ++i) {
-      x[i] = k[i]->x - period * std::round((k[i]->x - centre.x) / period);
-      y[i] = k[i]->y;
-      w[i] = k[i]->density;
-    }
-    const double lat = 0.5 * kPi - dlat * centre.y;
-    const int level = ripmap.level_for_latitude(lat);
-    const double level_columns = (ripmap.width(level) - 1) / period;  // level texels per level-0 texel
-    const double mid_x = 0.25 * (x[0] + x[1] + x[2] + x[3]), mid_y = 0.25 * (y[0] + y[1] + y[2] + y[3]);
-    const double mid_w = 0.25 * (w[0] + w[1] + w[2] + w[3]);
-    if (std::abs(mid_x - centre.x) * level_columns > kPositionTolerance ||
-        std::abs(mid_y - centre.y) > kPositionTolerance ||
-        std::abs(mid_w - centre.density) > kDensityTolerance * centre.density) {
-      exact(c, r, px);
-      continue;
-    }
-    // The cell's largest angular extent: its edges and half diagonals (chords, radians).
-    const double vertical = 1.0 / (1.0 - 2 * kInset);
-    const double extent =
-        std::max({(k[0]->dir - k[1]->dir).norm(), (k[2]->dir - k[3]->dir).norm(),
-                  vertical * (k[0]->dir - k[2]->dir).norm(), vertical * (k[1]->dir - k[3]->dir).norm(),
-                  std::sqrt(0.5) * (k[0]->dir - k[3]->dir).norm(), std::sqrt(0.5) * (k[1]->dir - k[2]->dir).norm()});
-    const double step = std::min(dlat, ripmap.longitude_step(level) * std::abs(std::cos(lat)));
-    const double footprint = step > 0 ? extent / step : double(max_n);
-    const int n = std::clamp(int(std::ceil(options.supersampling * footprint - 1e-9)), 1, max_n);
-    // A texel that may hold more than the energy tolerance of the whole map (a sun and its
-    // neighbours: the brightest source texel anywhere in its footprint times its solid angle) takes
-    // the exact path: the interpolated cell's small bulge against the true one would move a real
-    // share of the map's energy.
-    const double spread =
-        std::max({std::abs(x[0] - x[3]), std::abs(x[1] - x[2]), std::abs(y[0] - y[3]), std::abs(y[1] - y[2])});
-    if (peaks.bright(centre.x, centre.y, spread, centre.density)) {
-      exact(c, r, px);
-      continue;
-    }
-    if (n == 1) {
-      ripmap.bilinear(level, centre.x, centre.y, px);
-      continue;
-    }
-    for (int q = 0; q < ch; ++q) acc[q] = 0.0;
-    double wsum = 0.0;
-    for (int j = 0; j < n; ++j) {
-      const double t = ((j + 0.5) / n - kInset) / (1.0 - 2 * kInset);  // 0 at the top corners, 1 at the bottom
-      const double lx = x[0] + t * (x[2] - x[0]), rx = x[1] + t * (x[3] - x[1]);
-      const double ly = y[0] + t * (y[2] - y[0]), ry = y[1] + t * (y[3] - y[1]);
-      const double lw = w[0] + t * (w[2] - w[0]), rw = w[1] + t * (w[3] - w[1]);
-      for (int i = 0; i < n; ++i) {
-        const double s = (i + 0.5) / n;
-        const double tw = lw + s * (rw - lw);
-        ripmap.bilinear(level, lx + s * (rx - lx), ly + s * (ry - ly), tap);
-        for (int q = 0; q < ch; ++q) acc[q] += tw * tap[q];
-        wsum += tw;
+    float* row = out.pixels.ptr<float>(r);
+    for (int c = 0; c < width; ++c) {
+      float* px = row + std::size_t(c) * ch;
+      const PointSample* k[4] = {&top[std::size_t(c)], &top[std::size_t(c) + 1], &bottom[std::size_t(c)],
+                                 &bottom[std::size_t(c) + 1]};
+      bool ok = third != nullptr && k[0]->ok && k[1]->ok && k[2]->ok && k[3]->ok;
+      const double ref = ok ? k[0]->x : 0.0;
+      const auto unwrap = [&](double x) { return x - period * std::round((x - ref) / period); };
+      double x[4], y[4], w[4];
+      for (int i = 0; ok && i < 4; ++i) x[i] = unwrap(k[i]->x), y[i] = k[i]->y, w[i] = k[i]->density;
+      // Second differences along each line (at the texel's corners that have both neighbours) and
+      // across the rows (at its two columns).
+      double fxx[3] = {0, 0, 0}, fyy[3] = {0, 0, 0};  // x, y, density
+      for (int side = 0; ok && side < 2; ++side) {
+        const std::vector<PointSample>& l = side == 0 ? top : bottom;
+        for (int m = c; m <= c + 1; ++m) {
+          if (m - 1 < 0 || m + 1 > width) continue;
+          const PointSample &a = l[std::size_t(m) - 1], &b = l[std::size_t(m)], &d = l[std::size_t(m) + 1];
+          if (!a.ok || !b.ok || !d.ok) {
+            ok = false;
+            break;
+          }
+          fxx[0] = std::max(fxx[0], std::abs(unwrap(a.x) - 2 * unwrap(b.x) + unwrap(d.x)));
+          fxx[1] = std::max(fxx[1], std::abs(a.y - 2 * b.y + d.y));
+          fxx[2] = std::max(fxx[2], std::abs(a.density - 2 * b.density + d.density));
+        }
       }
+      for (int m = c; ok && m <= c + 1; ++m) {
+        const PointSample& t = (*third)[std::size_t(m)];
+        if (!t.ok) {
+          ok = false;
+          break;
+        }
+        const PointSample &u = top[std::size_t(m)], &v = bottom[std::size_t(m)];
+        const PointSample &a = third_below ? u : t, &b = third_below ? v : u, &d = third_below ? t : v;
+        fyy[0] = std::max(fyy[0], std::abs(unwrap(a.x) - 2 * unwrap(b.x) + unwrap(d.x)));
+        fyy[1] = std::max(fyy[1], std::abs(a.y - 2 * b.y + d.y));
+        fyy[2] = std::max(fyy[2], std::abs(a.density - 2 * b.density + d.density));
+      }
+      if (!ok) {
+        exact(c, r, px);
+        continue;
+      }
+      const double mid_x = 0.25 * (x[0] + x[1] + x[2] + x[3]), mid_y = 0.25 * (y[0] + y[1] + y[2] + y[3]);
+      const double mid_w = 0.25 * (w[0] + w[1] + w[2] + w[3]);
+      const double lat = 0.5 * kPi - dlat * mid_y;
+      const int level = ripmap.level_for_latitude(lat);
+      const double level_columns = (ripmap.width(level) - 1) / period;  // level texels per level-0 texel
+      if ((fxx[0] + fyy[0]) / 8 * level_columns > kPositionTolerance || (fxx[1] + fyy[1]) / 8 > kPositionTolerance ||
+          (fxx[2] + fyy[2]) / 8 > kDensityTolerance * mid_w || !(mid_w > 0)) {
+        exact(c, r, px);
+        continue;
+      }
+      // A texel that may hold more than the energy tolerance of the whole map (a sun and its
+      // neighbours: the brightest source texel anywhere in its footprint times its solid angle)
+      // takes the exact path: the interpolated cell's small bulge against the true one would move a
+      // real share of the map's energy.
+      const double spread =
+          std::max({std::abs(x[0] - x[3]), std::abs(x[1] - x[2]), std::abs(y[0] - y[3]), std::abs(y[1] - y[2])});
+      if (peaks.bright(mid_x, mid_y, spread, mid_w)) {
+        exact(c, r, px);
+        continue;
+      }
+      // The cell's largest angular extent: its edges and half diagonals (chords, radians).
+      const double vertical = 1.0 / (1.0 - lines.offset(r, r) + lines.offset(r + 1, r));
+      const double extent =
+          std::max({(k[0]->dir - k[1]->dir).norm(), (k[2]->dir - k[3]->dir).norm(),
+                    vertical * (k[0]->dir - k[2]->dir).norm(), vertical * (k[1]->dir - k[3]->dir).norm(),
+                    std::sqrt(0.5) * (k[0]->dir - k[3]->dir).norm(), std::sqrt(0.5) * (k[1]->dir - k[2]->dir).norm()});
+      const double step = std::min(dlat, ripmap.longitude_step(level) * std::abs(std::cos(lat)));
+      const double footprint = step > 0 ? extent / step : double(max_n);
+      const int n = std::clamp(int(std::ceil(options.supersampling * footprint - 1e-9)), 1, max_n);
+      if (n == 1) {  // enlarging: one bilinear tap at the exact centre, as sample_bilinear takes it
+        const PointSample centre = point_sample(dst, src.layout, Vec2(c, r));
+        if (centre.ok)
+          ripmap.bilinear(level, centre.x, centre.y, px);
+        else
+          exact(c, r, px);
+        continue;
+      }
+      // Tap (i, j) at pixel offset ((i + 1/2) / n - 1/2, (j + 1/2) / n - 1/2) from the centre; the
+      // corners' lines lie at offsets -1/2 + top and 1/2 + bottom (the insets).
+      const double y_top = -0.5 + lines.offset(r, r), y_bottom = 0.5 + lines.offset(r + 1, r);
+      if (ch == 3) {
+        rgb_taps(ripmap, level, n, x, y, w, y_top, y_bottom, px);
+        continue;
+      }
+      for (int q = 0; q < ch; ++q) acc[q] = 0.0;
+      double wsum = 0.0;
+      for (int j = 0; j < n; ++j) {
+        const double t = ((j + 0.5) / n - 0.5 - y_top) / (y_bottom - y_top);
+        const double lx = x[0] + t * (x[2] - x[0]), rx = x[1] + t * (x[3] - x[1]);
+        const double ly = y[0] + t * (y[2] - y[0]), ry = y[1] + t * (y[3] - y[1]);
+        const double lw = w[0] + t * (w[2] - w[0]), rw = w[1] + t * (w[3] - w[1]);
+        for (int i = 0; i < n; ++i) {
+          const double s = (i + 0.5) / n;
+          const double tw = lw + s * (rw - lw);
+          ripmap.bilinear(level, lx + s * (rx - lx), ly + s * (ry - ly), tap);
+          for (int q = 0; q < ch; ++q) acc[q] += tw * tap[q];
+          wsum += tw;
+        }
+      }
+      for (int q = 0; q < ch; ++q) px[q] = float(acc[q] / wsum);
     }
-    for (int q = 0; q < ch; ++q) px[q] = float(acc[q] / wsum);
   }
 }
 
@@ -226,7 +350,7 @@ EnvMap resample(const EnvMap& src, const Layout& dst, const ResampleOptions& opt
   if (options.energy_tolerance > 0) {
     peak.layout = src.layout;
     magnitude.create(src.pixels.rows, src.pixels.cols, CV_32FC1);
-    for (int r = 0; r < src.pixels.rows; ++r) {
+    parallel_for_rows(src.pixels.rows, [&](int r) {
       const float* p = src.pixels.ptr<float>(r);
       float* m = magnitude.ptr<float>(r);
       for (int c = 0; c < src.pixels.cols; ++c) {
@@ -234,7 +358,7 @@ EnvMap resample(const EnvMap& src, const Layout& dst, const ResampleOptions& opt
         for (int k = 0; k < ch; ++k) v = std::max(v, std::isfinite(p[c * ch + k]) ? std::abs(p[c * ch + k]) : 0.f);
         m[c] = v;
       }
-    }
+    });
     cv::dilate(magnitude, peak.pixels, cv::Mat::ones(3, 3, CV_8U));
     energy = integral(EnvMap{src.layout, magnitude, {}})[0];
   }
@@ -315,17 +439,20 @@ EnvMap resample(const EnvMap& src, const Layout& dst, const ResampleOptions& opt
     peaks.emplace(magnitude, energy, options.energy_tolerance);
   }
 
-  parallel_for_rows(dst.height(), [&](int r) {
-    float* row = out.pixels.ptr<float>(r);
+  // Rows in ranges of 16, so that the interpolated path shares corner lines between rows.
+  constexpr int kRange = 16;
+  parallel_for_rows((dst.height() + kRange - 1) / kRange, [&](int range) {
+    const int r0 = range * kRange, r1 = std::min(dst.height(), r0 + kRange);
     if (!ripmap) {
-      for (int c = 0; c < dst.width(); ++c) exact_texel(c, r, row + std::size_t(c) * ch);
+      for (int r = r0; r < r1; ++r)
+        for (int c = 0; c < dst.width(); ++c) exact_texel(c, r, out.pixels.ptr<float>(r) + std::size_t(c) * ch);
     } else {
-      interpolated_row(src, dst, *ripmap, options, *peaks, r, row, exact_texel);
+      interpolated_rows(src, dst, *ripmap, options, *peaks, r0, r1, out, exact_texel);
     }
     if (options.progress) {
-      // Reported only from rows that finish; the callback itself decides how often to draw.
-      const int done = ++rows_done;
-      if (done % 16 == 0 || done == dst.height()) options.progress(double(done) / dst.height());
+      // Reported only from ranges that finish; the callback itself decides how often to draw.
+      const int done = rows_done += r1 - r0;
+      options.progress(double(done) / dst.height());
     }
   });
   return out;
