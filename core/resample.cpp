@@ -347,7 +347,9 @@ EnvMap resample(const EnvMap& src, const Layout& dst, const ResampleOptions& opt
   EnvMap peak;
   double energy = 0;
   cv::Mat magnitude;
-  if (options.energy_tolerance > 0) {
+  const bool interpolated = src.layout.kind() == LayoutKind::LatLong &&
+                            options.reconstruction == Reconstruction::Bilinear && options.interpolate_taps;
+  if (options.energy_tolerance > 0 || interpolated) {
     peak.layout = src.layout;
     magnitude.create(src.pixels.rows, src.pixels.cols, CV_32FC1);
     parallel_for_rows(src.pixels.rows, [&](int r) {
@@ -365,7 +367,7 @@ EnvMap resample(const EnvMap& src, const Layout& dst, const ResampleOptions& opt
   // Taps per side a texel of this solid-angle density needs so that no tap carries more than the
   // energy tolerance of the whole map's energy (1 where the tolerance is off).
   const auto energy_taps = [&](const Vec3& dir, double density) {
-    if (!(energy > 0)) return 1;
+    if (!(energy > 0) || !(options.energy_tolerance > 0)) return 1;
     float local_peak = 0;
     sample_nearest(peak, dir, &local_peak);
     const double need = std::sqrt(local_peak * density / (options.energy_tolerance * energy));
@@ -433,10 +435,14 @@ EnvMap resample(const EnvMap& src, const Layout& dst, const ResampleOptions& opt
   // sphere map's rim) takes the exact path.
   std::optional<LatLongRipmap> ripmap;
   std::optional<PeakPyramid> peaks;
-  if (src.layout.kind() == LayoutKind::LatLong && options.reconstruction == Reconstruction::Bilinear &&
-      options.interpolate_taps) {
+  if (interpolated) {
     ripmap.emplace(src);
-    peaks.emplace(magnitude, energy, options.energy_tolerance);
+    // The share of the map's energy above which a texel is rendered exactly: a tenth of the energy
+    // tolerance (of the default's where it is off: the interpolated cell is an approximation even
+    // when no extra taps are asked for), so that no knob's integral error grows against the
+    // exact path's (docs/tradeoffs.md).
+    peaks.emplace(magnitude, energy,
+                  0.1 * (options.energy_tolerance > 0 ? options.energy_tolerance : ResampleOptions{}.energy_tolerance));
   }
 
   // Rows in ranges of 16, so that the interpolated path shares corner lines between rows.

@@ -35,8 +35,8 @@ struct ResampleOptions {
   // From a lat-long source (bilinear): a texel's taps are placed by interpolating the exact source
   // positions at its corners (checked at its centre) and read from the level of a longitude ripmap
   // whose texels are square at that latitude (core/latlong_ripmap.h); texels the check refuses, or
-  // that may hold more than energy_tolerance of the map, take the exact path. false: every tap's
-  // direction is computed (the reference the interpolated taps are tested against).
+  // that may hold more than a tenth of energy_tolerance of the map, take the exact path. false:
+  // every tap's direction is computed (the reference the interpolated taps are tested against).
   bool interpolate_taps = true;
   // Called with the fraction done (0..1), from worker threads (must be thread-safe); may be empty.
   std::function<void(double)> progress;
