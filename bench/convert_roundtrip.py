@@ -65,7 +65,10 @@ def replace_section(path, title, body):
     if start < 0:
         text = text.rstrip("\n") + "\n\n" + section
     else:
-        end = text.find("\n## ", start + 1)
+        # The section ends at the next one, or at the closing "Notes:" paragraph that
+        # bench/performance.py keeps last in docs/performance.md.
+        ends = [e for e in (text.find("\n## ", start + 1), text.find("\nNotes: ", start + 1)) if e >= 0]
+        end = min(ends) if ends else -1
         # A blank line before the next section, whether the body ended with one or not.
         text = text[:start] + section + ("\n" + text[end + 1:] if end >= 0 else "")
     tmp = path + ".tmp"
