@@ -1,7 +1,6 @@
 #include "core/mip_pyramid.h"
 
 #include "core/parallel.h"
-#include "core/latlong_area_resize.h"
 #include "core/resample.h"
 
 #include <algorithm>
@@ -138,9 +137,7 @@ MipPyramid::MipPyramid(const EnvMap& base) {
     }
     if (!next || *next == top) break;
     // A lat-long resizes exactly (separable overlaps, linear in its texels); others resample.
-    levels_.push_back(top.kind() == LayoutKind::LatLong
-                          ? latlong_area_resize(levels_.back(), next->width(), next->height())
-                          : resample(levels_.back(), *next));
+    levels_.push_back(resample(levels_.back(), *next));
   }
 }
 
