@@ -23,14 +23,16 @@ namespace rsibr {
 namespace {
 
 // The .cameramodel syntax, checked before mrcal sees the text: mrcal 2.2's parser reads past the
-// end of some malformed texts (found by fuzz/fuzz_camera_model), so only well-formed ones reach it.
+// end of some malformed texts and of some comments (found by fuzz/fuzz_camera_model), so only
+// well-formed ones reach it, and with their comments blanked out (newlines kept, so line numbers in
+// mrcal's messages still match the file).
 //   model  := '{' [ string ':' value { ',' string ':' value } [','] ] '}'
 //   value  := string | number | '[' [ value { ',' value } [','] ] ']'
 //   string := '...' or "..." on one line;  number := [+-] digits [. digits] [(e|E) [+-] digits]
 // with blanks and '#' comments (to the end of the line) between tokens, and nothing after '}'.
 class CameraModelSyntax {
  public:
-  explicit CameraModelSyntax(const std::string& text) : s_(text) {}
+  explicit CameraModelSyntax(const std::string& text) : s_(text), blanked_(text) {}
 
   // "" when the text is well formed, else what is wrong and where.
   std::string problem() {
@@ -52,6 +54,9 @@ class CameraModelSyntax {
     }
     return "";
   }
+  // The text with every comment replaced by blanks, ending in a newline; valid after problem()
+  // returned "".
+  std::string blanked() const { return blanked_ + "\n"; }
 
  private:
   [[noreturn]] void fail(const std::string& what) {
@@ -62,7 +67,7 @@ class CameraModelSyntax {
   void skip() {
     while (i_ < s_.size()) {
       if (s_[i_] == '#') {
-        while (i_ < s_.size() && s_[i_] != '\n') ++i_;
+        for (; i_ < s_.size() && s_[i_] != '\n'; ++i_) blanked_[i_] = ' ';
       } else if (s_[i_] == ' ' || s_[i_] == '\t' || s_[i_] == '\n' || s_[i_] == '\r') {
         ++i_;
       } else {
@@ -123,6 +128,7 @@ class CameraModelSyntax {
     expect(']');
   }
   const std::string& s_;
+  std::string blanked_;
   std::size_t i_ = 0;
 };
 
@@ -179,8 +185,10 @@ LensModel LensModel::pinhole(double f, int width, int height) {
 }
 
 LensModel LensModel::parse(const std::string& text, const std::string& what) {
-  if (const std::string problem = CameraModelSyntax(text).problem(); !problem.empty())
+  CameraModelSyntax syntax(text);
+  if (const std::string problem = syntax.problem(); !problem.empty())
     throw std::invalid_argument(what + ": not a valid mrcal .cameramodel (" + problem + ")");
+  const std::string clean = syntax.blanked();
   // mrcal's parser reports problems on stderr; catch that line so the error stays one line that
   // names the file (the CLI contract).
   std::string diagnostic;
@@ -192,7 +200,7 @@ LensModel LensModel::parse(const std::string& text, const std::string& what) {
     FILE* sink = std::tmpfile();
     const int saved = sink ? ::dup(2) : -1;
     if (saved >= 0) ::dup2(::fileno(sink), 2);
-    m.reset(mrcal_read_cameramodel_string(text.c_str(), int(text.size())));
+    m.reset(mrcal_read_cameramodel_string(clean.c_str(), int(clean.size())));
     if (saved >= 0) {
       std::fflush(stderr);
       ::dup2(saved, 2);

@@ -120,6 +120,21 @@ TEST(LensModel, MalformedTextsThatMrcalReadsPastTheirEndAreRefusedBeforeMrcalSee
   }
 }
 
+TEST(LensModel, CommentsAnywhereAreIgnoredEvenWithQuotesAndNoFinalNewline) {
+  // Found by fuzz/fuzz_camera_model: mrcal 2.2 crashed on a well-formed model whose last line was a
+  // comment holding a quote, with no newline after it. Comments are now blanked before mrcal reads.
+  const std::string text =
+      "# it's a model\n{\n    'lensmodel':  'LENSMODEL_PINHOLE', # the 'core' only\n"
+      "    'intrinsics': [ 100, 101, 47.5, 31.5 ],\n    'imagersize': [ 96, 64 ],\n"
+      "    'extrinsics': [ 0, 0, 0, 0, 0, 0 ],\n}\n#e'";
+  const LensModel lens = LensModel::parse(text, "m.cameramodel");
+  EXPECT_EQ(lens.name(), "LENSMODEL_PINHOLE");
+  ASSERT_EQ(lens.intrinsics().size(), 4u);
+  EXPECT_EQ(lens.intrinsics()[1], 101.0);
+  EXPECT_EQ(lens.width(), 96);
+  EXPECT_EQ(lens.height(), 64);
+}
+
 TEST(RayTable, InterpolatedRaysReprojectToTheirPixels) {
   for (const LensModel& lens : {LensModel::pinhole(800, 640, 480), wide_opencv8()}) {
     const RayTable table(lens, 8);
