@@ -22,6 +22,7 @@
 #include "hdr/noise_model.h"
 #include "hdr/photo_set_merge.h"
 #include "hdr/response_recovery.h"
+#include "pipeline/vignetting_input.h"
 
 #include "core/image_codecs.h"
 
@@ -42,7 +43,7 @@ namespace fs = std::filesystem;
 
 struct HdrArgs {
   std::string photoset, out, response, model = "auto", channels = "auto", noise, input_colour_space, json, saturation,
-                                       white_balance;
+                                       white_balance, vignetting = "auto", lens;
   std::vector<std::string> views;
   int samples = 20000;
   double smoothness = 1000.0, ghost_sigmas = -1;
@@ -167,6 +168,10 @@ int run_hdr(const HdrArgs& a) {
     }
   }
 
+  // A vignetting file is read before any work (its model needs neither the response nor the lens).
+  if (a.vignetting != "auto" && a.vignetting != "none")
+    photo_set_vignetting(set, a.vignetting, ResponseCurve{}, LensModel::pinhole(1, 1, 1), nullptr);
+
   // Outputs: the folder may be new (its parent must exist); no output may name an input.
   const fs::path out_dir = fs::absolute(a.out);
   if (!fs::is_directory(out_dir)) {
@@ -175,17 +180,24 @@ int run_hdr(const HdrArgs& a) {
   }
   std::vector<fs::path> inputs = set.files();
   if (!a.response.empty()) inputs.push_back(a.response);
+  if (!a.lens.empty()) inputs.push_back(a.lens);
+  for (const fs::path& f : vignetting_inputs(set, a.vignetting)) inputs.push_back(f);
+  const std::optional<LensModel> given_lens = !a.lens.empty() ? std::optional<LensModel>(LensModel::read(a.lens))
+                                              : set.camera_model
+                                                  ? std::optional<LensModel>(LensModel::read(*set.camera_model))
+                                                  : std::nullopt;
   OutputPlan outputs(inputs);
   outputs.folder(a.out);
   const std::string json = outputs.file(a.json);
   std::vector<std::pair<fs::path, fs::path>> staged;  // (temporary, final)
   const fs::path response_out = out_dir / "response.json";
+  const fs::path vignetting_out = out_dir / "vignetting.json";
   for (const PhotoView* v : views)
     for (const char* ext : {".exr", ".png"}) {
       const fs::path target = file_in_folder(out_dir, v->name + ext);
       for (const fs::path& in : inputs) check_not_same_file(in, target);
     }
-  for (const fs::path& in : inputs) check_not_same_file(in, response_out);
+  for (const fs::path& in : inputs) check_not_same_file(in, response_out), check_not_same_file(in, vignetting_out);
 
   // Everything goes to a staging folder inside the output folder and is renamed into place only
   // when every view has merged: a failure leaves no partial output.
@@ -265,25 +277,44 @@ int run_hdr(const HdrArgs& a) {
       response_model = s.str();
     }
 
+    // Vignetting, chosen as the hdr step of rsibr process chooses it (pipeline/vignetting_input.h),
+    // about the lens's principal point: --lens, else the photo set's camera model, else the centre
+    // of the photos (the first view's size).
+    const LensModel lens = given_lens ? *given_lens : [&] {
+      if (a.vignetting == "none") return LensModel::pinhole(1, 1, 1);
+      const BracketSet first = load_brackets(*views.front(), alignment != Alignment::off);
+      return LensModel::pinhole(std::hypot(double(first.cols()), double(first.rows())), first.cols(), first.rows());
+    }();
+    nlohmann::json vignetting_report;
+    const Vignetting vignetting = photo_set_vignetting(set, a.vignetting, curve, lens, &vignetting_report);
+    vignetting_report["principal_point_from"] = !a.lens.empty()    ? "--lens " + a.lens
+                                                : set.camera_model ? "the photo set's camera model"
+                                                                   : std::string("the image centre");
+    summary["vignetting"] = vignetting_report;
+    write_text_atomically(stage / "vignetting.json", vignetting_report["model"].dump(2) + "\n");
+    staged.push_back({stage / "vignetting.json", vignetting_out});
+
+    ViewMergeSettings vs;
+    vs.noise = pooled_noise;
+    vs.align = alignment;
+    vs.merge.ghost_sigmas = a.ghost_sigmas;
+    vs.merge.deghost = a.deghost;
+    vs.vignetting = &vignetting;
+    vs.white_balance = gains;
+    vs.input_colour_space = a.input_colour_space;
+    vs.camera_colour_space = set.camera_colour_space;
     nlohmann::json view_list = nlohmann::json::array();
     for (std::size_t vi = 0; vi < views.size(); ++vi) {
       const PhotoView& v = *views[vi];
-      MergeOptions mo;
-      mo.ghost_sigmas = a.ghost_sigmas;
-      mo.deghost = a.deghost;
       const auto t0 = std::chrono::steady_clock::now();
-      ViewMerge vm = merge_photo_view(v, curve, pooled_noise, alignment, mo);
+      ViewMerge vm = merge_view_radiance(v, curve, vs);
       const auto t1 = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                std::chrono::duration<double>(vm.seconds_load));
       const BracketSet& b = vm.brackets;
       const std::vector<cv::Point>& shifts = vm.shifts;
       const NoiseModel& noise = vm.noise;
       MergedImage& m = vm.image;
-      // The user's white balance on the camera's (the merge keeps the camera's own), then the
-      // working space (hdr/merged_colour.h).
-      if (gains) apply_white_balance(m, *gains);
-      const std::string from = merged_colour_space(b.raw && a.input_colour_space.empty() ? "" : input_space, b.raw);
-      merged_to_working_space(m, from);
+      const std::string& from = vm.input_colour_space;
       const auto t2 = std::chrono::steady_clock::now();
       std::string files;
       for (const std::string& f : b.files) files += (files.empty() ? "" : ";") + relative_name(f, set.folder);
@@ -311,6 +342,7 @@ int run_hdr(const HdrArgs& a) {
                                                     : std::string("median threshold bitmaps, coarse to fine (") +
                                                           to_string(alignment) + "), shifts " + shift_text},
           {"ghosts", a.deghost ? "flagged; longest usable bracket alone" : "flagged; merged as usual"},
+          {"vignetting", vignetting.is_identity() ? std::string("none") : vignetting.source + " (divided out)"},
           {"flags",
            "clipped: lower bound (saturated in every bracket); black: nothing recorded; ghost: brackets disagree"}};
       write_merged_exr(file_in_folder(stage, v.name + ".exr").string(), m, attrs);
@@ -418,7 +450,7 @@ Runner add_hdr(CLI::App& app) {
       "shot + read noise model (estimated from the brackets, or --noise), and the inverse-variance merge. A bracket "
       "saturated in any channel is left out for that pixel; pixels saturated in every bracket are flagged 'clipped' "
       "and hold a lower bound. OUT/<view>.exr has R,G,B, variance.R/G/B, clipped, black, ghost; OUT/<view>.png is a "
-      "preview. Radiance unit: X/e, the signal over its saturation value per relative exposure t*iso/100/N^2. "
+      "preview; OUT/vignetting.json is the lens falloff divided out (--vignetting). Radiance unit: X/e, the signal over its saturation value per relative exposure t*iso/100/N^2. "
       "Photos: PNG, JPEG, TIFF, or camera RAW files (DNG, CR2, CR3, NEF, ARW, ... through LibRaw: linear, no response "
       "to recover, saturation from the file). Handheld brackets are registered first (--align, --no-align).\n"
       "Example: rsibr hdr shoot/photoset.yaml --out shoot/hdr --json shoot/hdr.json");
@@ -447,6 +479,12 @@ Runner add_hdr(CLI::App& app) {
   c->add_option("--ghost-sigmas", a->ghost_sigmas,
                 "Ghost threshold in standard deviations of chi-square (default: 6, 8 for JPEG)")
       ->check(CLI::Range(0.0, 1e6));
+  c->add_option("--vignetting", a->vignetting,
+                "Lens falloff divided out: auto (from the photo set's chessboards, else lensfun's profile of the "
+                "lens the EXIF names, else none), none, or a vignetting.json (as rsibr process does)");
+  c->add_option("--lens", a->lens,
+                "The camera's .cameramodel: the principal point vignetting is about (default: the photo set's "
+                "camera model, else the image centre)");
   c->add_option("--input-colorspace", a->input_colour_space,
                 "OpenColorIO colour space of the linearised camera RGB (default: the working space; $OCIO honoured)");
   c->add_option("--preview-exposure", a->preview_exposure, "Preview exposure in stops (default: median grey at 0.18)");

@@ -1,5 +1,7 @@
 #include "hdr/photo_set_merge.h"
 
+#include "hdr/merged_colour.h"
+
 #include "hdr/alignment.h"
 #include "hdr/bracket_statistics.h"
 
@@ -86,6 +88,19 @@ ViewMerge merge_photo_view(const PhotoView& view, const ResponseCurve& curve, co
   const auto t2 = std::chrono::steady_clock::now();
   m.seconds_load = std::chrono::duration<double>(t1 - t0).count();
   m.seconds_merge = std::chrono::duration<double>(t2 - t1).count();
+  return m;
+}
+
+ViewMerge merge_view_radiance(const PhotoView& view, const ResponseCurve& curve, const ViewMergeSettings& settings) {
+  ViewMerge m = merge_photo_view(view, curve, settings.noise, settings.align, settings.merge, settings.vignetting);
+  if (settings.white_balance) apply_white_balance(m.image, *settings.white_balance);
+  // A RAW file is developed to linear Rec.709 whatever the photo set says; only the user's own
+  // choice overrides that.
+  const std::string given = !settings.input_colour_space.empty() ? settings.input_colour_space
+                            : m.brackets.raw                     ? std::string()
+                                                                 : settings.camera_colour_space;
+  m.input_colour_space = merged_colour_space(given, m.brackets.raw);
+  merged_to_working_space(m.image, m.input_colour_space);
   return m;
 }
 

@@ -1,6 +1,7 @@
 // A photo set's views merged the way rsibr hdr and rsibr process both do it: the camera response
 // and the noise model recovered once, from every view (loaded one at a time, aligned when asked;
-// bracket_statistics.h), then each view's brackets loaded again and merged. `align`: how brackets
+// bracket_statistics.h), then each view's brackets loaded again and merged (merge_view_radiance:
+// the one function both call, so the verb and the step write the same radiance). `align`: how brackets
 // are registered first (hdr/alignment.h; files of different sizes are accepted unless off).
 #pragma once
 
@@ -40,6 +41,7 @@ struct ViewMerge {
   NoiseModel noise;
   MergedImage image;
   double seconds_load = 0, seconds_merge = 0;  // loading + alignment + noise estimate; the merge
+  std::string input_colour_space;              // what image was converted from ("": the working space)
 };
 
 // `noise` nullopt: estimated from this view alone. `vignetting`, when given, is divided out of the
@@ -47,5 +49,21 @@ struct ViewMerge {
 // when the photos' bit depth is not the curve's.
 ViewMerge merge_photo_view(const PhotoView& view, const ResponseCurve& curve, const std::optional<NoiseModel>& noise,
                            Alignment align, const MergeOptions& options = {}, const Vignetting* vignetting = nullptr);
+
+// How rsibr hdr and the hdr step of rsibr process merge a view.
+struct ViewMergeSettings {
+  std::optional<NoiseModel> noise;  // nullopt: estimated from the view alone
+  Alignment align = Alignment::automatic;
+  MergeOptions merge;
+  const Vignetting* vignetting = nullptr;  // divided out when given
+  std::optional<cv::Vec3f> white_balance;  // the user's gains on top of the camera's own
+  std::string input_colour_space;          // the user's choice ("": none)
+  std::string camera_colour_space;         // the photo set's camera.colour_space ("": none)
+};
+
+// merge_photo_view, then the user's white balance, then the working space: from the user's input
+// colour space, else (RAW excepted: developed to linear Rec.709) the photo set's
+// (hdr/merged_colour.h). Same throws as merge_photo_view.
+ViewMerge merge_view_radiance(const PhotoView& view, const ResponseCurve& curve, const ViewMergeSettings& settings);
 
 }  // namespace rsibr

@@ -369,13 +369,16 @@ void step_hdr(Context& c) {
              Progress bar("hdr", c.o.progress);
              for (std::size_t i = 0; i < c.set.views.size(); ++i) {
                const PhotoView& v = c.set.views[i];
-               ViewMerge vm = merge_photo_view(v, curve, psr.noise, Alignment::automatic, {}, &vig);
+               ViewMergeSettings vs;
+               vs.noise = psr.noise;
+               vs.vignetting = &vig;
+               vs.input_colour_space = c.o.input_colour_space;
+               vs.camera_colour_space = c.set.camera_colour_space;
+               ViewMerge vm = merge_view_radiance(v, curve, vs);
                const BracketSet& b = vm.brackets;
                const NoiseModel& noise = vm.noise;
                MergedImage& m = vm.image;
-               const std::string from =
-                   merged_colour_space(b.raw && c.o.input_colour_space.empty() ? "" : input_space, b.raw);
-               merged_to_working_space(m, from);
+               const std::string& from = vm.input_colour_space;
                const fs::path exr = merged_path(c, v.name);
                write_merged_exr(exr.string(), m,
                                 {{"version", RSIBR_VERSION},

@@ -517,6 +517,28 @@ check "process prints the report's path" bash -c "[ \"\$(cat '$work/p1.out')\" =
 check "process: every step ran, captured grey within 10% of computed" python3 -c "
 import json; j = json.load(open('$work/p1.json')); assert all(s['ran'] for s in j['steps']), j['steps']
 b = j['results']['compare']['balls'][0]; assert b['ball'] == 'grey' and b['overall']['after']['relative_rms'] < 0.1, b['overall']"
+# rsibr hdr and process's hdr step are one merge (hdr/photo_set_merge.h): about the same lens, the
+# same radiance to the bit, vignetting (estimated from minimal-grey's chessboards) divided out by both.
+"$rsibr" hdr "$work/psyn/photos" --out "$work/phdr" --lens "$work/pout/camera.cameramodel" --json "$work/phdr.json" -q
+"$rsibr" hdr "$work/psyn/photos" --out "$work/phdrnv" --vignetting none -q
+for v in view00 view01 view02; do
+  "$rsibr" compare "$work/phdr/$v.exr" "$work/pout/hdr/$v.exr" --layout latlong --no-fit --json "$work/phdr-$v.json" -q
+  "$rsibr" compare "$work/phdrnv/$v.exr" "$work/pout/hdr/$v.exr" --layout latlong --no-fit --json "$work/phdrnv-$v.json" -q
+done
+check "hdr and process's hdr step write the same radiance, vignetting divided out by both" python3 -c "
+import json
+for v in ['view00', 'view01', 'view02']:
+    same = json.load(open('$work/phdr-' + v + '.json'))['overall']['before']['relative_rms']
+    none = json.load(open('$work/phdrnv-' + v + '.json'))['overall']['before']['relative_rms']
+    assert same == 0 and none > 1e-4, (v, same, none)
+h = json.load(open('$work/phdr.json'))['vignetting']
+assert h['model']['source'] == 'chessboards' and h['model'] == json.load(open('$work/pout/hdr/vignetting.json')), h"
+check "hdr writes the vignetting it divided out" test -s "$work/phdr/vignetting.json"
+echo '{"k": [0, 0, 0]}' >"$work/badvig.json"
+expect_error "hdr: a vignetting file that holds no model, named, before any work" "badvig.json: not a vignetting model" \
+  hdr "$work/psyn/photos" --out "$work/phdr-e1" --vignetting "$work/badvig.json"
+expect_error "hdr: a missing vignetting file" "novig2.json" hdr "$work/psyn/photos" --out "$work/phdr-e2" --vignetting "$work/novig2.json"
+check "hdr: nothing written after the vignetting errors" bash -c "test ! -e '$work/phdr-e1' && test ! -e '$work/phdr-e2'"
 # The camera's colour space: process takes the merged radiance into the working space as hdr does
 # (a wide-gamut camera space mixes the channels); a display space is refused before any work.
 "$rsibr" process "$work/psyn/photos" --out "$work/pcs" --poses "$work/psyn/truth/truth.yaml" --chrome-fresnel "$fres" \
