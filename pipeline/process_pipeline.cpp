@@ -706,7 +706,7 @@ void step_extract(Context& c) {
   for (const BallSpec& b : c.set.balls) balls.push_back({b.name, to_string(b.kind), b.diameter_m.value_or(0.0)});
   for (const BallOverride& o : overrides)
     given.push_back({o.view, o.ball, o.guess.centre_px.x(), o.guess.centre_px.y(), o.guess.radius_px});
-  nlohmann::json settings = {{"map_size", c.o.map_size}, {"balls", balls}, {"given", given}, {"identification", 4}};
+  nlohmann::json settings = {{"map_size", c.o.map_size}, {"balls", balls}, {"given", given}};
   if (c.o.occluder_light)
     settings["occluder_light"] = {{"fresnel", c.o.chrome_fresnel},
                                   {"probe_width", c.o.probe_width},

@@ -1,5 +1,7 @@
 #include "pipeline/step_record.h"
 
+#include "pipeline/code_version.h"
+
 #include "core/atomic_file.h"
 
 #include <openssl/evp.h>
@@ -144,6 +146,13 @@ std::string step_stale_reason(const fs::path& dir, const std::string& step, cons
   } catch (const std::exception&) {
     return "unreadable record";
   }
+  // Outputs made by other code (another rsibr, or this one's sources changed since) are redone,
+  // never reused: the code's fix or change is what the user runs a newer build for.
+  if (!j.contains("code") || !j["code"].is_string() || j["code"].get<std::string>() != rsibr_code_version())
+    return "made by other code (rsibr " +
+           (j.contains("rsibr_version") && j["rsibr_version"].is_string() ? j["rsibr_version"].get<std::string>()
+                                                                          : std::string("unknown")) +
+           ")";
   if (!j.contains("settings") || j["settings"] != settings) return "settings changed";
   if (!j.contains("inputs") || !j.contains("outputs") || !j["inputs"].is_array() || !j["outputs"].is_array())
     return "incomplete record";
@@ -172,7 +181,9 @@ std::string step_stale_reason(const fs::path& dir, const std::string& step, cons
 void write_step_record(const fs::path& dir, const StepRecord& r, const RecordRoots& given) {
   const RecordRoots roots = with_run(dir, given);
   nlohmann::json j;
-  j["rsibr_step"] = 2;
+  j["rsibr_step"] = 3;
+  j["rsibr_version"] = RSIBR_VERSION;
+  j["code"] = rsibr_code_version();
   j["step"] = r.step;
   j["settings"] = r.settings;
   j["inputs"] = nlohmann::json::array();
@@ -194,6 +205,8 @@ fs::path failed_step_record_path(const fs::path& dir, const std::string& step) {
 void write_failed_step_record(const fs::path& dir, const StepRecord& r, const std::string& error) {
   nlohmann::json j;
   j["step"] = r.step;
+  j["rsibr_version"] = RSIBR_VERSION;
+  j["code"] = rsibr_code_version();
   j["status"] = "failed";
   j["error"] = error;
   j["settings"] = r.settings;

@@ -4,7 +4,8 @@
 // folder DIR ("root": "run") or the photo folder ("root": "photos"), else absolute; so a run
 // folder copied or moved elsewhere (and a photo folder moved) still resolves its records.
 //
-// A step is up to date, and skipped, when its record exists, its settings are equal, its inputs
+// Each record holds rsibr's version and the code's (pipeline/code_version.h). A step is up to date,
+// and skipped, when its record exists and was made by this code, its settings are equal, its inputs
 // are the same files (the same names under the same roots) and every input and output still has
 // the recorded contents: the same size and either the same mtime or, when the mtime differs (a
 // copy that did not keep times), the same SHA-256. Anything else (a missing record, changed
@@ -45,7 +46,8 @@ std::filesystem::path stamp_path(const nlohmann::json& stamp, const RecordRoots&
 
 std::filesystem::path step_record_path(const std::filesystem::path& dir, const std::string& step);
 
-// Why the step must run ("" when it is up to date): "no record", "settings changed", "inputs
+// Why the step must run ("" when it is up to date): "no record", "made by other code (rsibr V)",
+// "settings changed", "inputs
 // changed", "<input> changed", "<input> missing", "<output> missing", "<output> changed".
 // roots.run is the run folder DIR (empty: `dir`).
 std::string step_stale_reason(const std::filesystem::path& dir, const std::string& step, const nlohmann::json& settings,

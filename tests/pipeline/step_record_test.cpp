@@ -2,11 +2,15 @@
 // or outputs say so.
 #include "pipeline/step_record.h"
 
+#include "pipeline/code_version.h"
+
 #include <gtest/gtest.h>
 
 #include <unistd.h>
 
+#include <cstdlib>
 #include <fstream>
+#include <sstream>
 #include <thread>
 
 namespace rsibr {
@@ -76,6 +80,46 @@ TEST_F(StepRecordTest, MissingRecordChangedSettingsTouchedInputOrDeletedOutputAr
   EXPECT_EQ(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}), "");
   fs::remove(dir / "out.txt");
   EXPECT_NE(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}).find("missing"), std::string::npos);
+}
+
+TEST_F(StepRecordTest, ARecordMadeByOtherCodeIsRedone) {
+  write(dir / "in.txt", "a");
+  write(dir / "out.txt", "b");
+  touch_later(dir / "out.txt", dir / "in.txt");
+  write_step_record(dir, record({{"samples", 64}}));
+  ASSERT_EQ(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}), "");
+  const fs::path file = step_record_path(dir, "bake");
+  nlohmann::json j;
+  std::ifstream(file) >> j;
+  EXPECT_EQ(j["code"], rsibr_code_version());
+  EXPECT_EQ(j["rsibr_version"], RSIBR_VERSION);
+  // Another build of the same version (its sources differ): redone.
+  j["code"] = std::string(64, '0');
+  std::ofstream(file) << j.dump();
+  EXPECT_EQ(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}),
+            std::string("made by other code (rsibr ") + RSIBR_VERSION + ")");
+  // A record of an rsibr that kept no code version: redone too.
+  j.erase("code");
+  j.erase("rsibr_version");
+  std::ofstream(file) << j.dump();
+  EXPECT_EQ(step_stale_reason(dir, "bake", {{"samples", 64}}, {dir / "in.txt"}), "made by other code (rsibr unknown)");
+}
+
+TEST(CodeVersion, IsTheHashOfTheSourcesThisBuildWasMadeFrom) {
+  // Recomputed from the source tree now by the build's own script: a source that changed without
+  // the version changing (a stale or hand-written version) fails here.
+  const fs::path out = fs::temp_directory_path() / ("rsibr-code-version-" + std::to_string(::getpid()) + ".cpp");
+  const std::string command = std::string("'") + RSIBR_CMAKE_COMMAND + "' -DROOT='" + RSIBR_SOURCE_DIR + "' -DOUT='" +
+                              out.string() + "' -DFOLDERS=" + RSIBR_CODE_FOLDERS + " -P '" + RSIBR_SOURCE_DIR +
+                              "/pipeline/code_version.cmake'";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  std::stringstream text;
+  text << std::ifstream(out).rdbuf();
+  fs::remove(out);
+  const std::string version = rsibr_code_version();
+  ASSERT_EQ(version.size(), 64u);
+  EXPECT_EQ(version.find_first_not_of("0123456789abcdef"), std::string::npos) << version;
+  EXPECT_NE(text.str().find('"' + version + '"'), std::string::npos) << text.str();
 }
 
 TEST_F(StepRecordTest, AMalformedRecordIsStaleAndReadingItNamesTheFile) {
