@@ -7,6 +7,7 @@
 #include "core/atomic_file.h"
 #include "core/atomic_folder.h"
 #include "compare/compare_pictures.h"
+#include "compare/comparison_report.h"
 #include "core/exr_io.h"
 #include "compare/map_compare.h"
 #include "core/input_file.h"
@@ -33,16 +34,6 @@ struct CompareArgs {
   float exposure = NAN;
   long fit_texels = 1 << 17;
 };
-
-nlohmann::json metrics_json(const ErrorMetrics& m) {
-  return {{"relative_rms", m.relative_rms},
-          {"log_rms_stops", m.log_rms_stops},
-          {"psnr_db", m.psnr_db},
-          {"psnr_capped", m.psnr_capped},
-          {"mse", m.mse},
-          {"mean_a", m.mean_a},
-          {"mean_b", m.mean_b}};
-}
 
 std::string direction_text(const Vec3& v) {
   std::ostringstream s;
@@ -115,101 +106,38 @@ int run_compare(const CompareArgs& a) {
   }
 
   // Heat maps of the error after the fit (the errors of shape), one scale for every view.
-  std::vector<cv::Mat> calibrated, errors, weights;
-  for (const PairComparison& p : c.pairs) {
-    calibrated.push_back(c.fit ? apply_gains(p.images.a, c.fit->gains) : p.images.a);
-    errors.push_back(log_error_image(p.images.a, p.images.b, p.images.weight, c.settings.log_epsilon,
-                                     c.fit ? c.fit->gains : std::array<double, 3>{1, 1, 1}));
-    weights.push_back(p.images.weight);
-  }
-  const double heat_max = a.heat_max > 0 ? a.heat_max : heat_scale_max(errors, weights);
-  std::vector<cv::Mat> shown, weighted;
-  for (const auto& p : c.pairs) shown.push_back(p.images.b), weighted.push_back(p.images.weight > 0);
-  const float exposure = std::isfinite(a.exposure) ? a.exposure : preview_exposure(shown, weighted);
+  const ComparisonImages images = comparison_images(c, a.heat_max, a.exposure);
+  const double heat_max = images.heat_max;
 
-  nlohmann::json j;
+  nlohmann::json j = comparison_json(c, images, kind == "map set");
   j["a"] = a.a;
   j["values_sanitized"] = sanitized;
   j["b"] = a.b;
   j["kind"] = kind;
-  j["settings"] = {{"log_epsilon", c.settings.log_epsilon},
-                   {"log_epsilon_fraction_of_median_b", a.log_eps},
-                   {"psnr_peak", c.settings.psnr_peak},
-                   {"psnr_peak_source", a.psnr_peak > 0 ? "--psnr-peak" : "largest weighted value of B"},
-                   {"psnr_cap_db", kPsnrCapDb},
-                   {"view_tolerance_deg", a.view_tolerance},
-                   {"weights", kind == "map set" ? "texel centre inside the disc x confidence of A and B"
-                                                 : "sphere layout: disc; other layouts: texel solid angle"}};
-  j["overall"] = {{"before", metrics_json(c.before)},
-                  {"after", metrics_json(c.after)},
-                  {"texels", c.before.texels},
-                  {"weight", c.before.weight}};
-  if (c.fit) {
-    j["fit"] = {{"gains", c.fit->gains},
-                {"exposure_stops", c.fit->exposure_stops},
-                {"chroma", c.fit->chroma},
-                {"model", "g_c a_c ~ b_c; residual ln(g a' + eps) - ln(b' + eps); Cauchy loss"},
-                {"loss_scale", a.loss_scale},
-                {"texels_used", c.fit->texels_used},
-                {"iterations", c.fit->iterations},
-                {"converged", c.fit->converged},
-                {"initial_cost", c.fit->initial_cost},
-                {"final_cost", c.fit->final_cost}};
-  } else {
-    j["fit"] = nullptr;
-  }
-  j["heat_map"] = {{"quantity", std::string("sqrt(mean over R,G,B of log2((a' + eps)/(b' + eps))^2), A ") +
-                                    (c.fit ? "after the fit" : "as read")},
-                   {"unit", "stops"},
-                   {"colormap", "viridis"},
-                   {"min", 0.0},
-                   {"max", heat_max},
-                   {"ticks", {0.0, 0.5 * heat_max, heat_max}},
-                   {"no_weight_colour_rgb", {kNoWeightColour[2], kNoWeightColour[1], kNoWeightColour[0]}},
-                   {"display_exposure_stops", exposure}};
+  j["settings"]["log_epsilon_fraction_of_median_b"] = a.log_eps;
+  j["settings"]["psnr_peak_source"] = a.psnr_peak > 0 ? "--psnr-peak" : "largest weighted value of B";
+  j["settings"]["view_tolerance_deg"] = a.view_tolerance;
+  j["settings"]["weights"] = kind == "map set" ? "texel centre inside the disc x confidence of A and B"
+                                               : "sphere layout: disc; other layouts: texel solid angle";
+  if (c.fit) j["fit"]["loss_scale"] = a.loss_scale;
 
   FolderContents files;
   std::vector<cv::Mat> panels;
-  nlohmann::json views = nlohmann::json::array();
   auto bar = std::make_shared<Progress>("compare", !a.quiet && Progress::stderr_is_terminal());
   for (std::size_t i = 0; i < c.pairs.size(); ++i) {
     const PairComparison& p = c.pairs[i];
-    nlohmann::json jv = {{"name", p.name},
-                         {"texels", p.before.texels},
-                         {"weight", p.before.weight},
-                         {"before", metrics_json(p.before)},
-                         {"after", metrics_json(p.after)}};
-    if (kind == "map set") {
-      jv["a_part"] = p.index_a;
-      jv["b_part"] = p.index_b;
-      jv["view"] = {p.view.x(), p.view.y(), p.view.z()};
-      jv["angle_deg"] = p.angle_deg;
-      jv["frame_angle_deg"] = p.frame_angle_deg;
-      jv["b_resampled_to_a_frame"] = p.b_resampled;
-    }
     if (!a.out.empty()) {
-      SideBySideInput in;
-      in.a_rgb = calibrated[i];
-      in.b_rgb = p.images.b;
-      in.error = errors[i];
-      in.weight = p.images.weight;
-      in.exposure_stops = exposure;
-      in.heat_max = heat_max;
-      in.title = p.name + (kind == "map set" ? "  view " + direction_text(p.view) : "") + "   log RMS " +
-                 std::to_string(p.after.log_rms_stops).substr(0, 6) + " stops";
-      in.a_label = c.fit ? "A x fitted gains" : "A";
-      in.heat_label = "log2 error";
-      const cv::Mat panel = side_by_side(in);
+      const std::string title = p.name + (kind == "map set" ? "  view " + direction_text(p.view) : "") + "   log RMS " +
+                                std::to_string(p.after.log_rms_stops).substr(0, 6) + " stops";
+      const cv::Mat panel = comparison_panel(c, images, i, title, c.fit ? "A x fitted gains" : "A", "B");
       const std::string name = p.name + ".png";
       files[name] = encode_png(panel, (fs::path(a.out) / name).string());
-      jv["picture"] = (fs::path(a.out) / name).string();
+      j["views"][i]["picture"] = (fs::path(a.out) / name).string();
       panels.push_back(panel);
     }
-    views.push_back(jv);
     bar->update(double(i + 1) / double(c.pairs.size()));
   }
   bar->done();
-  j["views"] = views;
   if (!a.out.empty()) {
     files["contact.png"] = encode_png(contact_sheet(panels), (fs::path(a.out) / "contact.png").string());
     j["contact_sheet"] = (fs::path(a.out) / "contact.png").string();

@@ -26,6 +26,7 @@
 #include "compare/compare_pictures.h"
 #include "core/exr_io.h"
 #include "core/lens_model.h"
+#include "compare/comparison_report.h"
 #include "compare/map_compare.h"
 #include "core/map_set.h"
 #include "core/mesh.h"
@@ -88,14 +89,6 @@ std::vector<unsigned char> png_bytes(const cv::Mat& bgr, const std::string& name
   std::vector<unsigned char> bytes;
   if (!encode_image(".png", bgr, bytes)) throw std::runtime_error(name + ": cannot encode the PNG");
   return bytes;
-}
-
-nlohmann::json metrics_json(const ErrorMetrics& m) {
-  return {{"relative_rms", m.relative_rms},
-          {"log_rms_stops", m.log_rms_stops},
-          {"psnr_db", m.psnr_db},
-          {"mean_a", m.mean_a},
-          {"mean_b", m.mean_b}};
 }
 
 // Runs `body` unless the step is up to date; body fills outputs and summary.
@@ -1278,57 +1271,31 @@ void step_compare(Context& c) {
       co.name_a = captured_path(c, *b).string();
       co.name_b = computed_path(c, *b).string();
       const Comparison cmp = compare_map_sets(captured, computed, co);
-      std::vector<cv::Mat> errors, weights;
-      for (const PairComparison& p : cmp.pairs) {
-        errors.push_back(log_error_image(p.images.a, p.images.b, p.images.weight, cmp.settings.log_epsilon,
-                                         cmp.fit ? cmp.fit->gains : std::array<double, 3>{1, 1, 1}));
-        weights.push_back(p.images.weight);
-      }
-      const double heat_max = heat_scale_max(errors, weights);
-      std::vector<cv::Mat> shown, weighted;
-      for (const auto& p : cmp.pairs) shown.push_back(p.images.b), weighted.push_back(p.images.weight > 0);
-      const float exposure = preview_exposure(shown, weighted);
+      // The same JSON and pictures as rsibr compare (compare/comparison_report.h), plus the ball,
+      // each view's image and the views left out.
+      const ComparisonImages images = comparison_images(cmp);
+      nlohmann::json bj = comparison_json(cmp, images, true);
       FolderContents files;
-      nlohmann::json views = nlohmann::json::array();
       for (std::size_t i = 0; i < cmp.pairs.size(); ++i) {
         const PairComparison& p = cmp.pairs[i];
-        SideBySideInput in;
-        in.a_rgb = cmp.fit ? apply_gains(p.images.a, cmp.fit->gains) : p.images.a;
-        in.b_rgb = p.images.b;
-        in.error = errors[i];
-        in.weight = p.images.weight;
-        in.exposure_stops = exposure;
-        in.heat_max = heat_max;
         const std::string image = captured.views[p.index_a].attributes.count("image")
                                       ? captured.views[p.index_a].attributes.at("image")
                                       : p.name;
-        in.title = b->name + " " + image;
-        in.a_label = "captured x gains";
-        in.b_label = "computed";
-        in.heat_label = "log2 error";
         const std::string name = p.name + ".png";
-        files[name] = png_bytes(side_by_side(in), name);
-        views.push_back({{"name", p.name},
-                         {"image", image},
-                         {"picture", name},
-                         {"view", {p.view.x(), p.view.y(), p.view.z()}},
-                         {"before", metrics_json(p.before)},
-                         {"after", metrics_json(p.after)}});
+        files[name] =
+            png_bytes(comparison_panel(cmp, images, i, b->name + " " + image, "captured x gains", "computed"), name);
+        bj["views"][i]["image"] = image;
+        bj["views"][i]["picture"] = name;
       }
       const fs::path folder = c.dir / "compare" / b->name;
       fs::create_directories(folder.parent_path());
       write_folder_atomically(folder, files);
       for (const auto& [name, bytes] : files) r.outputs.push_back(folder / name);
-      nlohmann::json bj = {{"ball", b->name},
-                           {"folder", "compare/" + b->name},
-                           {"views", views},
-                           {"untrusted_views", untrusted},
-                           {"overall", {{"before", metrics_json(cmp.before)}, {"after", metrics_json(cmp.after)}}},
-                           {"heat_max_stops", heat_max},
-                           {"log_epsilon", cmp.settings.log_epsilon}};
-      if (cmp.fit)
-        bj["fit"] = {
-            {"gains", cmp.fit->gains}, {"exposure_stops", cmp.fit->exposure_stops}, {"chroma", cmp.fit->chroma}};
+      bj["ball"] = b->name;
+      bj["folder"] = "compare/" + b->name;
+      bj["untrusted_views"] = untrusted;
+      bj["heat_max_stops"] = images.heat_max;
+      bj["log_epsilon"] = cmp.settings.log_epsilon;
       balls.push_back(bj);
     }
     r.summary = {{"balls", balls}};

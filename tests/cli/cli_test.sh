@@ -534,6 +534,18 @@ for v in ['view00', 'view01', 'view02']:
 h = json.load(open('$work/phdr.json'))['vignetting']
 assert h['model']['source'] == 'chessboards' and h['model'] == json.load(open('$work/pout/hdr/vignetting.json')), h"
 check "hdr writes the vignetting it divided out" test -s "$work/phdr/vignetting.json"
+# rsibr compare and process's compare step write one JSON (compare/comparison_report.h).
+"$rsibr" compare "$work/pout/maps/captured-grey.exr" "$work/pout/maps/computed-grey.exr" --json "$work/pcmp.json" -q
+check "compare and process's compare step report the same numbers under the same keys" python3 -c "
+import json
+step = json.load(open('$work/p1.json'))['results']['compare']['balls'][0]; verb = json.load(open('$work/pcmp.json'))
+for k in ['overall', 'fit', 'heat_map']:
+    assert set(verb[k]) - {'loss_scale'} <= set(step[k]), (k, set(verb[k]) - set(step[k]))
+assert step['overall'] == verb['overall'], (step['overall'], verb['overall'])
+assert step['fit']['gains'] == verb['fit']['gains']
+assert len(step['views']) == len(verb['views']) == 3
+for s, v in zip(step['views'], verb['views']):
+    assert set(v) - {'picture'} <= set(s) and s['after'] == v['after'], (s, v)"
 echo '{"k": [0, 0, 0]}' >"$work/badvig.json"
 expect_error "hdr: a vignetting file that holds no model, named, before any work" "badvig.json: not a vignetting model" \
   hdr "$work/psyn/photos" --out "$work/phdr-e1" --vignetting "$work/badvig.json"

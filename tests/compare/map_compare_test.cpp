@@ -1,5 +1,7 @@
 #include "compare/map_compare.h"
 
+#include "compare/comparison_report.h"
+
 #include "core/sphere_map.h"
 
 #include <gtest/gtest.h>
@@ -217,6 +219,40 @@ TEST(MapCompare, EnvironmentsAreWeightedBySolidAngle) {
   EXPECT_NEAR(c.before.relative_rms, std::sqrt(row / (4 * row + total - row)), 1e-6);
   EnvMap cube = EnvMap::zeros(Layout::with_size(LayoutKind::Cube, 8));
   EXPECT_THROW(compare_environments(a, cube, CompareOptions{}), std::invalid_argument);
+}
+
+TEST(ComparisonReport, TheJsonHoldsEachPairsMetricsAndThePicturesShareOneScale) {
+  MapSet a = normal_set(16);
+  const MapSet b = normal_set(16);
+  for (MapView& v : a.views) v.rgb *= 2.0;  // one exposure off: the fit takes it out
+  const Comparison c = compare_map_sets(a, b, CompareOptions{});
+  const ComparisonImages auto_images = comparison_images(c);
+  EXPECT_GT(auto_images.heat_max, 0);
+  EXPECT_TRUE(std::isfinite(auto_images.exposure_stops));
+  const ComparisonImages images = comparison_images(c, 0.5, 1.25f);
+  EXPECT_EQ(images.heat_max, 0.5);
+  EXPECT_EQ(images.exposure_stops, 1.25f);
+  ASSERT_EQ(images.errors.size(), c.pairs.size());
+  // A after the fit is B here, so every error is ~0 where there is weight.
+  for (std::size_t i = 0; i < c.pairs.size(); ++i) {
+    double worst = 0;
+    cv::minMaxLoc(images.errors[i], nullptr, &worst, nullptr, nullptr, c.pairs[i].images.weight > 0);
+    EXPECT_LT(worst, 1e-3) << i;
+  }
+  const nlohmann::json j = comparison_json(c, images, true);
+  EXPECT_EQ(j["overall"]["before"]["relative_rms"].get<double>(), c.before.relative_rms);
+  EXPECT_NEAR(j["fit"]["exposure_stops"].get<double>(), -1.0, 1e-6);
+  EXPECT_EQ(j["heat_map"]["max"].get<double>(), 0.5);
+  ASSERT_EQ(j["views"].size(), c.pairs.size());
+  for (std::size_t i = 0; i < c.pairs.size(); ++i) {
+    EXPECT_EQ(j["views"][i]["name"], c.pairs[i].name);
+    EXPECT_EQ(j["views"][i]["after"]["log_rms_stops"].get<double>(), c.pairs[i].after.log_rms_stops);
+    EXPECT_TRUE(j["views"][i].contains("view"));
+  }
+  EXPECT_FALSE(comparison_json(c, images, false)["views"][0].contains("view"));
+  const cv::Mat panel = comparison_panel(c, images, 0, "title", "A x gains", "B");
+  EXPECT_EQ(panel.type(), CV_8UC3);
+  EXPECT_GT(panel.cols, 3 * 192);
 }
 
 }  // namespace
