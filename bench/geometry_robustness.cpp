@@ -149,7 +149,7 @@ int main(int argc, char** argv) {
       if (!is_grey) continue;
       MapSet m = read_map_set((run / "maps" / ("captured-" + name + ".exr")).string());
       for (MapView& v : m.views) {
-        const std::string img = v.attributes.at("image");
+        const std::string img = v.image;
         v.world_from_view =
             tru.find(img)->world_from_cam * est.find(img)->world_from_cam.transpose() * v.world_from_view;
         v.view = v.world_from_view.col(2);
@@ -158,8 +158,7 @@ int main(int argc, char** argv) {
       co.view_tolerance_deg = 2;
       const Comparison c = compare_map_sets(m, read_map_set((syn / "truth" / "maps" / (name + ".exr")).string()), co);
       for (const PairComparison& p : c.pairs) {
-        grey.push_back(
-            {{"ball", name}, {"view", m.views[p.index_a].attributes.at("image")}, {"stops", p.after.log_rms_stops}});
+        grey.push_back({{"ball", name}, {"view", m.views[p.index_a].image}, {"stops", p.after.log_rms_stops}});
         worst = std::max(worst, p.after.log_rms_stops);
       }
       out["grey_overall_stops"] = c.after.log_rms_stops;
@@ -167,18 +166,17 @@ int main(int argc, char** argv) {
         // The views both runs kept (each may leave out different ones).
         MapSet ref = read_map_set((fs::path(argv[3]) / "maps" / ("captured-" + name + ".exr")).string());
         auto has = [](const MapSet& s, const std::string& img) {
-          return std::any_of(s.views.begin(), s.views.end(),
-                             [&](const MapView& v) { return v.attributes.at("image") == img; });
+          return std::any_of(s.views.begin(), s.views.end(), [&](const MapView& v) { return v.image == img; });
         };
         MapSet both;
         for (const MapView& v : m.views)
-          if (has(ref, v.attributes.at("image"))) both.views.push_back(v);
-        std::erase_if(ref.views, [&](const MapView& v) { return !has(both, v.attributes.at("image")); });
+          if (has(ref, v.image)) both.views.push_back(v);
+        std::erase_if(ref.views, [&](const MapView& v) { return !has(both, v.image); });
         const Comparison r = compare_map_sets(both, ref, co);
         nlohmann::json per = nlohmann::json::array();
         double rw = 0;
         for (const PairComparison& p : r.pairs) {
-          per.push_back({{"view", both.views[p.index_a].attributes.at("image")}, {"stops", p.after.log_rms_stops}});
+          per.push_back({{"view", both.views[p.index_a].image}, {"stops", p.after.log_rms_stops}});
           rw = std::max(rw, p.after.log_rms_stops);
         }
         out["reference"] = {

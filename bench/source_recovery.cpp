@@ -167,7 +167,7 @@ int main(int argc, char** argv) {
       }
       for (MapSet* set : {&c, &cap})
         for (MapView& mv : set->views) {
-          const std::string image = mv.attributes.count("image") ? mv.attributes.at("image") : "";
+          const std::string image = mv.image;
           const Vec3 u = unit.count(image) && unit[image].count(ball)
                              ? unit[image][ball]
                              : Vec3(Vec3::Constant(gain).cwiseProduct(response_scale));

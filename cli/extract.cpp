@@ -124,7 +124,7 @@ int run_extract(const ExtractArgs& a) {
   std::ostringstream centre;
   centre.precision(10);
   centre << loc.centre_px.x() << " " << loc.centre_px.y();
-  mv.attributes["image"] = std::filesystem::path(a.image).filename().string();
+  mv.image = std::filesystem::path(a.image).filename().string();
   mv.attributes["lens"] = std::filesystem::path(a.lens).filename().string();
   mv.attributes["ballCentrePx"] = centre.str();
   mv.attributes["ballHalfAngleRad"] = std::to_string(loc.fit.cone.half_angle);

@@ -164,6 +164,7 @@ int info_map_set(const InfoArgs& a) {
     jv["warp"] = to_string(v.warp);
     jv["source"] = to_string(v.source);
     jv["material"] = v.material;
+    if (!v.image.empty()) jv["image"] = v.image;
     jv["confidence"] = !v.confidence.empty();
     jv["albedo_normalised"] = !v.albedo.empty();
     if (!v.albedo.empty()) jv["albedo_table"] = v.albedo;

@@ -79,7 +79,7 @@ int run_probe(const ProbeArgs& a) {
     const auto frame = all.views[v].attributes.find("frame");
     if (frame != all.views[v].attributes.end() && frame->second.rfind("camera", 0) == 0)
       throw std::invalid_argument(
-          (all.views[v].attributes.count("image") ? all.views[v].attributes.at("image") : "view " + std::to_string(v)) +
+          (!all.views[v].image.empty() ? all.views[v].image : "view " + std::to_string(v)) +
           ": extracted in its camera's frame (no pose); blending views needs their world orientations");
   }
   std::vector<MapSet> ball_sets;

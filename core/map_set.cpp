@@ -36,7 +36,7 @@ std::string part_name(std::size_t i) {
   return buf;
 }
 
-const std::vector<std::string> kReserved = {"view", "worldFromView", "warp", "source", "material", "albedo"};
+const std::vector<std::string> kReserved = {"view", "worldFromView", "warp", "source", "material", "albedo", "image"};
 
 }  // namespace
 
@@ -102,6 +102,7 @@ void write_map_set(const std::string& path, const MapSet& set) {
                        {"rsibr.source", std::string(to_string(v.source))},
                        {"rsibr.material", v.material}};
     if (!v.albedo.empty()) part.attributes.emplace_back("rsibr.albedo", v.albedo);
+    if (!v.image.empty()) part.attributes.emplace_back("rsibr.image", v.image);
     for (const auto& [key, value] : v.attributes) part.attributes.emplace_back("rsibr." + key, value);
     parts.push_back(std::move(part));
   }
@@ -154,6 +155,7 @@ MapSet read_map_set(const std::string& path, BadTexels bad, long* zeroed) {
     }
     if (const auto m = h.get<std::string>("rsibr.material")) v.material = *m;
     if (const auto a = h.get<std::vector<float>>("rsibr.albedo")) v.albedo = *a;
+    if (const auto m = h.get<std::string>("rsibr.image")) v.image = *m;
     for (const auto& [key, value] : h.strings_with_prefix("rsibr.")) {
       bool reserved = false;
       for (const std::string& r : kReserved) reserved = reserved || key == r;

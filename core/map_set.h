@@ -38,6 +38,9 @@ struct MapView {
   CentralDirection warp = CentralDirection::Mirror;  // which central direction the runtime warps
   MapSource source = MapSource::Computed;
   std::string material;
+  // The photo view a captured map was extracted from (its name in the photo set; stored as
+  // rsibr.image), which matches a map to its view across balls and steps; "" when none.
+  std::string image;
   // Empty, or the albedo table of albedo-normalised maps (core/albedo_normalisation.h): rgb then holds
   // L / A(n.v) and the runtime (runtime/blend_engine.h) multiplies A back at the destination.
   std::vector<float> albedo;

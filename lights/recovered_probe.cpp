@@ -51,12 +51,11 @@ RecoveredProbe recover_probe_sources(const MapSet& chrome, const ProbeOptions& p
     std::map<std::string, EnvMap> without;
     if (options.jackknife && chrome.views.size() >= 3)
       for (std::size_t v = 0; v < chrome.views.size(); ++v) {
-        const auto it = chrome.views[v].attributes.find("image");
-        if (it == chrome.views[v].attributes.end()) continue;
+        if (chrome.views[v].image.empty()) continue;
         MapSet rest;
         for (std::size_t u = 0; u < chrome.views.size(); ++u)
           if (u != v) rest.views.push_back(chrome.views[u]);
-        without[it->second] = assemble_probe(rest, probe).env;
+        without[chrome.views[v].image] = assemble_probe(rest, probe).env;
       }
     out.recovery = recover_sources(measured.env, out.regions, grey, glossy, options, without);
   }

@@ -370,8 +370,7 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
   std::vector<std::string> view_names;
   std::vector<std::string> ball_names, ball_kinds;
   auto image_of = [](const MapView& mv, std::size_t v) {
-    const auto it = mv.attributes.find("image");
-    return it != mv.attributes.end() ? it->second : "view." + std::to_string(v);
+    return !mv.image.empty() ? mv.image : "view." + std::to_string(v);
   };
   const KnownIrradiance irradiance(known, options.known_width);
   std::unique_ptr<Integrator> fis;

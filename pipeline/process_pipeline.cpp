@@ -876,7 +876,7 @@ void step_extract(Context& c) {
         MapView mv = extract_sphere_map(img.radiance, img.flags, lens, cone, world_from_cam, eo,
                                         c.o.occluder_light && int(b) == chrome_index ? &hidden : nullptr);
         if (c.o.occluder_light && int(b) == chrome_index) chrome_hidden[v.name] = hidden;
-        mv.attributes["image"] = v.name;
+        mv.image = v.name;
         mv.attributes["ball"] = ball.name;
         mv.attributes["ballKind"] = to_string(ball.kind);
         mv.attributes["frame"] = "world (poses.yaml)";
@@ -909,8 +909,7 @@ void step_extract(Context& c) {
       std::vector<MapView> kept;
       for (MapView& mv : sets[std::size_t(chrome_index)].views) {
         const std::size_t k = std::size_t(
-            std::find_if(vb.begin(), vb.end(), [&](const ViewBalls& x) { return x.name == mv.attributes["image"]; }) -
-            vb.begin());
+            std::find_if(vb.begin(), vb.end(), [&](const ViewBalls& x) { return x.name == mv.image; }) - vb.begin());
         if (k < vb.size() && suspects.suspect[k]) {
           if (nlohmann::json* bj = ball_entry(vb[k].name, listed[std::size_t(chrome_index)].name)) {
             char note[200];
@@ -963,7 +962,7 @@ void step_extract(Context& c) {
       for (const GreyScene& g : grey_scenes) {
         auto of_view = [&](std::vector<MapView>& maps) -> MapView* {
           for (MapView& mv : maps)
-            if (mv.attributes["image"] == g.view) return &mv;
+            if (mv.image == g.view) return &mv;
           return nullptr;
         };
         MapView* grey = of_view(sets[g.ball].views);
@@ -992,7 +991,7 @@ void step_extract(Context& c) {
       std::vector<MapView> kept;
       for (std::size_t k = 0; k < cons.size(); ++k) {
         MapView& mv = sets[b].views[k];
-        nlohmann::json* bj = ball_entry(mv.attributes["image"], listed[b].name);
+        nlohmann::json* bj = ball_entry(mv.image, listed[b].name);
         if (bj) {
           (*bj)["consensus"] = {
               {"judged", cons[k].judged}, {"masked", cons[k].masked}, {"median_stops", cons[k].median_stops}};
@@ -1015,7 +1014,7 @@ void step_extract(Context& c) {
     // Each map's mask for the report.
     for (std::size_t b = 0; b < listed.size(); ++b)
       for (const MapView& mv : sets[b].views) {
-        const std::string image = mv.attributes.at("image");
+        const std::string image = mv.image;
         const std::string name = int(b) == chrome_index ? image + ".png" : image + "-" + listed[b].name + ".png";
         masks[name] = png_bytes(mask_picture(mv, preview_exposure(mv.rgb)), name);
         if (nlohmann::json* bj = ball_entry(image, listed[b].name)) (*bj)["mask"] = "masks/" + name;
@@ -1224,8 +1223,7 @@ void step_bake(Context& c) {
       bo.res = captured.width();
       MapSet computed = bake_map_set(*brdf, *integrator, frames, bo);
       for (std::size_t i = 0; i < computed.views.size(); ++i) {
-        const auto image = captured.views[i].attributes.find("image");
-        computed.views[i].attributes["image"] = image == captured.views[i].attributes.end() ? "" : image->second;
+        computed.views[i].image = captured.views[i].image;
       }
       const fs::path out = computed_path(c, *b);
       write_map_set(out.string(), computed);
@@ -1254,8 +1252,8 @@ void step_compare(Context& c) {
         MapSet a, bset;
         for (std::size_t i = 0; i < captured.views.size(); ++i) {
           if (cv::countNonZero(captured.views[i].confidence > 0) == 0) {
-            untrusted.push_back(captured.views[i].attributes.count("image") ? captured.views[i].attributes.at("image")
-                                                                            : "view." + std::to_string(i));
+            untrusted.push_back(!captured.views[i].image.empty() ? captured.views[i].image
+                                                                 : "view." + std::to_string(i));
             continue;
           }
           a.views.push_back(std::move(captured.views[i]));
@@ -1278,9 +1276,7 @@ void step_compare(Context& c) {
       FolderContents files;
       for (std::size_t i = 0; i < cmp.pairs.size(); ++i) {
         const PairComparison& p = cmp.pairs[i];
-        const std::string image = captured.views[p.index_a].attributes.count("image")
-                                      ? captured.views[p.index_a].attributes.at("image")
-                                      : p.name;
+        const std::string image = !captured.views[p.index_a].image.empty() ? captured.views[p.index_a].image : p.name;
         const std::string name = p.name + ".png";
         files[name] =
             png_bytes(comparison_panel(cmp, images, i, b->name + " " + image, "captured x gains", "computed"), name);

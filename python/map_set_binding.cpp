@@ -50,6 +50,8 @@ void bind_map_set(py::module_& m) {
           [](MapView& v, const std::string& name) { v.source = map_source_from_string(name); },
           "'computed' or 'captured'.")
       .def_readwrite("material", &MapView::material, "The BRDF spec as YAML text.")
+      .def_readwrite("image", &MapView::image,
+                     "The photo view a captured map was extracted from (its name in the photo set); '' when none.")
       .def_readwrite("albedo", &MapView::albedo,
                      "Empty, or the albedo table of albedo-normalised maps: N rows of (r, g, b) at cos = (k+0.5)/N, "
                      "flattened (a list copy).")

@@ -60,6 +60,7 @@ MapSet make_set(unsigned seed = 1, int size = 33) {
     for (float *p = v.rgb.ptr<float>(), *e = p + size * size * 3; p != e; ++p) *p = u(rng);
     v.rgb.at<cv::Vec3f>(0, 0) = cv::Vec3f(1e9f, 1e-30f, -0.f);
     if (v.source == MapSource::Captured) {
+      v.image = "IMG_" + std::to_string(4000 + i) + " é";
       v.confidence = cv::Mat(size, size, CV_32FC1);
       for (int r = 0; r < size; ++r)
         for (int c = 0; c < size; ++c) v.confidence.at<float>(r, c) = float((r * size + c + i) % 17) / 16.f;
@@ -107,6 +108,7 @@ TEST(MapSet, RoundTripKeepsEveryPixelAndAttribute) {
     EXPECT_EQ(a.warp, b.warp);
     EXPECT_EQ(a.source, b.source);
     EXPECT_EQ(a.material, b.material);
+    EXPECT_EQ(a.image, b.image);
     EXPECT_EQ(a.attributes, b.attributes);
   }
   // Determinism: writing what was read gives the same bytes, and so does writing the original again.
@@ -187,6 +189,7 @@ TEST(MapSet, ValidationRejectsBadSets) {
       {"view.010", "third column", [](MapView& v) { v.world_from_view.transposeInPlace(); }},
       {"view.011", "reserved", [](MapView& v) { v.attributes["view"] = "x"; }},
       {"view.000", "reserved", [](MapView& v) { v.attributes["material"] = "x"; }},
+      {"view.001", "reserved", [](MapView& v) { v.attributes["image"] = "x"; }},
       {"view.011", "31", [](MapView& v) { v.attributes[std::string(26, 'a')] = "x"; }},
   };
   for (const auto& [part, words, mutate] : cases) {

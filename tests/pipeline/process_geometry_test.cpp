@@ -202,7 +202,7 @@ void expect_grey_within_a_tenth_of_a_stop(const fs::path& run, const fs::path& t
   const PoseSet est = read_pose_file((run / "poses.yaml").string());
   MapSet grey = read_map_set((run / "maps" / "captured-grey.exr").string());
   for (MapView& v : grey.views) {
-    const std::string img = v.attributes.at("image");
+    const std::string img = v.image;
     v.world_from_view = truth.find(img)->world_from_cam * est.find(img)->world_from_cam.transpose() * v.world_from_view;
     v.view = v.world_from_view.col(2);
   }
@@ -211,8 +211,8 @@ void expect_grey_within_a_tenth_of_a_stop(const fs::path& run, const fs::path& t
   const Comparison c = compare_map_sets(grey, read_map_set((truth_maps / "grey.exr").string()), co);
   ASSERT_GE(c.pairs.size(), 7u);
   for (const PairComparison& p : c.pairs) {
-    std::printf("  %s: %.3f stops\n", grey.views[p.index_a].attributes.at("image").c_str(), p.after.log_rms_stops);
-    EXPECT_LT(p.after.log_rms_stops, 0.1) << grey.views[p.index_a].attributes.at("image");
+    std::printf("  %s: %.3f stops\n", grey.views[p.index_a].image.c_str(), p.after.log_rms_stops);
+    EXPECT_LT(p.after.log_rms_stops, 0.1) << grey.views[p.index_a].image;
   }
 }
 
@@ -235,7 +235,7 @@ TEST_F(ProcessGeometry, ByDefaultThePhotographersLightIsRestoredAndWhereThereIsN
       }
   EXPECT_GE(restored, 7);
   for (const MapView& v : read_map_set((root_ / "out" / "maps" / "captured-grey.exr").string()).views)
-    EXPECT_NE(v.attributes.count("occluderLight"), 0u) << v.attributes.at("image");
+    EXPECT_NE(v.attributes.count("occluderLight"), 0u) << v.image;
 }
 
 // --no-occluder-light: the grey maps as photographed, with no restoration recorded. The steps before
@@ -249,7 +249,7 @@ TEST_F(ProcessGeometry, WithoutRestorationTheGreyMapsAreAsPhotographed) {
   for (const auto& v : r.summary["extract"]["views"])
     for (const auto& b : v["balls"]) EXPECT_FALSE(b.contains("occluder_light")) << v["name"];
   for (const MapView& v : read_map_set((o.out / "maps" / "captured-grey.exr").string()).views)
-    EXPECT_EQ(v.attributes.count("occluderLight"), 0u) << v.attributes.at("image");
+    EXPECT_EQ(v.attributes.count("occluderLight"), 0u) << v.image;
   expect_grey_within_a_tenth_of_a_stop(o.out, root_ / "syn" / "truth" / "maps", *truth_);
 }
 
