@@ -91,6 +91,15 @@ std::vector<unsigned char> png_bytes(const cv::Mat& bgr, const std::string& name
   return bytes;
 }
 
+// A fact an earlier step recorded in its summary (DIR/steps/STEP.json) that a later step needs:
+// its absence is an error naming the step, never a default.
+const nlohmann::json& recorded(const Context& c, const std::string& step, const std::string& key) {
+  const nlohmann::json& all = c.result.summary;
+  if (!all.contains(step) || !all.at(step).is_object() || !all.at(step).contains(key))
+    throw std::runtime_error(step + ": its record has no '" + key + "' (rerun with --force " + step + ")");
+  return all.at(step).at(key);
+}
+
 // Runs `body` unless the step is up to date; body fills outputs and summary.
 void run_step(Context& c, const std::string& step, const nlohmann::json& settings, const std::vector<fs::path>& inputs,
               const std::function<void(StepRecord&)>& body) {
@@ -449,12 +458,13 @@ std::string suspect_bracket(const PhotoView& v, const nlohmann::json& hdr) {
 void step_lens(Context& c) {
   std::vector<fs::path> inputs = hdr_files(c);
   inputs.push_back(c.dir / "camera.cameramodel");
-  const nlohmann::json& cal = c.result.summary["calibrate"];
   LensStep s;
   s.calibrated = c.dir / "camera.cameramodel";
-  s.source = cal.value("source", "");
-  s.prior_sigma_relative = cal.value("focal_sigma_relative", 0.0);
-  if (s.source == "outlines") s.metadata_note = cal.value("lensfun", "");
+  s.source = recorded(c, "calibrate", "source").get<std::string>();
+  // A focal length from the metadata has a prior sigma; a lens from boards or a file has none.
+  if (s.source == "exif" || s.source == "lensfun")
+    s.prior_sigma_relative = recorded(c, "calibrate", "focal_sigma_relative").get<double>();
+  if (s.source == "outlines") s.metadata_note = recorded(c, "calibrate", "lensfun").get<std::string>();
   s.refine = c.o.self_calibrate;
   s.balls = listed_balls(c.set);
   s.out = c.dir / "lens.cameramodel";
@@ -491,10 +501,7 @@ void step_lens(Context& c) {
 ViewImage read_merged_view(const Context& c, const PhotoView& v, const LensModel& lens) {
   const std::string file = merged_path(c, v.name).string();
   ViewImage img = read_view_image(file);
-  const nlohmann::json& step = c.result.summary.at("lens");
-  if (!step.contains("far_camera"))
-    throw std::runtime_error("lens: its record has no far_camera field; rerun with --force lens");
-  if (step["far_camera"].get<bool>()) return on_lens_canvas(std::move(img), lens, file);
+  if (recorded(c, "lens", "far_camera").get<bool>()) return on_lens_canvas(std::move(img), lens, file);
   if (img.radiance.cols != lens.width() || img.radiance.rows != lens.height())
     throw std::invalid_argument(file + ": " + std::to_string(img.radiance.cols) + "x" +
                                 std::to_string(img.radiance.rows) + " but the lens model is " +
@@ -1071,8 +1078,7 @@ void step_extract(Context& c) {
 // The probe's width: the user's, else the one the extract step chose (pipeline/default_sizes.h).
 int probe_width(const Context& c) {
   if (c.o.probe_width > 0) return c.o.probe_width;
-  const nlohmann::json& e = c.result.summary.contains("extract") ? c.result.summary.at("extract") : nlohmann::json();
-  return e.is_object() && e.contains("probe_width") ? e.at("probe_width").get<int>() : 256;
+  return recorded(c, "extract", "probe_width").get<int>();
 }
 
 // ---- probe: the chrome maps blended.
@@ -1147,8 +1153,7 @@ void step_sources(Context& c) {
   for (const BallSpec* b : balls_of(c, BallKind::glossy)) s.glossy.push_back({b->name, captured_path(c, *b)});
   s.given_probe = !c.o.probe_file.empty();
   // The balls' maps and settings matter only when the probe step found light clipped in every view.
-  const nlohmann::json& probe = c.result.summary["probe"];
-  const bool clipped = !s.given_probe && probe.is_object() && probe.value("clipped_fraction", 1.0) > 0;
+  const bool clipped = !s.given_probe && recorded(c, "probe", "clipped_fraction").get<double>() > 0;
   if (!s.given_probe) inputs.insert(inputs.end(), s.chrome.begin(), s.chrome.end());
   if (clipped) {
     for (const auto& g : s.grey) inputs.push_back(g.second);

@@ -534,6 +534,13 @@ for v in ['view00', 'view01', 'view02']:
 h = json.load(open('$work/phdr.json'))['vignetting']
 assert h['model']['source'] == 'chessboards' and h['model'] == json.load(open('$work/pout/hdr/vignetting.json')), h"
 check "hdr writes the vignetting it divided out" test -s "$work/phdr/vignetting.json"
+# A fact a later step needs from an earlier step's record is required, never defaulted.
+cp -r "$work/pout" "$work/pfact"
+python3 -c "
+import json; p = '$work/pfact/steps/extract.json'; j = json.load(open(p)); del j['summary']['probe_width']; json.dump(j, open(p, 'w'))"
+expect_error "process: a record without a fact a later step needs is an error naming the step" \
+  "extract: its record has no 'probe_width' (rerun with --force extract)" process "$work/psyn/photos" --out "$work/pfact" \
+  --poses "$work/psyn/truth/truth.yaml" --chrome-fresnel "$fres" --map-size 32 --turntable 2 --size 64x48 -q
 # rsibr compare and process's compare step write one JSON (compare/comparison_report.h).
 "$rsibr" compare "$work/pout/maps/captured-grey.exr" "$work/pout/maps/computed-grey.exr" --json "$work/pcmp.json" -q
 check "compare and process's compare step report the same numbers under the same keys" python3 -c "
