@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
 #include <type_traits>
 
 namespace rsibr {
@@ -95,6 +96,12 @@ bool jpeg_is_complete(const std::string& path) {
 cv::Mat decode_image(const std::vector<unsigned char>& bytes, int flags) {
   static const auto f = codecs().function<DecodeFn>("_ZN2cv8imdecodeERKNS_11_InputArrayEi");
   return f(bytes, flags);
+}
+
+std::vector<unsigned char> png_bytes(const cv::Mat& image, const std::string& what) {
+  std::vector<unsigned char> bytes;
+  if (!encode_image(".png", image, bytes)) throw std::runtime_error(what + ": cannot encode the PNG");
+  return bytes;
 }
 
 }  // namespace rsibr

@@ -18,6 +18,8 @@ bool write_image(const std::string& path, const cv::Mat& image, const std::vecto
 bool encode_image(const std::string& extension, const cv::Mat& image, std::vector<unsigned char>& bytes,
                   const std::vector<int>& params = {});
 cv::Mat decode_image(const std::vector<unsigned char>& bytes, int flags);
+// A BGR(A) image as PNG bytes; throws std::runtime_error("<what>: cannot encode the PNG").
+std::vector<unsigned char> png_bytes(const cv::Mat& image, const std::string& what);
 
 // Whether the JPEG file at `path` holds its image data to the end-of-image marker. libjpeg decodes
 // a truncated file without failing (grey rows where the data stopped, a warning on stderr), so a

@@ -47,6 +47,7 @@
 #include "pipeline/ball_override.h"
 #include "pipeline/chessboard_problem.h"
 #include "pipeline/default_sizes.h"
+#include "pipeline/extract_step.h"
 #include "pipeline/html_report.h"
 #include "pipeline/lens_step.h"
 #include "pipeline/light_sources_step.h"
@@ -84,12 +85,6 @@ struct Context {
   PhotoSet set;
   ProcessResult& result;
 };
-
-std::vector<unsigned char> png_bytes(const cv::Mat& bgr, const std::string& name) {
-  std::vector<unsigned char> bytes;
-  if (!encode_image(".png", bgr, bytes)) throw std::runtime_error(name + ": cannot encode the PNG");
-  return bytes;
-}
 
 // A fact an earlier step recorded in its summary (DIR/steps/STEP.json) that a later step needs:
 // its absence is an error naming the step, never a default.
@@ -675,28 +670,8 @@ void step_orient(Context& c) {
   });
 }
 
-// ---- extract: every listed ball of every view, identified and checked across views
-// (calib/ball_identification.h), in the world frame; a ball not found in a view is left out of that
-// ball's maps and reported. Chrome maps mask the other balls, the stands and the photographer by
-// geometry (calib/occluders.h); each chrome view's mask is drawn into DIR/masks/<view>.png.
-nlohmann::json finding_json(const std::string& ball, const BallFinding& f) {
-  nlohmann::json j = {{"ball", ball}, {"status", f.status}, {"note", f.note}};
-  if (f.predicted_px) j["predicted_px"] = {f.predicted_px->x(), f.predicted_px->y(), f.predicted_radius_px};
-  if (f.disagreement >= 0) j["disagreement_radii"] = f.disagreement;
-  if (!f.ball) return j;
-  const BallCandidate& b = *f.ball;
-  j.update({{"centre_px", {b.loc.centre_px.x(), b.loc.centre_px.y()}},
-            {"radius_px", b.loc.radius_px},
-            {"outline_rms_px", b.loc.fit.rms_px},
-            {"inlier_fraction", b.inlier_fraction},
-            {"texture", b.texture},
-            {"mirror_score", b.mirror_score},
-            {"diffuse_residual", std::isfinite(b.diffuse_residual) ? b.diffuse_residual : -1.0},
-            {"frame_fraction", b.frame_fraction},
-            {"cut", b.cut}});
-  return j;
-}
-
+// ---- extract: every listed ball of every view, in the world frame (pipeline/extract_step.h) ->
+// DIR/maps/captured-<ball>.exr and each map's mask in DIR/masks/.
 void step_extract(Context& c) {
   std::vector<fs::path> inputs = hdr_files(c);
   inputs.push_back(c.dir / "lens.cameramodel");
@@ -716,362 +691,40 @@ void step_extract(Context& c) {
   run_step(c, "extract", settings, inputs, [&](StepRecord& r) {
     if (c.set.balls.empty()) throw std::invalid_argument(c.o.photoset + ": balls: the photo set lists no ball");
     const LensModel lens = LensModel::read(c.dir / "lens.cameramodel");
-    const PoseSet poses = read_pose_file((c.dir / "poses.yaml").string());
-    const std::vector<ListedBall> listed = listed_balls(c.set);
-    // World down for the stands and the photographer: -Y when the world is +Y up, else the first camera's +y.
-    const Vec3 world_down = poses.gauge != "first-view" ? Vec3(0, -1, 0) : Vec3(0, 1, 0);
-    int chrome_index = -1;
-    for (std::size_t b = 0; b < listed.size(); ++b)
-      if (listed[b].kind == BallKind::chrome && chrome_index < 0) chrome_index = int(b);
-    const double chrome_radius_m = chrome_index >= 0 && listed[std::size_t(chrome_index)].diameter_m
-                                       ? 0.5 * *listed[std::size_t(chrome_index)].diameter_m
-                                       : 0.05;
-    auto read_view = [&](const PhotoView& v) { return read_merged_view(c, v, lens); };
-    // Pass 1: every view's candidates and its chrome ball (the anchor).
-    std::vector<ViewBalls> vb;
-    std::vector<const PhotoView*> used;
-    nlohmann::json views = nlohmann::json::array();
-    Progress bar("extract", c.o.progress);
-    const double steps = 2.0 * double(c.set.views.size());
-    for (std::size_t vi = 0; vi < c.set.views.size(); ++vi) {
-      const PhotoView& v = c.set.views[vi];
-      const ViewPose* pose = poses.find(v.name);
-      if (!pose) {
-        views.push_back({{"name", v.name},
-                         {"left_out", "no pose (the orient step found no chrome ball in it)"},
-                         {"balls", nlohmann::json::array()}});
-        continue;
-      }
-      const ViewImage img = read_view(v);
-      ViewBalls one;
-      one.name = v.name;
-      one.world_from_cam = pose->world_from_cam;
-      one.candidates = find_ball_candidates(img.radiance, lens);
-      if (chrome_index >= 0) {
-        if (auto g = find_override(overrides, v.name, listed[std::size_t(chrome_index)].name)) {
-          one.chrome = given_ball(img.radiance, lens, *g).loc.fit.cone;
-        } else if (pose->ball) {
-          one.chrome = pose->ball;  // refined with the orientations (the outline lies inside its limb)
-        } else {
-          const std::vector<int> pick = assign_balls_in_view(one.candidates, listed);
-          if (pick[std::size_t(chrome_index)] >= 0)
-            one.chrome = one.candidates[std::size_t(pick[std::size_t(chrome_index)])].loc.fit.cone;
-        }
-      }
-      vb.push_back(std::move(one));
-      used.push_back(&v);
-      bar.update(double(vi + 1) / steps);
+    ExtractStep s;
+    s.lens = &lens;
+    s.poses = read_pose_file((c.dir / "poses.yaml").string());
+    s.balls = listed_balls(c.set);
+    for (const PhotoView& v : c.set.views) {
+      s.views.push_back(v.name);
+      s.given.emplace_back();
+      for (const ListedBall& b : s.balls) s.given.back().push_back(find_override(overrides, v.name, b.name));
     }
-    const std::vector<RigMember> rig = fit_ball_rig(vb, listed);
-    for (ViewBalls& v : vb)
-      if (auto a = anchor_from_rig(v, rig, listed)) {
-        v.chrome = a->chrome;
-        v.anchor_note = "chrome ball placed by the rig from ball " + a->placed_from + " (within " +
-                        std::to_string(a->disagreement).substr(0, 4) + " chrome radii)";
-      }
-    int anchored = 0;
-    for (const ViewBalls& v : vb) anchored += v.chrome.has_value();
-    const bool trust_views = anchored < 2;  // one view: nothing to check it against
-    // Map sizes (pipeline/default_sizes.h): from the chrome ball's largest pixel radius over the
-    // views, scaled by the rig's radius ratio for the other balls (they are decided view by view
-    // below, after the size is needed); a size the user gives wins.
-    double chrome_px = 0;
-    for (const ViewBalls& v : vb)
-      if (v.chrome) chrome_px = std::max(chrome_px, ball_pixel_radius(*v.chrome, lens));
-    std::vector<int> map_size(listed.size(), c.o.map_size);
-    for (std::size_t b = 0; b < listed.size(); ++b)
-      if (c.o.map_size <= 0) {
-        const double scale = rig.size() == listed.size() && rig[b].known && rig[b].scale > 0 ? rig[b].scale : 1.0;
-        map_size[b] = default_map_size(listed[b].kind, chrome_px * scale);
-      }
-    const int probe_width = c.o.probe_width > 0
-                                ? c.o.probe_width
-                                : default_probe_width(chrome_index >= 0 ? map_size[std::size_t(chrome_index)] : 64);
-    // Pass 2: each view's balls decided, extracted; the chrome maps masked.
-    std::vector<MapSet> sets(listed.size());
-    FolderContents masks;
-    std::vector<double> view_disagreement(vb.size(), -1.0);  // per view: its other balls' largest
-    // Per grey map: what occludes its light (calib/occluded_light.h), restored once the probe is known.
-    struct GreyScene {
-      std::size_t ball;
-      std::string view;
-      BallCone cone;
-      Mat3 world_from_cam;
-      std::vector<OccluderLight> occluders;
-      Vec3 chrome_centre = Vec3::Zero();  // camera frame, the grey ball's radii
+    s.read_view = [&](const std::string& name) {
+      for (const PhotoView& v : c.set.views)
+        if (v.name == name) return read_merged_view(c, v, lens);
+      throw std::logic_error("extract: no view " + name);
     };
-    std::vector<GreyScene> grey_scenes;
-    std::map<std::string, cv::Mat> chrome_hidden;  // per view: the chrome texels another ball hides
-    for (std::size_t k = 0; k < vb.size(); ++k) {
-      const PhotoView& v = *used[k];
-      const ViewImage img = read_view(v);
-      std::vector<BallFinding> found = identify_view_balls(vb[k], rig, listed, img.radiance, lens, {}, {}, trust_views);
-      for (std::size_t b = 0; b < listed.size(); ++b)
-        if (int(b) != chrome_index && found[b].found() && found[b].disagreement > 0)
-          view_disagreement[k] = std::max(view_disagreement[k], found[b].disagreement);
-      for (std::size_t b = 0; b < listed.size(); ++b)
-        if (auto g = find_override(overrides, v.name, listed[b].name)) {
-          found[b] = BallFinding{};
-          found[b].status = "given";
-          found[b].note = "--ball";
-          found[b].ball = given_ball(img.radiance, lens, *g);
-          if (int(b) == chrome_index && vb[k].chrome) found[b].ball->loc.fit.cone = *vb[k].chrome;
-        }
-      const Mat3 world_from_cam = vb[k].world_from_cam;
-      const Vec3 down_cam = world_from_cam.transpose() * world_down;
-      std::vector<OtherBall> others;
-      for (std::size_t b = 0; b < listed.size(); ++b)
-        if (int(b) != chrome_index && found[b].found() && chrome_index >= 0 &&
-            found[std::size_t(chrome_index)].found()) {
-          const BallCone chrome = found[std::size_t(chrome_index)].ball->loc.fit.cone,
-                         cone = found[b].ball->loc.fit.cone;
-          // The radius over the chrome's: the rig's, else the listed diameters', else the same distance as the chrome ball.
-          double scale = rig.size() == listed.size() && rig[b].known ? rig[b].scale : 0;
-          if (!(scale > 0) && listed[b].diameter_m && listed[std::size_t(chrome_index)].diameter_m)
-            scale = *listed[b].diameter_m / *listed[std::size_t(chrome_index)].diameter_m;
-          if (!(scale > 0)) scale = std::sin(cone.half_angle) / std::sin(chrome.half_angle);
-          others.push_back({listed[b].name, cone, scale});
-        }
-      nlohmann::json vj = {{"name", v.name}, {"balls", nlohmann::json::array()}};
-      for (std::size_t b = 0; b < listed.size(); ++b) {
-        const ListedBall& ball = listed[b];
-        nlohmann::json bj = finding_json(ball.name, found[b]);
-        if (!found[b].found()) {
-          vj["balls"].push_back(bj);
-          continue;
-        }
-        const BallCone cone = found[b].ball->loc.fit.cone;
-        ExtractOptions eo;
-        eo.size = map_size[b];
-        eo.mirror = ball.kind == BallKind::chrome;
-        eo.indexing = eo.mirror ? SphereIndexing::reflection : SphereIndexing::orthographic;
-        eo.camera_mask_deg = eo.mirror ? 12.0 : 0.0;
-        eo.down = down_cam;
-        eo.material = eo.mirror ? "{type: mirror}" : "{type: lambert}";
-        // Radii of this ball over the chrome's (the extraction's geometry is in this ball's radii).
-        double own_scale = 1;
-        for (const OtherBall& o : others)
-          if (o.name == ball.name) own_scale = o.scale;
-        std::vector<OtherBall> rest;
-        if (chrome_index >= 0 && int(b) != chrome_index && found[std::size_t(chrome_index)].found())
-          rest.push_back(
-              {listed[std::size_t(chrome_index)].name, found[std::size_t(chrome_index)].ball->loc.fit.cone, 1.0});
-        for (const OtherBall& o : others)
-          if (o.name != ball.name) rest.push_back(o);
-        for (const OtherBall& o : rest) {
-          Occluder f;
-          f.centre = o.scale / own_scale * o.cone.axis.normalized() / std::sin(o.cone.half_angle);
-          f.radius = 1.03 * o.scale / own_scale;
-          f.what = "ball " + o.name + " in front";
-          eo.in_front.push_back(f);
-        }
-        if (eo.mirror && int(b) == chrome_index) eo.occluders = chrome_occluders(cone, rest, down_cam, chrome_radius_m);
-        if (ball.kind == BallKind::grey && c.o.occluder_light && chrome_index >= 0 &&
-            found[std::size_t(chrome_index)].found()) {
-          // The photographer, in this ball's radii, lit as the view's chrome ball sees it. The other
-          // balls are not restored: restoring the chrome ball beside the grey one did not lower the
-          // error on the held-out shoots (docs/tradeoffs.md, "calib/occluded_light.h: what is restored").
-          GreyScene g{b, v.name, cone, world_from_cam, {}, Vec3::Zero()};
-          for (const OtherBall& o : rest)
-            if (o.name == listed[std::size_t(chrome_index)].name)
-              g.chrome_centre = o.scale / own_scale * o.cone.axis.normalized() / std::sin(o.cone.half_angle);
-          for (const Occluder& o : chrome_occluders(cone, {}, down_cam, chrome_radius_m * own_scale))
-            if (o.what == "photographer") g.occluders.push_back({o, OccluderLight::seen_by_chrome, 0});
-          grey_scenes.push_back(std::move(g));
-        }
-        cv::Mat hidden;
-        MapView mv = extract_sphere_map(img.radiance, img.flags, lens, cone, world_from_cam, eo,
-                                        c.o.occluder_light && int(b) == chrome_index ? &hidden : nullptr);
-        if (c.o.occluder_light && int(b) == chrome_index) chrome_hidden[v.name] = hidden;
-        mv.image = v.name;
-        mv.attributes["ball"] = ball.name;
-        mv.attributes["ballKind"] = to_string(ball.kind);
-        mv.attributes["frame"] = "world (poses.yaml)";
-        mv.attributes["identified"] = found[b].status;
-        const cv::Mat& conf = mv.confidence;
-        bj["confident_fraction"] = cv::countNonZero(conf > 0.5) / (kPiD / 4 * eo.size * eo.size);
-        nlohmann::json occ = nlohmann::json::array();
-        for (const Occluder& o : eo.occluders) occ.push_back(o.what);
-        for (const Occluder& o : eo.in_front) occ.push_back(o.what);
-        bj["masked"] = occ;
-        vj["balls"].push_back(bj);
-        sets[b].views.push_back(std::move(mv));
-      }
-      views.push_back(vj);
-      bar.update(double(vb.size() + k + 1) / steps);
-    }
-    bar.done();
-    auto ball_entry = [&](const std::string& view, const std::string& ball) -> nlohmann::json* {
-      for (auto& vj : views)
-        if (vj["name"] == view)
-          for (auto& bj : vj["balls"])
-            if (bj["ball"] == ball) return &bj;
-      return nullptr;
-    };
-    // A view whose other balls disagree with the rig has its chrome ball or its rotation off
-    // (calib/ball_identification.h, rig_suspects): its chrome map stays out of the probe.
-    const RigSuspects suspects = rig_suspects(view_disagreement);
-    std::vector<MapView> chrome_left_out;  // still the view's own light for its grey ball (below)
-    if (chrome_index >= 0 && std::count(suspects.suspect.begin(), suspects.suspect.end(), 1) > 0) {
-      std::vector<MapView> kept;
-      for (MapView& mv : sets[std::size_t(chrome_index)].views) {
-        const std::size_t k = std::size_t(
-            std::find_if(vb.begin(), vb.end(), [&](const ViewBalls& x) { return x.name == mv.image; }) - vb.begin());
-        if (k < vb.size() && suspects.suspect[k]) {
-          if (nlohmann::json* bj = ball_entry(vb[k].name, listed[std::size_t(chrome_index)].name)) {
-            char note[200];
-            std::snprintf(note, sizeof note,
-                          "left out of the probe: the view's other balls lie %.2f chrome radii from where the rig "
-                          "puts them (median of the views %.2f): its chrome ball or its rotation is off",
-                          view_disagreement[k], suspects.median);
-            (*bj)["status"] = "left out: disagrees with the rig";
-            (*bj)["note"] = note;
-          }
-          chrome_left_out.push_back(std::move(mv));
-          continue;
-        }
-        kept.push_back(std::move(mv));
-      }
-      sets[std::size_t(chrome_index)].views = std::move(kept);
-    }
-    // Grey balls: the light the photographer takes from them restored, from the chrome maps' probe
-    // and each view's own chrome map (calib/occluded_light.h). The probe is the one the sources step
-    // makes (the light clipped in every view recovered from the grey balls, lights/recovered_probe.h):
-    // the restored share is the photographer's light over the whole light, so a probe that lacks a
-    // clipped sun overstates it (by 2-3x on shoots where the sun is 60% of the light).
-    if (!grey_scenes.empty() && !sets[std::size_t(chrome_index)].views.empty()) {
-      const auto fresnel = chrome_fresnel_from_spec(c.o.chrome_fresnel, "--chrome-fresnel");
-      ProbeOptions po;
-      po.width = probe_width;
-      po.fresnel = fresnel.get();
-      std::vector<GreyBallMaps> grey_maps;
-      for (std::size_t b = 0; b < listed.size(); ++b)
-        if (listed[b].kind == BallKind::grey && !sets[b].views.empty())
-          grey_maps.push_back({listed[b].name, &sets[b], Vec3::Constant(c.o.grey_albedo)});
-      SourceRecoveryOptions ro;
-      ro.seed = c.o.seed;
-      // Only the light is needed here, not its sigma, and the regions' centroids serve a 64 x 32
-      // quadrature (refining them cost 12 s of a 26 s extract on a shoot with 8 sources, and the
-      // grey maps came out no closer to the truth).
-      ro.jackknife = false;
-      ro.refine = false;
-      const RecoveredProbe probe =
-          recover_probe_sources(sets[std::size_t(chrome_index)], po, grey_maps, {}, ro, c.o.recover_sources);
-      // Clipped texels count as seen: the recovery put its light there (0 where it put none). Left
-      // unseen, a sun's quadrature cell, mostly clipped glare, dropped out of both irradiances
-      // (on the clipped-sun test's low sun, view00's grey map went from 0.33 to 0.10 stops).
-      cv::Mat seen_weight = probe.measured.weight.clone();
-      for (int y = 0; y < seen_weight.rows; ++y)
-        for (int x = 0; x < seen_weight.cols; ++x)
-          if (probe.measured.clipped.at<float>(y, x) > 0)
-            seen_weight.at<float>(y, x) = std::max(seen_weight.at<float>(y, x), 1.0f);
-      const OpenLight light = open_light(probe.env, seen_weight, fresnel.get(), std::min(64, probe_width));
-      for (const GreyScene& g : grey_scenes) {
-        auto of_view = [&](std::vector<MapView>& maps) -> MapView* {
-          for (MapView& mv : maps)
-            if (mv.image == g.view) return &mv;
-          return nullptr;
-        };
-        MapView* grey = of_view(sets[g.ball].views);
-        if (!grey) continue;
-        // A view left out of the probe keeps its own chrome map here: the photographer's light is
-        // read in the view's frame, whatever its rotation's error.
-        const MapView* chrome = of_view(sets[std::size_t(chrome_index)].views);
-        if (!chrome) chrome = of_view(chrome_left_out);
-        const OccludedLight ol = occluded_light(*grey, g.world_from_cam, g.cone, g.occluders, light, chrome,
-                                                g.chrome_centre, chrome_hidden[g.view]);
-        restore_occluded_light(*grey, ol);
-        char text[160];
-        std::snprintf(text, sizeof text, "restored: mean %.3f, largest %.3f stops%s", ol.mean_stops, ol.max_stops,
-                      chrome ? "" : " (none: the view has no chrome map)");
-        grey->attributes["occluderLight"] = text;
-        if (nlohmann::json* bj = ball_entry(g.view, listed[g.ball].name))
-          (*bj)["occluder_light"] = {
-              {"mean_stops", ol.mean_stops}, {"largest_stops", ol.max_stops}, {"photographer", chrome != nullptr}};
-      }
-    }
-    // Grey balls: what one view alone sees differently (the photographer's shadow) is masked, a view
-    // mostly so is left out (calib/lambert_consensus.h).
-    for (std::size_t b = 0; b < listed.size(); ++b) {
-      if (listed[b].kind != BallKind::grey) continue;
-      const std::vector<LambertConsensusView> cons = mask_lambert_inconsistencies(sets[b].views);
-      std::vector<MapView> kept;
-      for (std::size_t k = 0; k < cons.size(); ++k) {
-        MapView& mv = sets[b].views[k];
-        nlohmann::json* bj = ball_entry(mv.image, listed[b].name);
-        if (bj) {
-          (*bj)["consensus"] = {
-              {"judged", cons[k].judged}, {"masked", cons[k].masked}, {"median_stops", cons[k].median_stops}};
-          (*bj)["confident_fraction"] = cv::countNonZero(mv.confidence > 0.5) / (kPiD / 4 * mv.rgb.cols * mv.rgb.rows);
-        }
-        if (cons[k].left_out) {
-          if (bj) {
-            (*bj)["status"] = "left out: inconsistent with the other views";
-            (*bj)["note"] = std::to_string(cons[k].masked) + " of " + std::to_string(cons[k].judged) +
-                            " texels differ from the other views' median by more than 0.12 stops (median " +
-                            std::to_string(cons[k].median_stops).substr(0, 5) +
-                            "): a shadow or occluder of this view alone";
-          }
-          continue;
-        }
-        kept.push_back(std::move(mv));
-      }
-      sets[b].views = std::move(kept);
-    }
-    // Each map's mask for the report.
-    for (std::size_t b = 0; b < listed.size(); ++b)
-      for (const MapView& mv : sets[b].views) {
-        const std::string image = mv.image;
-        const std::string name = int(b) == chrome_index ? image + ".png" : image + "-" + listed[b].name + ".png";
-        masks[name] = png_bytes(mask_picture(mv, preview_exposure(mv.rgb)), name);
-        if (nlohmann::json* bj = ball_entry(image, listed[b].name)) (*bj)["mask"] = "masks/" + name;
-      }
-    for (std::size_t b = 0; b < listed.size(); ++b)
-      if (sets[b].views.empty())
-        throw std::runtime_error("ball '" + listed[b].name +
-                                 "' was found in no view (see the balls' notes with --json; "
-                                 "give it with --ball VIEW:" +
-                                 listed[b].name + "=X,Y,R)");
+    s.map_size = c.o.map_size;
+    s.probe_width = c.o.probe_width;
+    s.occluder_light = c.o.occluder_light;
+    s.chrome_fresnel = c.o.chrome_fresnel;
+    s.recover_sources = c.o.recover_sources;
+    s.grey_albedo = c.o.grey_albedo;
+    s.seed = c.o.seed;
+    s.progress = c.o.progress;
+    ExtractedMaps e = run_extract_step(s);
     fs::create_directories(c.dir / "maps");
     for (std::size_t bi = 0; bi < c.set.balls.size(); ++bi) {
       const fs::path out = captured_path(c, c.set.balls[bi]);
-      write_map_set(out.string(), sets[bi]);
+      write_map_set(out.string(), e.sets[bi]);
       r.outputs.push_back(out);
     }
-    if (!masks.empty()) {
-      write_folder_atomically(c.dir / "masks", masks);
-      for (const auto& [name, bytes] : masks) r.outputs.push_back(c.dir / "masks" / name);
+    if (!e.masks.empty()) {
+      write_folder_atomically(c.dir / "masks", e.masks);
+      for (const auto& [name, bytes] : e.masks) r.outputs.push_back(c.dir / "masks" / name);
     }
-    nlohmann::json rj = nlohmann::json::array();
-    for (std::size_t b = 0; b < listed.size(); ++b) {
-      const RigMember& m = rig.size() == listed.size() ? rig[b] : RigMember{};
-      rj.push_back({{"ball", listed[b].name},
-                    {"known", m.known},
-                    {"offset_chrome_radii", {m.offset.x(), m.offset.y(), m.offset.z()}},
-                    {"scale", m.scale},
-                    {"scale_from_diameters", m.scale_given},
-                    {"views_agreeing", m.support},
-                    {"rms_radii", m.rms}});
-    }
-    nlohmann::json sizes = nlohmann::json::object();
-    std::size_t bytes = 0;
-    for (std::size_t b = 0; b < listed.size(); ++b) {
-      sizes[listed[b].name] = map_size[b];
-      bytes += map_set_bytes(map_size[b], sets[b].views.size());
-    }
-    r.summary = {
-        {"views", views},
-        {"map_size", sizes},
-        {"map_size_source",
-         c.o.map_size > 0 ? "--map-size"
-                          : "the balls' pixel radii (chrome: " + std::to_string(int(std::lround(chrome_px))) + " px)"},
-        {"probe_width", probe_width},
-        {"probe_width_source", c.o.probe_width > 0 ? "--probe-width" : "the chrome map's size"},
-        {"maps_memory_mb", double(bytes) / (1 << 20)},
-        {"rig", rj},
-        {"chrome_radius_m", chrome_radius_m},
-        {"chrome_radius_source",
-         chrome_index >= 0 && listed[std::size_t(chrome_index)].diameter_m ? "listed diameter" : "assumed 5 cm"}};
+    r.summary = std::move(e.summary);
   });
 }
 
