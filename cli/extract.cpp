@@ -1,6 +1,8 @@
 // rsibr extract: one view's linear image (a merged view of `rsibr hdr`, or any float RGB EXR) + the
 // lens model -> the ball located (calib/ball_locator.h) -> its sphere map with a confidence channel
-// (calib/sphere_map_extraction.h), written as a captured one-view map set.
+// (calib/sphere_map_extraction.h), written as a captured one-view map set. With --photoset, the
+// rig mode of rsibr process's extract step (pipeline/extract_step.h): every listed ball of every
+// posed view, identified across views, one map set per ball.
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
@@ -14,11 +16,22 @@
 #include "core/lens_model.h"
 #include "core/map_set.h"
 #include "core/output_plan.h"
+#include "core/progress.h"
+#include "calib/far_camera.h"
+#include "core/atomic_folder.h"
+#include "core/photo_set.h"
+#include "calib/probe.h"
+#include "pipeline/ball_override.h"
+#include "pipeline/extract_step.h"
+
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <sstream>
 
 namespace rsibr::cli {
@@ -29,7 +42,92 @@ struct ExtractArgs {
   int which = 0, size = 128;
   double camera_mask_deg = -1, stand_mask_deg = 8;
   bool quiet = false, no_stand = false;
+  // The rig mode (--photoset).
+  std::string photoset, merged, chrome_fresnel = kDefaultChromeFresnel;
+  std::vector<std::string> balls;  // --ball VIEW:BALL=X,Y,R
+  bool size_given = false, no_occluder_light = false, no_recover = false;
+  int probe_width = 0;
+  double grey_albedo = 0.18;
+  std::uint64_t seed = 0;
 };
+
+// Every listed ball of every posed view (pipeline/extract_step.h, as rsibr process runs it):
+// OUT/captured-<ball>.exr per ball and OUT/masks/, written only when every ball was extracted.
+int run_extract_rig(const ExtractArgs& a) {
+  if (a.poses.empty()) throw std::invalid_argument("--photoset: needs --poses (rsibr orient's poses.yaml)");
+  if (!a.image.empty()) throw std::invalid_argument("--photoset: give the merged views with --merged, not an image");
+  if (a.merged.empty()) throw std::invalid_argument("--photoset: needs --merged (the folder rsibr hdr wrote)");
+  const PhotoSet set = load_photo_set(a.photoset);
+  if (set.balls.empty()) throw std::invalid_argument(a.photoset + ": balls: the photo set lists no ball");
+  const LensModel lens = LensModel::read(a.lens);
+  ExtractStep s;
+  s.lens = &lens;
+  s.poses = read_pose_file(a.poses);
+  s.balls = listed_balls(set);
+  const std::vector<BallOverride> overrides = parse_ball_overrides(a.balls, set);
+  std::vector<std::filesystem::path> inputs = {a.lens, a.poses};
+  for (const PhotoView& v : set.views) {
+    s.views.push_back(v.name);
+    s.given.emplace_back();
+    for (const ListedBall& b : s.balls) s.given.back().push_back(find_override(overrides, v.name, b.name));
+    const std::filesystem::path file = std::filesystem::path(a.merged) / (v.name + ".exr");
+    if (s.poses.find(v.name)) {
+      if (!std::filesystem::is_regular_file(file))
+        throw std::invalid_argument(file.string() + ": missing (the merged view of posed view '" + v.name + "')");
+      inputs.push_back(file);
+    }
+  }
+  // A view of the lens's size as it is; crops of the ball on a far camera's canvas (calib/far_camera.h).
+  s.read_view = [&](const std::string& name) {
+    const std::string file = (std::filesystem::path(a.merged) / (name + ".exr")).string();
+    return on_lens_canvas(read_view_image(file), lens, file);
+  };
+  s.map_size = a.size_given ? a.size : 0;
+  s.probe_width = a.probe_width;
+  s.occluder_light = !a.no_occluder_light;
+  s.chrome_fresnel = a.chrome_fresnel;
+  s.recover_sources = !a.no_recover;
+  s.grey_albedo = a.grey_albedo;
+  s.seed = a.seed;
+  s.progress = !a.quiet && Progress::stderr_is_terminal();
+
+  OutputPlan outputs(inputs);
+  outputs.folder(a.out);
+  const std::string json = outputs.file(a.json);
+  ExtractedMaps e = run_extract_step(s);
+  // The map sets pass through a temporary file each (the EXR writer writes files), then every
+  // output goes into OUT at once.
+  FolderContents files;
+  const std::filesystem::path tmp =
+      std::filesystem::temp_directory_path() / ("rsibr-extract-" + std::to_string(::getpid()) + ".exr");
+  for (std::size_t b = 0; b < set.balls.size(); ++b) {
+    try {
+      write_map_set(tmp.string(), e.sets[b]);
+      std::ifstream in(tmp, std::ios::binary);
+      files["captured-" + set.balls[b].name + ".exr"] =
+          std::vector<unsigned char>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    } catch (...) {
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      throw;
+    }
+    std::filesystem::remove(tmp);
+  }
+  for (const auto& [name, bytes] : e.masks) files["mask-" + name] = bytes;
+  for (auto& view : e.summary["views"])
+    for (auto& ball : view["balls"])
+      if (ball.contains("mask"))
+        ball["mask"] = "mask-" + ball["mask"].get<std::string>().substr(std::string("masks/").size());
+  e.summary["out"] = a.out;
+  write_summary(json, e.summary);
+  write_folder_atomically(a.out, files);
+  outputs.commit();
+  if (!a.quiet && a.json != "-")
+    for (std::size_t b = 0; b < set.balls.size(); ++b)
+      std::cerr << "rsibr extract: " << set.balls[b].name << ": " << e.sets[b].views.size() << " of "
+                << set.views.size() << " views -> " << a.out << "/captured-" << set.balls[b].name << ".exr\n";
+  return 0;
+}
 
 BallGuess parse_ball(const std::string& text) {
   BallGuess g;
@@ -45,6 +143,8 @@ BallGuess parse_ball(const std::string& text) {
 }
 
 int run_extract(const ExtractArgs& a) {
+  if (!a.photoset.empty()) return run_extract_rig(a);
+  if (a.image.empty()) throw std::invalid_argument("extract: give an IMAGE, or --photoset for every view and ball");
   OutputPlan outputs({a.image, a.lens, a.poses});
   const std::string exr = outputs.file(a.out), json = outputs.file(a.json);
   if (a.kind != "chrome" && a.kind != "grey")
@@ -182,14 +282,16 @@ Runner add_extract(CLI::App& app) {
       "The map's world frame is the pose file's (--poses, from rsibr orient; the entry named like the image: its "
       "header's rsibr.view, else the file stem), else the image header's rsibr.worldFromCam, else the camera's.\n"
       "Example: rsibr extract hdr/north.exr --lens camera.cameramodel --out north-chrome.exr --json -");
-  c->add_option("image", a->image, "Merged view EXR (rsibr hdr) or float RGB EXR")->required();
+  c->add_option("image", a->image, "Merged view EXR (rsibr hdr) or float RGB EXR (not with --photoset)");
   c->add_option("--lens", a->lens, "mrcal .cameramodel of the camera")->required();
   c->add_option("--out", a->out, "Output map set (.exr)")->required();
   c->add_option("--ball", a->ball, "Ball guess X,Y,R in pixels (default: detected)");
   c->add_option("--which", a->which, "Detected ball to use, 0 = leftmost")->check(CLI::Range(0, 7));
   c->add_option("--kind", a->kind, "chrome (mirror map) or grey (normal map)");
   c->add_option("--indexing", a->indexing, "reflection (exact for mirrors) or orthographic");
-  c->add_option("--size", a->size, "Map size in texels (square)")->check(CLI::Range(8, 4096));
+  c->add_option("--size", a->size, "Map size in texels (square; --photoset: default from the balls' pixel radii)")
+      ->check(CLI::Range(8, 4096))
+      ->each([a](const std::string&) { a->size_given = true; });
   c->add_option("--camera-mask-deg", a->camera_mask_deg,
                 "Mask reflections within this of the camera (default 12 chrome, 0 grey)")
       ->check(CLI::Range(0.0, 90.0));
@@ -199,6 +301,20 @@ Runner add_extract(CLI::App& app) {
   c->add_option("--poses", a->poses,
                 "Pose file (rsibr orient): the world frame of the entry named like the image, and for a chrome ball "
                 "its cone as refined with the orientations");
+  c->add_option("--photoset", a->photoset,
+                "Rig mode: every ball the photo set lists in every posed view, identified across views, as rsibr "
+                "process's extract step; --out is then a folder (captured-<ball>.exr, mask-<view>[-<ball>].png)");
+  c->add_option("--merged", a->merged, "Rig mode: the folder of merged views <view>.exr (rsibr hdr --out)");
+  c->add_option("--view-ball", a->balls, "Rig mode: VIEW:BALL=X,Y,R gives one ball of one view by hand (repeatable)");
+  c->add_option("--chrome-fresnel", a->chrome_fresnel,
+                "Rig mode: the chrome ball's Fresnel spec, for the grey balls' occluded light");
+  c->add_option("--grey-albedo", a->grey_albedo, "Rig mode: the grey ball's albedo")->check(CLI::Range(0.001, 1.0));
+  c->add_option("--probe-width", a->probe_width, "Rig mode: width of the probe the occluded light is read from")
+      ->check(CLI::Range(16, 1 << 14));
+  c->add_flag("--no-occluder-light", a->no_occluder_light,
+              "Rig mode: do not restore the light the photographer takes from the grey balls");
+  c->add_flag("--no-recover", a->no_recover, "Rig mode: that probe without the clipped light recovered");
+  c->add_option("--seed", a->seed, "Rig mode: seed of the light recovery");
   c->add_option("--json", a->json, "Write a JSON summary to FILE ('-' for stdout)");
   c->add_flag("-q,--quiet", a->quiet, "No report line");
   return [a] { return run_extract(*a); };

@@ -541,6 +541,23 @@ import json; p = '$work/pfact/steps/extract.json'; j = json.load(open(p)); del j
 expect_error "process: a record without a fact a later step needs is an error naming the step" \
   "extract: its record has no 'probe_width' (rerun with --force extract)" process "$work/psyn/photos" --out "$work/pfact" \
   --poses "$work/psyn/truth/truth.yaml" --chrome-fresnel "$fres" --map-size 32 --turntable 2 --size 64x48 -q
+# rsibr extract --photoset is process's extract step (pipeline/extract_step.h): the same maps to the byte.
+"$rsibr" extract --photoset "$work/psyn/photos" --merged "$work/pout/hdr" --lens "$work/pout/lens.cameramodel" \
+  --poses "$work/pout/poses.yaml" --chrome-fresnel "$fres" --size 32 --out "$work/prig" --json "$work/prig.json" -q
+check "extract --photoset writes process's extract maps to the byte, and its masks" bash -c "
+cmp -s '$work/prig/captured-grey.exr' '$work/pout/maps/captured-grey.exr' &&
+cmp -s '$work/prig/captured-chrome.exr' '$work/pout/maps/captured-chrome.exr' && test -s '$work/prig/mask-view00.png'"
+check "extract --photoset: the JSON names its masks as written" python3 -c "
+import json, os; j = json.load(open('$work/prig.json'))
+masks = [b['mask'] for v in j['views'] for b in v['balls'] if 'mask' in b]
+assert len(masks) == 6 and all(os.path.isfile('$work/prig/' + m) for m in masks), masks"
+expect_error "extract --photoset: needs the poses" "needs --poses" extract --photoset "$work/psyn/photos" \
+  --merged "$work/pout/hdr" --lens "$work/pout/lens.cameramodel" --out "$work/prig-e1"
+expect_error "extract --photoset: a missing merged view, named" "view00.exr: missing" extract --photoset "$work/psyn/photos" \
+  --merged "$work/psyn" --lens "$work/pout/lens.cameramodel" --poses "$work/pout/poses.yaml" --out "$work/prig-e2"
+expect_error "extract: neither an image nor a photo set" "give an IMAGE" extract --lens "$work/pout/lens.cameramodel" \
+  --out "$work/prig-e3.exr"
+check "extract --photoset: nothing written after the errors" bash -c "test ! -e '$work/prig-e1' && test ! -e '$work/prig-e2'"
 # rsibr compare and process's compare step write one JSON (compare/comparison_report.h).
 "$rsibr" compare "$work/pout/maps/captured-grey.exr" "$work/pout/maps/computed-grey.exr" --json "$work/pcmp.json" -q
 check "compare and process's compare step report the same numbers under the same keys" python3 -c "
