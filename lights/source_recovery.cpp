@@ -354,102 +354,93 @@ struct KnownIrradiance {
   }
 };
 
-}  // namespace
-
-SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedRegion>& regions,
-                               const std::vector<GreyBallMaps>& grey, const std::vector<GlossyBallMaps>& glossy,
-                               const SourceRecoveryOptions& options,
-                               const std::map<std::string, EnvMap>& known_without) {
-  SourceRecovery out;
-  if (regions.empty()) return out;
-  if (known.layout.kind() != LayoutKind::LatLong) throw std::invalid_argument("sources: the probe must be lat-long");
-
-  // The balls' trusted texels.
+// The balls' trusted texels, each with the known part's prediction, and the names they index.
+struct TrustedTexels {
   std::vector<Texel> texels;
-  std::map<std::string, int> view_index;
-  std::vector<std::string> view_names;
+  std::vector<std::string> view_names;  // distinct image names (MapView::image, else view.N)
   std::vector<std::string> ball_names, ball_kinds;
-  auto image_of = [](const MapView& mv, std::size_t v) {
-    return !mv.image.empty() ? mv.image : "view." + std::to_string(v);
-  };
-  const KnownIrradiance irradiance(known, options.known_width);
-  std::unique_ptr<Integrator> fis;
-  auto add_ball = [&](const std::string& name, const MapSet& maps, const Vec3& albedo, const Brdf* brdf) {
-    const int ball = int(ball_names.size());
-    ball_names.push_back(name);
-    ball_kinds.push_back(brdf ? "glossy" : "grey");
-    std::vector<Texel> mine;
-    for (std::size_t v = 0; v < maps.views.size(); ++v) {
-      const MapView& mv = maps.views[v];
-      if (mv.confidence.empty() || mv.rgb.type() != CV_32FC3)
-        throw std::invalid_argument("sources: " + name + " view." + std::to_string(v) +
-                                    " has no confidence (not captured)");
-      const std::string image = image_of(mv, v);
-      const auto [it, fresh] = view_index.emplace(image, int(view_names.size()));
-      if (fresh) view_names.push_back(image);
-      cv::Mat glossy_known;
-      if (brdf) {
-        if (!fis) fis = make_integrator("fis", known);
-        IntegratorOptions io;
-        io.samples = options.glossy_samples;
-        io.seed = options.seed;
-        glossy_known = fis->radiance_map(*brdf, mv.view, mv.world_from_view, mv.rgb.cols, io);
-      }
-      const int W = mv.rgb.cols, H = mv.rgb.rows;
-      std::vector<std::vector<Texel>> rows(static_cast<std::size_t>(H));
-      parallel_for_rows(H, [&](int r) {
-        for (int c = 0; c < W; ++c) {
-          const float conf = mv.confidence.at<float>(r, c);
-          const cv::Vec3f o = mv.rgb.at<cv::Vec3f>(r, c);
-          if (!(conf > 0) || !std::isfinite(conf) ||
-              !(std::isfinite(o[0]) && std::isfinite(o[1]) && std::isfinite(o[2])))
-            continue;
-          const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), W, H);
-          if (xy.squaredNorm() >= 1) continue;
-          Texel t;
-          t.n = (mv.world_from_view * sphere_map::g_normal(xy)).normalized();
-          t.v = mv.view.normalized();
-          t.obs = Vec3(std::max(0.f, o[0]), std::max(0.f, o[1]), std::max(0.f, o[2]));
-          t.sqrt_w = std::sqrt(double(conf));
-          t.ball = ball;
-          t.view = it->second;
-          if (brdf) {
-            const cv::Vec3f g = glossy_known.at<cv::Vec3f>(r, c);
-            t.known = Vec3(g[0], g[1], g[2]);
-            t.gain = Vec3::Ones();
-            t.brdf = brdf;
-            t.mirror = 2 * t.n.dot(t.v) * t.n - t.v;
-            if (brdf->central_direction() == CentralDirection::Mirror) {
-              t.lobe = brdf->lobe_width(shading::Frame::around(t.n).to_local(t.v));
-            }
-          } else {
-            t.gain = albedo / kPi;
-            t.known = t.gain.cwiseProduct(irradiance(t.n));
-          }
-          rows[std::size_t(r)].push_back(t);
-        }
-      });
-      for (auto& row : rows) mine.insert(mine.end(), row.begin(), row.end());
-    }
-    // Relative residuals with a floor of 5% of the ball's median value per channel.
-    Vec3 floor = Vec3::Zero();
-    for (int ch = 0; ch < 3 && !mine.empty(); ++ch) {
-      std::vector<double> vals;
-      for (const Texel& t : mine) vals.push_back(t.obs[ch]);
-      std::nth_element(vals.begin(), vals.begin() + long(vals.size() / 2), vals.end());
-      floor[ch] = std::max(0.05 * vals[vals.size() / 2], 1e-30);
-    }
-    for (Texel& t : mine)
-      for (int ch = 0; ch < 3; ++ch) t.inv_scale[ch] = 1 / std::max(t.obs[ch], floor[ch]);
-    texels.insert(texels.end(), mine.begin(), mine.end());
-  };
-  for (const GreyBallMaps& g : grey)
-    if (g.maps) add_ball(g.name, *g.maps, g.albedo, nullptr);
-  for (const GlossyBallMaps& g : glossy)
-    if (g.maps && g.brdf) add_ball(g.name, *g.maps, Vec3::Ones(), g.brdf);
-  out.texels = long(texels.size());
+};
 
-  // Which regions the balls can constrain.
+// One ball's maps added: every texel with confidence > 0 and finite radiance inside the disc; a
+// grey ball's known part is albedo / pi times the known irradiance at its normal, a glossy ball's
+// the FIS bake of its BRDF under the known part (made once, on the first glossy ball). Residuals
+// are relative, with a floor of 5% of the ball's median value per channel.
+void add_ball_texels(TrustedTexels& all, const std::string& name, const MapSet& maps, const Vec3& albedo,
+                     const Brdf* brdf, const EnvMap& known, const KnownIrradiance& irradiance,
+                     std::unique_ptr<Integrator>& fis, const SourceRecoveryOptions& options) {
+  const int ball = int(all.ball_names.size());
+  all.ball_names.push_back(name);
+  all.ball_kinds.push_back(brdf ? "glossy" : "grey");
+  std::map<std::string, int> view_index;
+  for (std::size_t v = 0; v < all.view_names.size(); ++v) view_index[all.view_names[v]] = int(v);
+  std::vector<Texel> mine;
+  for (std::size_t v = 0; v < maps.views.size(); ++v) {
+    const MapView& mv = maps.views[v];
+    if (mv.confidence.empty() || mv.rgb.type() != CV_32FC3)
+      throw std::invalid_argument("sources: " + name + " view." + std::to_string(v) +
+                                  " has no confidence (not captured)");
+    const std::string image = !mv.image.empty() ? mv.image : "view." + std::to_string(v);
+    const auto [it, fresh] = view_index.emplace(image, int(all.view_names.size()));
+    if (fresh) all.view_names.push_back(image);
+    cv::Mat glossy_known;
+    if (brdf) {
+      if (!fis) fis = make_integrator("fis", known);
+      IntegratorOptions io;
+      io.samples = options.glossy_samples;
+      io.seed = options.seed;
+      glossy_known = fis->radiance_map(*brdf, mv.view, mv.world_from_view, mv.rgb.cols, io);
+    }
+    const int W = mv.rgb.cols, H = mv.rgb.rows;
+    std::vector<std::vector<Texel>> rows(static_cast<std::size_t>(H));
+    parallel_for_rows(H, [&](int r) {
+      for (int c = 0; c < W; ++c) {
+        const float conf = mv.confidence.at<float>(r, c);
+        const cv::Vec3f o = mv.rgb.at<cv::Vec3f>(r, c);
+        if (!(conf > 0) || !std::isfinite(conf) || !(std::isfinite(o[0]) && std::isfinite(o[1]) && std::isfinite(o[2])))
+          continue;
+        const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), W, H);
+        if (xy.squaredNorm() >= 1) continue;
+        Texel t;
+        t.n = (mv.world_from_view * sphere_map::g_normal(xy)).normalized();
+        t.v = mv.view.normalized();
+        t.obs = Vec3(std::max(0.f, o[0]), std::max(0.f, o[1]), std::max(0.f, o[2]));
+        t.sqrt_w = std::sqrt(double(conf));
+        t.ball = ball;
+        t.view = it->second;
+        if (brdf) {
+          const cv::Vec3f g = glossy_known.at<cv::Vec3f>(r, c);
+          t.known = Vec3(g[0], g[1], g[2]);
+          t.gain = Vec3::Ones();
+          t.brdf = brdf;
+          t.mirror = 2 * t.n.dot(t.v) * t.n - t.v;
+          if (brdf->central_direction() == CentralDirection::Mirror) {
+            t.lobe = brdf->lobe_width(shading::Frame::around(t.n).to_local(t.v));
+          }
+        } else {
+          t.gain = albedo / kPi;
+          t.known = t.gain.cwiseProduct(irradiance(t.n));
+        }
+        rows[std::size_t(r)].push_back(t);
+      }
+    });
+    for (auto& row : rows) mine.insert(mine.end(), row.begin(), row.end());
+  }
+  Vec3 floor = Vec3::Zero();
+  for (int ch = 0; ch < 3 && !mine.empty(); ++ch) {
+    std::vector<double> vals;
+    for (const Texel& t : mine) vals.push_back(t.obs[ch]);
+    std::nth_element(vals.begin(), vals.begin() + long(vals.size() / 2), vals.end());
+    floor[ch] = std::max(0.05 * vals[vals.size() / 2], 1e-30);
+  }
+  for (Texel& t : mine)
+    for (int ch = 0; ch < 3; ++ch) t.inv_scale[ch] = 1 / std::max(t.obs[ch], floor[ch]);
+  all.texels.insert(all.texels.end(), mine.begin(), mine.end());
+}
+
+// The regions the balls can constrain (at most max_sources, each lighting at least min_lit_texels
+// trusted texels), in order; the others are added to `out` as unrecovered, with why.
+std::vector<int> constrained_regions(const std::vector<ClippedRegion>& regions, const std::vector<Texel>& texels,
+                                     const SourceRecoveryOptions& options, SourceRecovery& out) {
   std::vector<int> chosen;
   for (std::size_t ri = 0; ri < regions.size(); ++ri) {
     const ClippedRegion& g = regions[ri];
@@ -475,7 +466,172 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
     }
     chosen.push_back(int(ri));
   }
+  return chosen;
+}
+
+// The model M = K + sum_s P_s G_s at a texel (params: one block per source).
+Vec3 model_value(const Texel& t, const std::vector<Frame>& frames, const std::vector<std::array<double, kBlock>>& x) {
+  Vec3 m = t.known;
+  for (std::size_t s = 0; s < frames.size(); ++s)
+    m += kernel(t, direction_of(frames[s], x[s].data()), x[s][5]).cwiseProduct(Vec3(x[s][2], x[s][3], x[s][4]));
+  return m;
+}
+
+// Each ball's relative RMS residual, overall and per view, of the known part alone (after =
+// false) or with the sources (after = true), into `residuals` (one entry per ball, made on the
+// first call).
+void record_ball_residuals(const TrustedTexels& all, const std::vector<Frame>& frames,
+                           const std::vector<std::array<double, kBlock>>& params, bool after,
+                           std::vector<BallResidual>& residuals) {
+  const std::size_t balls = all.ball_names.size();
+  std::vector<double> num(balls, 0), den(balls, 0);
+  std::vector<std::map<int, std::pair<double, double>>> per_view(balls);
+  std::vector<long> count(balls, 0);
+  for (const Texel& t : all.texels) {
+    const Vec3 m = after ? model_value(t, frames, params) : t.known;
+    const double w = t.sqrt_w * t.sqrt_w, e = (t.obs - m).squaredNorm(), o = t.obs.squaredNorm();
+    num[std::size_t(t.ball)] += w * e, den[std::size_t(t.ball)] += w * o, ++count[std::size_t(t.ball)];
+    auto& pv = per_view[std::size_t(t.ball)][t.view];
+    pv.first += w * e, pv.second += w * o;
+  }
+  for (std::size_t b = 0; b < balls; ++b) {
+    if (residuals.size() <= b) {
+      BallResidual br;
+      br.ball = all.ball_names[b];
+      br.kind = all.ball_kinds[b];
+      br.texels = count[b];
+      for (const auto& [v, nd] : per_view[b]) br.views.push_back(all.view_names[std::size_t(v)]);
+      residuals.push_back(br);
+    }
+    BallResidual& br = residuals[b];
+    const double rel = den[b] > 0 ? std::sqrt(num[b] / den[b]) : 0;
+    (after ? br.after : br.before) = rel;
+    auto& list = after ? br.view_after : br.view_before;
+    list.clear();
+    for (const auto& [v, nd] : per_view[b]) list.push_back(nd.second > 0 ? std::sqrt(nd.first / nd.second) : 0);
+  }
+}
+
+// Leave-one-view-out solves from the full solution x, one per view (the known part without that
+// view's chrome map too, when `known_without` has it: the grey balls' texels re-predicted from it;
+// the glossy balls keep the full probe's bake). A fold moves the solution little: a few iterations.
+std::vector<std::vector<std::array<double, kBlock>>> jackknife_folds(
+    const TrustedTexels& all, const std::vector<Frame>& frames, const std::vector<std::array<double, kBlock>>& x,
+    double delta, bool fit_radius, const SourceRecoveryOptions& options,
+    const std::map<std::string, EnvMap>& known_without) {
+  std::vector<std::vector<std::array<double, kBlock>>> folds;
+  const std::vector<Texel>& texels = all.texels;
+  for (std::size_t v = 0; v < all.view_names.size(); ++v) {
+    std::vector<char> use(texels.size());
+    for (std::size_t i = 0; i < texels.size(); ++i) use[i] = texels[i].view != int(v);
+    std::vector<Texel> refolded;
+    if (const auto it = known_without.find(all.view_names[v]); it != known_without.end()) {
+      const KnownIrradiance fold_irradiance(it->second, options.known_width);
+      refolded = texels;
+      parallel_for_rows(int(refolded.size()), [&](int i) {
+        Texel& t = refolded[std::size_t(i)];
+        if (!t.brdf) t.known = t.gain.cwiseProduct(fold_irradiance(t.n));
+      });
+    }
+    folds.push_back(
+        refine(refolded.empty() ? texels : refolded, frames, x, delta, options.refine, fit_radius, false, use, 8).x);
+  }
+  return folds;
+}
+
+struct SourceSigmas {
+  Vec3 power = Vec3::Zero();
+  double direction = 0, radius = 0;
+};
+
+// Source s's sigmas: the larger of the fit's covariance (tangent offsets u ~ angles near u = 0)
+// and the jackknife's spread, and for its power the model's misfit as a floor: on the texels this
+// source lights, the fit's relative RMS residual r (per channel) is an error of the model
+// M = K + P G that the sources cannot be known better than; it moves P by r M / G, i.e.
+// sigma >= r P / f with f the source's mean share of M there. (The errors the views share, e.g.
+// the probe's known part near the source, escape the covariance and the jackknife; this is where
+// they show.)
+SourceSigmas source_sigmas(int s, const Fit& fit, const std::vector<std::vector<std::array<double, kBlock>>>& folds,
+                           const std::vector<Texel>& texels, const std::vector<Frame>& frames,
+                           const std::vector<std::array<double, kBlock>>& x, const LightSource& src,
+                           const SourceRecoveryOptions& options) {
+  SourceSigmas out;
+  const Frame& f = frames[std::size_t(s)];
+  const auto& xs = x[std::size_t(s)];
+  Vec3& sp = out.power;
+  double &sd = out.direction, &sr = out.radius;
+  if (fit.covariance_ok) {
+    const auto& c = fit.covariance[std::size_t(s)];
+    for (int k = 0; k < 3; ++k) sp[k] = std::sqrt(std::max(0.0, c(2 + k, 2 + k)));
+    const double cu = std::max(0.0, c(0, 0) + c(1, 1)) / std::pow(1 + xs[0] * xs[0] + xs[1] * xs[1], 2);
+    sd = std::sqrt(cu);
+    sr = std::sqrt(std::max(0.0, c(5, 5)));
+  }
+  if (!folds.empty()) {
+    const double n = double(folds.size());
+    Vec3 jp = Vec3::Zero(), mean = Vec3::Zero();
+    for (const auto& fo : folds) mean += Vec3(fo[std::size_t(s)][2], fo[std::size_t(s)][3], fo[std::size_t(s)][4]) / n;
+    double jd = 0, jr = 0, mean_r = 0;
+    for (const auto& fo : folds) mean_r += fo[std::size_t(s)][5] / n;
+    for (const auto& fo : folds) {
+      const Vec3 p(fo[std::size_t(s)][2], fo[std::size_t(s)][3], fo[std::size_t(s)][4]);
+      jp += (p - mean).cwiseAbs2();
+      jd += std::pow(angle_between(direction_of(f, fo[std::size_t(s)].data()), src.direction), 2);
+      jr += std::pow(fo[std::size_t(s)][5] - mean_r, 2);
+    }
+    const double k = (n - 1) / n;
+    for (int ch = 0; ch < 3; ++ch) sp[ch] = std::max(sp[ch], std::sqrt(k * jp[ch]));
+    sd = std::max(sd, std::sqrt(k * jd));
+    sr = std::max(sr, std::sqrt(k * jr));
+  }
+  Vec3 num = Vec3::Zero(), den = Vec3::Zero(), share = Vec3::Zero();
+  double count = 0;
+  for (const Texel& t : texels) {
+    const Vec3 g = kernel(t, src.direction, xs[5]);
+    if (t.brdf || light_kernels::mean_clamped_cosine(t.n.dot(src.direction), 0.0) <= options.min_lit_kernel) continue;
+    const Vec3 m = model_value(t, frames, x);
+    const double w = t.sqrt_w * t.sqrt_w;
+    for (int ch = 0; ch < 3; ++ch) {
+      if (!(m[ch] > 0)) continue;
+      num[ch] += w * (t.obs[ch] - m[ch]) * (t.obs[ch] - m[ch]);
+      den[ch] += w * m[ch] * m[ch];
+      share[ch] += w * g[ch] * src.power[ch] / m[ch];
+    }
+    count += w;
+  }
+  for (int ch = 0; ch < 3 && count > 0; ++ch)
+    if (den[ch] > 0 && share[ch] > 0)
+      sp[ch] = std::max(sp[ch], std::sqrt(num[ch] / den[ch]) * src.power[ch] / (share[ch] / count));
+  return out;
+}
+
+}  // namespace
+
+SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedRegion>& regions,
+                               const std::vector<GreyBallMaps>& grey, const std::vector<GlossyBallMaps>& glossy,
+                               const SourceRecoveryOptions& options,
+                               const std::map<std::string, EnvMap>& known_without) {
+  SourceRecovery out;
+  if (regions.empty()) return out;
+  if (known.layout.kind() != LayoutKind::LatLong) throw std::invalid_argument("sources: the probe must be lat-long");
+
+  TrustedTexels all;
+  {
+    const KnownIrradiance irradiance(known, options.known_width);
+    std::unique_ptr<Integrator> fis;
+    for (const GreyBallMaps& g : grey)
+      if (g.maps) add_ball_texels(all, g.name, *g.maps, g.albedo, nullptr, known, irradiance, fis, options);
+    for (const GlossyBallMaps& g : glossy)
+      if (g.maps && g.brdf)
+        add_ball_texels(all, g.name, *g.maps, Vec3::Ones(), g.brdf, known, irradiance, fis, options);
+  }
+  const std::vector<Texel>& texels = all.texels;
+  out.texels = long(texels.size());
+
+  const std::vector<int> chosen = constrained_regions(regions, texels, options, out);
   const int S = int(chosen.size());
+  // Each source starts at its region's centroid, its radius the option's (at least a quarter of
+  // the region's when glossy balls fit it).
   std::vector<Frame> frames;
   std::vector<std::array<double, kBlock>> x;
   for (int ri : chosen) {
@@ -496,44 +652,9 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
     for (int s = 0; s < S; ++s)
       x[std::size_t(s)][5] = std::max(x[std::size_t(s)][5], 0.25 * frames[std::size_t(s)].max_radius);
 
-  // Before: the known part alone.
-  auto ball_residuals = [&](const std::vector<std::array<double, kBlock>>& params, bool after) {
-    std::vector<Vec3> dirs;
-    for (int s = 0; s < S; ++s) dirs.push_back(direction_of(frames[std::size_t(s)], params[std::size_t(s)].data()));
-    std::vector<double> num(ball_names.size(), 0), den(ball_names.size(), 0);
-    std::vector<std::map<int, std::pair<double, double>>> per_view(ball_names.size());
-    std::vector<long> count(ball_names.size(), 0);
-    for (const Texel& t : texels) {
-      Vec3 m = t.known;
-      if (after)
-        for (int s = 0; s < S; ++s)
-          m += kernel(t, dirs[std::size_t(s)], params[std::size_t(s)][5])
-                   .cwiseProduct(Vec3(params[std::size_t(s)][2], params[std::size_t(s)][3], params[std::size_t(s)][4]));
-      const double w = t.sqrt_w * t.sqrt_w, e = (t.obs - m).squaredNorm(), o = t.obs.squaredNorm();
-      num[std::size_t(t.ball)] += w * e, den[std::size_t(t.ball)] += w * o, ++count[std::size_t(t.ball)];
-      auto& pv = per_view[std::size_t(t.ball)][t.view];
-      pv.first += w * e, pv.second += w * o;
-    }
-    for (std::size_t b = 0; b < ball_names.size(); ++b) {
-      if (out.residuals.size() <= b) {
-        BallResidual br;
-        br.ball = ball_names[b];
-        br.kind = ball_kinds[b];
-        br.texels = count[b];
-        for (const auto& [v, nd] : per_view[b]) br.views.push_back(view_names[std::size_t(v)]);
-        out.residuals.push_back(br);
-      }
-      BallResidual& br = out.residuals[b];
-      const double rel = den[b] > 0 ? std::sqrt(num[b] / den[b]) : 0;
-      (after ? br.after : br.before) = rel;
-      auto& list = after ? br.view_after : br.view_before;
-      list.clear();
-      for (const auto& [v, nd] : per_view[b]) list.push_back(nd.second > 0 ? std::sqrt(nd.first / nd.second) : 0);
-    }
-  };
-  ball_residuals(x, false);
+  record_ball_residuals(all, frames, x, false, out.residuals);
   if (S == 0) {
-    ball_residuals(x, true);
+    record_ball_residuals(all, frames, x, true, out.residuals);
     return out;
   }
 
@@ -552,29 +673,10 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
     fit = refine(texels, frames, x, delta, false, false, true, {});
   x = fit.x;
 
-  // Leave-one-view-out solves (from the full solution).
   std::vector<std::vector<std::array<double, kBlock>>> folds;
-  if (options.jackknife && view_names.size() >= 3) {
-    for (std::size_t v = 0; v < view_names.size(); ++v) {
-      std::vector<char> use(texels.size());
-      for (std::size_t i = 0; i < texels.size(); ++i) use[i] = texels[i].view != int(v);
-      // The known part without this view's chrome map too, when given (the grey balls' texels
-      // re-predicted from it; the glossy balls keep the full probe's bake).
-      std::vector<Texel> refolded;
-      if (const auto it = known_without.find(view_names[v]); it != known_without.end()) {
-        const KnownIrradiance fold_irradiance(it->second, options.known_width);
-        refolded = texels;
-        parallel_for_rows(int(refolded.size()), [&](int i) {
-          Texel& t = refolded[std::size_t(i)];
-          if (!t.brdf) t.known = t.gain.cwiseProduct(fold_irradiance(t.n));
-        });
-      }
-      // From the full solution, which a fold moves little: a few iterations.
-      folds.push_back(
-          refine(refolded.empty() ? texels : refolded, frames, x, delta, options.refine, fit_radius, false, use, 8).x);
-    }
-  }
-  ball_residuals(x, true);
+  if (options.jackknife && all.view_names.size() >= 3)
+    folds = jackknife_folds(all, frames, x, delta, fit_radius, options, known_without);
+  record_ball_residuals(all, frames, x, true, out.residuals);
 
   for (int s = 0; s < S; ++s) {
     const ClippedRegion& g = regions[std::size_t(chosen[std::size_t(s)])];
@@ -589,76 +691,20 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
     src.region_solid_angle = g.solid_angle;
     src.region_radius = g.radius;
     src.lower_bound = g.lower_bound;
-    // Sigmas: the covariance (tangent offsets u ~ angles near u = 0), then the jackknife.
-    Vec3 sp = Vec3::Zero();
-    double sd = 0, sr = 0;
-    if (fit.covariance_ok) {
-      const auto& c = fit.covariance[std::size_t(s)];
-      for (int k = 0; k < 3; ++k) sp[k] = std::sqrt(std::max(0.0, c(2 + k, 2 + k)));
-      const double cu = std::max(0.0, c(0, 0) + c(1, 1)) / std::pow(1 + xs[0] * xs[0] + xs[1] * xs[1], 2);
-      sd = std::sqrt(cu);
-      sr = std::sqrt(std::max(0.0, c(5, 5)));
-    }
-    if (!folds.empty()) {
-      const double n = double(folds.size());
-      Vec3 jp = Vec3::Zero(), mean = Vec3::Zero();
-      for (const auto& fo : folds)
-        mean += Vec3(fo[std::size_t(s)][2], fo[std::size_t(s)][3], fo[std::size_t(s)][4]) / n;
-      double jd = 0, jr = 0, mean_r = 0;
-      for (const auto& fo : folds) mean_r += fo[std::size_t(s)][5] / n;
-      for (const auto& fo : folds) {
-        const Vec3 p(fo[std::size_t(s)][2], fo[std::size_t(s)][3], fo[std::size_t(s)][4]);
-        jp += (p - mean).cwiseAbs2();
-        jd += std::pow(angle_between(direction_of(f, fo[std::size_t(s)].data()), src.direction), 2);
-        jr += std::pow(fo[std::size_t(s)][5] - mean_r, 2);
-      }
-      const double k = (n - 1) / n;
-      for (int ch = 0; ch < 3; ++ch) sp[ch] = std::max(sp[ch], std::sqrt(k * jp[ch]));
-      sd = std::max(sd, std::sqrt(k * jd));
-      sr = std::max(sr, std::sqrt(k * jr));
-    }
-    // The model's misfit as a floor: on the texels this source lights, the fit's relative RMS
-    // residual r (per channel) is an error of the model M = K + P G the sources cannot be known
-    // better than; it moves P by r M / G, i.e. sigma >= r P / f with f the source's mean share of M
-    // there. (The errors the views share, e.g. the probe's known part near the source, escape the
-    // covariance and the jackknife; this is where they show.)
-    {
-      Vec3 num = Vec3::Zero(), den = Vec3::Zero(), share = Vec3::Zero();
-      double count = 0;
-      for (const Texel& t : texels) {
-        const Vec3 g = kernel(t, src.direction, xs[5]);
-        if (t.brdf || light_kernels::mean_clamped_cosine(t.n.dot(src.direction), 0.0) <= options.min_lit_kernel)
-          continue;
-        Vec3 m = t.known;
-        for (int q = 0; q < S; ++q)
-          m += kernel(t, direction_of(frames[std::size_t(q)], x[std::size_t(q)].data()), x[std::size_t(q)][5])
-                   .cwiseProduct(Vec3(x[std::size_t(q)][2], x[std::size_t(q)][3], x[std::size_t(q)][4]));
-        const double w = t.sqrt_w * t.sqrt_w;
-        for (int ch = 0; ch < 3; ++ch) {
-          if (!(m[ch] > 0)) continue;
-          num[ch] += w * (t.obs[ch] - m[ch]) * (t.obs[ch] - m[ch]);
-          den[ch] += w * m[ch] * m[ch];
-          share[ch] += w * g[ch] * src.power[ch] / m[ch];
-        }
-        count += w;
-      }
-      for (int ch = 0; ch < 3 && count > 0; ++ch)
-        if (den[ch] > 0 && share[ch] > 0)
-          sp[ch] = std::max(sp[ch], std::sqrt(num[ch] / den[ch]) * src.power[ch] / (share[ch] / count));
-    }
-    src.power_sigma = sp;
-    src.direction_sigma = sd;
-    src.radius_sigma = fit_radius ? sr : 0;
+    const SourceSigmas sigmas = source_sigmas(s, fit, folds, texels, frames, x, src, options);
+    src.power_sigma = sigmas.power;
+    src.direction_sigma = sigmas.direction;
+    src.radius_sigma = fit_radius ? sigmas.radius : 0;
     // The views and balls whose trusted texels it lights.
     std::map<int, long> lit_views;
-    std::vector<char> lit_balls(ball_names.size(), 0);
+    std::vector<char> lit_balls(all.ball_names.size(), 0);
     for (const Texel& t : texels)
       if (light_kernels::mean_clamped_cosine(t.n.dot(src.direction), 0.0) > options.min_lit_kernel)
         ++lit_views[t.view], lit_balls[std::size_t(t.ball)] = 1;
     for (const auto& [v, count] : lit_views)
-      if (count >= 10) src.views.push_back(view_names[std::size_t(v)]);
-    for (std::size_t b = 0; b < ball_names.size(); ++b)
-      if (lit_balls[b]) src.balls.push_back(ball_names[b]);
+      if (count >= 10) src.views.push_back(all.view_names[std::size_t(v)]);
+    for (std::size_t b = 0; b < all.ball_names.size(); ++b)
+      if (lit_balls[b]) src.balls.push_back(all.ball_names[b]);
     const bool finite = src.direction.allFinite() && src.power.allFinite() && src.power_sigma.allFinite() &&
                         std::isfinite(src.direction_sigma) && std::isfinite(src.radius) &&
                         std::isfinite(src.radius_sigma);
