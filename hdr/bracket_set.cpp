@@ -1,9 +1,12 @@
 #include "hdr/bracket_set.h"
+
+#include "core/parallel.h"
 #include "core/image_codecs.h"
 
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <exception>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
@@ -155,13 +158,30 @@ BracketSet load_brackets(const PhotoView& view, bool fit_sizes) {
       metadata.push_back(resolve_exposure(b));
       if (is_jpeg_file(b.file) && !jpeg_is_complete(name))
         throw std::invalid_argument(name + ": a truncated JPEG (its image data stops before the end-of-image marker)");
-      ranges.push_back(to_codes(read_image(name, cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH), c, name, true));
+      ranges.push_back(0);  // decoded below, with the view's other images
       raw_info.emplace_back();
       raw_saturated.emplace_back();
     }
     exposures.push_back(metadata.back().relative);
     codes.push_back(std::move(c));
     names.push_back(name);
+  }
+  // The images (not RAW: LibRaw's files take the first one's white balance, in order) decoded in
+  // parallel, each on its own: decoding is most of a view's load. The first error in bracket
+  // order is the one reported.
+  if (raw_count == 0) {
+    std::vector<std::exception_ptr> errors(codes.size());
+    parallel_for_rows(int(codes.size()), [&](int j) {
+      const std::size_t k = std::size_t(j);
+      try {
+        ranges[k] =
+            to_codes(read_image(names[k], cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH), codes[k], names[k], true);
+      } catch (...) {
+        errors[k] = std::current_exception();
+      }
+    });
+    for (const std::exception_ptr& e : errors)
+      if (e) std::rethrow_exception(e);
   }
   if (codes.empty()) throw std::runtime_error("view " + view.name + ": no brackets");
   if (raw_count > 0 && raw_count < int(codes.size()))
