@@ -5,6 +5,7 @@
 #include <opencv2/core.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -23,6 +24,13 @@ LensModel far_camera_lens(const std::vector<std::pair<int, int>>& sizes) {
     w = std::max(w, sw), h = std::max(h, sh);
   }
   return LensModel::pinhole(kFarCameraFocalPerSide * double(std::max(w, h)), w, h);
+}
+
+bool is_far_camera(const LensModel& lens) {
+  const std::vector<double>& in = lens.intrinsics();
+  const double f = kFarCameraFocalPerSide * double(std::max(lens.width(), lens.height()));
+  return lens.name() == "LENSMODEL_PINHOLE" && in.size() == 4 && std::abs(in[0] - f) <= 1e-6 * f &&
+         std::abs(in[1] - f) <= 1e-6 * f;
 }
 
 ViewImage on_lens_canvas(ViewImage view, const LensModel& lens, const std::string& name) {

@@ -33,6 +33,10 @@ bool fills_frame(double radius_px, int width, int height);
 // The far-camera pinhole for views of these sizes (>= 1): canvas = the largest width and height.
 LensModel far_camera_lens(const std::vector<std::pair<int, int>>& sizes);
 
+// Whether `lens` is such a far camera (a pinhole whose focal length is k times its canvas's longer
+// side, as far_camera_lens makes it; a written and re-read model to 1e-6).
+bool is_far_camera(const LensModel& lens);
+
 // `view` placed at the canvas's top-left corner when the lens's canvas is larger: the radiance
 // continued by replicating its border (no edge where the photo ends, for the ball finder) and the
 // added pixels flagged kOutside (hdr/merge.h: not seen, for extraction and features). Returns the

@@ -64,7 +64,14 @@ int run_extract_rig(const ExtractArgs& a) {
   s.lens = &lens;
   s.poses = read_pose_file(a.poses);
   s.balls = listed_balls(set);
-  const std::vector<BallOverride> overrides = parse_ball_overrides(a.balls, set);
+  std::vector<BallOverride> overrides;
+  try {
+    overrides = parse_ball_overrides(a.balls, set);
+  } catch (const std::invalid_argument& e) {
+    // The library names the option as rsibr process spells it.
+    const std::string what = e.what();
+    throw std::invalid_argument(what.rfind("--ball ", 0) == 0 ? "--view-ball " + what.substr(7) : what);
+  }
   std::vector<std::filesystem::path> inputs = {a.lens, a.poses};
   for (const PhotoView& v : set.views) {
     s.views.push_back(v.name);
@@ -78,9 +85,16 @@ int run_extract_rig(const ExtractArgs& a) {
     }
   }
   // A view of the lens's size as it is; crops of the ball on a far camera's canvas (calib/far_camera.h).
+  // Any other lens of another size is the wrong lens: refused, as rsibr process refuses it.
+  const bool far = is_far_camera(lens);
   s.read_view = [&](const std::string& name) {
     const std::string file = (std::filesystem::path(a.merged) / (name + ".exr")).string();
-    return on_lens_canvas(read_view_image(file), lens, file);
+    ViewImage img = read_view_image(file);
+    if (!far && (img.radiance.cols != lens.width() || img.radiance.rows != lens.height()))
+      throw std::invalid_argument(file + ": " + std::to_string(img.radiance.cols) + "x" +
+                                  std::to_string(img.radiance.rows) + " but the lens model " + a.lens + " is " +
+                                  std::to_string(lens.width()) + "x" + std::to_string(lens.height()));
+    return on_lens_canvas(std::move(img), lens, file);
   };
   s.map_size = a.size_given ? a.size : 0;
   s.probe_width = a.probe_width;

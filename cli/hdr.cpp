@@ -23,6 +23,7 @@
 #include "hdr/photo_set_merge.h"
 #include "hdr/response_recovery.h"
 #include "pipeline/vignetting_input.h"
+#include "calib/far_camera.h"
 
 #include "core/image_codecs.h"
 
@@ -315,6 +316,16 @@ int run_hdr(const HdrArgs& a) {
       const NoiseModel& noise = vm.noise;
       MergedImage& m = vm.image;
       const std::string& from = vm.input_colour_space;
+      // The model is in the lens's pixels: a given lens of another size than the photos is the
+      // wrong one (unless it is a far camera's canvas for crops), and so is any lens the model
+      // divides out about.
+      const bool other_size = m.radiance.cols != lens.width() || m.radiance.rows != lens.height();
+      if (other_size && (!vignetting.is_identity() || (given_lens && a.vignetting != "none" && !is_far_camera(lens))))
+        throw std::invalid_argument(
+            (given_lens ? (!a.lens.empty() ? a.lens : set.camera_model->string()) : std::string("the lens")) + ": " +
+            std::to_string(lens.width()) + "x" + std::to_string(lens.height()) + " but view " + v.name +
+            "'s photos are " + std::to_string(m.radiance.cols) + "x" + std::to_string(m.radiance.rows) +
+            " (vignetting is about its principal point)");
       const auto t2 = std::chrono::steady_clock::now();
       std::string files;
       for (const std::string& f : b.files) files += (files.empty() ? "" : ";") + relative_name(f, set.folder);

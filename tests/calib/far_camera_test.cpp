@@ -3,6 +3,7 @@
 // added; and a rendered chrome ball cropped as people crop them (the ball filling the frame, cut
 // by one edge) is found and taken as the crop's ball.
 #include "calib/far_camera.h"
+#include "core/test_data.h"  // tests/core/test_data.h
 
 #include "calib/ball_identification.h"
 #include "calib/sphere_map_extraction.h"
@@ -35,6 +36,18 @@ TEST(FarCamera, LensCoversTheLargestViewAndKeepsEveryBallNearlyOrthographic) {
   EXPECT_LT(std::asin(250.0 / f) / kDeg, 0.29);
   EXPECT_THROW(far_camera_lens({}), std::invalid_argument);
   EXPECT_THROW(far_camera_lens({{0, 10}}), std::invalid_argument);
+}
+
+TEST(FarCamera, IsRecognisedAfterAWriteAndReadAndOtherLensesAreNot) {
+  const LensModel far = far_camera_lens({{493, 493}, {493, 494}});
+  EXPECT_TRUE(is_far_camera(far));
+  testing::TempDir dir;
+  const auto file = dir.path() / "far.cameramodel";
+  far.write(file);
+  EXPECT_TRUE(is_far_camera(LensModel::read(file)));
+  EXPECT_FALSE(is_far_camera(LensModel::pinhole(0.99 * kFarCameraFocalPerSide * 494, 493, 494)));
+  EXPECT_FALSE(is_far_camera(LensModel::pinhole(700, 640, 480)));
+  EXPECT_FALSE(is_far_camera(LensModel("LENSMODEL_OPENCV4", {49400, 49400, 246, 246.5, 0, 0, 0, 0}, 493, 494)));
 }
 
 TEST(FarCamera, CanvasKeepsThePhotoReplicatesItsBorderAndFlagsTheRest) {

@@ -558,6 +558,17 @@ expect_error "extract --photoset: a missing merged view, named" "view00.exr: mis
 expect_error "extract: neither an image nor a photo set" "give an IMAGE" extract --lens "$work/pout/lens.cameramodel" \
   --out "$work/prig-e3.exr"
 check "extract --photoset: nothing written after the errors" bash -c "test ! -e '$work/prig-e1' && test ! -e '$work/prig-e2'"
+pinhole_lens "$work/small.cameramodel"
+expect_error "extract --photoset: a lens of another size than the views (not a far camera), named" \
+  "but the lens model $work/small.cameramodel is 96x64" extract --photoset "$work/psyn/photos" --merged "$work/pout/hdr" \
+  --lens "$work/small.cameramodel" --poses "$work/pout/poses.yaml" --out "$work/prig-e4" -q
+expect_error "extract --photoset: a malformed --view-ball is named as such" "--view-ball 'view00:chrome'" \
+  extract --photoset "$work/psyn/photos" --merged "$work/pout/hdr" --lens "$work/pout/lens.cameramodel" \
+  --poses "$work/pout/poses.yaml" --out "$work/prig-e5" --view-ball view00:chrome -q
+expect_error "hdr: a lens of another size than the photos, when vignetting is divided out" \
+  "small.cameramodel: 96x64 but view view00's photos are 320x240" hdr "$work/psyn/photos" --out "$work/phdr-e3" \
+  --lens "$work/small.cameramodel" -q
+check "no output after the lens-size errors" bash -c "test ! -e '$work/prig-e4' && test ! -e '$work/prig-e5' && test ! -e '$work/phdr-e3'"
 # rsibr compare and process's compare step write one JSON (compare/comparison_report.h).
 "$rsibr" compare "$work/pout/maps/captured-grey.exr" "$work/pout/maps/computed-grey.exr" --json "$work/pcmp.json" -q
 check "compare and process's compare step report the same numbers under the same keys" python3 -c "
