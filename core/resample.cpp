@@ -208,7 +208,6 @@ void interpolated_rows(const EnvMap& src, const Layout& dst, const LatLongRipmap
   constexpr double kPositionTolerance = 0.02, kDensityTolerance = 1e-3;
   const int width = dst.width(), ch = src.channels(), max_n = std::max(1, options.max_subsamples);
   const double period = src.layout.width() - 1, dlat = ripmap.latitude_step();
-  const double kInset = CornerLines::kInset;
   CornerLines lines(dst, src.layout);
   double acc[kMaxChannels];
   float tap[kMaxChannels];
