@@ -58,6 +58,7 @@ std::map<std::string, Runner> add_verbs(CLI::App& app) {
   runners["balls"] = add_balls(app);
   runners["process"] = add_process(app);
   runners["plan"] = add_plan(app);
+  runners["export"] = add_export(app);
   return runners;
 }
 

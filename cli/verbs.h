@@ -28,5 +28,6 @@ Runner add_orient(CLI::App& app);
 Runner add_balls(CLI::App& app);
 Runner add_process(CLI::App& app);
 Runner add_plan(CLI::App& app);
+Runner add_export(CLI::App& app);
 
 }  // namespace rsibr::cli

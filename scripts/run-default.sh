@@ -77,5 +77,11 @@ elif ! report=$("${process[@]}"); then
   echo "run-default: the orientation solve failed (above: the minimal sky is featureless); using the synthetic truth's poses" >&2
   report=$("${process[@]}" --poses "$out/onset/truth/truth.yaml")
 fi
+# The run as a Blender scene (world, cameras on their poses, the balls), with frame 1 rendered by
+# Cycles over its photo; skipped where Blender is not installed.
+if command -v blender >/dev/null; then
+  "$rsibr" export blender "$out/onset/process" --out "$out/onset/blender" --preview 64 -q
+  echo "run-default: Blender scene: $out/onset/blender/scene.blend (Cycles preview: preview.png)"
+fi
 echo "run-default: results in $out/ (EXR, PNG previews, JSON summaries)"
 echo "run-default: report: $report"

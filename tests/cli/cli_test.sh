@@ -6,7 +6,7 @@ set -u
 rsibr=$1
 . "$(dirname "$0")/contract_lib.sh"
 
-for verb in convert info pattern blend bake reference render view hdr compare synth extract calibrate probe orient balls process plan; do
+for verb in convert info pattern blend bake reference render view hdr compare synth extract calibrate probe orient balls process plan export; do
   check "$verb --help" bash -c "'$rsibr' $verb --help | grep -q Usage"
 done
 check "top-level --help" bash -c "'$rsibr' --help | grep -q convert"
