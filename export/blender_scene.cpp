@@ -144,10 +144,15 @@ std::vector<Vec3> fresnel_table(const std::string& fresnel_spec, int n) {
   return table;
 }
 
-BlenderExport blender_export_from_run(const fs::path& run, const BlenderExportOptions& options) {
+namespace {
+
+// `json_file` is set to each record before its fields are read, so a record of the wrong shape is
+// named in the error.
+BlenderExport export_from_run(const fs::path& run, const BlenderExportOptions& options, fs::path& json_file) {
   BlenderExport out;
   out.samples = options.samples;
   const fs::path extract_file = run / "steps" / "extract.json";
+  json_file = extract_file;
   const nlohmann::json extract = read_json(extract_file);
   const nlohmann::json& settings = field(extract, "settings", extract_file);
   const nlohmann::json& summary = field(extract, "summary", extract_file);
@@ -175,8 +180,10 @@ BlenderExport blender_export_from_run(const fs::path& run, const BlenderExportOp
     ball.radius = member->at("scale").get<double>() * chrome_radius;
     if (kind == "chrome") {
       const fs::path probe_file = run / "steps" / "probe.json";
+      json_file = probe_file;
       const nlohmann::json probe = read_json(probe_file);
       const std::string spec = field(field(probe, "summary", probe_file), "fresnel", probe_file).get<std::string>();
+      json_file = extract_file;
       ball.fresnel_table = "fresnel-" + name + ".exr";
       const std::vector<Vec3> table = fresnel_table(spec);
       cv::Mat rgb(1, int(table.size()), CV_32FC3);
@@ -255,11 +262,23 @@ BlenderExport blender_export_from_run(const fs::path& run, const BlenderExportOp
 
   const fs::path render_file = run / "steps" / "render.json";
   if (fs::is_regular_file(render_file)) {
+    json_file = render_file;
     const nlohmann::json render = read_json(render_file);
     if (render.contains("summary") && render["summary"].contains("display_exposure_stops"))
       out.exposure_stops = render["summary"]["display_exposure_stops"].get<double>();
   }
   return out;
+}
+
+}  // namespace
+
+BlenderExport blender_export_from_run(const fs::path& run, const BlenderExportOptions& options) {
+  fs::path json_file = run / "steps";
+  try {
+    return export_from_run(run, options, json_file);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::invalid_argument(json_file.string() + ": not a record rsibr process writes (" + e.what() + ")");
+  }
 }
 
 nlohmann::json blender_scene_json(const BlenderExport& scene) {
