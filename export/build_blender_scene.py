@@ -179,6 +179,10 @@ def build(scene_file):
     scene.render.engine = "CYCLES"
     scene.cycles.samples = spec["samples"]
     scene.cycles.use_denoising = False
+    # No clamping: the run's radiance is in its own units (often thousands), and Cycles' default
+    # indirect clamp of 10 would blacken every reflection of one ball in another.
+    scene.cycles.sample_clamp_direct = 0.0
+    scene.cycles.sample_clamp_indirect = 0.0
     scene.render.film_transparent = True
     scene.view_settings.view_transform = "Standard"
     scene.view_settings.exposure = spec["display"]["exposure_stops"]
