@@ -80,7 +80,7 @@ fi
 # The run as a Blender scene (world, cameras on their poses, the balls), with frame 1 rendered by
 # Cycles over its photo; skipped where Blender is not installed.
 if command -v blender >/dev/null; then
-  "$rsibr" export blender "$out/onset/process" --out "$out/onset/blender" --preview 64 -q
+  "$rsibr" export blender "$out/onset/process" --out "$out/onset/blender" --preview 128 -q
   echo "run-default: Blender scene: $out/onset/blender/scene.blend (Cycles preview: preview.png)"
 fi
 echo "run-default: results in $out/ (EXR, PNG previews, JSON summaries)"
