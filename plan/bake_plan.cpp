@@ -13,6 +13,9 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace rsibr {
 namespace {
@@ -142,6 +145,483 @@ struct Pilots {
   }
 };
 
+// Throws std::invalid_argument for options no plan can use (a budget outside (0, 1), an empty
+// candidate list, a margin outside (0, 1], a size under 2, a view set that cannot be named, sigmas <
+// 0, negative confirmation views, a guide size neither 0 nor >= 2), in that order; returns the named
+// view sets, in order.
+std::vector<ViewSet> check_options(const BakePlanOptions& options) {
+  if (!(options.max_error > 0 && options.max_error < 1))
+    throw std::invalid_argument("plan: the error budget must lie in (0, 1) (a relative RMS, e.g. 0.02 for 2%), not " +
+                                std::to_string(options.max_error));
+  if (options.view_sets.empty() || options.sizes.empty() || options.integrators.empty())
+    throw std::invalid_argument("plan: no view set, map size or integrator to choose from");
+  if (!(options.margin > 0 && options.margin <= 1)) throw std::invalid_argument("plan: the margin must lie in (0, 1]");
+  for (int r : options.sizes)
+    if (r < 2) throw std::invalid_argument("plan: map sizes must be at least 2, not " + std::to_string(r));
+  std::vector<ViewSet> view_sets;
+  for (const std::string& name : options.view_sets) view_sets.push_back(ViewSet::named(name));
+
+  if (!(options.sigmas >= 0)) throw std::invalid_argument("plan: the number of standard errors must be >= 0");
+  if (options.confirm_views < 0)
+    throw std::invalid_argument("plan: the confirmation's views must be >= 0 (0: the pilot's own)");
+  if (options.confirm_max_views < 0) throw std::invalid_argument("plan: the confirmation's most views must be >= 0");
+  if (options.guide_size != 0 && options.guide_size < 2)
+    throw std::invalid_argument("plan: the guide's size must be 0 (no guide) or at least 2");
+  return view_sets;
+}
+
+// `views` novel views x pilot_texels texels of pilot_size discs drawn from `seed`, guided by a cheap
+// bake of the interpolation integrator (with the plan's seed) unless guide_size is 0.
+ErrorSample plan_sample(Pilots& pilots, const Brdf& brdf, const BakePlanOptions& options, int views,
+                        std::uint64_t seed) {
+  if (options.guide_size > 0)
+    return ErrorSample(views, options.pilot_texels, options.pilot_size, seed,
+                       squared_radiance_guide(pilots.integrator(kInterpolationIntegrator.method), brdf,
+                                              options_of(kInterpolationIntegrator, options.seed), options.guide_size));
+  return ErrorSample(views, options.pilot_texels, options.pilot_size, seed);
+}
+
+// A candidate: its planned setting, the index of its view set and e_int + k s_int.
+struct Candidate {
+  PlannedSetting planned;
+  std::size_t set;
+  double integration_upper;  // e_int + k s_int
+};
+
+// The screen counts e_interp at half: the FIS maps' blend against FIS direct values carries FIS's
+// own error pattern, which does not cancel between the two and is not the whole of what the
+// subtraction in quadrature takes out (under hall with GGX gold the pilot's e_interp for 642 x
+// 64^2 was 2.9% while the whole setting checked at 1.86%), and a pessimistic screen keeps the
+// cheaper candidates from ever being measured.
+constexpr double kInterpolationScreen = 0.5;
+// The model screens, a measurement decides (see the header): a screened-in candidate is blended
+// at the confirmation texels with its own integrator and taken when that error plus k sigma fits. The
+// screen is optimistic: an unbiased integrator's (mis) error counts at a third, the most the
+// blend's 3 sources x 4 taps can average its noise away, and e_interp at half (above).
+constexpr double kMisScreen = 1.0 / 3.0;
+// A confirmation stops (when it may) once its pooled error provably exceeds kStopAbove times the
+// planned budget (BakePlanner::confirm).
+constexpr double kStopAbove = 1.5;
+
+// plan_bake in steps, with the state they share: the pilot (the constructor), the screen with its
+// confirmations, the two fall-back measurements and the plan with its why (finish). Each step
+// fills in plan_; e_interp, the confirmations' samples and the screen's factors are measured once
+// and kept here.
+class BakePlanner {
+ public:
+  // The pilot; view_sets are options.view_sets named (check_options).
+  BakePlanner(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& options, std::vector<ViewSet> view_sets);
+
+  void screen_and_confirm();
+  void measure_least_screened();
+  void measure_least_bound();
+  BakePlan finish();
+
+ private:
+  std::pair<const ErrorSample&, const std::vector<Vec3>&> confirmation(std::size_t j);
+  bool may_extend(int pooled) const;
+  double planned_budget(int pooled) const;
+  ErrorEstimate interpolation_error(std::size_t set, int res);
+  std::vector<Candidate> candidates() const;
+  double screened_integration(const PlannedSetting& s) const;
+  bool dominated(std::size_t set, int res, double allowance) const;
+  std::optional<ErrorEstimate> reached_interpolation(const Candidate& c, double ie);
+  void calibrate(const PlannedSetting& s, double m, double ie, double interp);
+  std::optional<ErrorEstimate> confirm(Candidate& c, bool may_stop);
+  std::string explain() const;
+
+  // The confirmations' texels of one round, with the truth there (own: nullopt for the pilot's).
+  struct ConfirmRound {
+    std::optional<ErrorSample> own;
+    std::vector<Vec3> truth;
+  };
+
+  const Brdf& brdf_;
+  const BakePlanOptions& options_;
+  const std::vector<ViewSet> view_sets_;
+  const double budget_;  // margin * max_error: the planned budget at the first round's views
+  const double k_;       // options.sigmas
+  const std::chrono::steady_clock::time_point t_start_;
+  BakePlan plan_;
+  Pilots pilots_;
+  const ErrorSample sample_;  // the pilot's texels
+  const int first_round_views_;
+  // The confirmations' work is bounded by max_confirmations candidates' worth of first-round views
+  // (a confirmation stopped early counts the views it measured; its later rounds are not counted, so
+  // that a decision started is finished).
+  const long long views_allowed_;
+  int confirmations_ = 0;
+  long long views_measured_ = 0;
+  std::vector<ConfirmRound> rounds_;
+  // e_interp's cache: the interpolation integrator's direct values at the pilot's texels, its own
+  // error there, and each (view set, size) pair measured.
+  std::vector<Vec3> interpolation_direct_;
+  double interpolation_own_ = 0;
+  std::map<std::pair<std::size_t, int>, ErrorEstimate> interpolation_;
+  std::vector<Candidate> candidates_;  // by predicted time; plan_.settings follows it
+  // The screen's factors (calibrate).
+  double interpolation_screen_ = kInterpolationScreen;
+  double mis_screen_ = kMisScreen;
+  bool calibrated_ = false, mis_calibrated_ = false;
+};
+
+// The pilot's texels, guided by a cheap bake of the interpolation integrator; the truth there and
+// every integrator setting's error and time per texel. Throws std::invalid_argument when no setting
+// can bake the BRDF.
+BakePlanner::BakePlanner(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& options,
+                         std::vector<ViewSet> view_sets)
+    : brdf_(brdf),
+      options_(options),
+      view_sets_(std::move(view_sets)),
+      budget_(options.margin * options.max_error),
+      k_(options.sigmas),
+      t_start_(std::chrono::steady_clock::now()),
+      pilots_(env),
+      sample_(plan_sample(pilots_, brdf, options, options.pilot_views, options.seed)),
+      first_round_views_(options.confirm_views > 0 ? options.confirm_views : options.pilot_views),
+      views_allowed_((long long)options.max_confirmations * first_round_views_) {
+  plan_.options = options;
+  pilots_.measure(brdf, sample_, options.integrators, options.seed, options.pilot_size);
+  plan_.integrators = pilots_.integrators;
+  plan_.truth_texels = sample_.count();
+  if (plan_.integrators.empty()) throw std::invalid_argument("plan: no integrator setting can bake this BRDF");
+  plan_.interpolation_integrator = interpolation_integrator(plan_.integrators, budget_);
+  candidates_ = candidates();
+}
+
+// The confirmations' texels, in rounds: round 0 is a sample of its own (confirm_views novel views,
+// another seed, drawn the same way), the pilot's own when confirm_views is 0; round j >= 1 adds
+// confirm_views 2^(j-1) fresh views, so that rounds 0..j pool confirm_views 2^j. Each is made, with
+// the truth there, when first needed: a plan that measures no candidate does not pay for its truth.
+// The references hold until the next call.
+std::pair<const ErrorSample&, const std::vector<Vec3>&> BakePlanner::confirmation(std::size_t j) {
+  while (rounds_.size() <= j) {
+    ConfirmRound r;
+    if (options_.confirm_views > 0) {
+      const std::size_t n = rounds_.size();
+      const int views = n == 0 ? options_.confirm_views : options_.confirm_views << (n - 1);
+      const std::uint64_t confirm_seed = (options_.seed ^ 0x9e3779b97f4a7c15ull) + n;
+      r.own.emplace(plan_sample(pilots_, brdf_, options_, views, confirm_seed));
+      r.truth =
+          direct_values(pilots_.integrator("reference"), brdf_, options_of({"reference", 0, 0}, options_.seed), *r.own);
+      plan_.truth_texels += r.own->count();
+    }
+    rounds_.push_back(std::move(r));
+  }
+  if (j == 0) plan_.confirm_texels = rounds_[0].own ? rounds_[0].own->count() : sample_.count();
+  if (rounds_[j].own) return {*rounds_[j].own, rounds_[j].truth};
+  return {sample_, pilots_.truth};
+}
+
+// Rounds beyond the first: only with a sample of the confirmations' own, up to confirm_max_views.
+bool BakePlanner::may_extend(int pooled) const {
+  return options_.confirm_views > 0 && 2 * pooled <= options_.confirm_max_views;
+}
+
+// The planned budget at n pooled views: the reserve (1 - margin) of the budget is for the
+// confirmation's scatter between samples, which falls as 1 / sqrt(n); it is the whole reserve at
+// the first round's views.
+double BakePlanner::planned_budget(int pooled) const {
+  const double reserve = options_.max_error - budget_;
+  return options_.max_error - reserve * std::sqrt(double(first_round_views_) / std::max(pooled, first_round_views_));
+}
+
+// e_interp(N, r) with its standard error, measured when first needed: the FIS maps' blend against
+// FIS direct values, less (in quadrature) FIS's own error against the truth at the same texels,
+// which the direct side carries and the blend does not share. Each measurement is added to
+// plan_.interpolation.
+ErrorEstimate BakePlanner::interpolation_error(std::size_t set, int res) {
+  const auto key = std::make_pair(set, res);
+  if (auto it = interpolation_.find(key); it != interpolation_.end()) return it->second;
+  const Integrator& integrator = pilots_.integrator(plan_.interpolation_integrator.method);
+  const IntegratorOptions o = options_of(plan_.interpolation_integrator, options_.seed);
+  if (interpolation_direct_.empty()) {
+    interpolation_direct_ = direct_values(integrator, brdf_, o, sample_);
+    interpolation_own_ = sample_error(sample_, interpolation_direct_, pilots_.truth).value;
+    plan_.interpolation_integrator_error = interpolation_own_;
+  }
+  const SampledBlend b = sampled_blend(integrator, brdf_, o, view_sets_[set], res, options_.normalise_albedo, sample_);
+  InterpolationPilot p;
+  p.views = options_.view_sets[set];
+  p.view_count = int(view_sets_[set].views().size());
+  p.res = res;
+  ErrorEstimate e = sample_error(sample_, b.values, interpolation_direct_, &b.weights);
+  p.raw_error = e.value;
+  e.value = std::sqrt(std::max(0.0, e.value * e.value - interpolation_own_ * interpolation_own_));
+  p.error = e.value;
+  p.error_sigma = e.sigma;
+  p.texels = b.texels_baked;
+  p.seconds = b.seconds;
+  plan_.interpolation.push_back(p);
+  interpolation_[key] = e;
+  return e;
+}
+
+// Every candidate with its predicted time, cheapest first (a stable sort: ties keep the order view
+// set, size, integrator).
+std::vector<Candidate> BakePlanner::candidates() const {
+  std::vector<Candidate> candidates;
+  for (std::size_t v = 0; v < view_sets_.size(); ++v)
+    for (int r : options_.sizes)
+      for (const IntegratorPilot& p : plan_.integrators) {
+        PlannedSetting s;
+        s.setting = {options_.view_sets[v], int(view_sets_[v].views().size()), r, p.setting};
+        s.integration_error = p.error;
+        s.error = p.error;
+        s.upper_error = p.error + k_ * p.error_sigma;
+        s.seconds = p.setup_seconds + double(s.setting.view_count) * double(disc_texel_count(r)) * p.seconds_per_texel;
+        candidates.push_back({s, v, s.upper_error});
+      }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.planned.seconds < b.planned.seconds; });
+  return candidates;
+}
+
+// The integration part of the screen: mis's error times its factor, any other's as measured.
+double BakePlanner::screened_integration(const PlannedSetting& s) const {
+  return s.setting.integrator.method == "mis" ? mis_screen_ * s.integration_error : s.integration_error;
+}
+
+// A pair (N, r) cannot meet an allowance that a measured pair with at least as many views and at
+// least the size already misses (more views and texels do not interpolate worse): not measured.
+bool BakePlanner::dominated(std::size_t set, int res, double allowance) const {
+  for (const auto& [key, e] : interpolation_)
+    if (view_sets_[key.first].views().size() >= view_sets_[set].views().size() && key.second >= res &&
+        interpolation_screen_ * e.value > allowance)
+      return true;
+  return false;
+}
+
+// e_interp for c's pair when the screen reaches it (every pair when asked; else before a choice,
+// when the screened integration part ie fits the budget and no measured pair dominates it), else
+// the one already measured for the pair; nullopt when neither.
+std::optional<ErrorEstimate> BakePlanner::reached_interpolation(const Candidate& c, double ie) {
+  const int res = c.planned.setting.res;
+  const double allowance = ie < budget_ ? std::sqrt(budget_ * budget_ - ie * ie) : 0.0;
+  if (options_.every_pair || (!plan_.chosen && ie <= budget_ && !dominated(c.set, res, allowance)))
+    return interpolation_error(c.set, res);
+  if (auto it = interpolation_.find({c.set, res}); it != interpolation_.end()) return it->second;
+  return std::nullopt;
+}
+
+// The screen, calibrated by what the measurements say. Each factor starts as above and becomes
+// the least that the measurements so far imply, from measured^2 = (a e_interp)^2 + (b e_int)^2:
+// the interpolation factor a from the measurements whose screened interpolation part is at least
+// their integration part, mis's factor b from mis measurements whose integration part is the
+// larger (elsewhere the factor is ill-determined). The screen stays as optimistic as the most
+// favourable candidate measured, but it no longer spends the confirmations on candidates that
+// every measurement so far says will miss (under a low sun the implied a was about 1 for every
+// method, and 32 confirmations at half ran out before the candidates that could pass).
+// m is s's measured error (or its lower bound), ie its screened integration part, interp its
+// e_interp.
+void BakePlanner::calibrate(const PlannedSetting& s, double m, double ie, double interp) {
+  const double ip = interpolation_screen_ * interp;
+  if (ip >= ie && interp > 0) {
+    const double a = std::sqrt(std::max(0.0, m * m - ie * ie)) / interp;
+    interpolation_screen_ = calibrated_ ? std::min(interpolation_screen_, a) : a;
+    calibrated_ = true;
+  } else if (s.setting.integrator.method == "mis" && s.integration_error > 0) {
+    const double b = std::sqrt(std::max(0.0, m * m - ip * ip)) / s.integration_error;
+    mis_screen_ = mis_calibrated_ ? std::min(mis_screen_, b) : b;
+    mis_calibrated_ = true;
+  }
+}
+
+// A candidate's measurement: its set's blend at the confirmation texels with its own integrator,
+// round by round (below), each round an eighth of its views at a time, stopped (unless it may not
+// stop) once the pooled error provably exceeds kStopAbove times the planned budget: then it misses
+// whatever its standard error, its lower bound is kept, and nullopt is returned. Not at the budget
+// itself: a bound just above the budget would tell the screen's calibration nothing, and a near
+// miss is most of a measurement's cost anyway.
+// The rounds, a sequential test on the pooled estimate e +- s over n views:
+//   e + k s <= planned_budget(n): taken, once at least two rounds agree (the first round's views are
+//     the ones every candidate was screened and selected at: the cheapest candidate they pass is
+//     the one they favour most, and fresh views take that selection's luck out);
+//   e - s > planned_budget(n): a miss (one standard error over);
+//   else undecided: a further round doubles n, up to confirm_max_views; undecided there is a miss.
+// A near miss on a flat error curve is decided by more views, not by a step up the grid, and a
+// low draw of a heavy-tailed estimate meets fresh views before it is taken.
+// Fills in c.planned's measured fields and meets.
+std::optional<ErrorEstimate> BakePlanner::confirm(Candidate& c, bool may_stop) {
+  PlannedSetting& s = c.planned;
+  ErrorSums pooled;
+  for (std::size_t j = 0;; ++j) {
+    const auto [confirm_sample, confirm_values_truth] = confirmation(j);
+    BlendErrorOptions stop;
+    if (may_stop && options_.stop_early) {
+      stop.stop_above = kStopAbove * budget_;
+      stop.step = std::max(1, std::min(confirm_sample.view_count(), first_round_views_) / 8);
+    } else {
+      stop.step = confirm_sample.view_count();
+    }
+    const BlendErrorMeasure m =
+        sampled_blend_error(pilots_.integrator(s.setting.integrator.method), brdf_,
+                            options_of(s.setting.integrator, options_.seed), view_sets_[c.set], s.setting.res,
+                            options_.normalise_albedo, confirm_sample, confirm_values_truth, stop, pooled);
+    plan_.confirm_seconds += m.seconds;
+    if (j == 0) views_measured_ += m.views;  // a decision started is finished
+    s.measured_views = pooled.views() + m.views;
+    if (!m.error) {
+      s.measured_error.reset();
+      s.measured_sigma.reset();
+      s.measured_at_least = m.at_least;
+      s.upper_error = m.at_least;
+      s.meets = false;
+      return std::nullopt;
+    }
+    pooled = m.sums;
+    const ErrorEstimate e = *m.error;
+    s.measured_at_least.reset();
+    s.measured_error = e.value;
+    s.measured_sigma = e.sigma;
+    s.upper_error = e.upper(k_);
+    const double planned = planned_budget(pooled.views());
+    s.meets = s.upper_error <= planned;
+    const bool extend = may_extend(pooled.views());
+    if (s.meets && (j > 0 || !extend)) return e;
+    if (e.value - e.sigma > planned || !extend) {
+      s.meets = false;
+      return e;
+    }
+  }
+}
+
+// The candidates in order of predicted time, each screened by the model (once e_interp for its pair
+// is known) and, before a choice and within the confirmations' allowance, measured when the screen
+// lets it through; the first that meets the budget is chosen. Every candidate is added to
+// plan_.settings.
+void BakePlanner::screen_and_confirm() {
+  for (Candidate& c : candidates_) {
+    PlannedSetting& s = c.planned;
+    const double ie = screened_integration(s);
+    const std::optional<ErrorEstimate> interp = reached_interpolation(c, ie);
+    if (interp) {
+      s.interpolation_error = interp->value;
+      s.error = std::hypot(interp->value, s.integration_error);
+      s.upper_error = std::hypot(interp->upper(k_), c.integration_upper);
+      const double screened = std::hypot(interpolation_screen_ * interp->value, ie);
+      if (!plan_.chosen) {
+        s.screened_error = screened;
+        s.interpolation_screen = interpolation_screen_;
+        s.mis_screen = mis_screen_;
+      }
+      if (!plan_.chosen && screened <= budget_ && views_measured_ < views_allowed_) {
+        ++confirmations_;
+        // A confirmation stopped early calibrates with its lower bound: the factor it implies is a
+        // lower bound of the one its whole measurement would, and the screen stays optimistic.
+        const std::optional<ErrorEstimate> measured = confirm(c, true);
+        calibrate(s, measured ? measured->value : *s.measured_at_least, ie, interp->value);
+      }
+    }
+    if (s.meets && !plan_.chosen) plan_.chosen = s;
+    plan_.settings.push_back(s);
+  }
+}
+
+// When the screen let nothing through but its least screened candidate is within twice the plan,
+// that one is measured, so that the plan can name the closest setting and the error it reaches
+// (a near-mirror coat under a small bright lamp is screened out everywhere, and the plan would
+// have nothing to name). Taken if it meets the budget after all. The full reference is left out:
+// its measurement integrates the full quadrature at every texel the blend reads (minutes), for a
+// setting that would bake for days, and the most accurate sampled integrator on the same set
+// screens within a hair of it.
+void BakePlanner::measure_least_screened() {
+  if (plan_.chosen || confirmations_ != 0 || views_allowed_ <= 0) return;
+  Candidate* least = nullptr;
+  for (Candidate& c : candidates_) {
+    const PlannedSetting& s = c.planned;
+    const bool full_reference = s.setting.integrator.method == "reference" && s.setting.integrator.reference_width == 0;
+    if (!full_reference && s.screened_error && *s.screened_error <= 2 * budget_ &&
+        (!least || *s.screened_error < *least->planned.screened_error))
+      least = &c;
+  }
+  if (!least) return;
+  ++confirmations_;
+  confirm(*least, false);
+  plan_.settings[std::size_t(least - candidates_.data())] = least->planned;  // settings follow candidates
+  if (least->planned.meets) plan_.chosen = least->planned;
+}
+
+// Without a choice, the plan names the closest setting with its error: when every confirmation
+// stopped early, the one stopped at the least bound is measured at every view.
+void BakePlanner::measure_least_bound() {
+  if (plan_.chosen) return;
+  for (const Candidate& c : candidates_)
+    if (c.planned.measured_error) return;
+  Candidate* least = nullptr;
+  for (Candidate& c : candidates_)
+    if (c.planned.measured_at_least && (!least || *c.planned.measured_at_least < *least->planned.measured_at_least))
+      least = &c;
+  if (!least) return;
+  confirm(*least, false);
+  plan_.settings[std::size_t(least - candidates_.data())] = least->planned;
+}
+
+// The plan: its time, the closest measured setting when none was chosen, and why.
+BakePlan BakePlanner::finish() {
+  plan_.pilot_seconds = seconds_since(t_start_);
+  if (!plan_.chosen)
+    for (const PlannedSetting& s : plan_.settings)
+      if (s.measured_error && (!plan_.closest || s.upper_error < plan_.closest->upper_error)) plan_.closest = s;
+  plan_.why = explain();
+  return std::move(plan_);
+}
+
+// A cheaper candidate's line of the why: what was measured or modelled for it, and its time.
+void explain_miss(std::ostream& why, const PlannedSetting& s) {
+  why << "cheaper, misses: " << setting_text(s.setting) << ": ";
+  if (s.measured_error)
+    why << "measured " << percent(*s.measured_error) << " +- " << percent(*s.measured_sigma) << " at "
+        << s.measured_views << " views (modelled " << percent(s.error) << ")";
+  else if (s.measured_at_least)
+    why << "measured over " << percent(*s.measured_at_least) << " (stopped early; modelled " << percent(s.error) << ")";
+  else if (s.interpolation_error)
+    why << "modelled " << percent(s.error) << ", at most " << percent(s.upper_error) << " (interpolation "
+        << percent(*s.interpolation_error) << ", integration " << percent(s.integration_error) << ")";
+  else
+    why << "integration alone " << percent(s.integration_error) << ", at most " << percent(s.upper_error);
+  why << ", " << s.seconds << " s\n";
+}
+
+// Why, in a few lines: the choice with its measurement, or that there is none with the closest
+// setting; then up to three cheaper candidates and why they miss.
+std::string BakePlanner::explain() const {
+  std::ostringstream why;
+  if (plan_.chosen) {
+    const PlannedSetting& c = *plan_.chosen;
+    why << "chosen: " << setting_text(c.setting) << ": measured " << percent(*c.measured_error) << " +- "
+        << percent(*c.measured_sigma) << " at " << c.measured_views << " confirmation views (at most "
+        << percent(c.upper_error) << " with " << k_ << " standard errors; modelled " << percent(c.error)
+        << ": interpolation " << percent(*c.interpolation_error) << ", integration " << percent(c.integration_error)
+        << "), " << c.seconds << " s; the budget is " << percent(options_.max_error) << ", planned to "
+        << percent(planned_budget(c.measured_views)) << " at its " << c.measured_views << " views.\n";
+  } else {
+    why << "no setting is predicted to meet " << percent(options_.max_error) << " (planned to " << percent(budget_)
+        << " at " << first_round_views_ << " views";
+    if (may_extend(first_round_views_))
+      why << ", to " << percent(planned_budget(options_.confirm_max_views)) << " at " << options_.confirm_max_views;
+    why << "); the most accurate measured ones are listed in the table";
+    if (views_measured_ >= views_allowed_)
+      why << " (the plan stopped after measuring " << confirmations_
+          << " candidates that the model let through, its allowance of confirmation views)";
+    why << ".\n";
+    if (plan_.closest) {
+      const PlannedSetting& c = *plan_.closest;
+      why << "closest: " << setting_text(c.setting) << ": measured " << percent(*c.measured_error) << " +- "
+          << percent(*c.measured_sigma) << " at " << c.measured_views << " views (at most " << percent(c.upper_error)
+          << "), " << c.seconds << " s; it is planned to meet a budget of "
+          << percent(c.upper_error / (planned_budget(c.measured_views) / options_.max_error)) << ".\n";
+    }
+  }
+  int shown = 0;
+  for (const PlannedSetting& s : plan_.settings) {
+    if (plan_.chosen && s.seconds >= plan_.chosen->seconds) break;
+    if (shown++ == 3) break;
+    explain_miss(why, s);
+  }
+  return why.str();
+}
+
 }  // namespace
 
 std::string IntegratorSetting::label() const {
@@ -171,371 +651,11 @@ const PlannedSetting* setting_to_bake(const BakePlan& plan, bool* fallback) {
 }
 
 BakePlan plan_bake(const EnvMap& env, const Brdf& brdf, const BakePlanOptions& options) {
-  if (!(options.max_error > 0 && options.max_error < 1))
-    throw std::invalid_argument("plan: the error budget must lie in (0, 1) (a relative RMS, e.g. 0.02 for 2%), not " +
-                                std::to_string(options.max_error));
-  if (options.view_sets.empty() || options.sizes.empty() || options.integrators.empty())
-    throw std::invalid_argument("plan: no view set, map size or integrator to choose from");
-  if (!(options.margin > 0 && options.margin <= 1)) throw std::invalid_argument("plan: the margin must lie in (0, 1]");
-  for (int r : options.sizes)
-    if (r < 2) throw std::invalid_argument("plan: map sizes must be at least 2, not " + std::to_string(r));
-  std::vector<ViewSet> view_sets;
-  for (const std::string& name : options.view_sets) view_sets.push_back(ViewSet::named(name));
-
-  if (!(options.sigmas >= 0)) throw std::invalid_argument("plan: the number of standard errors must be >= 0");
-  if (options.confirm_views < 0)
-    throw std::invalid_argument("plan: the confirmation's views must be >= 0 (0: the pilot's own)");
-  if (options.confirm_max_views < 0) throw std::invalid_argument("plan: the confirmation's most views must be >= 0");
-  if (options.guide_size != 0 && options.guide_size < 2)
-    throw std::invalid_argument("plan: the guide's size must be 0 (no guide) or at least 2");
-  const auto t_start = std::chrono::steady_clock::now();
-  BakePlan plan;
-  plan.options = options;
-  const double budget = options.margin * options.max_error;
-  const double k = options.sigmas;
-
-  // The pilot's texels, guided by a cheap bake of the interpolation integrator; the truth there and
-  // every integrator setting's error and time per texel.
-  Pilots pilots(env);
-  const ErrorSample sample =
-      options.guide_size > 0
-          ? ErrorSample(options.pilot_views, options.pilot_texels, options.pilot_size, options.seed,
-                        squared_radiance_guide(pilots.integrator(kInterpolationIntegrator.method), brdf,
-                                               options_of(kInterpolationIntegrator, options.seed), options.guide_size))
-          : ErrorSample(options.pilot_views, options.pilot_texels, options.pilot_size, options.seed);
-  pilots.measure(brdf, sample, options.integrators, options.seed, options.pilot_size);
-  plan.integrators = pilots.integrators;
-  plan.truth_texels = sample.count();
-  auto integrator_for = [&](const std::string& method) -> const Integrator& { return pilots.integrator(method); };
-  if (plan.integrators.empty()) throw std::invalid_argument("plan: no integrator setting can bake this BRDF");
-
-  // The confirmations' texels, in rounds: round 0 is a sample of its own (confirm_views novel views,
-  // another seed, drawn the same way), the pilot's own when confirm_views is 0; round j >= 1 adds
-  // confirm_views 2^(j-1) fresh views, so that rounds 0..j pool confirm_views 2^j. Each is made, with
-  // the truth there, when first needed: a plan that measures no candidate does not pay for its truth.
-  struct ConfirmRound {
-    std::optional<ErrorSample> own;
-    std::vector<Vec3> truth;
-  };
-  std::vector<ConfirmRound> rounds;
-  auto confirmation = [&](std::size_t j) -> std::pair<const ErrorSample&, const std::vector<Vec3>&> {
-    while (rounds.size() <= j) {
-      ConfirmRound r;
-      if (options.confirm_views > 0) {
-        const std::size_t n = rounds.size();
-        const int views = n == 0 ? options.confirm_views : options.confirm_views << (n - 1);
-        const std::uint64_t confirm_seed = (options.seed ^ 0x9e3779b97f4a7c15ull) + n;
-        r.own.emplace(options.guide_size > 0
-                          ? ErrorSample(views, options.pilot_texels, options.pilot_size, confirm_seed,
-                                        squared_radiance_guide(pilots.integrator(kInterpolationIntegrator.method), brdf,
-                                                               options_of(kInterpolationIntegrator, options.seed),
-                                                               options.guide_size))
-                          : ErrorSample(views, options.pilot_texels, options.pilot_size, confirm_seed));
-        r.truth =
-            direct_values(pilots.integrator("reference"), brdf, options_of({"reference", 0, 0}, options.seed), *r.own);
-        plan.truth_texels += r.own->count();
-      }
-      rounds.push_back(std::move(r));
-    }
-    if (j == 0) plan.confirm_texels = rounds[0].own ? rounds[0].own->count() : sample.count();
-    if (rounds[j].own) return {*rounds[j].own, rounds[j].truth};
-    return {sample, pilots.truth};
-  };
-  // Rounds beyond the first: only with a sample of the confirmations' own, up to confirm_max_views.
-  const int first_round_views = options.confirm_views > 0 ? options.confirm_views : options.pilot_views;
-  auto may_extend = [&](int pooled) { return options.confirm_views > 0 && 2 * pooled <= options.confirm_max_views; };
-  // The planned budget at n pooled views: the reserve (1 - margin) of the budget is for the
-  // confirmation's scatter between samples, which falls as 1 / sqrt(n); it is the whole reserve at
-  // the first round's views.
-  auto planned_budget = [&](int pooled) {
-    const double reserve = options.max_error - budget;
-    return options.max_error - reserve * std::sqrt(double(first_round_views) / std::max(pooled, first_round_views));
-  };
-
-  // e_interp(N, r) with its standard error, measured when first needed: the FIS maps' blend against
-  // FIS direct values, less (in quadrature) FIS's own error against the truth at the same texels,
-  // which the direct side carries and the blend does not share.
-  plan.interpolation_integrator = interpolation_integrator(plan.integrators, budget);
-  std::vector<Vec3> interpolation_direct;
-  double interpolation_own = 0;
-  std::map<std::pair<std::size_t, int>, ErrorEstimate> interpolation;
-  auto interpolation_error = [&](std::size_t set, int res) {
-    const auto key = std::make_pair(set, res);
-    if (auto it = interpolation.find(key); it != interpolation.end()) return it->second;
-    const Integrator& integrator = integrator_for(plan.interpolation_integrator.method);
-    const IntegratorOptions o = options_of(plan.interpolation_integrator, options.seed);
-    if (interpolation_direct.empty()) {
-      interpolation_direct = direct_values(integrator, brdf, o, sample);
-      interpolation_own = sample_error(sample, interpolation_direct, pilots.truth).value;
-      plan.interpolation_integrator_error = interpolation_own;
-    }
-    const SampledBlend b = sampled_blend(integrator, brdf, o, view_sets[set], res, options.normalise_albedo, sample);
-    InterpolationPilot p;
-    p.views = options.view_sets[set];
-    p.view_count = int(view_sets[set].views().size());
-    p.res = res;
-    ErrorEstimate e = sample_error(sample, b.values, interpolation_direct, &b.weights);
-    p.raw_error = e.value;
-    e.value = std::sqrt(std::max(0.0, e.value * e.value - interpolation_own * interpolation_own));
-    p.error = e.value;
-    p.error_sigma = e.sigma;
-    p.texels = b.texels_baked;
-    p.seconds = b.seconds;
-    plan.interpolation.push_back(p);
-    interpolation[key] = e;
-    return e;
-  };
-
-  // Every candidate with its predicted time, cheapest first.
-  struct Candidate {
-    PlannedSetting planned;
-    std::size_t set;
-    double integration_upper;  // e_int + k s_int
-  };
-  std::vector<Candidate> candidates;
-  for (std::size_t v = 0; v < view_sets.size(); ++v)
-    for (int r : options.sizes)
-      for (const IntegratorPilot& p : plan.integrators) {
-        PlannedSetting s;
-        s.setting = {options.view_sets[v], int(view_sets[v].views().size()), r, p.setting};
-        s.integration_error = p.error;
-        s.error = p.error;
-        s.upper_error = p.error + k * p.error_sigma;
-        s.seconds = p.setup_seconds + double(s.setting.view_count) * double(disc_texel_count(r)) * p.seconds_per_texel;
-        candidates.push_back({s, v, s.upper_error});
-      }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const Candidate& a, const Candidate& b) { return a.planned.seconds < b.planned.seconds; });
-  // The screen counts e_interp at half: the FIS maps' blend against FIS direct values carries FIS's
-  // own error pattern, which does not cancel between the two and is not the whole of what the
-  // subtraction in quadrature takes out (under hall with GGX gold the pilot's e_interp for 642 x
-  // 64^2 was 2.9% while the whole setting checked at 1.86%), and a pessimistic screen keeps the
-  // cheaper candidates from ever being measured.
-  constexpr double kInterpolationScreen = 0.5;
-  // The model screens, a measurement decides (see the header): a screened-in candidate is blended
-  // at the confirmation texels with its own integrator and taken when that error plus k sigma fits. The
-  // screen is optimistic: an unbiased integrator's (mis) error counts at a third, the most the
-  // blend's 3 sources x 4 taps can average its noise away, and e_interp at half (above).
-  constexpr double kMisScreen = 1.0 / 3.0;
-  // The screen, calibrated by what the measurements say. Each factor starts as above and becomes
-  // the least that the measurements so far imply, from measured^2 = (a e_interp)^2 + (b e_int)^2:
-  // the interpolation factor a from the measurements whose screened interpolation part is at least
-  // their integration part, mis's factor b from mis measurements whose integration part is the
-  // larger (elsewhere the factor is ill-determined). The screen stays as optimistic as the most
-  // favourable candidate measured, but it no longer spends the confirmations on candidates that
-  // every measurement so far says will miss (under a low sun the implied a was about 1 for every
-  // method, and 32 confirmations at half ran out before the candidates that could pass).
-  double interpolation_screen = kInterpolationScreen;
-  double mis_screen = kMisScreen;
-  bool calibrated = false, mis_calibrated = false;
-  auto screened_integration = [&](const PlannedSetting& s) {
-    return s.setting.integrator.method == "mis" ? mis_screen * s.integration_error : s.integration_error;
-  };
-  // A pair (N, r) cannot meet an allowance that a measured pair with at least as many views and at
-  // least the size already misses (more views and texels do not interpolate worse): not measured.
-  auto dominated = [&](std::size_t set, int res, double allowance) {
-    for (const auto& [key, e] : interpolation)
-      if (view_sets[key.first].views().size() >= view_sets[set].views().size() && key.second >= res &&
-          interpolation_screen * e.value > allowance)
-        return true;
-    return false;
-  };
-  // The confirmations' work is bounded by max_confirmations candidates' worth of first-round views
-  // (a confirmation stopped early counts the views it measured; its later rounds are not counted, so
-  // that a decision started is finished).
-  int confirmations = 0;
-  long long views_measured = 0;
-  const long long views_allowed =
-      (long long)options.max_confirmations * (options.confirm_views > 0 ? options.confirm_views : options.pilot_views);
-  // A candidate's measurement: its set's blend at the confirmation texels with its own integrator,
-  // round by round (below), each round an eighth of its views at a time, stopped (unless it may not
-  // stop) once the pooled error provably exceeds kStopAbove times the planned budget: then it misses
-  // whatever its standard error, its lower bound is kept, and nullopt is returned. Not at the budget
-  // itself: a bound just above the budget would tell the screen's calibration nothing, and a near
-  // miss is most of a measurement's cost anyway.
-  constexpr double kStopAbove = 1.5;
-  // The rounds, a sequential test on the pooled estimate e +- s over n views:
-  //   e + k s <= planned_budget(n): taken, once at least two rounds agree (the first round's views are
-  //     the ones every candidate was screened and selected at: the cheapest candidate they pass is
-  //     the one they favour most, and fresh views take that selection's luck out);
-  //   e - s > planned_budget(n): a miss (one standard error over);
-  //   else undecided: a further round doubles n, up to confirm_max_views; undecided there is a miss.
-  // A near miss on a flat error curve is decided by more views, not by a step up the grid, and a
-  // low draw of a heavy-tailed estimate meets fresh views before it is taken.
-  auto confirm = [&](Candidate& c, bool may_stop) -> std::optional<ErrorEstimate> {
-    PlannedSetting& s = c.planned;
-    ErrorSums pooled;
-    for (std::size_t j = 0;; ++j) {
-      const auto [confirm_sample, confirm_values_truth] = confirmation(j);
-      BlendErrorOptions stop;
-      if (may_stop && options.stop_early) {
-        stop.stop_above = kStopAbove * budget;
-        stop.step = std::max(1, std::min(confirm_sample.view_count(), first_round_views) / 8);
-      } else {
-        stop.step = confirm_sample.view_count();
-      }
-      const BlendErrorMeasure m =
-          sampled_blend_error(integrator_for(s.setting.integrator.method), brdf,
-                              options_of(s.setting.integrator, options.seed), view_sets[c.set], s.setting.res,
-                              options.normalise_albedo, confirm_sample, confirm_values_truth, stop, pooled);
-      plan.confirm_seconds += m.seconds;
-      if (j == 0) views_measured += m.views;  // a decision started is finished
-      s.measured_views = pooled.views() + m.views;
-      if (!m.error) {
-        s.measured_error.reset();
-        s.measured_sigma.reset();
-        s.measured_at_least = m.at_least;
-        s.upper_error = m.at_least;
-        s.meets = false;
-        return std::nullopt;
-      }
-      pooled = m.sums;
-      const ErrorEstimate e = *m.error;
-      s.measured_at_least.reset();
-      s.measured_error = e.value;
-      s.measured_sigma = e.sigma;
-      s.upper_error = e.upper(k);
-      const double planned = planned_budget(pooled.views());
-      s.meets = s.upper_error <= planned;
-      const bool extend = may_extend(pooled.views());
-      if (s.meets && (j > 0 || !extend)) return e;
-      if (e.value - e.sigma > planned || !extend) {
-        s.meets = false;
-        return e;
-      }
-    }
-  };
-  for (Candidate& c : candidates) {
-    PlannedSetting& s = c.planned;
-    const double ie = screened_integration(s);
-    const double allowance = ie < budget ? std::sqrt(budget * budget - ie * ie) : 0.0;
-    std::optional<ErrorEstimate> interp;
-    if (options.every_pair || (!plan.chosen && ie <= budget && !dominated(c.set, s.setting.res, allowance))) {
-      interp = interpolation_error(c.set, s.setting.res);
-    } else if (auto it = interpolation.find({c.set, s.setting.res}); it != interpolation.end()) {
-      interp = it->second;
-    }
-    if (interp) {
-      s.interpolation_error = interp->value;
-      s.error = std::hypot(interp->value, s.integration_error);
-      s.upper_error = std::hypot(interp->upper(k), c.integration_upper);
-      const double screened = std::hypot(interpolation_screen * interp->value, ie);
-      if (!plan.chosen) {
-        s.screened_error = screened;
-        s.interpolation_screen = interpolation_screen;
-        s.mis_screen = mis_screen;
-      }
-      if (!plan.chosen && screened <= budget && views_measured < views_allowed) {
-        ++confirmations;
-        // A confirmation stopped early calibrates with its lower bound: the factor it implies is a
-        // lower bound of the one its whole measurement would, and the screen stays optimistic.
-        const std::optional<ErrorEstimate> measured = confirm(c, true);
-        const double m = measured ? measured->value : *s.measured_at_least;
-        const double ip = interpolation_screen * interp->value;
-        if (ip >= ie && interp->value > 0) {
-          const double a = std::sqrt(std::max(0.0, m * m - ie * ie)) / interp->value;
-          interpolation_screen = calibrated ? std::min(interpolation_screen, a) : a;
-          calibrated = true;
-        } else if (s.setting.integrator.method == "mis" && s.integration_error > 0) {
-          const double b = std::sqrt(std::max(0.0, m * m - ip * ip)) / s.integration_error;
-          mis_screen = mis_calibrated ? std::min(mis_screen, b) : b;
-          mis_calibrated = true;
-        }
-      }
-    }
-    if (s.meets && !plan.chosen) plan.chosen = s;
-    plan.settings.push_back(s);
-  }
-  // When the screen let nothing through but its least screened candidate is within twice the plan,
-  // that one is measured, so that the plan can name the closest setting and the error it reaches
-  // (a near-mirror coat under a small bright lamp is screened out everywhere, and the plan would
-  // have nothing to name). Taken if it meets the budget after all. The full reference is left out:
-  // its measurement integrates the full quadrature at every texel the blend reads (minutes), for a
-  // setting that would bake for days, and the most accurate sampled integrator on the same set
-  // screens within a hair of it.
-  if (!plan.chosen && confirmations == 0 && views_allowed > 0) {
-    Candidate* least = nullptr;
-    for (Candidate& c : candidates) {
-      const PlannedSetting& s = c.planned;
-      const bool full_reference =
-          s.setting.integrator.method == "reference" && s.setting.integrator.reference_width == 0;
-      if (!full_reference && s.screened_error && *s.screened_error <= 2 * budget &&
-          (!least || *s.screened_error < *least->planned.screened_error))
-        least = &c;
-    }
-    if (least) {
-      ++confirmations;
-      confirm(*least, false);
-      plan.settings[std::size_t(least - candidates.data())] = least->planned;  // settings follow candidates
-      if (least->planned.meets) plan.chosen = least->planned;
-    }
-  }
-  // Without a choice, the plan names the closest setting with its error: when every confirmation
-  // stopped early, the one stopped at the least bound is measured at every view.
-  if (!plan.chosen && std::none_of(candidates.begin(), candidates.end(),
-                                   [](const Candidate& c) { return c.planned.measured_error.has_value(); })) {
-    Candidate* least = nullptr;
-    for (Candidate& c : candidates)
-      if (c.planned.measured_at_least && (!least || *c.planned.measured_at_least < *least->planned.measured_at_least))
-        least = &c;
-    if (least) {
-      confirm(*least, false);
-      plan.settings[std::size_t(least - candidates.data())] = least->planned;
-    }
-  }
-  plan.pilot_seconds = seconds_since(t_start);
-  if (!plan.chosen)
-    for (const PlannedSetting& s : plan.settings)
-      if (s.measured_error && (!plan.closest || s.upper_error < plan.closest->upper_error)) plan.closest = s;
-
-  // Why, in a few lines.
-  std::ostringstream why;
-  if (plan.chosen) {
-    const PlannedSetting& c = *plan.chosen;
-    why << "chosen: " << setting_text(c.setting) << ": measured " << percent(*c.measured_error) << " +- "
-        << percent(*c.measured_sigma) << " at " << c.measured_views << " confirmation views (at most "
-        << percent(c.upper_error) << " with " << k << " standard errors; modelled " << percent(c.error)
-        << ": interpolation " << percent(*c.interpolation_error) << ", integration " << percent(c.integration_error)
-        << "), " << c.seconds << " s; the budget is " << percent(options.max_error) << ", planned to "
-        << percent(planned_budget(c.measured_views)) << " at its " << c.measured_views << " views.\n";
-  } else {
-    why << "no setting is predicted to meet " << percent(options.max_error) << " (planned to " << percent(budget)
-        << " at " << first_round_views << " views";
-    if (may_extend(first_round_views))
-      why << ", to " << percent(planned_budget(options.confirm_max_views)) << " at " << options.confirm_max_views;
-    why << "); the most accurate measured ones are listed in the table";
-    if (views_measured >= views_allowed)
-      why << " (the plan stopped after measuring " << confirmations
-          << " candidates that the model let through, its allowance of confirmation views)";
-    why << ".\n";
-    if (plan.closest) {
-      const PlannedSetting& c = *plan.closest;
-      why << "closest: " << setting_text(c.setting) << ": measured " << percent(*c.measured_error) << " +- "
-          << percent(*c.measured_sigma) << " at " << c.measured_views << " views (at most " << percent(c.upper_error)
-          << "), " << c.seconds << " s; it is planned to meet a budget of "
-          << percent(c.upper_error / (planned_budget(c.measured_views) / options.max_error)) << ".\n";
-    }
-  }
-  int shown = 0;
-  for (const PlannedSetting& s : plan.settings) {
-    if (plan.chosen && s.seconds >= plan.chosen->seconds) break;
-    if (shown++ == 3) break;
-    why << "cheaper, misses: " << setting_text(s.setting) << ": ";
-    if (s.measured_error)
-      why << "measured " << percent(*s.measured_error) << " +- " << percent(*s.measured_sigma) << " at "
-          << s.measured_views << " views (modelled " << percent(s.error) << ")";
-    else if (s.measured_at_least)
-      why << "measured over " << percent(*s.measured_at_least) << " (stopped early; modelled " << percent(s.error)
-          << ")";
-    else if (s.interpolation_error)
-      why << "modelled " << percent(s.error) << ", at most " << percent(s.upper_error) << " (interpolation "
-          << percent(*s.interpolation_error) << ", integration " << percent(s.integration_error) << ")";
-    else
-      why << "integration alone " << percent(s.integration_error) << ", at most " << percent(s.upper_error);
-    why << ", " << s.seconds << " s\n";
-  }
-  plan.why = why.str();
-  return plan;
+  BakePlanner planner(env, brdf, options, check_options(options));  // the pilot
+  planner.screen_and_confirm();
+  planner.measure_least_screened();
+  planner.measure_least_bound();
+  return planner.finish();
 }
 
 nlohmann::json BakePlan::to_json() const {

@@ -8,6 +8,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <string>
+#include <vector>
 
 namespace rsibr {
 namespace {
@@ -430,6 +433,38 @@ TEST(BakePlan, BadBudgetsAndEmptyChoicesAreRefused) {
   o = small(0.05);
   o.confirm_max_views = -1;
   EXPECT_THROW(plan_bake(env, *brdf, o), std::invalid_argument);
+}
+
+// Every option outside its range is refused, and before the pilot: with a BRDF that no integrator
+// of the plan can bake, the message is the option's, not the pilot's.
+TEST(BakePlan, OptionsOutOfRangeAreRefusedBeforeThePilot) {
+  const EnvMap env = sky(Vec3(0, 1, 0), 32);
+  const auto ggx = parse_brdf("{type: ggx, roughness: 0.3, fresnel: {type: none}}");
+  auto refusal = [&](const std::function<void(BakePlanOptions&)>& change) -> std::string {
+    BakePlanOptions o = small(0.05);
+    o.integrators = {{"sh", 0, 0}};  // the pilot would refuse: sh bakes Lambert only
+    change(o);
+    try {
+      plan_bake(env, *ggx, o);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_NE(refusal([](BakePlanOptions&) {}).find("no integrator setting"), std::string::npos);
+  const std::vector<std::function<void(BakePlanOptions&)>> bad = {
+      [](BakePlanOptions& o) { o.max_error = 1.5; },      [](BakePlanOptions& o) { o.view_sets.clear(); },
+      [](BakePlanOptions& o) { o.integrators.clear(); },  [](BakePlanOptions& o) { o.margin = 0; },
+      [](BakePlanOptions& o) { o.margin = 1.1; },         [](BakePlanOptions& o) { o.sizes = {16, 1}; },
+      [](BakePlanOptions& o) { o.view_sets = {"nope"}; }, [](BakePlanOptions& o) { o.sigmas = -1; },
+      [](BakePlanOptions& o) { o.confirm_views = -1; },   [](BakePlanOptions& o) { o.confirm_max_views = -1; },
+      [](BakePlanOptions& o) { o.guide_size = 1; },
+  };
+  for (std::size_t i = 0; i < bad.size(); ++i) {
+    const std::string message = refusal(bad[i]);
+    EXPECT_FALSE(message.empty()) << i;
+    EXPECT_EQ(message.find("no integrator setting"), std::string::npos) << i << ": " << message;
+  }
 }
 
 // Confirming at the pilot's own texels (confirm_views 0) and at a sample of their own both decide by
