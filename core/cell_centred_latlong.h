@@ -7,8 +7,8 @@
 //   rows 0 and H-1 on the poles).
 // Cell-centred: texel (i, j) is at longitude pi (1 - 2(i+0.5)/W), latitude pi/2 - pi (j+0.5)/H.
 // Both put longitude 0 at +Z and +pi/2 at +X, latitude +pi/2 at +Y. Handing one program's file to
-// the other unchanged stretches the sphere by one texel in each direction: a Lambert sphere under
-// a 512 x 256 sky then differs by about 1% (measured against Cycles, docs/blender.md).
+// the other unchanged stretches the sphere by one texel in each direction: a Lambert ball changes
+// by +-0.1% radially, a sharp highlight moves by half a texel (docs/blender.md).
 #pragma once
 
 #include "core/env_map.h"
