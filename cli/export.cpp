@@ -8,19 +8,17 @@
 #include "core/atomic_folder.h"
 #include "core/output_plan.h"
 #include "core/progress.h"
+#include "core/exr_io.h"
+#include "core/input_file.h"
+#include "core/map_set.h"
+#include "export/blender_folder.h"
 #include "export/blender_scene.h"
 
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <cstdlib>
-#include <fcntl.h>
 #include <fstream>
 #include <iostream>
 #include <iterator>
-
-extern char** environ;
 
 namespace rsibr::cli {
 namespace {
@@ -28,56 +26,10 @@ namespace {
 namespace fs = std::filesystem;
 
 struct ExportArgs {
-  std::string run, out, blender, json;
+  std::string run, maps, env, out, blender, json;
   int samples = 256, world_width = 0, preview_samples = 0;
   bool no_blend = false, quiet = false;
 };
-
-// The Blender program: --blender, else $RSIBR_BLENDER, else `blender` on PATH.
-std::string blender_program(const std::string& given) {
-  if (!given.empty()) return given;
-  if (const char* e = std::getenv("RSIBR_BLENDER"); e && *e) return e;
-  return "blender";
-}
-
-// Runs Blender with `args`, its output into `log`. Throws std::runtime_error with the log's last
-// line when it fails, std::invalid_argument when it cannot be started.
-void run_blender(const std::string& program, const std::vector<std::string>& args, const fs::path& log) {
-  std::vector<std::string> words = {program, "-b", "--factory-startup", "--python-exit-code", "3"};
-  words.insert(words.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (std::string& w : words) argv.push_back(w.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0)
-    throw std::invalid_argument("cannot run Blender ('" + program +
-                                "'; install Debian's blender, give --blender PATH, or --no-blend for the script only)");
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) throw std::runtime_error("waiting for Blender failed");
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
-  std::ifstream in(log);
-  std::string line, last;
-  while (std::getline(in, line))
-    if (line.find("rror") != std::string::npos || line.find("build_blender_scene.py:") != std::string::npos)
-      last = line;
-  throw std::runtime_error("Blender failed (" +
-                           (WIFEXITED(status) ? "exit " + std::to_string(WEXITSTATUS(status)) : std::string("killed")) +
-                           ")" + (last.empty() ? std::string() : ": " + last));
-}
-
-void write_bytes(const fs::path& file, const std::vector<unsigned char>& bytes) {
-  std::ofstream out(file, std::ios::binary);
-  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-  if (!out) throw std::runtime_error(file.string() + ": cannot write");
-}
 
 std::vector<unsigned char> read_bytes(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
@@ -85,16 +37,37 @@ std::vector<unsigned char> read_bytes(const fs::path& file) {
 }
 
 int run_export_blender(const ExportArgs& a) {
-  if (!fs::is_directory(a.run)) throw std::invalid_argument(a.run + ": not a folder (give rsibr process's DIR)");
-  OutputPlan outputs({fs::path(a.run)});
+  if (a.run.empty() == a.maps.empty())
+    throw std::invalid_argument(a.run.empty() ? "give a process run (DIR) or a map set (--maps with --env)"
+                                              : "give a process run or --maps, not both");
+  if (!a.maps.empty() && a.env.empty())
+    throw std::invalid_argument("--maps: needs --env (the environment it was baked under)");
+  if (a.maps.empty() && !a.env.empty())
+    throw std::invalid_argument("--env: only with --maps (a run's world is its probe)");
+  if (!a.run.empty() && !fs::is_directory(a.run))
+    throw std::invalid_argument(a.run + ": not a folder (give rsibr process's DIR)");
+  std::vector<fs::path> inputs;
+  for (const std::string& p : {a.run, a.maps, a.env})
+    if (!p.empty()) inputs.push_back(p);
+  OutputPlan outputs(inputs);
   outputs.folder(a.out);
   const std::string json = outputs.file(a.json);
-  check_output_folder(a.out, {fs::path(a.run)});
+  check_output_folder(a.out, inputs);
   BlenderExportOptions options;
   options.samples = a.samples;
   options.world_width = a.world_width;
-  const BlenderExport scene = blender_export_from_run(a.run, options);
-  const std::string program = blender_program(a.blender);
+  BlenderExport scene;
+  if (!a.run.empty()) {
+    scene = blender_export_from_run(a.run, options);
+  } else {
+    require_regular_file(a.maps);
+    require_regular_file(a.env);
+    EnvReadReport report;
+    EnvMap env = read_environment(a.env, std::nullopt, &report);
+    const std::string warning = fold_environment_ringing(env, a.env, report, false);
+    if (!warning.empty() && !a.quiet) std::cerr << "rsibr: warning: " << warning << "\n";
+    scene = blender_export_from_map_set(read_map_set(a.maps), env, a.maps, options);
+  }
 
   // Everything is made in a staging folder beside OUT (Blender writes files), then moved in at once.
   const fs::path target = fs::absolute(a.out).lexically_normal();
@@ -104,28 +77,13 @@ int run_export_blender(const ExportArgs& a) {
   fs::create_directories(staging);
   FolderContents files;
   try {
-    for (const auto& [name, bytes] : scene.files) write_bytes(staging / name, bytes);
-    const std::string scene_json = blender_scene_json(scene).dump(2) + "\n";
-    write_bytes(staging / "scene.json", std::vector<unsigned char>(scene_json.begin(), scene_json.end()));
-    const std::string script = blender_scene_script();
-    write_bytes(staging / "build_blender_scene.py", std::vector<unsigned char>(script.begin(), script.end()));
-    if (!a.no_blend) {
-      const fs::path log = staging / "blender.log";
-      std::vector<std::string> args = {"--python",
-                                       (staging / "build_blender_scene.py").string(),
-                                       "--",
-                                       "--scene",
-                                       (staging / "scene.json").string(),
-                                       "--blend",
-                                       (staging / "scene.blend").string()};
-      if (a.preview_samples > 0) {
-        args.insert(args.end(), {"--render", "1", "--samples", std::to_string(a.preview_samples), "--image",
-                                 (staging / "preview.png").string()});
-      }
-      if (!a.quiet && Progress::stderr_is_terminal()) std::cerr << "rsibr export: running Blender...\n";
-      run_blender(program, args, log);
-      fs::remove(log);
-    }
+    BlenderFolderOptions run;
+    run.program = a.blender;
+    run.build_blend = !a.no_blend;
+    run.preview_samples = a.preview_samples;
+    if (run.build_blend && !a.quiet && Progress::stderr_is_terminal())
+      std::cerr << "rsibr export: running Blender...\n";
+    write_blender_folder(scene, staging, run);
     for (const auto& entry : fs::directory_iterator(staging))
       if (entry.is_regular_file()) files[entry.path().filename().string()] = read_bytes(entry.path());
   } catch (...) {
@@ -136,7 +94,8 @@ int run_export_blender(const ExportArgs& a) {
   fs::remove_all(staging);
   write_folder_atomically(target, files);
 
-  nlohmann::json j = {{"run", a.run},
+  nlohmann::json j = {{"run", a.run.empty() ? nlohmann::json() : nlohmann::json(a.run)},
+                      {"maps", a.maps.empty() ? nlohmann::json() : nlohmann::json(a.maps)},
                       {"out", a.out},
                       {"blend", a.no_blend ? nlohmann::json() : nlohmann::json("scene.blend")},
                       {"cameras", scene.cameras.size()},
@@ -174,8 +133,15 @@ Runner add_export(CLI::App& app) {
       "focal length and principal point (timeline frame i is camera i; the compositor lays the render over photo i), "
       "the grey ball at its solved place as a Lambert of the run's albedo, the chrome as a mirror with the run's "
       "conductor Fresnel. Rendering frame i in Cycles puts the balls on photo i's balls.\n"
+      "--maps M --env E instead of a run: the sphere map set M as a scene (a unit sphere with M's material, lit by E "
+      "as rsibr reads it, converted like the probe; camera i on view i's frame, orthographic, 2 wide, each pixel its "
+      "centre): Cycles' render of frame i is view i's map computed by another renderer.\n"
       "Example: rsibr export blender run --out run-blender && blender run-blender/scene.blend");
-  b->add_option("run", a->run, "rsibr process's DIR (after its bake step)")->required();
+  b->add_option("run", a->run, "rsibr process's DIR (after its bake step)");
+  b->add_option("--maps", a->maps,
+                "Instead of a run: a computed map set; its views of a unit sphere with its material (Lambert, GGX), "
+                "one orthographic camera per view, so frame i renders view i's sphere map");
+  b->add_option("--env", a->env, "--maps: the environment the maps were baked under (the world)");
   b->add_option("--out", a->out, "Output folder")->required();
   b->add_option("--blender", a->blender, "The Blender program (default $RSIBR_BLENDER, else blender on PATH)");
   b->add_option("--samples", a->samples, "Cycles samples per pixel set in the scene (default 256)")

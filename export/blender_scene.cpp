@@ -90,7 +90,7 @@ cv::Mat undistorted(const cv::Mat& radiance, const LensModel& lens) {
   return out;
 }
 
-// The Lambert albedo of a computed grey map set's material (rsibr process bakes Lambert greys).
+// The Lambert albedo of a computed map set's material (rsibr process bakes Lambert greys).
 Vec3 lambert_albedo(const MapSet& set, const fs::path& file) {
   if (set.views.empty()) throw std::invalid_argument(file.string() + ": no views");
   const YAML::Node spec = YAML::Load(set.views[0].material);
@@ -131,6 +131,24 @@ double camera_distance(const ViewPose& v, double d0, const Vec3& chrome_centre_w
       lo = a;
   }
   return 0.5 * (lo + hi);
+}
+
+// The world image: `env` in Blender's cell-centred convention, `width` wide (0: twice env's, at
+// most 8192), as EXR bytes.
+std::vector<unsigned char> world_exr(const EnvMap& env, int width) {
+  if (width <= 0) width = std::min(8192, 2 * env.layout.width());
+  const EnvMap world = to_cell_centred_latlong(env, width, std::max(1, width / 2));
+  ExrPartOut part;
+  part.channels = {{"R", world.pixels, 0}, {"G", world.pixels, 1}, {"B", world.pixels, 2}};
+  return exr_bytes({part});
+}
+
+std::vector<unsigned char> fresnel_exr(const std::string& spec) {
+  const std::vector<Vec3> table = fresnel_table(spec);
+  cv::Mat rgb(1, int(table.size()), CV_32FC3);
+  for (int k = 0; k < rgb.cols; ++k)
+    rgb.at<cv::Vec3f>(0, k) = cv::Vec3f(float(table[k].x()), float(table[k].y()), float(table[k].z()));
+  return rgb_exr_bytes(rgb);
 }
 
 }  // namespace
@@ -184,17 +202,15 @@ BlenderExport export_from_run(const fs::path& run, const BlenderExportOptions& o
       const nlohmann::json probe = read_json(probe_file);
       const std::string spec = field(field(probe, "summary", probe_file), "fresnel", probe_file).get<std::string>();
       json_file = extract_file;
+      ball.material = "glossy";
       ball.fresnel_table = "fresnel-" + name + ".exr";
-      const std::vector<Vec3> table = fresnel_table(spec);
-      cv::Mat rgb(1, int(table.size()), CV_32FC3);
-      for (int k = 0; k < rgb.cols; ++k)
-        rgb.at<cv::Vec3f>(0, k) = cv::Vec3f(float(table[k].x()), float(table[k].y()), float(table[k].z()));
-      out.files[ball.fresnel_table] = rgb_exr_bytes(rgb);
+      out.files[ball.fresnel_table] = fresnel_exr(spec);
       if (!have_chrome) chrome_centre = ball.centre;
       have_chrome = true;
     } else if (kind == "grey") {
       const fs::path maps = existing(run / "maps" / ("computed-" + name + ".exr"));
-      ball.albedo = lambert_albedo(read_map_set(maps.string()), maps);
+      ball.material = "diffuse";
+      ball.colour = lambert_albedo(read_map_set(maps.string()), maps);
     } else {
       out.notes.push_back("ball '" + name + "' (" + kind + ") is left out: only chrome and grey balls are exported");
       continue;
@@ -206,11 +222,7 @@ BlenderExport export_from_run(const fs::path& run, const BlenderExportOptions& o
   // The world: the probe in Blender's cell-centred equirectangular convention.
   const fs::path probe_file = existing(run / "probe.exr");
   const EnvMap probe = read_environment(probe_file.string());
-  const int world_width = options.world_width > 0 ? options.world_width : probe.layout.width();
-  const EnvMap world = to_cell_centred_latlong(probe, world_width, std::max(1, world_width / 2));
-  ExrPartOut part;
-  part.channels = {{"R", world.pixels, 0}, {"G", world.pixels, 1}, {"B", world.pixels, 2}};
-  out.files["world.exr"] = exr_bytes({part});
+  out.files["world.exr"] = world_exr(probe, options.world_width);
 
   // The cameras: each view's pose, its chrome cone and the lens.
   const LensModel lens = LensModel::read(existing(run / "lens.cameramodel"));
@@ -281,25 +293,91 @@ BlenderExport blender_export_from_run(const fs::path& run, const BlenderExportOp
   }
 }
 
+BlenderExport blender_export_from_map_set(const MapSet& maps, const EnvMap& env, const std::string& what,
+                                          const BlenderExportOptions& options) {
+  if (maps.views.empty()) throw std::invalid_argument(what + ": no views");
+  const std::string material = maps.views[0].material;
+  for (std::size_t v = 1; v < maps.views.size(); ++v)
+    if (maps.views[v].material != material)
+      throw std::invalid_argument(what + ": view." + std::to_string(v) +
+                                  "'s material differs from view.0's (one sphere, one material)");
+  BlenderExport out;
+  out.samples = options.samples;
+  out.pixel_centres = true;
+  BlenderBall ball;
+  ball.name = "sphere";
+  ball.kind = "sphere";
+  ball.centre = Vec3::Zero();
+  ball.radius = 1;
+  ball.exact = true;  // a UV sphere's rim, seen edge-on, is 2% off at 48^2 (r > 0.9)
+  const YAML::Node spec = YAML::Load(material);
+  const std::string type = spec.IsMap() && spec["type"] ? spec["type"].as<std::string>() : "";
+  if (type == "lambert") {
+    ball.material = "diffuse";
+    ball.colour = lambert_albedo(maps, what);
+  } else if (type == "ggx") {
+    ball.material = "glossy";
+    ball.roughness = std::sqrt(spec["roughness"].as<double>());
+    if (spec["fresnel"] && !(spec["fresnel"]["type"] && spec["fresnel"]["type"].as<std::string>() == "none")) {
+      ball.fresnel_table = "fresnel-sphere.exr";
+      YAML::Emitter e;
+      e << YAML::Flow << spec["fresnel"];
+      out.files[ball.fresnel_table] = fresnel_exr(e.c_str());
+    }
+    out.notes.push_back(
+        "Cycles 3.x's GGX masks with the separable Smith form, rsibr's with the height-correlated one (up to 1% "
+        "darker toward the rim of a rough ball)");
+    if (!ball.fresnel_table.empty() && ball.roughness > 0)
+      out.notes.push_back("the Fresnel tints by F(n.v): exact for a mirror, an approximation for a rough lobe");
+  } else {
+    throw std::invalid_argument(what + ": material '" + material +
+                                "' has no Cycles counterpart here (Lambert and GGX are exported)");
+  }
+  out.balls.push_back(ball);
+  out.files["world.exr"] = world_exr(env, options.world_width);
+  for (std::size_t v = 0; v < maps.views.size(); ++v) {
+    const MapView& mv = maps.views[v];
+    BlenderCamera cam;
+    cam.name = "view." + std::to_string(v);
+    // The view frame (x right, y up, z toward the viewer) is a Blender camera's own frame.
+    cam.rotation = blender_from_rsibr() * mv.world_from_view;
+    cam.location = blender_from_rsibr() * (mv.view.normalized() * 10.0);
+    cam.orthographic = 2;
+    cam.width = mv.rgb.cols;
+    cam.height = mv.rgb.rows;
+    cam.near = 1;
+    cam.far = 100;
+    out.cameras.push_back(cam);
+  }
+  return out;
+}
+
 nlohmann::json blender_scene_json(const BlenderExport& scene) {
   auto vec = [](const Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
   nlohmann::json cameras = nlohmann::json::array(), balls = nlohmann::json::array();
   for (const BlenderCamera& c : scene.cameras) {
     nlohmann::json rows = nlohmann::json::array();
     for (int r = 0; r < 3; ++r) rows.push_back(vec(c.rotation.row(r).transpose()));
-    cameras.push_back({{"name", c.name},
-                       {"location", vec(c.location)},
-                       {"rotation", rows},
-                       {"focal_px", {c.fx, c.fy}},
-                       {"principal_px", {c.cx, c.cy}},
-                       {"size", {c.width, c.height}},
-                       {"clip", {c.near, c.far}},
-                       {"photo", c.photo}});
+    nlohmann::json j = {{"name", c.name},
+                        {"location", vec(c.location)},
+                        {"rotation", rows},
+                        {"size", {c.width, c.height}},
+                        {"clip", {c.near, c.far}}};
+    if (c.orthographic > 0) {
+      j["orthographic_width"] = c.orthographic;
+    } else {
+      j["focal_px"] = {c.fx, c.fy};
+      j["principal_px"] = {c.cx, c.cy};
+    }
+    if (!c.photo.empty()) j["photo"] = c.photo;
+    cameras.push_back(j);
   }
   for (const BlenderBall& b : scene.balls) {
-    nlohmann::json j = {{"name", b.name}, {"kind", b.kind}, {"centre", vec(b.centre)}, {"radius", b.radius}};
-    if (b.kind == "grey") j["albedo"] = vec(b.albedo);
-    if (b.kind == "chrome") j["fresnel_table"] = b.fresnel_table;
+    nlohmann::json j = {{"name", b.name},          {"kind", b.kind},         {"centre", vec(b.centre)},
+                        {"radius", b.radius},      {"material", b.material}, {"colour", vec(b.colour)},
+                        {"roughness", b.roughness}};
+    if (!b.fresnel_table.empty()) j["fresnel_table"] = b.fresnel_table;
+    j["geometry"] = b.exact ? "exact" : "mesh";
     balls.push_back(j);
   }
   return {{"rsibr_blender_scene", 1},
@@ -308,6 +386,7 @@ nlohmann::json blender_scene_json(const BlenderExport& scene) {
           {"world", {{"image", "world.exr"}, {"convention", "cell-centred equirectangular (Blender's)"}}},
           {"display", {{"exposure_stops", scene.exposure_stops}}},
           {"samples", scene.samples},
+          {"pixel_filter", scene.pixel_centres ? "centre" : "area"},
           {"cameras", cameras},
           {"balls", balls},
           {"notes", scene.notes}};

@@ -9,6 +9,8 @@
 // Every position and rotation in the scene is in Blender's world (export/blender_axes.h).
 #pragma once
 
+#include "core/env_map.h"
+#include "core/map_set.h"
 #include "core/vec.h"
 
 #include <nlohmann/json.hpp>
@@ -29,30 +31,36 @@ struct BlenderCamera {
   double cx = 0, cy = 0;  // pixels, mrcal's convention ((0, 0) is the top-left pixel's centre)
   int width = 0, height = 0;
   double near = 0, far = 0;  // clipping distances, metres
-  std::string photo;         // file in the export folder
+  std::string photo;         // file in the export folder; "" for none
+  double orthographic = 0;   // > 0: an orthographic camera this wide (metres); intrinsics unused
 };
 
 struct BlenderBall {
   std::string name;
-  std::string kind;  // "chrome" or "grey"
+  std::string kind;  // "chrome", "grey" or "sphere" (a map set's material)
   Vec3 centre;       // Blender world, metres
   double radius = 0;
-  Vec3 albedo = Vec3::Zero();  // grey: the Lambert albedo
-  std::string fresnel_table;   // chrome: file in the export folder
+  std::string material = "diffuse";  // "diffuse" (Lambert) or "glossy" (Cycles' Glossy BSDF, F = 1)
+  Vec3 colour = Vec3::Ones();        // diffuse: the albedo; glossy: a tint
+  double roughness = 0;              // glossy: Cycles' roughness, sqrt(GGX alpha); 0: a mirror
+  std::string fresnel_table;         // glossy: file in the export folder tinting by F(n.v); "" for none
+  bool exact = false;                // an exact sphere (a point-cloud point) instead of an editable UV-sphere mesh
 };
 
 // The scene and the files it refers to (name in the export folder -> bytes).
 struct BlenderExport {
   std::vector<BlenderCamera> cameras;
   std::vector<BlenderBall> balls;
-  double exposure_stops = 0;  // the run's display exposure
-  int samples = 256;          // Cycles samples per pixel
+  double exposure_stops = 0;   // the run's display exposure
+  int samples = 256;           // Cycles samples per pixel
+  bool pixel_centres = false;  // each pixel the radiance at its centre (sphere maps), not its area
   std::map<std::string, std::vector<unsigned char>> files;
   std::vector<std::string> notes;  // what was left out and why
 };
 
 struct BlenderExportOptions {
-  int world_width = 0;  // the world image's width (height = width / 2); 0: the probe's
+  int world_width = 0;  // the world image's width (height = width / 2); 0: twice the environment's,
+                        // at most 8192 (Cycles' bilinear lookup of rsibr's resampling blurs less)
   int samples = 256;
 };
 
@@ -60,6 +68,16 @@ struct BlenderExportOptions {
 // and steps/{extract,probe,render}.json. Throws std::invalid_argument("<file>: <problem>") when
 // the run lacks what the scene needs (a run that has not reached its bake step).
 BlenderExport blender_export_from_run(const std::filesystem::path& run, const BlenderExportOptions& options = {});
+
+// A map set's views of a sphere (radius 1 at the origin) with the set's material, lit by `env`
+// (as rsibr read it: ringing folded): one orthographic camera per view on the view's frame, the
+// image as wide as the ball, each pixel its centre, so Cycles renders each view's sphere map.
+// Materials: Lambert; GGX (Cycles' GGX masks with the separable Smith form, rsibr's with the
+// height-correlated one: up to 1% darker at the rim of a rough ball) with its Fresnel as a tint by
+// F(n.v) (exact for a mirror, an approximation for a rough lobe). Others throw
+// std::invalid_argument(`what`: ...). `what` names the map set in errors.
+BlenderExport blender_export_from_map_set(const MapSet& maps, const EnvMap& env, const std::string& what,
+                                          const BlenderExportOptions& options = {});
 
 // scene.json (version 1), read by export/build_blender_scene.py.
 nlohmann::json blender_scene_json(const BlenderExport& scene);

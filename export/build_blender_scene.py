@@ -7,8 +7,8 @@
 # Contract of scene.json (written by rsibr, export/blender_scene.h): every position, direction and
 # rotation is already in Blender's +Z-up world (rsibr's (x, y, z) is Blender's (z, x, y)); lengths
 # in metres; the world image is an equirectangular EXR in Blender's cell-centred convention; the
-# photos are scene-linear radiance (the run's merged views, undistorted to the cameras' pinholes).
-# Frame i (1-based) of the timeline shows camera i over photo i.
+# photos, when there are any, are scene-linear radiance (a run's merged views, undistorted to the
+# cameras' pinholes). Frame i (1-based) of the timeline shows camera i (over photo i).
 import argparse
 import json
 import os
@@ -66,59 +66,93 @@ def clear_material(name):
     return material, nodes, material.node_tree.links
 
 
-def grey_material(ball):
-    # Lambert: Cycles' Diffuse BSDF at roughness 0 with the run's albedo.
+def diffuse_material(ball):
+    # Lambert: Cycles' Diffuse BSDF at roughness 0.
     material, nodes, links = clear_material(ball["name"])
     diffuse = nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = (*ball["albedo"], 1.0)
+    diffuse.inputs["Color"].default_value = (*ball["colour"], 1.0)
     diffuse.inputs["Roughness"].default_value = 0.0
     links.new(diffuse.outputs["BSDF"], nodes["Material Output"].inputs["Surface"])
     return material
 
 
-def chrome_material(ball, folder):
-    # A perfect mirror (Glossy at roughness 0 has Fresnel 1) tinted by the run's conductor
-    # Fresnel F(cos), looked up in a table rsibr wrote: texel k holds F at cos = (k + 0.5) / N.
+def glossy_material(ball, folder):
+    # Cycles' Glossy BSDF (Fresnel 1): sharp at roughness 0, else GGX with roughness sqrt(alpha).
+    # A Fresnel table tints it by F(cos) of the angle between the normal and the viewer, looked up
+    # in a table rsibr wrote (texel k holds F at cos = (k + 0.5) / N): exact for a mirror, the
+    # usual approximation of F at the half vector for a rough lobe.
     material, nodes, links = clear_material(ball["name"])
-    geometry = nodes.new("ShaderNodeNewGeometry")
-    dot = nodes.new("ShaderNodeVectorMath")
-    dot.operation = "DOT_PRODUCT"
-    links.new(geometry.outputs["Normal"], dot.inputs[0])
-    links.new(geometry.outputs["Incoming"], dot.inputs[1])
-    absolute = nodes.new("ShaderNodeMath")
-    absolute.operation = "ABSOLUTE"
-    links.new(dot.outputs["Value"], absolute.inputs[0])
-    uv = nodes.new("ShaderNodeCombineXYZ")
-    links.new(absolute.outputs["Value"], uv.inputs["X"])
-    uv.inputs["Y"].default_value = 0.5
-    table = nodes.new("ShaderNodeTexImage")
-    table.image = load_image(folder, ball["fresnel_table"], "Non-Color")
-    table.extension = "EXTEND"
-    table.interpolation = "Linear"
-    links.new(uv.outputs["Vector"], table.inputs["Vector"])
     glossy = nodes.new("ShaderNodeBsdfGlossy")
-    glossy.distribution = "SHARP"
-    links.new(table.outputs["Color"], glossy.inputs["Color"])
+    roughness = ball["roughness"]
+    glossy.distribution = "SHARP" if roughness == 0 else "GGX"
+    glossy.inputs["Roughness"].default_value = roughness
+    glossy.inputs["Color"].default_value = (*ball["colour"], 1.0)
+    if ball.get("fresnel_table"):
+        geometry = nodes.new("ShaderNodeNewGeometry")
+        dot = nodes.new("ShaderNodeVectorMath")
+        dot.operation = "DOT_PRODUCT"
+        links.new(geometry.outputs["Normal"], dot.inputs[0])
+        links.new(geometry.outputs["Incoming"], dot.inputs[1])
+        absolute = nodes.new("ShaderNodeMath")
+        absolute.operation = "ABSOLUTE"
+        links.new(dot.outputs["Value"], absolute.inputs[0])
+        uv = nodes.new("ShaderNodeCombineXYZ")
+        links.new(absolute.outputs["Value"], uv.inputs["X"])
+        uv.inputs["Y"].default_value = 0.5
+        table = nodes.new("ShaderNodeTexImage")
+        table.image = load_image(folder, ball["fresnel_table"], "Non-Color")
+        table.extension = "EXTEND"
+        table.interpolation = "Linear"
+        links.new(uv.outputs["Vector"], table.inputs["Vector"])
+        tint = nodes.new("ShaderNodeMixRGB")
+        tint.blend_type = "MULTIPLY"
+        tint.inputs["Fac"].default_value = 1.0
+        tint.inputs["Color1"].default_value = (*ball["colour"], 1.0)
+        links.new(table.outputs["Color"], tint.inputs["Color2"])
+        links.new(tint.outputs["Color"], glossy.inputs["Color"])
     links.new(glossy.outputs["BSDF"], nodes["Material Output"].inputs["Surface"])
     return material
+
+
+def exact_sphere(obj, radius, material):
+    # One point of a point cloud, which Cycles intersects as an exact sphere (geometry nodes: the
+    # object's single vertex to a point of this radius, with the material).
+    tree = bpy.data.node_groups.new(obj.name + " sphere", "GeometryNodeTree")
+    tree.inputs.new("NodeSocketGeometry", "Geometry")
+    tree.outputs.new("NodeSocketGeometry", "Geometry")
+    given = tree.nodes.new("NodeGroupInput")
+    result = tree.nodes.new("NodeGroupOutput")
+    points = tree.nodes.new("GeometryNodeMeshToPoints")
+    points.inputs["Radius"].default_value = radius
+    set_material = tree.nodes.new("GeometryNodeSetMaterial")
+    set_material.inputs["Material"].default_value = material
+    tree.links.new(given.outputs[0], points.inputs["Mesh"])
+    tree.links.new(points.outputs["Points"], set_material.inputs["Geometry"])
+    tree.links.new(set_material.outputs["Geometry"], result.inputs[0])
+    obj.modifiers.new("sphere", "NODES").node_group = tree
 
 
 def add_ball(scene, ball, folder):
     mesh = bpy.data.meshes.new(ball["name"])
     obj = bpy.data.objects.new(ball["name"], mesh)
     scene.collection.objects.link(obj)
-    # A fine UV sphere, smooth shaded: normals within about 1e-4 rad of the true sphere's.
-    import bmesh
+    material = diffuse_material(ball) if ball["material"] == "diffuse" else glossy_material(ball, folder)
+    if ball.get("geometry") == "exact":
+        mesh.from_pydata([(0.0, 0.0, 0.0)], [], [])
+        exact_sphere(obj, ball["radius"], material)
+    else:
+        # A fine UV sphere, smooth shaded (editable, seen in every viewport): within about 1e-4 rad
+        # of the true sphere's normals except in the last few percent of the radius seen edge-on.
+        import bmesh
 
-    bm = bmesh.new()
-    bmesh.ops.create_uvsphere(bm, u_segments=128, v_segments=64, radius=ball["radius"])
-    bm.to_mesh(mesh)
-    bm.free()
-    for polygon in mesh.polygons:
-        polygon.use_smooth = True
-    obj.location = ball["centre"]
-    material = chrome_material(ball, folder) if ball["kind"] == "chrome" else grey_material(ball)
+        bm = bmesh.new()
+        bmesh.ops.create_uvsphere(bm, u_segments=128, v_segments=64, radius=ball["radius"])
+        bm.to_mesh(mesh)
+        bm.free()
+        for polygon in mesh.polygons:
+            polygon.use_smooth = True
     mesh.materials.append(material)
+    obj.location = ball["centre"]
     obj["rsibr_kind"] = ball["kind"]
     return obj
 
@@ -129,18 +163,23 @@ def add_camera(scene, view, index):
     scene.collection.objects.link(obj)
     rotation = mathutils.Matrix(view["rotation"])
     obj.matrix_world = mathutils.Matrix.Translation(view["location"]) @ rotation.to_4x4()
-    width, height = view["size"]
-    fx, fy = view["focal_px"]
-    cx, cy = view["principal_px"]
-    # Pinhole from the intrinsics (pixels, mrcal's convention: (0, 0) is the top-left pixel's
-    # centre). Horizontal fit with fx; the other focal length through the pixel aspect.
-    data.sensor_fit = "HORIZONTAL"
-    data.sensor_width = 36.0
-    data.lens = fx * data.sensor_width / width
-    larger = max(width, height)
-    data.shift_x = ((width - 1) / 2 - cx) / larger
-    data.shift_y = (cy - (height - 1) / 2) / larger
     data.clip_start, data.clip_end = view["clip"]
+    if view.get("orthographic_width"):
+        # A sphere map's view: orthographic, the image as wide as the ball.
+        data.type = "ORTHO"
+        data.ortho_scale = view["orthographic_width"]
+    else:
+        width, height = view["size"]
+        fx, fy = view["focal_px"]
+        cx, cy = view["principal_px"]
+        # Pinhole from the intrinsics (pixels, mrcal's convention: (0, 0) is the top-left pixel's
+        # centre). Horizontal fit with fx; the other focal length through the pixel aspect.
+        data.sensor_fit = "HORIZONTAL"
+        data.sensor_width = 36.0
+        data.lens = fx * data.sensor_width / width
+        larger = max(width, height)
+        data.shift_x = ((width - 1) / 2 - cx) / larger
+        data.shift_y = (cy - (height - 1) / 2) / larger
     marker = scene.timeline_markers.new(view["name"], frame=index + 1)
     marker.camera = obj
     return obj
@@ -189,19 +228,30 @@ def build(scene_file):
     width, height = spec["cameras"][0]["size"]
     scene.render.resolution_x, scene.render.resolution_y = width, height
     scene.render.resolution_percentage = 100
-    fx, fy = spec["cameras"][0]["focal_px"]
-    scene.render.pixel_aspect_x, scene.render.pixel_aspect_y = 1.0, max(1.0, fx / fy)
+    if "focal_px" in spec["cameras"][0]:
+        fx, fy = spec["cameras"][0]["focal_px"]
+        scene.render.pixel_aspect_x, scene.render.pixel_aspect_y = 1.0, max(1.0, fx / fy)
+    if spec.get("pixel_filter") == "centre":
+        # Each pixel the radiance at its centre, as a sphere map's texel is (Cycles' Box filter
+        # averages the whole pixel whatever its width; a 0.01 px Gaussian samples the centre).
+        scene.cycles.filter_width = 0.01
+        scene.cycles.pixel_filter_type = "GAUSSIAN"
     world_node_tree(scene, load_image(folder, spec["world"]["image"], "Linear"))
     for ball in spec["balls"]:
         add_ball(scene, ball, folder)
     cameras = [add_camera(scene, view, i) for i, view in enumerate(spec["cameras"])]
-    for cam, view in zip(cameras, spec["cameras"]):
-        background = cam.data.background_images.new()
-        background.image = load_image(folder, view["photo"], "Linear")
-        cam.data.show_background_images = True
+    photos = [view.get("photo") for view in spec["cameras"]]
+    for cam, photo in zip(cameras, photos):
+        if photo:
+            background = cam.data.background_images.new()
+            background.image = load_image(folder, photo, "Linear")
+            cam.data.show_background_images = True
     scene.camera = cameras[0]
     scene.frame_start, scene.frame_end = 1, len(cameras)
-    compositor(scene, folder, [view["photo"] for view in spec["cameras"]])
+    if all(photos):
+        compositor(scene, folder, photos)
+    else:
+        scene.render.film_transparent = False
     return scene
 
 
@@ -225,8 +275,8 @@ def render(scene, args):
             if obj.type == "MESH" and obj.name != args.alpha_of:
                 obj.hide_render = True
     # EXR: the linear render itself (world visible, no compositing); PNG: the composite, displayed.
-    scene.render.film_transparent = not exr or bool(args.alpha_of)
-    scene.render.use_compositing = not exr
+    scene.render.film_transparent = bool(args.alpha_of) or (not exr and scene.use_nodes)
+    scene.render.use_compositing = not exr and scene.use_nodes
     settings = scene.render.image_settings
     settings.file_format = "OPEN_EXR" if exr else "PNG"
     settings.color_mode = "RGBA"

@@ -100,7 +100,61 @@ for s in (1, 2):
     assert b['relative_rms'] < noise + run, (b['relative_rms'], noise, run)
     assert all(abs(r - 1) < 0.02 for r in ratio), ratio"
 
-# 3. The contract.
+# 3. A map set as a scene: Cycles renders each view's sphere map (Lambert, three views, one of them
+# oblique) within its own noise of rsibr's bake.
+module="$(dirname "$rsibr")/python"
+"$rsibr" pattern sun-sky "$work/sun.exr" --to latlong --size 128 >/dev/null
+printf '0 0 1\n1 0 0\n0.3 0.8 0.2\n' >"$work/views.txt"
+printf '{type: lambert, albedo: [0.8, 0.6, 0.4]}\n' >"$work/lambert.yaml"
+"$rsibr" bake --env "$work/sun.exr" --brdf "$work/lambert.yaml" --views "$work/views.txt" --res 32 --method reference \
+  "$work/lambert.exr" -q
+"$rsibr" export blender --maps "$work/lambert.exr" --env "$work/sun.exr" --out "$work/ms" -q
+ok=1
+for seed in 1 2; do
+  for frame in 1 2 3; do
+    blender -b "$work/ms/scene.blend" --python-exit-code 3 --python "$work/ms/build_blender_scene.py" -- --render "$frame" \
+      --samples 256 --seed "$seed" --image "$work/ms/s$seed-$frame.exr" >>"$work/blender.log" 2>&1 || ok=0
+  done
+done
+check "Cycles renders every view of the exported map set" test "$ok" = 1
+if [ -d "$module" ]; then
+  cat >"$work/maps.py" <<'PY'
+import bpy, sys, numpy as np
+work, module = sys.argv[sys.argv.index("--") + 1:]
+sys.path.insert(0, module)
+import rsibr
+maps = rsibr.read_map_set(work + "/lambert.exr")
+def load(p):
+    image = bpy.data.images.load(p); w, h = image.size
+    return np.array(image.pixels[:], dtype=np.float64).reshape(h, w, 4)[::-1, :, :3]
+for v in range(len(maps)):
+    a = np.asarray(maps[v].rgb, dtype=np.float64)
+    c1, c2 = (load("%s/ms/s%d-%d.exr" % (work, s, v + 1)) for s in (1, 2))
+    n = a.shape[0]; ys, xs = np.mgrid[0:n, 0:n]
+    inside = (2 * (xs + 0.5) / n - 1) ** 2 + (1 - 2 * (ys + 0.5) / n) ** 2 < 0.98 ** 2
+    c = (c1 + c2) / 2
+    bias = (c - a)[inside].sum() / a[inside].sum()
+    rel = np.sqrt(((c - a)[inside] ** 2).sum() / (a[inside] ** 2).sum())
+    noise = np.sqrt(((c1 - c2)[inside] ** 2 / 4).sum() / (a[inside] ** 2).sum())
+    print("view %d: bias %+.4f relative RMS %.4f noise %.4f" % (v, bias, rel, noise))
+    print("CHECK %d" % (abs(bias) < 0.003 + 4 * noise / np.sqrt(inside.sum()) and rel < np.hypot(noise, 0.003) * 1.2))
+PY
+  PATH=/usr/bin:$PATH blender -b --factory-startup --python "$work/maps.py" -- "$work" "$module" >"$work/maps.log" 2>&1
+  grep "^view" "$work/maps.log"
+  check "Cycles' render of each exported view = rsibr's map within its noise" \
+    bash -c "[ \"\$(grep -c '^CHECK 1' '$work/maps.log')\" = 3 ]"
+else
+  echo "skipped the map-set comparison: the Python module is not built ($module)"
+fi
+expect_error "export: --maps without --env" "needs --env" export blender --maps "$work/lambert.exr" --out "$work/e6"
+expect_error "export: a run and --maps" "not both" export blender "$work/run" --maps "$work/lambert.exr" \
+  --env "$work/sun.exr" --out "$work/e7"
+printf '{type: phong, albedo: [0.5, 0.5, 0.5], exponent: 20}\n' >"$work/phong.yaml"
+"$rsibr" bake --env "$work/sun.exr" --brdf "$work/phong.yaml" --views "$work/views.txt" --res 8 "$work/phong.exr" -q
+expect_error "export: a material Cycles has no counterpart for" "no Cycles counterpart" export blender \
+  --maps "$work/phong.exr" --env "$work/sun.exr" --out "$work/e8" --no-blend
+
+# 4. The contract.
 expect_error "export: not a run" "steps/extract.json" export blender "$work/syn" --out "$work/e1"
 check "export: nothing left after an error" bash -c "! ls -A '$work' | grep -q '^\.\?e1'"
 expect_error "export: Blender missing" "nonexistent-blender" export blender "$work/run" --out "$work/e2" \
