@@ -581,21 +581,6 @@ bool nested_in(const BallCandidate& c, const BallCone& chrome) {
   return a < chrome.half_angle && angle_between(c.loc.fit.cone.axis, chrome.axis) + 0.5 * a <= chrome.half_angle;
 }
 
-// The covariance (world, chrome radii squared, up to one common factor) of the offset a view
-// implies, R (s g - c): a ball's centre at distance |x| = 1 / sin(alpha) radii is known across its
-// axis to |x| sigma and along it to |d|x|/d alpha| sigma = cos(alpha) / sin^2(alpha) sigma, for
-// one angular error sigma of the outline's centre and radius. Along the axis is 1/alpha times worse
-// (about 20x for a ball 1 m away at 700 px focal length): the view's depth is the weak part.
-Mat3 implied_offset_covariance(const ViewBalls& v, const BallCandidate& c, double scale) {
-  auto centre_covariance = [](const BallCone& cone) {
-    const double sa = std::sin(cone.half_angle), ca = std::cos(cone.half_angle);
-    const double across = 1 / (sa * sa), along = ca * ca / (sa * sa * sa * sa);
-    return Mat3(across * Mat3::Identity() + (along - across) * cone.axis * cone.axis.transpose());
-  };
-  const Mat3 cam = scale * scale * centre_covariance(c.loc.fit.cone) + centre_covariance(*v.chrome);
-  return v.world_from_cam * cam * v.world_from_cam.transpose();
-}
-
 // Least squares (scale, offset) over observations R_i (s g_i - c_i) = o: 3 equations each.
 std::pair<double, Vec3> solve_scale_offset(const std::vector<Mat3>& r, const std::vector<Vec3>& g,
                                            const std::vector<Vec3>& c) {
@@ -715,23 +700,16 @@ std::vector<RigMember> fit_ball_rig(const std::vector<ViewBalls>& views, const s
       if (int(who.size()) < need) break;
       std::vector<Mat3> r;
       std::vector<Vec3> g, c;
-      // With the scale known, the views' implied offsets weighted by their inverse covariances:
-      // each view's depth is weak, the others' across-axis directions pin it.
-      Mat3 information = Mat3::Zero();
-      Vec3 weighted = Vec3::Zero();
+      Vec3 mean = Vec3::Zero();
       for (const Obs& ob : who) {
         const ViewBalls& v = views[std::size_t(ob.view)];
-        const BallCandidate& cand = v.candidates[std::size_t(ob.cand)];
         r.push_back(v.world_from_cam);
-        g.push_back(centre_in_radii(cand.loc.fit.cone));
+        g.push_back(centre_in_radii(v.candidates[std::size_t(ob.cand)].loc.fit.cone));
         c.push_back(centre_in_radii(*v.chrome));
-        const Mat3 inv = implied_offset_covariance(v, cand, best_s).inverse();
-        information += inv;
-        weighted += inv * implied_offset(v, cand, best_s);
+        mean += implied_offset(v, v.candidates[std::size_t(ob.cand)], best_s);
       }
       if (scale_given || who.size() < 2) {
-        const Vec3 off = information.ldlt().solve(weighted);
-        if (off.allFinite()) best_off = off;
+        best_off = mean / double(who.size());
       } else {
         const auto [s, off] = solve_scale_offset(r, g, c);
         if (s > 0.05 && s < 20 && off.allFinite()) best_s = s, best_off = off;
