@@ -1,6 +1,7 @@
 #include "export/blender_scene.h"
 
 #include "bake/brdf_spec.h"
+#include "calib/ball_offset.h"
 #include "calib/far_camera.h"
 #include "calib/pose_file.h"
 #include "calib/view_image.h"
@@ -102,6 +103,33 @@ Vec3 lambert_albedo(const MapSet& set, const fs::path& file) {
   return Vec3::Constant(a.as<double>());
 }
 
+// The views where the extract step found ball `name`: its circle as a cone (axis through the
+// circle's centre, half angle from the rays through its rim) beside the pose's chrome cone.
+std::vector<BallOffsetView> ball_views(const nlohmann::json& summary, const PoseSet& poses, const LensModel& lens,
+                                       const std::string& name) {
+  std::vector<BallOffsetView> views;
+  for (const auto& view : summary.value("views", nlohmann::json::array())) {
+    const ViewPose* pose = poses.find(view.value("name", ""));
+    if (!pose || !pose->ball) continue;
+    for (const auto& found : view.value("balls", nlohmann::json::array())) {
+      if (found.value("ball", "") != name || found.value("status", "") != "found" || !found.contains("centre_px") ||
+          !found.contains("radius_px"))
+        continue;
+      const Vec2 c(found["centre_px"][0], found["centre_px"][1]);
+      const double r = found["radius_px"];
+      BallCone cone;
+      cone.axis = lens.unproject(c).normalized();
+      double half = 0;
+      for (const Vec2& d : {Vec2(r, 0), Vec2(0, r)})
+        half += 0.25 * angle_between(lens.unproject(c + d), lens.unproject(c - d));
+      cone.half_angle = half;
+      if (cone.half_angle > 0 && cone.half_angle < 0.5 * kPi)
+        views.push_back({pose->world_from_cam, *pose->ball, cone});
+    }
+  }
+  return views;
+}
+
 // The camera's distance from the chrome centre along its chrome cone. The cone's half angle gives
 // it to about 1% (a fraction of a pixel on the outline's radius), which moves a ball 30 cm away by
 // pixels; the directions in which the view sees the other placed balls give it far better. The
@@ -176,7 +204,15 @@ BlenderExport export_from_run(const fs::path& run, const BlenderExportOptions& o
   const nlohmann::json& summary = field(extract, "summary", extract_file);
   const double chrome_radius = field(summary, "chrome_radius_m", extract_file).get<double>();
 
-  // The balls: (name, kind) from the extract step's settings, places from its rig.
+  const LensModel lens = LensModel::read(existing(run / "lens.cameramodel"));
+  if (lens.intrinsics().size() < 4)
+    throw std::invalid_argument((run / "lens.cameramodel").string() + ": " + lens.name() +
+                                " has no pinhole core (fx, fy, cx, cy) for Blender's camera");
+  const PoseSet poses = read_pose_file(existing(run / "poses.yaml").string());
+
+  // The balls: (name, kind) from the extract step's settings, places from its rig; a ball the
+  // views saw is placed from their circles by calib/ball_offset.h (the rig's offset is their mean,
+  // which carries each view's weak depth).
   const nlohmann::json& rig = field(summary, "rig", extract_file);
   const nlohmann::json& listed = field(settings, "balls", extract_file);
   Vec3 chrome_centre = Vec3::Zero();
@@ -194,8 +230,12 @@ BlenderExport export_from_run(const fs::path& run, const BlenderExportOptions& o
     ball.name = name;
     ball.kind = kind;
     const auto& o = member->at("offset_chrome_radii");
-    ball.centre = blender_from_rsibr() * Vec3(o[0], o[1], o[2]) * chrome_radius;
-    ball.radius = member->at("scale").get<double>() * chrome_radius;
+    const double scale = member->at("scale").get<double>();
+    Vec3 offset(o[0], o[1], o[2]);
+    if (kind != "chrome")
+      if (const auto weighted = weighted_ball_offset(ball_views(summary, poses, lens, name), scale)) offset = *weighted;
+    ball.centre = blender_from_rsibr() * offset * chrome_radius;
+    ball.radius = scale * chrome_radius;
     if (kind == "chrome") {
       const fs::path probe_file = run / "steps" / "probe.json";
       json_file = probe_file;
@@ -225,11 +265,6 @@ BlenderExport export_from_run(const fs::path& run, const BlenderExportOptions& o
   out.files["world.exr"] = world_exr(probe, options.world_width);
 
   // The cameras: each view's pose, its chrome cone and the lens.
-  const LensModel lens = LensModel::read(existing(run / "lens.cameramodel"));
-  if (lens.intrinsics().size() < 4)
-    throw std::invalid_argument((run / "lens.cameramodel").string() + ": " + lens.name() +
-                                " has no pinhole core (fx, fy, cx, cy) for Blender's camera");
-  const PoseSet poses = read_pose_file(existing(run / "poses.yaml").string());
   for (const ViewPose& v : poses.views) {
     if (!v.ball) {
       out.notes.push_back("view '" + v.name + "' is left out: its pose has no chrome ball to place the camera");
