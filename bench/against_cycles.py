@@ -39,6 +39,8 @@ import sys
 import tempfile
 import time
 
+from doc_section import write_section
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TITLE = "## Against Cycles"
 RENDER = os.path.join(ROOT, "scripts/blender/render_sphere.py")
@@ -319,22 +321,6 @@ def format_section(data):
     return lines
 
 
-def write_section(path, section):
-    lines = open(path).read().splitlines() if os.path.exists(path) else []
-    # Replace an existing section (up to the next "## " or "Notes:"), else insert before "Notes:"
-    # (bench/performance.py keeps the sections other scripts write, in place).
-    start = next((i for i, l in enumerate(lines) if l.startswith(TITLE)), None)
-    if start is not None:
-        end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith(("## ", "Notes:"))), len(lines))
-        lines[start:end] = section
-    else:
-        at = next((i for i, l in enumerate(lines) if l.startswith("Notes:")), len(lines))
-        lines[at:at] = section
-    with open(path + ".tmp", "w") as f:
-        f.write("\n".join(lines).rstrip("\n") + "\n")
-    os.replace(path + ".tmp", path)
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--rsibr", default=os.path.join(ROOT, "build/release/rsibr"))
@@ -370,7 +356,7 @@ def main():
     if args.no_write:
         print("\n".join(section))
     else:
-        write_section(args.out, section)
+        write_section(args.out, TITLE, section)
         print("against_cycles: wrote", args.out)
 
 

@@ -18,6 +18,8 @@ import os
 import subprocess
 import tempfile
 
+from doc_section import write_section
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TITLE = "## Viewer"
 
@@ -87,19 +89,7 @@ def main():
         "target on a GPU is not measured here).",
         "",
     ]
-    with open(args.out) as f:
-        lines = f.read().splitlines()
-    # Replace an existing Viewer section (up to the next "## " or "Notes:"), else insert before "Notes:".
-    start = next((i for i, l in enumerate(lines) if l.startswith(TITLE)), None)
-    if start is not None:
-        end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith(("## ", "Notes:"))), len(lines))
-        lines[start:end] = section
-    else:
-        at = next((i for i, l in enumerate(lines) if l.startswith("Notes:")), len(lines))
-        lines[at:at] = section
-    with open(args.out + ".tmp", "w") as f:
-        f.write("\n".join(lines) + "\n")
-    os.replace(args.out + ".tmp", args.out)
+    write_section(args.out, TITLE, section)
     print("viewer_fps: wrote", args.out)
     print("\n".join(rows))
 
