@@ -64,21 +64,10 @@ argv = sys.argv[sys.argv.index("--") + 1:]
 sys.path.insert(0, argv[0])
 import rsibr
 # rsibr.read_environment folds lossy-codec ringing as every rsibr verb does; then the same radiance
-# in Blender's cell-centred lat-long convention at twice the resolution: the bilinear samples of
-# rsibr's map (texel centres on the seam and the poles) at the cell centres, separable along rows
-# and columns, as rsibr::to_cell_centred_latlong computes it.
+# in Blender's cell-centred lat-long convention at k times the resolution (core/cell_centred_latlong.h).
 env = rsibr.read_environment(argv[1])
-p = np.asarray(env.pixels, dtype=np.float64)
-H, W, _ = p.shape
 k = int(argv[3])
-xs = (np.arange(k * W) + 0.5) * (W - 1) / (k * W)
-ys = (np.arange(k * H) + 0.5) * (H - 1) / (k * H)
-x0 = np.floor(xs).astype(int); fx = (xs - x0)[None, :, None]; x1 = np.minimum(x0 + 1, W - 1)
-y0 = np.floor(ys).astype(int); fy = (ys - y0)[:, None, None]; y1 = np.minimum(y0 + 1, H - 1)
-top = p[y0][:, x0] * (1 - fx) + p[y0][:, x1] * fx
-bottom = p[y1][:, x0] * (1 - fx) + p[y1][:, x1] * fx
-out = np.ascontiguousarray((top * (1 - fy) + bottom * fy).astype(np.float32))
-rsibr.write_environment(argv[2], rsibr.Environment(out))
+rsibr.write_environment(argv[2], rsibr.to_cell_centred_latlong(env, k * env.layout.width, k * env.layout.height))
 '''
 
 METRICS = r'''

@@ -2,6 +2,7 @@
 #include "python/bindings.h"
 #include "python/numpy_mat.h"
 
+#include "core/cell_centred_latlong.h"
 #include "core/env_map.h"
 #include "core/exr_io.h"
 #include "core/texel_audit.h"
@@ -131,6 +132,24 @@ void bind_environment(py::module_& m) {
       "Writes an OpenEXR environment atomically (temporary name, then rename), with its layout, Rec.709 "
       "chromaticities and attributes (names under 32 characters). half=True stores half floats (values beyond "
       "65504 are an error). RuntimeError naming the file on failure.");
+  m.def(
+      "to_cell_centred_latlong",
+      [](const EnvMap& env, int width, int height) {
+        check_pixels(env);
+        if (width < 1 || height < 1) throw py::value_error("to_cell_centred_latlong: width and height must be >= 1");
+        py::gil_scoped_release release;
+        return to_cell_centred_latlong(env, width, height);
+      },
+      py::arg("environment"), py::arg("width"), py::arg("height"),
+      "The environment's radiance as a width x height lat-long image in the cell-centred convention of Blender, "
+      "Cycles and pbrt (texel (i, j) at longitude pi (1 - 2 (i + 1/2) / W), latitude pi/2 - pi (j + 1/2) / H), each "
+      "texel the bilinear sample at its direction. For other programs only: rsibr reads lat-long files in "
+      "OpenEXR's convention (docs/conventions.md), so this image read back by rsibr is stretched by a texel.");
+  m.def(
+      "cell_centred_latlong_direction",
+      [](double i, double j, int width, int height) { return cell_centred_latlong_direction(i, j, width, height); },
+      py::arg("i"), py::arg("j"), py::arg("width"), py::arg("height"),
+      "World direction (unit, rsibr's frame) of the cell-centred lat-long texel (i, j) of a width x height image.");
 }
 
 }  // namespace rsibr::python

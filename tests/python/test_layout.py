@@ -42,3 +42,22 @@ def test_a_view_frame_is_a_rotation_whose_z_is_the_view():
     t = rsibr.world_from_view_for(v)
     assert np.allclose(t.T @ t, np.eye(3)) and np.isclose(np.linalg.det(t), 1)
     assert np.allclose(t[:, 2], v / np.linalg.norm(v))
+
+
+def test_a_cell_centred_latlong_holds_the_environment_at_its_texel_centres():
+    # Values linear in rsibr's column and row: the cell-centred texel (i, j) is rsibr's pixel
+    # ((i + 1/2)(W - 1)/W, (j + 1/2)(H - 1)/H), interpolated exactly.
+    w, h = 16, 8
+    pixels = np.zeros((h, w, 3), np.float32)
+    pixels[..., 0] = np.arange(w)[None, :]
+    pixels[..., 1] = np.arange(h)[:, None]
+    pixels[..., 2] = 1
+    out = rsibr.to_cell_centred_latlong(rsibr.Environment(pixels), w, h)
+    assert out.layout.width == w and out.layout.height == h
+    got = np.asarray(out.pixels)
+    assert np.allclose(got[..., 0], ((np.arange(w) + 0.5) * (w - 1) / w)[None, :], atol=2e-4)
+    assert np.allclose(got[..., 1], ((np.arange(h) + 0.5) * (h - 1) / h)[:, None], atol=2e-4)
+    assert np.allclose(got[..., 2], 1)
+    # The image's centre looks at +Z (longitude 0, latitude 0).
+    d = rsibr.cell_centred_latlong_direction(w / 2 - 0.5, h / 2 - 0.5, w, h)
+    assert np.allclose(d, [0, 0, 1], atol=1e-12)
