@@ -59,7 +59,7 @@ THRESHOLDS = [0.01, 0.001]
 
 # Blender-side helpers (Blender's Python: numpy and the rsibr module).
 CONVERT = r'''
-import sys, numpy as np
+import sys
 argv = sys.argv[sys.argv.index("--") + 1:]
 sys.path.insert(0, argv[0])
 import rsibr
