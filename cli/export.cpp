@@ -147,7 +147,7 @@ Runner add_export(CLI::App& app) {
   b->add_option("--samples", a->samples, "Cycles samples per pixel set in the scene (default 256)")
       ->check(CLI::Range(1, 1 << 20));
   b->add_option("--world-width", a->world_width, "Width of world.exr (default the probe's)")
-      ->check(CLI::Range(0, 65536));
+      ->check(CLI::Range(0, 16384));
   b->add_option("--preview", a->preview_samples,
                 "Also render frame 1 over its photo at this many samples into OUT/preview.png")
       ->check(CLI::Range(1, 1 << 20));

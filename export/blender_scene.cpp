@@ -11,6 +11,7 @@
 #include "core/lens_model.h"
 #include "core/map_set.h"
 #include "export/blender_axes.h"
+#include "pipeline/step_record.h"
 
 #include <opencv2/imgproc.hpp>
 #include <unistd.h>
@@ -30,13 +31,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-nlohmann::json read_json(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) throw std::invalid_argument(file.string() + ": missing (has the run reached this step?)");
+// A step's record (pipeline/step_record.h): a missing or malformed one is the input's problem.
+StepRecord record_of(const fs::path& run, const std::string& step) {
   try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception&) {
-    throw std::invalid_argument(file.string() + ": not JSON");
+    return read_step_record(run, step);
+  } catch (const std::runtime_error& e) {
+    throw std::invalid_argument(e.what());
   }
 }
 
@@ -199,9 +199,9 @@ BlenderExport export_from_run(const fs::path& run, const BlenderExportOptions& o
   out.samples = options.samples;
   const fs::path extract_file = run / "steps" / "extract.json";
   json_file = extract_file;
-  const nlohmann::json extract = read_json(extract_file);
-  const nlohmann::json& settings = field(extract, "settings", extract_file);
-  const nlohmann::json& summary = field(extract, "summary", extract_file);
+  const StepRecord extract = record_of(run, "extract");
+  const nlohmann::json& settings = extract.settings;
+  const nlohmann::json& summary = extract.summary;
   const double chrome_radius = field(summary, "chrome_radius_m", extract_file).get<double>();
 
   const LensModel lens = LensModel::read(existing(run / "lens.cameramodel"));
@@ -239,8 +239,7 @@ BlenderExport export_from_run(const fs::path& run, const BlenderExportOptions& o
     if (kind == "chrome") {
       const fs::path probe_file = run / "steps" / "probe.json";
       json_file = probe_file;
-      const nlohmann::json probe = read_json(probe_file);
-      const std::string spec = field(field(probe, "summary", probe_file), "fresnel", probe_file).get<std::string>();
+      const std::string spec = field(record_of(run, "probe").summary, "fresnel", probe_file).get<std::string>();
       json_file = extract_file;
       ball.material = "glossy";
       ball.fresnel_table = "fresnel-" + name + ".exr";
@@ -310,9 +309,8 @@ BlenderExport export_from_run(const fs::path& run, const BlenderExportOptions& o
   const fs::path render_file = run / "steps" / "render.json";
   if (fs::is_regular_file(render_file)) {
     json_file = render_file;
-    const nlohmann::json render = read_json(render_file);
-    if (render.contains("summary") && render["summary"].contains("display_exposure_stops"))
-      out.exposure_stops = render["summary"]["display_exposure_stops"].get<double>();
+    const nlohmann::json render = record_of(run, "render").summary;
+    if (render.contains("display_exposure_stops")) out.exposure_stops = render["display_exposure_stops"].get<double>();
   }
   return out;
 }
