@@ -13,6 +13,10 @@
 #include <optional>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
 namespace rsibr {
 
 PixelFootprint pixel_footprint(const Layout& layout, const Vec2& p) {
@@ -123,8 +127,11 @@ class PeakPyramid {
 
 // The n x n taps of one texel from ripmap level `level`, for RGB: corner positions x, y (level-0
 // pixels, unwrapped) and densities w in the order top-left, top-right, bottom-left, bottom-right,
-// the corner lines at pixel offsets y_top and y_bottom. The same sums as LatLongRipmap::bilinear
-// per tap, with the level's constants hoisted out of the loop.
+// the corner lines at pixel offsets y_top and y_bottom. The same taps as LatLongRipmap::bilinear,
+// with the level's constants hoisted out of the loop: along a row of taps the position and density
+// step by constants, and a row's n taps are summed in float (n <= 64 terms of one sign pattern,
+// then added in double). A cell whose corners lie inside the level (neither seam nor pole within
+// it) needs no wrapping or clamping per tap; the taps are convex combinations of the corners.
 void rgb_taps(const LatLongRipmap& ripmap, int level, int n, const double* x, const double* y, const double* w,
               double y_top, double y_bottom, float* px) {
   const cv::Mat& m = ripmap.level(level);
@@ -132,29 +139,59 @@ void rgb_taps(const LatLongRipmap& ripmap, int level, int n, const double* x, co
   const double period = cols - 1, to_level = ripmap.inverse_scale(level), last_row = rows - 1;
   const std::size_t stride = m.step1();
   const float* base = m.ptr<float>(0);
+  const double x_lo = std::min({x[0], x[1], x[2], x[3]}) * to_level,
+               x_hi = std::max({x[0], x[1], x[2], x[3]}) * to_level;
+  const double y_lo = std::min({y[0], y[1], y[2], y[3]}), y_hi = std::max({y[0], y[1], y[2], y[3]});
+  const bool inside = x_lo >= 0 && x_hi <= period && y_lo >= 0 && y_hi <= last_row;
+  const double inv_n = 1.0 / n;
   double r = 0, g = 0, b = 0, wsum = 0;
   for (int j = 0; j < n; ++j) {
-    const double t = ((j + 0.5) / n - 0.5 - y_top) / (y_bottom - y_top);
+    const double t = ((j + 0.5) * inv_n - 0.5 - y_top) / (y_bottom - y_top);
     const double lx = (x[0] + t * (x[2] - x[0])) * to_level, rx = (x[1] + t * (x[3] - x[1])) * to_level;
     const double ly = y[0] + t * (y[2] - y[0]), ry = y[1] + t * (y[3] - y[1]);
     const double lw = w[0] + t * (w[2] - w[0]), rw = w[1] + t * (w[3] - w[1]);
-    for (int i = 0; i < n; ++i) {
-      const double s = (i + 0.5) / n;
-      double xx = lx + s * (rx - lx);
-      if (xx < 0 || xx > period) xx -= period * std::floor(xx / period);
-      xx = std::clamp(xx, 0.0, period);
-      const double yy = std::clamp(ly + s * (ry - ly), 0.0, last_row);
-      const int c0 = std::min(int(xx), cols - 2), r0 = std::min(int(yy), rows - 2);
-      const float fx = float(xx - c0), fy = float(yy - r0);
+    const double dx = (rx - lx) * inv_n, dy = (ry - ly) * inv_n, dw = (rw - lw) * inv_n;
+    double xx = lx + 0.5 * dx, yy = ly + 0.5 * dy, tw = lw + 0.5 * dw;
+    float fr = 0, fg = 0, fb = 0, fw = 0;
+#if defined(__SSE2__)
+    __m128 sum = _mm_setzero_ps();
+#endif
+    for (int i = 0; i < n; ++i, xx += dx, yy += dy, tw += dw) {
+      double u = xx, v = yy;
+      if (!inside) {
+        if (u < 0 || u > period) u -= period * std::floor(u / period);
+        u = std::clamp(u, 0.0, period);
+        v = std::clamp(v, 0.0, last_row);
+      }
+      const int c0 = std::min(int(u), cols - 2), r0 = std::min(int(v), rows - 2);
+      const float fx = float(u - c0), fy = float(v - r0), wt = float(tw);
       const float* a = base + std::size_t(r0) * stride + std::size_t(c0) * 3;
       const float* d = a + stride;
-      const float w00 = (1 - fx) * (1 - fy), w01 = fx * (1 - fy), w10 = (1 - fx) * fy, w11 = fx * fy;
-      const double tw = lw + s * (rw - lw);
-      r += tw * (w00 * a[0] + w01 * a[3] + w10 * d[0] + w11 * d[3]);
-      g += tw * (w00 * a[1] + w01 * a[4] + w10 * d[1] + w11 * d[4]);
-      b += tw * (w00 * a[2] + w01 * a[5] + w10 * d[2] + w11 * d[5]);
-      wsum += tw;
+#if defined(__SSE2__)
+      // RGB in three lanes: texel c0 from a[0..3], texel c0 + 1 from a[2..5] moved down one lane
+      // (a[6] may lie past the map's last texel, so it is never read).
+      const __m128 left_top = _mm_loadu_ps(a), left_bottom = _mm_loadu_ps(d);
+      const __m128 right_top = _mm_shuffle_ps(_mm_loadu_ps(a + 2), _mm_loadu_ps(a + 2), _MM_SHUFFLE(3, 3, 2, 1));
+      const __m128 right_bottom = _mm_shuffle_ps(_mm_loadu_ps(d + 2), _mm_loadu_ps(d + 2), _MM_SHUFFLE(3, 3, 2, 1));
+      const __m128 vx = _mm_set1_ps(fx), vy = _mm_set1_ps(fy);
+      const __m128 top = _mm_add_ps(left_top, _mm_mul_ps(vx, _mm_sub_ps(right_top, left_top)));
+      const __m128 bottom = _mm_add_ps(left_bottom, _mm_mul_ps(vx, _mm_sub_ps(right_bottom, left_bottom)));
+      sum = _mm_add_ps(sum, _mm_mul_ps(_mm_set1_ps(wt), _mm_add_ps(top, _mm_mul_ps(vy, _mm_sub_ps(bottom, top)))));
+#else
+      const float t0 = a[0] + fx * (a[3] - a[0]), t1 = a[1] + fx * (a[4] - a[1]), t2 = a[2] + fx * (a[5] - a[2]);
+      const float b0 = d[0] + fx * (d[3] - d[0]), b1 = d[1] + fx * (d[4] - d[1]), b2 = d[2] + fx * (d[5] - d[2]);
+      fr += wt * (t0 + fy * (b0 - t0));
+      fg += wt * (t1 + fy * (b1 - t1));
+      fb += wt * (t2 + fy * (b2 - t2));
+#endif
+      fw += wt;
     }
+#if defined(__SSE2__)
+    alignas(16) float lanes[4];
+    _mm_store_ps(lanes, sum);
+    fr = lanes[0], fg = lanes[1], fb = lanes[2];
+#endif
+    r += fr, g += fg, b += fb, wsum += fw;
   }
   px[0] = float(r / wsum), px[1] = float(g / wsum), px[2] = float(b / wsum);
 }
