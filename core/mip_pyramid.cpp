@@ -136,7 +136,7 @@ MipPyramid::MipPyramid(const EnvMap& base) {
         break;
     }
     if (!next || *next == top) break;
-    // A lat-long resizes exactly (separable overlaps, linear in its texels); others resample.
+    // One area-weighted resample (bilinear reconstruction of the base) to the nesting size.
     levels_.push_back(resample(levels_.back(), *next));
   }
 }
