@@ -1,5 +1,5 @@
 // A BRDF's directional albedo as a function of cos(theta_o) alone, tabulated for albedo-normalised
-// maps (the map-set attribute rsibr.albedo; core/map_set.h, runtime/blend.h).
+// maps (the map-set attribute rsibr.albedo; formats/map_set.h, runtime/blend.h).
 //
 // Why: a radiance map is view dependent mostly through a factor that depends on the outgoing angle
 // only (Fresnel: the coat's reflectance rises toward 1 at grazing; the coat transmittance T(wo) of

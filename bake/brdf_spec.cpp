@@ -6,7 +6,7 @@
 #include "bake/ggx.h"
 #include "bake/lambert.h"
 #include "bake/phong.h"
-#include "core/yaml_spec.h"
+#include "formats/yaml_spec.h"
 
 #include <algorithm>
 #include <cmath>

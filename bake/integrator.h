@@ -1,5 +1,5 @@
 // Lighting integrators: the radiance sphere map of a BRDF under a distant environment, for one
-// view (docs/conventions.md, "Light"; core/map_set.h).
+// view (docs/conventions.md, "Light"; formats/map_set.h).
 //
 // Contract of a texel (what every integrator computes). For the view v (world, unit, toward the
 // viewer), the map's world_from_view T and texel p = (c, r) of a size x size sphere map whose

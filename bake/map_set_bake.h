@@ -1,12 +1,12 @@
 // Baking a computed map set: one radiance sphere map per view of a view set, a BRDF integrated
 // against an environment by one integrator (bake/integrator.h for what a texel holds), with the
-// map-set attributes every computed set carries (core/map_set.h). Shared by `rsibr bake` and the
+// map-set attributes every computed set carries (formats/map_set.h). Shared by `rsibr bake` and the
 // Python module.
 #pragma once
 
 #include "bake/brdf.h"
 #include "bake/integrator.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/view_set.h"
 
 #include <functional>

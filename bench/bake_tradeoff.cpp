@@ -11,7 +11,7 @@
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
 #include "bench/measure.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "core/resample.h"
 #include "core/sphere_map.h"
 #include "core/view_set.h"

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Sphere-map extraction: the orthographic indexing's perspective error against the ball's distance,
-beside the exact reflection indexing (calib/sphere_map_extraction.h).
+beside the exact reflection indexing (calib/extraction/sphere_map_extraction.h).
 
 Runs the test that measures it (calib_tests, SphereMapExtraction.OrthographicErrorFallsWithDistance...,
 which extracts a rendered chrome ball at several distances and compares with capture/'s true maps)

@@ -21,9 +21,9 @@
 //                lens: every physical effect on the grey ball, the photographer's and the other balls'
 //                occlusion included, and none of the pipeline's errors): the grey maps against that
 //                run's, per view after the gain fit: the pipeline's own error
-#include "calib/pose_file.h"
+#include "calib/orientation/pose_file.h"
 #include "compare/map_compare.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "hdr/vignetting.h"
 #include "pipeline/pose_input.h"
 

@@ -21,13 +21,13 @@
 // the truth's. For the clipped class the same log2 luminance ratio is reported with the fraction
 // of saturated channel values at or below the truth (a lower bound should be).
 #include "bench/measure.h"
-#include "core/atomic_file.h"
-#include "core/truth_image.h"
+#include "formats/atomic_file.h"
+#include "formats/truth_image.h"
 #include "hdr/camera_shoot.h"
 #include "hdr/merge.h"
 #include "hdr/noise_model.h"
 #include "hdr/response_recovery.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

@@ -120,12 +120,12 @@ def main():
             "that states its focal length right and once 4% short (kit-4%: a zoom's nominal focal length,",
             "focus breathing). truth: `--lens` the true model; chessboards: 6 boards, mrcal, model by",
             "cross-validation; exif: no boards, a pinhole from the photos' FocalLengthIn35mmFilm",
-            "(calib/photo_optics.h; the kit's EXIF names no lens in these rows, so neither its distortion nor",
+            "(calib/lens/photo_optics.h; the kit's EXIF names no lens in these rows, so neither its distortion nor",
             "its vignetting is corrected); lensfun: no boards, lensfun's profile of the lens the EXIF names",
             "(core/lensfun_lens.h: its distortion, and its vignetting in the hdr step; with a right EXIF it",
             "equals the truth by construction, so it measures the chain from the EXIF to the model: the",
             "module's tests check the fit against lensfun's own mapping); + outlines: the lens step's",
-            "self-calibration of the focal length from the balls' outlines (calib/outline_focal.h), combined",
+            "self-calibration of the focal length from the balls' outlines (calib/lens/outline_focal.h), combined",
             "with the metadata's as a prior (the default); outlines alone: the pinhole rig's EXIF carries no",
             "focal length (stripped by a messaging app), so the outlines measure it from a guess of the image",
             "diagonal, searched over a factor 4 either way. Focal error of the lens the later steps use, against",
@@ -156,7 +156,7 @@ def main():
              "focal length about 6% long (2 sigmas), a pinhole that fits the balls better (the grey comparison",
              "falls from 17% to 5%) without being the true focal length. With no focal length in the EXIF the",
              "outlines alone find it within their sigma; that sigma is mostly the outline detector's systematic",
-             "shape error (calib/outline_focal.h), which more balls do not lower."]
+             "shape error (calib/lens/outline_focal.h), which more balls do not lower."]
     replace_section(os.path.join(ROOT, "docs/tradeoffs.md"), "Lens source (rsibr process)", "\n".join(body))
     print("wrote docs/tradeoffs.md section 'Lens source (rsibr process)'")
 

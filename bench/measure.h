@@ -2,7 +2,7 @@
 // CC0 environments as rsibr's --sanitize reads them, fixed random probe texels, pooled errors.
 #pragma once
 
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "core/sphere_map.h"
 
 #include <opencv2/core.hpp>

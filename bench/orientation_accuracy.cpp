@@ -1,10 +1,10 @@
-// Orientation accuracy of calib/view_orientation.h on rendered views: a chrome ball of a given
+// Orientation accuracy of calib/orientation/view_orientation.h on rendered views: a chrome ball of a given
 // radius in pixels in a real environment (cache/), views `spacing` degrees apart around it (20 by
 // default), features on the cube faces or in the image (--domain), Gaussian noise
 // of a given relative std dev; the ball found and every view oriented from the images alone (gauge:
 // the true up of the first view), compared with the renderer's poses. One JSON line per run;
 // bench/orientation_accuracy.py runs a grid and writes the docs/tradeoffs.md section.
-#include "calib/view_orientation.h"
+#include "calib/orientation/view_orientation.h"
 
 #include "calib_cases.h"
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Orientation accuracy of `rsibr orient`'s pipeline (calib/view_orientation.h) against the ball's
+"""Orientation accuracy of `rsibr orient`'s pipeline (calib/orientation/view_orientation.h) against the ball's
 radius in pixels and the image noise, with and without the joint ball refinement and the tracks'
 re-location by patch alignment.
 
@@ -104,13 +104,13 @@ def main():
     load = os.getloadavg()[0]
     body = (
         "Four views 20 degrees apart of a chrome ball (no stand) in the CC0 `lobby` environment, rendered by capture/\n"
-        "(features on the cube faces, calib/ball_cube_features.h),\n"
+        "(features on the cube faces, calib/orientation/ball_cube_features.h),\n"
         "with Gaussian noise of relative std dev `noise` (plus a 0.02 floor), the ball found and every view oriented\n"
-        "from the images alone (calib/view_orientation.h; gauge: the first view's true up). Ball `fixed` at its\n"
+        "from the images alone (calib/orientation/view_orientation.h; gauge: the first view's true up). Ball `fixed` at its\n"
         "outline fit, its `centres` refined jointly with the orientations (a prior of max(outline RMS, 0.25 px)),\n"
         "or `centres + radii` (the half angle too, a prior of 2 px of image radius); these three with SIFT's\n"
         "keypoints as they are. `tracks re-located` (the default) then aligns every observation of a track with its\n"
-        "sharpest one by a patch on the cube faces and solves again (calib/track_refinement.h).\n"
+        "sharpest one by a patch on the cube faces and solves again (calib/orientation/track_refinement.h).\n"
         "Errors over %d seeds x 3 oriented views; chi2 = mean (error / reported sigma)^2 (1 when the sigmas are\n"
         "honest). Regenerate: `python3 bench/orientation_accuracy.py` (load average %.1f when this was written).\n\n"
         "| ball radius px | noise | ball refined | tracks | median centre error px | median radius error px | median error deg | max error deg | chi2 | seconds |\n"
@@ -136,7 +136,7 @@ def main():
         "biquadratic between (an affine map biased a 120-px ball's 14-degree patches: 0.2-0.3 degrees on four views).\n"
         "tests/calib/view_orientation_test.cpp checks the 400-px ring against the truth, tests/calib/track_refinement_test.cpp the re-located tracks.\n\n"
         "Wide baselines: two views `spacing` degrees apart (120-px ball, noise 0.01, refined centres and radii, %d\n"
-        "seeds), features detected on gnomonic cube faces of the reflected world (`cube`, calib/ball_cube_features.h,\n"
+        "seeds), features detected on gnomonic cube faces of the reflected world (`cube`, calib/orientation/ball_cube_features.h,\n"
         "the default) or by SIFT on the ball's image itself (`image`, the earlier front end). A world feature near the\n"
         "ball's centre in one view lies near the rim, compressed up to ~10x radially, in the other; on the cube\n"
         "faces it looks the same in both. `oriented` counts the runs that solved (the others: too few shared\n"

@@ -13,7 +13,7 @@
 #include "bake/brdf_spec.h"
 #include "bake/integrator.h"
 #include "bake/map_set_bake.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "core/stopwatch.h"
 #include "core/texel_audit.h"
 #include "plan/bake_plan.h"

@@ -20,7 +20,7 @@
 // channel mean: below 1 where the brightest bracket clipped the sun), and the covered solid-angle
 // fraction.
 #include "core/env_map.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "core/resample.h"
 
 #include <CLI/CLI.hpp>

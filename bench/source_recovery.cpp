@@ -30,10 +30,10 @@
 //                           error_over_sigma = (recovered - needed) / sigma
 #include "capture/synth_capture.h"
 #include "capture/synth_scene.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "compare/map_compare.h"
-#include "core/map_set.h"
-#include "core/truth_image.h"
+#include "formats/map_set.h"
+#include "formats/truth_image.h"
 
 #include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>

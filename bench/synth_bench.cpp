@@ -8,7 +8,7 @@
 #include "capture/rig_renderer.h"
 #include "capture/sensor_noise.h"
 #include "capture/synth_capture.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <benchmark/benchmark.h>
 #include <opencv2/imgproc.hpp>

@@ -1,13 +1,13 @@
 // How well the views of a rsibr process run agree where they see the same direction
-// (calib/view_agreement.h), at the run's rotations and at those rotations turned by --perturb-deg
+// (calib/orientation/view_agreement.h), at the run's rotations and at those rotations turned by --perturb-deg
 // about random axes: an orientation measure that needs no truth, and the proof that it sees a
 // wrong rotation; and where the measure itself is lowest near the solved rotation (a local search),
 // how far that lies from it. bench/view_agreement.py runs it on the real two-view sets.
 //
 //   rsibr_view_agreement RUN_DIR [--perturb-deg 5] [--turns 8] [--json OUT]
-#include "calib/far_camera.h"
-#include "calib/pose_file.h"
-#include "calib/view_agreement.h"
+#include "calib/lens/far_camera.h"
+#include "calib/orientation/pose_file.h"
+#include "calib/orientation/view_agreement.h"
 #include "calib/view_image.h"
 #include "core/lens_model.h"
 

@@ -7,7 +7,7 @@ who found them in DIR/balls/VIEW.png would) and, where the set has a file of poi
 in bench/data (SET-points.yaml), with those too. The table gives what the orient step saw for the
 pair (the rotation search's score and runner-up, the matches, the inliers against what chance gives
 under the search's gate, the stated sigma) and the agreement of the two views at the solved
-rotations (calib/view_agreement.h: the median log2 ratio of their luminance where both see a
+rotations (calib/orientation/view_agreement.h: the median log2 ratio of their luminance where both see a
 direction cleanly, and the mismatch, the median absolute deviation around it), at the solved
 rotation turned 5 degrees about eight random axes, and where the mismatch is lowest nearby.
 
@@ -112,7 +112,7 @@ def main():
             "Reading: a median log2 ratio near 0 says the two merges share their radiance scale (the views' "
             "exposure times and response agree). A lowest mismatch further from the solved rotation than its "
             "sigma says the sigma does not cover the error: both sets are crops, for which the far-camera model "
-            "(calib/far_camera.h) leaves out the true perspective, which moves the directions near the rim by "
+            "(calib/lens/far_camera.h) leaves out the true perspective, which moves the directions near the rim by "
             "up to the ball's unknown half angle.\n")
     replace_section(os.path.join(ROOT, "docs", "tradeoffs.md"), "Two real views", body)
     return 0

@@ -4,7 +4,7 @@
 // bench/warp_methods.py runs it and writes the docs/tradeoffs.md section "Warp methods".
 //
 //   rsibr_warp_methods [--sizes 128,256,512] [--reps 5]      one JSON object per line on stdout
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/sphere_map.h"
 #include "core/view_set.h"
 #include "runtime/blend.h"

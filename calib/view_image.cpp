@@ -1,6 +1,6 @@
 #include "calib/view_image.h"
 
-#include "core/exr_file.h"
+#include "formats/exr_file.h"
 #include "core/safe_name.h"
 #include "hdr/merged_exr.h"
 

@@ -22,7 +22,7 @@ struct ViewImage {
   std::string name;  // the header's rsibr.view string attribute (rsibr hdr writes the view's name), or empty
 };
 
-// Throws FileError(path, problem) (core/file_error.h).
+// Throws FileError(path, problem) (formats/file_error.h).
 ViewImage read_view_image(const std::string& path);
 
 }  // namespace rsibr

@@ -1,7 +1,7 @@
 #include "capture/dng_file.h"
-#include "core/file_error.h"
+#include "formats/file_error.h"
 
-#include "core/atomic_file.h"
+#include "formats/atomic_file.h"
 
 #include <tiffio.h>
 

@@ -1,5 +1,5 @@
 #include "capture/synth_capture.h"
-#include "core/file_error.h"
+#include "formats/file_error.h"
 
 #include "capture/camera_poses.h"
 #include "capture/camera_processing.h"
@@ -7,18 +7,18 @@
 #include "capture/chessboard.h"
 #include "capture/dng_file.h"
 #include "capture/irradiance.h"
-#include "core/photo_set.h"
+#include "formats/photo_set.h"
 #include "capture/rig_renderer.h"
 #include "capture/sensor_noise.h"
 #include "capture/true_sphere_map.h"
-#include "core/truth_image.h"
-#include "core/atomic_file.h"
-#include "core/atomic_folder.h"
+#include "formats/truth_image.h"
+#include "formats/atomic_file.h"
+#include "formats/atomic_folder.h"
 #include "core/texel_audit.h"
-#include "core/written_file_check.h"
-#include "core/exr_io.h"
+#include "formats/written_file_check.h"
+#include "formats/exr_io.h"
 #include "core/patterns.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <exiv2/exiv2.hpp>
 #include <opencv2/imgproc.hpp>

@@ -1,6 +1,6 @@
 // `rsibr synth`: a synthetic capture with its ground truth, written as two folders under DIR:
 //
-//   DIR/photos/   a photo set (photoset.yaml, core/photo_set.h): per view <view>/<view>_bNN.<ext>
+//   DIR/photos/   a photo set (photoset.yaml, formats/photo_set.h): per view <view>/<view>_bNN.<ext>
 //                 (one file per exposure, shortest first, exposure_s/iso/aperture in the YAML) and
 //                 chessboards/boardNN.<ext> (the same camera: response, format, white balance)
 //   DIR/truth/    truth.yaml (the exposure convention's gain k, full well, read noise, response,

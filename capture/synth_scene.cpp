@@ -5,7 +5,7 @@
 #include "core/lensfun_lens.h"
 #include "core/safe_name.h"
 #include "core/text.h"
-#include "core/yaml_spec.h"
+#include "formats/yaml_spec.h"
 
 #include <cmath>
 #include <sstream>

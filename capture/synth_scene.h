@@ -1,7 +1,7 @@
 // The scene spec of `rsibr synth` (datasets-synthetic/README.md documents it with examples): an
 // environment at infinity, a ball rig, a camera (lens, response, noise, vignetting, white balance,
 // output format), exposure brackets, view plans and chessboards. Loading is strict
-// (core/yaml_spec.h): unknown keys, wrong types and out-of-range values are errors naming the key
+// (formats/yaml_spec.h): unknown keys, wrong types and out-of-range values are errors naming the key
 // path, std::invalid_argument("<file>: <path>: <problem>").
 //
 // World frame: +Y up, metres. Defaults are the values the README states.

@@ -15,7 +15,7 @@
 #include "capture/irradiance.h"
 #include "capture/synth_scene.h"
 #include "core/env_map.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 
 namespace rsibr {
 

@@ -6,7 +6,7 @@
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
-#include "core/atomic_file.h"
+#include "formats/atomic_file.h"
 
 #include "bake/brdf_lobes.h"
 #include "bake/brdf_spec.h"
@@ -14,9 +14,9 @@
 #include "bake/map_set_bake.h"
 #include "cluster/distributed_bake.h"
 #include "cluster/session.h"
-#include "core/exr_io.h"
-#include "core/map_set.h"
-#include "core/output_plan.h"
+#include "formats/exr_io.h"
+#include "formats/map_set.h"
+#include "formats/output_plan.h"
 #include "core/progress.h"
 #include "core/view_set.h"
 

@@ -1,16 +1,16 @@
 // rsibr balls: a merged view (rsibr hdr) -> the ball candidates calibration sees in it
-// (calib/ball_identification.h), numbered, with their measures and the ball each listed kind
-// would take, and a picture of them circled and numbered (calib/ball_candidates_picture.h). The
+// (calib/balls/ball_identification.h), numbered, with their measures and the ball each listed kind
+// would take, and a picture of them circled and numbered (calib/balls/ball_candidates_picture.h). The
 // tool for choosing --ball when a run cannot decide.
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
-#include "calib/ball_candidates_picture.h"
-#include "calib/ball_identification.h"
+#include "calib/balls/ball_candidates_picture.h"
+#include "calib/balls/ball_identification.h"
 #include "calib/view_image.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 #include "core/lens_model.h"
-#include "core/output_plan.h"
+#include "formats/output_plan.h"
 #include "core/srgb_curve.h"
 
 #include <opencv2/imgproc.hpp>

@@ -7,7 +7,7 @@
 
 #include "cluster/batch_spec.h"
 #include "cluster/session.h"
-#include "core/output_plan.h"
+#include "formats/output_plan.h"
 
 #include <nlohmann/json.hpp>
 

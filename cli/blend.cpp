@@ -1,20 +1,20 @@
 // rsibr blend: the radiance map for any view from a map set (the runtime's warp and blend), written
 // as a one-view map set whose confidence channel is the blend's total weight.
 #include "cli/bake_planning.h"
-#include "core/file_error.h"
+#include "formats/file_error.h"
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
-#include "core/atomic_file.h"
+#include "formats/atomic_file.h"
 #include "core/colour.h"
-#include "core/map_set.h"
-#include "core/output_plan.h"
+#include "formats/map_set.h"
+#include "formats/output_plan.h"
 #include "core/preview_exposure.h"
 #include "runtime/blend.h"
 #include "runtime/make_warp.h"
 #include "plan/warp_plan.h"
 
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <chrono>
 #include <iostream>

@@ -1,13 +1,13 @@
-// rsibr calibrate: the lens model of a photo set's camera from its chessboard images (calib/intrinsics.h):
+// rsibr calibrate: the lens model of a photo set's camera from its chessboard images (calib/lens/intrinsics.h):
 // mrgingham corners, mrcal's staged solve, the model chosen by cross-validation, a .cameramodel.
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
-#include "calib/intrinsics.h"
-#include "calib/photo_optics.h"
-#include "core/atomic_file.h"
-#include "core/output_plan.h"
-#include "core/photo_set.h"
+#include "calib/lens/intrinsics.h"
+#include "calib/lens/photo_optics.h"
+#include "formats/atomic_file.h"
+#include "formats/output_plan.h"
+#include "formats/photo_set.h"
 #include "core/progress.h"
 #include "hdr/bracket_set.h"
 #include "pipeline/chessboard_problem.h"
@@ -48,7 +48,7 @@ void write_with_comment(const LensModel& lens, const std::string& out, const std
   write_text_atomically(out, comment + text.str());  // renamed over the model: never half a file
 }
 
-// No chessboards: the lens from the first photo's metadata (calib/photo_optics.h metadata_lens),
+// No chessboards: the lens from the first photo's metadata (calib/lens/photo_optics.h metadata_lens),
 // lensfun's profile of the lens its EXIF names, else the EXIF pinhole, with its stated sigma.
 int calibrate_from_metadata(const CalibrateArgs& a, const PhotoSet& set, OutputPlan& outputs, const std::string& model,
                             const std::string& json) {
@@ -127,7 +127,7 @@ int run_calibrate(const CalibrateArgs& a) {
   const std::vector<ModelScore> scores = cross_validate_models(p, models, &chosen);
   const IntrinsicsFit fit = fit_intrinsics(p, models[chosen]);
 
-  // Projection uncertainty (calib/intrinsics.h: projection_covariance) at a 3 x 3 grid of pixels:
+  // Projection uncertainty (calib/lens/intrinsics.h: projection_covariance) at a 3 x 3 grid of pixels:
   // 1-sigma along the worst direction.
   nlohmann::json points = nlohmann::json::array();
   double worst_sigma = 0;

@@ -3,8 +3,8 @@
 #include "cli/option_checks.h"
 #include "cli/verbs.h"
 #include "cluster/session.h"
-#include "core/file_error.h"
-#include "core/output_plan.h"
+#include "formats/file_error.h"
+#include "formats/output_plan.h"
 
 #include <opencv2/core.hpp>
 #include <tbb/global_control.h>

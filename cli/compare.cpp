@@ -4,18 +4,18 @@
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
-#include "core/atomic_file.h"
-#include "core/atomic_folder.h"
+#include "formats/atomic_file.h"
+#include "formats/atomic_folder.h"
 #include "compare/compare_pictures.h"
 #include "compare/comparison_report.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "compare/map_compare.h"
-#include "core/input_file.h"
-#include "core/output_plan.h"
+#include "formats/input_file.h"
+#include "formats/output_plan.h"
 #include "core/preview_exposure.h"
 #include "core/progress.h"
 
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <cmath>
 #include <filesystem>

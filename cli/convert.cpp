@@ -1,17 +1,17 @@
 // rsibr convert: an environment map from one layout and size to another.
 #include "cli/summary.h"
-#include "core/file_error.h"
+#include "formats/file_error.h"
 #include "cli/verbs.h"
 
-#include "core/atomic_file.h"
+#include "formats/atomic_file.h"
 #include "core/colour.h"
-#include "core/exr_io.h"
-#include "core/output_plan.h"
+#include "formats/exr_io.h"
+#include "formats/output_plan.h"
 #include "core/preview_exposure.h"
 #include "core/progress.h"
 #include "core/resample.h"
 
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <chrono>
 #include <cmath>

@@ -5,12 +5,12 @@
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
-#include "core/atomic_folder.h"
-#include "core/output_plan.h"
+#include "formats/atomic_folder.h"
+#include "formats/output_plan.h"
 #include "core/progress.h"
-#include "core/exr_io.h"
-#include "core/input_file.h"
-#include "core/map_set.h"
+#include "formats/exr_io.h"
+#include "formats/input_file.h"
+#include "formats/map_set.h"
 #include "export/blender_folder.h"
 #include "export/blender_scene.h"
 

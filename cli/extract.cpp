@@ -1,26 +1,26 @@
 // rsibr extract: one view's linear image (a merged view of `rsibr hdr`, or any float RGB EXR) + the
-// lens model -> the ball located (calib/ball_locator.h) -> its sphere map with a confidence channel
-// (calib/sphere_map_extraction.h), written as a captured one-view map set. With --photoset, the
+// lens model -> the ball located (calib/balls/ball_locator.h) -> its sphere map with a confidence channel
+// (calib/extraction/sphere_map_extraction.h), written as a captured one-view map set. With --photoset, the
 // rig mode of rsibr process's extract step (pipeline/extract_step.h): every listed ball of every
 // posed view, identified across views, one map set per ball.
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
-#include "calib/ball_identification.h"
-#include "calib/ball_locator.h"
-#include "calib/pose_file.h"
-#include "calib/view_orientation.h"
-#include "calib/sphere_map_extraction.h"
+#include "calib/balls/ball_identification.h"
+#include "calib/balls/ball_locator.h"
+#include "calib/orientation/pose_file.h"
+#include "calib/orientation/view_orientation.h"
+#include "calib/extraction/sphere_map_extraction.h"
 #include "calib/view_image.h"
-#include "core/atomic_file.h"
+#include "formats/atomic_file.h"
 #include "core/lens_model.h"
-#include "core/map_set.h"
-#include "core/output_plan.h"
+#include "formats/map_set.h"
+#include "formats/output_plan.h"
 #include "core/progress.h"
-#include "calib/far_camera.h"
-#include "core/atomic_folder.h"
-#include "core/photo_set.h"
-#include "calib/probe.h"
+#include "calib/lens/far_camera.h"
+#include "formats/atomic_folder.h"
+#include "formats/photo_set.h"
+#include "calib/probe/probe.h"
 #include "pipeline/ball_override.h"
 #include "pipeline/extract_step.h"
 
@@ -84,7 +84,7 @@ int run_extract_rig(const ExtractArgs& a) {
       inputs.push_back(file);
     }
   }
-  // A view of the lens's size as it is; crops of the ball on a far camera's canvas (calib/far_camera.h).
+  // A view of the lens's size as it is; crops of the ball on a far camera's canvas (calib/lens/far_camera.h).
   // Any other lens of another size is the wrong lens: refused, as rsibr process refuses it.
   const bool far = is_far_camera(lens);
   s.read_view = [&](const std::string& name) {
@@ -185,7 +185,7 @@ int run_extract(const ExtractArgs& a) {
                                 std::to_string(view.radiance.rows) + " but the lens model " + a.lens + " is " +
                                 std::to_string(lens.width()) + "x" + std::to_string(lens.height()));
 
-  // The ball: given, or among the candidates with a clean outline (calib/ball_identification.h),
+  // The ball: given, or among the candidates with a clean outline (calib/balls/ball_identification.h),
   // left to right.
   int candidates = 0;
   BallLocation loc;

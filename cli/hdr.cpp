@@ -3,14 +3,14 @@
 // a shot + read noise model, the inverse-variance merge with variance, clipped, black and ghost
 // channels, conversion to the working colour space, EXR + PNG preview per view.
 #include "cli/summary.h"
-#include "core/file_error.h"
+#include "formats/file_error.h"
 #include "cli/verbs.h"
 
-#include "core/atomic_file.h"
-#include "core/atomic_folder.h"
+#include "formats/atomic_file.h"
+#include "formats/atomic_folder.h"
 #include "core/colour.h"
-#include "core/output_plan.h"
-#include "core/photo_set.h"
+#include "formats/output_plan.h"
+#include "formats/photo_set.h"
 #include "core/preview_exposure.h"
 #include "core/progress.h"
 #include "core/text.h"
@@ -23,9 +23,9 @@
 #include "hdr/photo_set_merge.h"
 #include "hdr/response_recovery.h"
 #include "pipeline/vignetting_input.h"
-#include "calib/far_camera.h"
+#include "calib/lens/far_camera.h"
 
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <unistd.h>
 

@@ -2,9 +2,9 @@
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
-#include "core/exr_io.h"
-#include "core/map_set.h"
-#include "core/output_plan.h"
+#include "formats/exr_io.h"
+#include "formats/map_set.h"
+#include "formats/output_plan.h"
 #include "core/luminance.h"
 
 #include <algorithm>

@@ -1,14 +1,14 @@
 // rsibr orient: merged views (rsibr hdr) + the lens model -> every view's orientation from the
-// features in its chrome ball (calib/view_orientation.h), written as a pose file (calib/pose_file.h).
+// features in its chrome ball (calib/orientation/view_orientation.h), written as a pose file (calib/orientation/pose_file.h).
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
-#include "calib/point_pairs.h"
-#include "calib/pose_file.h"
-#include "calib/view_orientation.h"
-#include "core/atomic_file.h"
+#include "calib/orientation/point_pairs.h"
+#include "calib/orientation/pose_file.h"
+#include "calib/orientation/view_orientation.h"
+#include "formats/atomic_file.h"
 #include "core/lens_model.h"
-#include "core/output_plan.h"
+#include "formats/output_plan.h"
 #include "core/progress.h"
 #include "core/safe_name.h"
 #include "pipeline/orientation_json.h"
@@ -179,7 +179,7 @@ Runner add_orient(CLI::App& app) {
       app.add_subcommand("orient", "Solve every view's camera orientation from the features in its chrome ball");
   c->footer(
       "Each image is a merged view (rsibr hdr) of the same ball rig from a different position. The chrome ball is "
-      "found in every view (calib/ball_identification.h: the candidate that looks like a mirror), features in it are turned into the world "
+      "found in every view (calib/balls/ball_identification.h: the candidate that looks like a mirror), features in it are turned into the world "
       "directions they reflect, matched across views and solved in one least-squares problem; each view's "
       "orientation std dev (degrees) is written with it. The world frame is the first view's camera frame, or with "
       "--up X,Y,Z (the world's up in the first camera's frame; 0,-1,0 for a camera levelled on a tripod) +Y up and "

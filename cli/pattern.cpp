@@ -3,10 +3,10 @@
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
-#include "core/atomic_file.h"
-#include "core/exr_io.h"
-#include "core/map_set.h"
-#include "core/output_plan.h"
+#include "formats/atomic_file.h"
+#include "formats/exr_io.h"
+#include "formats/map_set.h"
+#include "formats/output_plan.h"
 #include "core/patterns.h"
 #include "core/texel_audit.h"
 

@@ -9,7 +9,7 @@
 
 #include "bake/brdf_lobes.h"
 #include "bake/brdf_spec.h"
-#include "core/output_plan.h"
+#include "formats/output_plan.h"
 
 #include <iostream>
 #include <memory>

@@ -1,15 +1,15 @@
 // rsibr probe: captured chrome-ball maps (rsibr extract outputs, one world frame) blended by their
-// confidences into one lat-long light probe (calib/probe.h).
+// confidences into one lat-long light probe (calib/probe/probe.h).
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
 #include "bake/brdf_spec.h"
-#include "calib/probe.h"
-#include "core/atomic_file.h"
-#include "core/exr_io.h"
-#include "core/map_set.h"
-#include "core/output_plan.h"
-#include "core/yaml_spec.h"
+#include "calib/probe/probe.h"
+#include "formats/atomic_file.h"
+#include "formats/exr_io.h"
+#include "formats/map_set.h"
+#include "formats/output_plan.h"
+#include "formats/yaml_spec.h"
 #include "lights/recovered_probe.h"
 
 #include <yaml-cpp/yaml.h>

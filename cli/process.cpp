@@ -5,10 +5,10 @@
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
-#include "core/atomic_file.h"
+#include "formats/atomic_file.h"
 #include "core/camera.h"
-#include "core/output_plan.h"
-#include "core/photo_set.h"
+#include "formats/output_plan.h"
+#include "formats/photo_set.h"
 #include "core/progress.h"
 #include "pipeline/process_pipeline.h"
 

@@ -1,7 +1,7 @@
 // rsibr reference: the ground-truth render of a mesh with a BRDF under an environment, seen by a
 // perspective camera (bake/reference_renderer.h for what a pixel holds).
 #include "cli/camera_options.h"
-#include "core/file_error.h"
+#include "formats/file_error.h"
 #include "cli/option_checks.h"
 #include "cli/render_image.h"
 #include "cli/summary.h"
@@ -9,16 +9,16 @@
 
 #include "bake/brdf_spec.h"
 #include "bake/reference_renderer.h"
-#include "core/atomic_file.h"
+#include "formats/atomic_file.h"
 #include "core/colour.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "core/mesh.h"
-#include "core/output_plan.h"
+#include "formats/output_plan.h"
 #include "core/preview_exposure.h"
 #include "core/progress.h"
 #include "core/ray_scene.h"
 
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <atomic>
 #include <chrono>

@@ -1,8 +1,8 @@
 #include "cli/render_image.h"
 
-#include "core/exr_file.h"
-#include "core/exr_io.h"
-#include "core/map_set.h"
+#include "formats/exr_file.h"
+#include "formats/exr_io.h"
+#include "formats/map_set.h"
 #include "core/texel_audit.h"
 #include "core/text.h"
 

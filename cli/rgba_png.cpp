@@ -1,10 +1,10 @@
 #include "cli/rgba_png.h"
-#include "core/file_error.h"
+#include "formats/file_error.h"
 
-#include "core/atomic_file.h"
+#include "formats/atomic_file.h"
 #include "core/colour.h"
 
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 #include "cli/summary.h"
 
-#include "core/atomic_file.h"
+#include "formats/atomic_file.h"
 
 #include <fstream>
 #include <iostream>

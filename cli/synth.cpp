@@ -6,7 +6,7 @@
 
 #include "capture/synth_capture.h"
 #include "capture/synth_scene.h"
-#include "core/output_plan.h"
+#include "formats/output_plan.h"
 #include "core/progress.h"
 
 #include <iostream>

@@ -8,10 +8,10 @@
 #include "cli/summary.h"
 #include "cli/verbs.h"
 
-#include "core/atomic_file.h"
-#include "core/map_set.h"
+#include "formats/atomic_file.h"
+#include "formats/map_set.h"
 #include "core/mesh.h"
-#include "core/output_plan.h"
+#include "formats/output_plan.h"
 #include "core/progress.h"
 #include "core/text.h"
 #include "runtime/make_warp.h"

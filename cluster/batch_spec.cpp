@@ -1,6 +1,6 @@
 #include "cluster/batch_spec.h"
 
-#include "core/yaml_spec.h"
+#include "formats/yaml_spec.h"
 
 #include <algorithm>
 #include <set>

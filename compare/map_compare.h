@@ -14,7 +14,7 @@
 #include "core/env_map.h"
 #include "compare/gain_fit.h"
 #include "compare/image_error.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 
 #include <optional>
 #include <string>

@@ -19,7 +19,7 @@ class LazyLibrary {
   LazyLibrary(std::string soname, std::string purpose);
   void* symbol(const char* mangled_name) const;
   // The function `mangled_name` as a pointer of type F (the caller spells F from the library's
-  // header, so that a changed signature is a compile error there, see core/image_codecs.cpp).
+  // header, so that a changed signature is a compile error there, see formats/image_codecs.cpp).
   template <class F>
   F function(const char* mangled_name) const {
     return reinterpret_cast<F>(symbol(mangled_name));

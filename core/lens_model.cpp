@@ -1,8 +1,8 @@
 // mrcal's C header has no extern "C" guard of its own.
 #include "core/lens_model.h"
 
-#include "core/atomic_file.h"
-#include "core/input_file.h"
+#include "formats/atomic_file.h"
+#include "formats/input_file.h"
 
 extern "C" {
 #include <mrcal/mrcal.h>

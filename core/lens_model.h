@@ -38,7 +38,7 @@ class LensModel {
   // .cameramodel text or file; errors are std::invalid_argument("<what>: <problem>").
   static LensModel read(const std::filesystem::path& file);
   static LensModel parse(const std::string& text, const std::string& what = "cameramodel");
-  // Writes atomically (core/atomic_file.h) through mrcal_write_cameramodel_file. Throws
+  // Writes atomically (formats/atomic_file.h) through mrcal_write_cameramodel_file. Throws
   // std::runtime_error("<file>: <problem>").
   void write(const std::filesystem::path& file) const;
 

@@ -10,8 +10,8 @@
 // the indices come from the Draco stream), and the Draco buffer view is decoded here.
 #include "core/mesh.h"
 
-#include "core/file_error.h"
-#include "core/input_file.h"
+#include "formats/file_error.h"
+#include "formats/input_file.h"
 
 #include "core/text.h"
 

@@ -1,4 +1,4 @@
-// The MIP-mask blend's masks (runtime/blend_engine.h, calib/probe.h): which map of a set to trust at
+// The MIP-mask blend's masks (runtime/blend_engine.h, calib/probe/probe.h): which map of a set to trust at
 // which level of detail when the maps were measured at different resolutions (a chrome ball 43 px
 // across in one photo and 400 px in another, both extracted to the same map size).
 //
@@ -15,7 +15,7 @@
 // does, and a smooth change in between.
 #pragma once
 
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/mask_pyramid.h"
 
 #include <opencv2/core.hpp>

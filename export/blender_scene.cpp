@@ -1,15 +1,15 @@
 #include "export/blender_scene.h"
 
 #include "bake/brdf_spec.h"
-#include "calib/ball_offset.h"
-#include "calib/far_camera.h"
-#include "calib/pose_file.h"
+#include "calib/balls/ball_offset.h"
+#include "calib/lens/far_camera.h"
+#include "calib/orientation/pose_file.h"
 #include "calib/view_image.h"
 #include "core/cell_centred_latlong.h"
-#include "core/exr_file.h"
-#include "core/exr_io.h"
+#include "formats/exr_file.h"
+#include "formats/exr_io.h"
 #include "core/lens_model.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "export/blender_axes.h"
 #include "pipeline/step_record.h"
 
@@ -211,7 +211,7 @@ BlenderExport export_from_run(const fs::path& run, const BlenderExportOptions& o
   const PoseSet poses = read_pose_file(existing(run / "poses.yaml").string());
 
   // The balls: (name, kind) from the extract step's settings, places from its rig; a ball the
-  // views saw is placed from their circles by calib/ball_offset.h (the rig's offset is their mean,
+  // views saw is placed from their circles by calib/balls/ball_offset.h (the rig's offset is their mean,
   // which carries each view's weak depth).
   const nlohmann::json& rig = field(summary, "rig", extract_file);
   const nlohmann::json& listed = field(settings, "balls", extract_file);

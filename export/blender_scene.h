@@ -10,7 +10,7 @@
 #pragma once
 
 #include "core/env_map.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/vec.h"
 
 #include <nlohmann/json.hpp>

@@ -1,7 +1,7 @@
 // libFuzzer target: the environment reader (OpenEXR lat-long / cube / octahedral / sphere, and
 // Radiance .hdr through OpenCV), then a resample of what it read and its negative values folded
 // (core/texel_audit.h). The first byte picks the extension the reader sees.
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "core/resample.h"
 #include "core/texel_audit.h"
 #include "fuzz/fuzz_input.h"

@@ -1,6 +1,6 @@
 // libFuzzer target: the map-set reader (multi-part OpenEXR with rsibr's attributes). Any input
 // must give a map set or a std::exception: never a crash, a hang or a sanitizer report.
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "fuzz/fuzz_input.h"
 
 #include <exception>

@@ -1,10 +1,10 @@
 // libFuzzer target: the YAML specs a user hands rsibr: any YAML (anchors, aliases, nesting),
 // BRDF specs, photo sets, pose files and synthetic scene specs. Every input must parse or be a std::exception.
 #include "bake/brdf_spec.h"
-#include "calib/pose_file.h"
+#include "calib/orientation/pose_file.h"
 #include "capture/synth_scene.h"
-#include "core/photo_set.h"
-#include "core/yaml_spec.h"
+#include "formats/photo_set.h"
+#include "formats/yaml_spec.h"
 #include "fuzz/fuzz_input.h"
 
 #include <exception>

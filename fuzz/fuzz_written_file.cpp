@@ -1,8 +1,8 @@
-// libFuzzer target: the read-back of a file just written (core/written_file_check.h: an EXR decoded,
+// libFuzzer target: the read-back of a file just written (formats/written_file_check.h: an EXR decoded,
 // a PNG's or JPEG's end marker, a JSON parse) and the JPEG completeness walk of the photo reader
-// (core/image_codecs.h), on any bytes. The first byte picks the extension the check sees.
-#include "core/image_codecs.h"
-#include "core/written_file_check.h"
+// (formats/image_codecs.h), on any bytes. The first byte picks the extension the check sees.
+#include "formats/image_codecs.h"
+#include "formats/written_file_check.h"
 #include "fuzz/fuzz_input.h"
 
 #include <exception>

@@ -1,7 +1,7 @@
 #include "hdr/bracket_set.h"
 
 #include "core/parallel.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <opencv2/imgproc.hpp>
 

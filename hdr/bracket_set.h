@@ -4,7 +4,7 @@
 // load as linear 16-bit codes, 65535 marking saturation; a view's brackets are all RAW or none.
 #pragma once
 
-#include "core/photo_set.h"
+#include "formats/photo_set.h"
 #include "hdr/exposure_metadata.h"
 #include "hdr/raw_image.h"
 

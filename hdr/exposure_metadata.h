@@ -1,9 +1,9 @@
 // Exposure metadata of one bracket: from photoset.yaml, or from the file's EXIF (exiv2) for the
 // values the YAML leaves out. The relative exposure follows the project's convention
-// (core/photo_set.h): e = t * (iso/100) / N^2, a pixel records X = L * e * k.
+// (formats/photo_set.h): e = t * (iso/100) / N^2, a pixel records X = L * e * k.
 #pragma once
 
-#include "core/photo_set.h"
+#include "formats/photo_set.h"
 
 #include <string>
 

@@ -38,7 +38,7 @@
 
 namespace rsibr {
 
-// kOutside: no photo there (a view placed on a larger canvas, calib/far_camera.h); never written.
+// kOutside: no photo there (a view placed on a larger canvas, calib/lens/far_camera.h); never written.
 enum MergeFlag : unsigned char { kClipped = 1, kBlack = 2, kGhost = 4, kOutside = 8 };
 
 struct MergeOptions {

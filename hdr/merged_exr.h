@@ -3,7 +3,7 @@
 // Rec.709 `chromaticities` and provenance as rsibr.* string attributes (names < 32 characters).
 #pragma once
 
-#include "core/exr_file.h"
+#include "formats/exr_file.h"
 #include "hdr/merge.h"
 
 #include <map>

@@ -1,6 +1,6 @@
 #include "hdr/photo_exif.h"
 
-#include "core/heif_image.h"
+#include "formats/heif_image.h"
 
 namespace rsibr {
 

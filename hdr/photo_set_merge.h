@@ -5,7 +5,7 @@
 // are registered first (hdr/alignment.h; files of different sizes are accepted unless off).
 #pragma once
 
-#include "core/photo_set.h"
+#include "formats/photo_set.h"
 #include "hdr/alignment.h"
 #include "hdr/bracket_set.h"
 #include "hdr/merge.h"

@@ -1,7 +1,7 @@
 #include "hdr/response_curve.h"
 
-#include "core/atomic_file.h"
-#include "core/input_file.h"
+#include "formats/atomic_file.h"
+#include "formats/input_file.h"
 #include "hdr/saturation_level.h"
 
 #include <algorithm>

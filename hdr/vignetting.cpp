@@ -1,7 +1,7 @@
 #include "hdr/vignetting.h"
 
 #include "hdr/raw_image.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>

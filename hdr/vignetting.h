@@ -58,7 +58,7 @@ double vignetting_corner_radius(int width, int height, const Vec2& c);
 
 // A chessboard image for the estimate: its codes (CV_16UC3 RGB of the response curve's bit depth;
 // 8-bit boards against a 16-bit curve are scaled by 257) and its inner corners, gridn x gridn,
-// row-major (mrgingham's order, calib/intrinsics.h find_chessboard).
+// row-major (mrgingham's order, calib/lens/intrinsics.h find_chessboard).
 struct VignettingBoard {
   std::string name;
   cv::Mat codes;

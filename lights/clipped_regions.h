@@ -1,4 +1,4 @@
-// The regions of a light probe that no chrome view saw unclipped (calib/probe.h: Probe::clipped,
+// The regions of a light probe that no chrome view saw unclipped (calib/probe/probe.h: Probe::clipped,
 // texels where every view that saw the direction had it clipped in every bracket): connected
 // components of those texels on the lat-long sphere, each a candidate light source.
 //
@@ -14,7 +14,7 @@
 // power). Regions are sorted by that lower bound, largest first (ties by the first texel).
 #pragma once
 
-#include "calib/probe.h"
+#include "calib/probe/probe.h"
 
 #include <vector>
 

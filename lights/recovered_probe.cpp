@@ -1,8 +1,8 @@
 #include "lights/recovered_probe.h"
 
 #include "bake/brdf_spec.h"
-#include "calib/probe_fill.h"
-#include "core/yaml_spec.h"
+#include "calib/probe/probe_fill.h"
+#include "formats/yaml_spec.h"
 #include "lights/probe_sources.h"
 
 #include <yaml-cpp/yaml.h>

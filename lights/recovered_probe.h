@@ -1,4 +1,4 @@
-// The whole recovery on an assembled probe (calib/probe.h): its clipped regions
+// The whole recovery on an assembled probe (calib/probe/probe.h): its clipped regions
 // (lights/clipped_regions.h), the sources solved from the grey and glossy balls
 // (lights/source_recovery.h), written into a copy of the probe (lights/probe_sources.h) with their
 // provenance in its header, and a JSON summary for --json and the report:
@@ -18,7 +18,7 @@
 //                        after (lights/source_recovery.h BallResidual), per view too
 #pragma once
 
-#include "calib/probe.h"
+#include "calib/probe/probe.h"
 #include "lights/source_recovery.h"
 
 #include <nlohmann/json.hpp>
@@ -29,9 +29,9 @@
 namespace rsibr {
 
 struct RecoveredProbe {
-  Probe measured;  // the chrome maps' blend (calib/probe.h)
+  Probe measured;  // the chrome maps' blend (calib/probe/probe.h)
   EnvMap env;      // the probe with the sources added, and the lower bounds where none was recovered
-  cv::Mat flags;   // CV_8UC1: kProbeLowerBound, kProbeSource (calib/probe.h)
+  cv::Mat flags;   // CV_8UC1: kProbeLowerBound, kProbeSource (calib/probe/probe.h)
   std::vector<ClippedRegion> regions;
   SourceRecovery recovery;
   nlohmann::json summary;
@@ -50,12 +50,12 @@ RecoveredProbe recover_probe_sources(const MapSet& chrome, const ProbeOptions& p
                                      const SourceRecoveryOptions& options, bool recover = true);
 
 // Directions no view saw (neither trusted nor clipped) filled from the trusted ones
-// (calib/probe_fill.h) and flagged kProbeFilled, so a renderer can use the probe. Returns the filled
+// (calib/probe/probe_fill.h) and flagged kProbeFilled, so a renderer can use the probe. Returns the filled
 // solid-angle fraction.
 double fill_unseen_directions(RecoveredProbe& probe, double min_weight);
 
 // Writes `env` with its `confidence` (the trusted texels' summed weight, 0 elsewhere) and `flags`
-// channels (calib/probe.h, write_probe). Throws FileError(path, problem).
+// channels (calib/probe/probe.h, write_probe). Throws FileError(path, problem).
 void write_recovered_probe(const std::string& path, const RecoveredProbe& probe, double min_weight);
 
 // One line for a terminal or a report: "2 clipped light sources; recovered 61% / 59% / 47% (R/G/B)

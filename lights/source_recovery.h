@@ -37,7 +37,7 @@
 
 #include "bake/brdf.h"
 #include "core/env_map.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "lights/clipped_regions.h"
 #include "lights/light_source.h"
 

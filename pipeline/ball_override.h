@@ -1,10 +1,10 @@
 // `rsibr process --ball VIEW:BALL=X,Y,R`: one ball of one view given by hand (its image centre and
 // radius in pixels, roughly: within ~20%), instead of the detection. The ball is located at that
-// guess (calib/ball_locator.h) and used whatever the cross-view checks say.
+// guess (calib/balls/ball_locator.h) and used whatever the cross-view checks say.
 #pragma once
 
-#include "calib/ball_locator.h"
-#include "core/photo_set.h"
+#include "calib/balls/ball_locator.h"
+#include "formats/photo_set.h"
 
 #include <optional>
 #include <string>

@@ -1,7 +1,7 @@
 #include "pipeline/chessboard_problem.h"
 
 #include "hdr/raw_image.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <opencv2/imgproc.hpp>
 

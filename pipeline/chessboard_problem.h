@@ -1,10 +1,10 @@
-// The calibration problem of a photo set: the chessboard corners (mrgingham, calib/intrinsics.h)
+// The calibration problem of a photo set: the chessboard corners (mrgingham, calib/lens/intrinsics.h)
 // of every image listed under chessboards: in photoset.yaml, shared by rsibr calibrate and the
 // calibrate step of rsibr process.
 #pragma once
 
-#include "calib/intrinsics.h"
-#include "core/photo_set.h"
+#include "calib/lens/intrinsics.h"
+#include "formats/photo_set.h"
 
 #include <functional>
 #include <string>

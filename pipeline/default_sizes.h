@@ -14,9 +14,9 @@
 // clipped, lower bound and flags (36 bytes); memory_bytes states what a step holds at once.
 #pragma once
 
-#include "calib/ball_cone.h"
+#include "calib/balls/ball_cone.h"
 #include "core/lens_model.h"
-#include "core/photo_set.h"
+#include "formats/photo_set.h"
 
 #include <cstddef>
 

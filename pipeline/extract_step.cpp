@@ -1,11 +1,11 @@
 #include "pipeline/extract_step.h"
 
-#include "calib/lambert_consensus.h"
-#include "calib/occluded_light.h"
-#include "calib/occluders.h"
-#include "calib/probe.h"
-#include "calib/sphere_map_extraction.h"
-#include "core/image_codecs.h"
+#include "calib/extraction/lambert_consensus.h"
+#include "calib/extraction/occluded_light.h"
+#include "calib/extraction/occluders.h"
+#include "calib/probe/probe.h"
+#include "calib/extraction/sphere_map_extraction.h"
+#include "formats/image_codecs.h"
 #include "core/preview_exposure.h"
 #include "core/progress.h"
 #include "lights/recovered_probe.h"
@@ -121,7 +121,7 @@ ExtractedMaps run_extract_step(const ExtractStep& s) {
   // Pass 2: each view's balls decided, extracted; the chrome maps masked.
   std::vector<MapSet> sets(listed.size());
   std::vector<double> view_disagreement(vb.size(), -1.0);  // per view: its other balls' largest
-  // Per grey map: what occludes its light (calib/occluded_light.h), restored once the probe is known.
+  // Per grey map: what occludes its light (calib/extraction/occluded_light.h), restored once the probe is known.
   struct GreyScene {
     std::size_t ball;
     std::string view;
@@ -199,7 +199,7 @@ ExtractedMaps run_extract_step(const ExtractStep& s) {
           found[std::size_t(chrome_index)].found()) {
         // The photographer, in this ball's radii, lit as the view's chrome ball sees it. The other
         // balls are not restored: restoring the chrome ball beside the grey one did not lower the
-        // error on the held-out shoots (docs/tradeoffs.md, "calib/occluded_light.h: what is restored").
+        // error on the held-out shoots (docs/tradeoffs.md, "calib/extraction/occluded_light.h: what is restored").
         GreyScene g{b, name, cone, world_from_cam, {}, Vec3::Zero()};
         for (const OtherBall& o : rest)
           if (o.name == listed[std::size_t(chrome_index)].name)
@@ -238,7 +238,7 @@ ExtractedMaps run_extract_step(const ExtractStep& s) {
     return nullptr;
   };
   // A view whose other balls disagree with the rig has its chrome ball or its rotation off
-  // (calib/ball_identification.h, rig_suspects): its chrome map stays out of the probe.
+  // (calib/balls/ball_identification.h, rig_suspects): its chrome map stays out of the probe.
   const RigSuspects suspects = rig_suspects(view_disagreement);
   std::vector<MapView> chrome_left_out;  // still the view's own light for its grey ball (below)
   if (chrome_index >= 0 && std::count(suspects.suspect.begin(), suspects.suspect.end(), 1) > 0) {
@@ -264,7 +264,7 @@ ExtractedMaps run_extract_step(const ExtractStep& s) {
     sets[std::size_t(chrome_index)].views = std::move(kept);
   }
   // Grey balls: the light the photographer takes from them restored, from the chrome maps' probe
-  // and each view's own chrome map (calib/occluded_light.h). The probe is the one the sources step
+  // and each view's own chrome map (calib/extraction/occluded_light.h). The probe is the one the sources step
   // makes (the light clipped in every view recovered from the grey balls, lights/recovered_probe.h):
   // the restored share is the photographer's light over the whole light, so a probe that lacks a
   // clipped sun overstates it (by 2-3x on shoots where the sun is 60% of the light).
@@ -320,7 +320,7 @@ ExtractedMaps run_extract_step(const ExtractStep& s) {
     }
   }
   // Grey balls: what one view alone sees differently (the photographer's shadow) is masked, a view
-  // mostly so is left out (calib/lambert_consensus.h).
+  // mostly so is left out (calib/extraction/lambert_consensus.h).
   for (std::size_t b = 0; b < listed.size(); ++b) {
     if (listed[b].kind != BallKind::grey) continue;
     const std::vector<LambertConsensusView> cons = mask_lambert_inconsistencies(sets[b].views);

@@ -1,21 +1,21 @@
 // The `extract` step of rsibr process (pipeline/process_pipeline.h), after orient: every listed
-// ball of every posed view identified and checked across views (calib/ball_identification.h: the
+// ball of every posed view identified and checked across views (calib/balls/ball_identification.h: the
 // rig of balls fitted from every view's candidates, each view's balls decided against it), and
-// extracted into the world frame (calib/sphere_map_extraction.h). A ball not found in a view is
+// extracted into the world frame (calib/extraction/sphere_map_extraction.h). A ball not found in a view is
 // left out of that ball's maps and reported. Chrome maps mask the other balls, the stands and the
-// photographer by geometry (calib/occluders.h); a chrome view whose other balls disagree with the
+// photographer by geometry (calib/extraction/occluders.h); a chrome view whose other balls disagree with the
 // rig stays out of the probe. Grey maps get the light the photographer takes from them restored
-// (calib/occluded_light.h, from the chrome maps' probe with its clipped light recovered), and what
-// one view alone sees differently masked (calib/lambert_consensus.h). Nothing is written here:
+// (calib/extraction/occluded_light.h, from the chrome maps' probe with its clipped light recovered), and what
+// one view alone sees differently masked (calib/extraction/lambert_consensus.h). Nothing is written here:
 // the caller writes the map sets and the masks.
 #pragma once
 
-#include "calib/ball_identification.h"
-#include "calib/pose_file.h"
+#include "calib/balls/ball_identification.h"
+#include "calib/orientation/pose_file.h"
 #include "calib/view_image.h"
-#include "core/atomic_folder.h"
+#include "formats/atomic_folder.h"
 #include "core/lens_model.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 
 #include <nlohmann/json.hpp>
 

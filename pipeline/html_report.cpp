@@ -1,16 +1,16 @@
 #include "pipeline/html_report.h"
 
-#include "core/atomic_file.h"
+#include "formats/atomic_file.h"
 #include "core/colour.h"
 #include "compare/compare_pictures.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "core/preview_exposure.h"
 #include "core/text.h"
 #include "pipeline/light_sources_report.h"
 #include "pipeline/process_pipeline.h"
 #include "pipeline/response_choice_html.h"
 #include "pipeline/step_record.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>

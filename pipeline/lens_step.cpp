@@ -1,8 +1,8 @@
 #include "pipeline/lens_step.h"
 
-#include "calib/ball_candidates_picture.h"
-#include "calib/far_camera.h"
-#include "calib/outline_focal.h"
+#include "calib/balls/ball_candidates_picture.h"
+#include "calib/lens/far_camera.h"
+#include "calib/lens/outline_focal.h"
 #include "calib/view_image.h"
 #include "hdr/merge.h"
 
@@ -48,7 +48,7 @@ nlohmann::json run_lens_step(const LensStep& s) {
 
   // The listed balls of every view, located with the metadata's lens (a pinhole of the view's
   // diagonal where the view's size differs from it: crops); cut balls and points off their robust
-  // cone are left out (calib/outline_focal.h drops the rest).
+  // cone are left out (calib/lens/outline_focal.h drops the rest).
   std::vector<std::vector<Vec2>> outlines;
   nlohmann::json found = nlohmann::json::array(), sizes_json = nlohmann::json::array();
   std::vector<std::pair<int, int>> sizes;
@@ -133,7 +133,7 @@ nlohmann::json run_lens_step(const LensStep& s) {
   j["views"] = sizes_json;
   if (!s.pictures.empty()) j["candidates_pictures"] = pictures;
   if (crops) {
-    // Crops of the ball (calib/far_camera.h): the metadata's focal length is the uncropped frame's.
+    // Crops of the ball (calib/lens/far_camera.h): the metadata's focal length is the uncropped frame's.
     const LensModel far = far_camera_lens(sizes);
     far.write(s.out);
     double alpha = 0;

@@ -1,8 +1,8 @@
 // The `lens` step of rsibr process (pipeline/process_pipeline.h), between hdr and orient: the
-// calibrate step's lens, its focal length refined from the balls' outlines (calib/outline_focal.h)
+// calibrate step's lens, its focal length refined from the balls' outlines (calib/lens/outline_focal.h)
 // when it came from the photos' metadata (a pinhole from the EXIF, or lensfun's profile), whose
 // focal length is nominal and uncertain by a few percent. The listed balls of every merged view
-// (calib/ball_identification.h, located with the metadata's lens) give the outline estimate; the
+// (calib/balls/ball_identification.h, located with the metadata's lens) give the outline estimate; the
 // metadata's is its prior (Gaussian, the stated sigma), so
 //   f = (f0 / s0^2 + fo / so^2) / (1 / s0^2 + 1 / so^2),   sigma = (1 / s0^2 + 1 / so^2)^(-1/2).
 // An outline estimate more than 4 combined sigmas from the prior is not used (the balls or the
@@ -12,11 +12,11 @@
 // measured lens (chessboards,
 // --lens, the photo set's model) passes through unchanged. DIR/lens.cameramodel is the lens every
 // later step uses. Views that are crops of the ball (every view's chrome ball fills its frame)
-// get the far-camera model instead (calib/far_camera.h), whatever the metadata says: their EXIF
+// get the far-camera model instead (calib/lens/far_camera.h), whatever the metadata says: their EXIF
 // focal length belongs to the uncropped frame; views of different sizes are an error otherwise.
 #pragma once
 
-#include "calib/ball_identification.h"
+#include "calib/balls/ball_identification.h"
 #include "core/lens_model.h"
 
 #include <nlohmann/json.hpp>
@@ -43,7 +43,7 @@ struct LensStep {
   std::vector<std::vector<std::optional<BallGuess>>> given;
   bool refine = true;         // false: the calibrated lens unchanged
   std::filesystem::path out;  // lens.cameramodel
-  // Where each view's candidates picture goes (calib/ball_candidates_picture.h: every circle the
+  // Where each view's candidates picture goes (calib/balls/ball_candidates_picture.h: every circle the
   // finder located, numbered, the picks in green), <view>.png, so a user whose ball was missed or
   // mistaken can give it with --ball; empty: none written.
   std::filesystem::path pictures;

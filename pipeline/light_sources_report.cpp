@@ -1,9 +1,9 @@
 #include "pipeline/light_sources_report.h"
 
 #include "core/colour.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "pipeline/html_report.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <opencv2/imgproc.hpp>
 

@@ -1,8 +1,8 @@
 #include "pipeline/light_sources_step.h"
 
 #include "bake/brdf_spec.h"
-#include "core/exr_io.h"
-#include "core/map_set.h"
+#include "formats/exr_io.h"
+#include "formats/map_set.h"
 #include "lights/recovered_probe.h"
 
 namespace rsibr {
@@ -44,7 +44,7 @@ nlohmann::json run_light_sources_step(const LightSourcesStep& s) {
   SourceRecoveryOptions ro;
   ro.seed = s.seed;
   RecoveredProbe r = recover_probe_sources(chrome, po, grey, glossy, ro, s.recover);
-  // Directions no view saw, filled so a renderer can use the probe (calib/probe_fill.h); they keep
+  // Directions no view saw, filled so a renderer can use the probe (calib/probe/probe_fill.h); they keep
   // zero confidence and the kProbeFilled flag.
   const double filled = s.fill ? fill_unseen_directions(r, po.min_weight) : 0.0;
   r.env.attributes["views"] = std::to_string(chrome.views.size());

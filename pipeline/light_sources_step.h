@@ -1,10 +1,10 @@
 // The `sources` step of rsibr process (pipeline/process_pipeline.h), between probe and bake: the
-// chrome maps blended again (calib/probe.h, the probe step's settings) for the texels clipped in
+// chrome maps blended again (calib/probe/probe.h, the probe step's settings) for the texels clipped in
 // every view that saw them, the light missing there recovered from the grey (and glossy) balls
 // (lights/recovered_probe.h) and written into DIR/probe.exr, the probe the bake and the render
 // use. Texels clipped in every view and not recovered keep their lower bound, and directions no
-// view saw are filled (calib/probe_fill.h); probe.exr's `confidence` and `flags` channels say which
-// texels are which (calib/probe.h, ProbeFlag).
+// view saw are filled (calib/probe/probe_fill.h); probe.exr's `confidence` and `flags` channels say which
+// texels are which (calib/probe/probe.h, ProbeFlag).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -26,7 +26,7 @@ struct LightSourcesStep {
   std::string chrome_fresnel;
   double grey_albedo = 0.18;
   bool recover = true;
-  bool fill = true;          // directions no view saw filled (calib/probe_fill.h); false: they stay 0
+  bool fill = true;          // directions no view saw filled (calib/probe/probe_fill.h); false: they stay 0
   bool given_probe = false;  // the probe step used a given environment: nothing to recover
   std::uint64_t seed = 0;
 };

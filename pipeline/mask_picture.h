@@ -4,7 +4,7 @@
 // darkened. Each texel drawn as `zoom` x `zoom` pixels. BGR, 8-bit, ready for PNG.
 #pragma once
 
-#include "core/map_set.h"
+#include "formats/map_set.h"
 
 #include <opencv2/core.hpp>
 

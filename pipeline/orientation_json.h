@@ -1,7 +1,7 @@
 // What the orientation saw, as JSON for the orient step's record and `rsibr orient --json`.
 #pragma once
 
-#include "calib/view_orientation.h"
+#include "calib/orientation/view_orientation.h"
 
 #include <nlohmann/json.hpp>
 

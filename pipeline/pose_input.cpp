@@ -1,7 +1,7 @@
 #include "pipeline/pose_input.h"
 
 #include "core/safe_name.h"
-#include "core/yaml_spec.h"
+#include "formats/yaml_spec.h"
 
 #include <yaml-cpp/yaml.h>
 

@@ -1,10 +1,10 @@
 // Camera orientations given to rsibr process --poses instead of the orient step's solve: a
-// poses.yaml (calib/pose_file.h, as rsibr orient writes it) or the truth.yaml of rsibr synth
+// poses.yaml (calib/orientation/pose_file.h, as rsibr orient writes it) or the truth.yaml of rsibr synth
 // (views: [{name, world_from_cam: [[3], [3], [3]]}], world +Y up; sigma 0: the exact poses, for
 // tests and for measuring the other stages' errors alone).
 #pragma once
 
-#include "calib/pose_file.h"
+#include "calib/orientation/pose_file.h"
 
 #include <string>
 

@@ -4,38 +4,38 @@
 #include "bake/integrator.h"
 #include "bake/map_set_bake.h"
 #include "plan/bake_plan.h"
-#include "calib/ball_identification.h"
-#include "calib/ball_locator.h"
-#include "calib/far_camera.h"
-#include "calib/intrinsics.h"
-#include "calib/photo_optics.h"
-#include "calib/lambert_consensus.h"
-#include "calib/occluded_light.h"
-#include "calib/occluders.h"
-#include "calib/probe.h"
-#include "calib/sphere_map_extraction.h"
+#include "calib/balls/ball_identification.h"
+#include "calib/balls/ball_locator.h"
+#include "calib/lens/far_camera.h"
+#include "calib/lens/intrinsics.h"
+#include "calib/lens/photo_optics.h"
+#include "calib/extraction/lambert_consensus.h"
+#include "calib/extraction/occluded_light.h"
+#include "calib/extraction/occluders.h"
+#include "calib/probe/probe.h"
+#include "calib/extraction/sphere_map_extraction.h"
 #include "calib/view_image.h"
-#include "calib/view_orientation.h"
-#include "calib/pair_matches_picture.h"
-#include "calib/pose_file.h"
-#include "core/atomic_file.h"
-#include "core/atomic_folder.h"
+#include "calib/orientation/view_orientation.h"
+#include "calib/orientation/pair_matches_picture.h"
+#include "calib/orientation/pose_file.h"
+#include "formats/atomic_file.h"
+#include "formats/atomic_folder.h"
 #include "core/camera.h"
-#include "core/file_error.h"
+#include "formats/file_error.h"
 #include "core/colour.h"
 #include "compare/compare_pictures.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "core/lens_model.h"
 #include "compare/comparison_report.h"
 #include "compare/map_compare.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/mesh.h"
-#include "core/photo_set.h"
+#include "formats/photo_set.h"
 #include "core/preview_exposure.h"
 #include "core/progress.h"
 #include "core/resample.h"
 #include "core/view_set.h"
-#include "core/yaml_spec.h"
+#include "formats/yaml_spec.h"
 #include "hdr/bracket_set.h"
 #include "hdr/merge.h"
 #include "hdr/merged_colour.h"
@@ -58,7 +58,7 @@
 #include "pipeline/torus_mesh.h"
 #include "pipeline/vignetting_input.h"
 #include "runtime/renderer.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -186,7 +186,7 @@ void step_calibrate(Context& c) {
     inputs.push_back(*c.set.camera_model);
     settings = {{"source", "photo set"}};
   } else {
-    // The photos' own metadata: the first view's first bracket (calib/photo_optics.h).
+    // The photos' own metadata: the first view's first bracket (calib/lens/photo_optics.h).
     if (c.set.views.empty() || c.set.views[0].brackets.empty())
       throw std::invalid_argument(c.o.photoset + ": no views");
     inputs.push_back(c.set.views[0].brackets[0].file);
@@ -492,7 +492,7 @@ void step_lens(Context& c) {
 }
 
 // A view's merged image as the later steps read it: on the lens's canvas when the lens step chose
-// the far camera for crops of the ball (calib/far_camera.h), else of the lens's size exactly.
+// the far camera for crops of the ball (calib/lens/far_camera.h), else of the lens's size exactly.
 ViewImage read_merged_view(const Context& c, const PhotoView& v, const LensModel& lens) {
   const std::string file = merged_path(c, v.name).string();
   ViewImage img = read_view_image(file);
@@ -505,7 +505,7 @@ ViewImage read_merged_view(const Context& c, const PhotoView& v, const LensModel
 }
 
 // ---- orient: world_from_cam per view, solved from the chrome ball's reflected features
-// (calib/view_orientation.h; world +Y up: estimated from the views, or `up` given in the first
+// (calib/orientation/view_orientation.h; world +Y up: estimated from the views, or `up` given in the first
 // camera's frame), or given (--poses: the file's chrome balls, refined here by the features with
 // the rotations held when the file has none; a first-view file levelled by the estimated up).
 nlohmann::json world_up_json(const WorldUp& w) {

@@ -2,22 +2,22 @@
 // turntable render and an HTML report, as a graph of resumable steps (pipeline/step_record.h):
 //
 //   calibrate  chessboards -> DIR/camera.cameramodel (mrcal, model by cross-validation), or --lens,
-//              or the photo set's model, or a pinhole from the photos' EXIF (calib/photo_optics.h)
+//              or the photo set's model, or a pinhole from the photos' EXIF (calib/lens/photo_optics.h)
 //   hdr        brackets -> DIR/hdr/<view>.exr, DIR/hdr/response.json (response recovered once),
 //              DIR/hdr/vignetting.json (estimated from the chessboards, divided out of every view)
 //   lens       the calibrated lens, its focal length refined from the balls' outlines when it came
 //              from the photos' metadata (pipeline/lens_step.h) -> DIR/lens.cameramodel, the lens
 //              of every later step
 //   orient     -> DIR/poses.yaml (world_from_cam per view: solved from the chrome ball's features,
-//              calib/view_orientation.h, world +Y up estimated from the views or given; or --poses,
+//              calib/orientation/view_orientation.h, world +Y up estimated from the views or given; or --poses,
 //              whose chrome balls are refined here when the file has none)
 //   extract    every ball of every view, identified and checked across views
-//              (calib/ball_identification.h) -> DIR/maps/captured-<ball>.exr, one part per view in
+//              (calib/balls/ball_identification.h) -> DIR/maps/captured-<ball>.exr, one part per view in
 //              the world frame (chrome: reflection indexing, mirror warp, the other balls, the stands
-//              and the photographer masked, calib/occluders.h; grey/glossy: orthographic), and each
+//              and the photographer masked, calib/extraction/occluders.h; grey/glossy: orthographic), and each
 //              chrome view's mask as DIR/masks/<view>.png; a ball not found in a view is left out;
 //              with occluder_light (the default), the grey maps get back the light the photographer
-//              takes from them (calib/occluded_light.h, from a probe of the chrome maps with the
+//              takes from them (calib/extraction/occluded_light.h, from a probe of the chrome maps with the
 //              clipped light recovered, lights/recovered_probe.h, and the view's own chrome map)
 //   probe      chrome maps -> DIR/probe-measured.exr (lat-long, confidence-weighted blend)
 //   sources    the light clipped in every chrome view, recovered from the grey (and glossy) balls
@@ -33,7 +33,7 @@
 // atomically and then its record. Frames: world +Y up (the gauge of the poses).
 #pragma once
 
-#include "calib/probe.h"
+#include "calib/probe/probe.h"
 #include "core/vec.h"
 
 #include <nlohmann/json.hpp>
@@ -53,9 +53,10 @@ struct ProcessOptions {
   std::string lens;            // given .cameramodel (skips the chessboards)
   bool self_calibrate = true;  // lens step: refine a metadata lens's focal length from the balls' outlines
   std::string poses;           // given poses (pipeline/pose_input.h); empty: the orientation solve
-  std::string points;          // points picked by hand for the solve (calib/point_pairs.h); empty: none
+  std::string points;          // points picked by hand for the solve (calib/orientation/point_pairs.h); empty: none
   std::optional<Vec3> up;      // world up in the first camera's frame (e.g. 0,-1,0 for a levelled camera)
-  bool estimate_up = true;     // without `up`: estimated from the views (calib/world_up.h); false: first-view gauge
+  bool estimate_up =
+      true;  // without `up`: estimated from the views (calib/orientation/world_up.h); false: first-view gauge
   std::vector<std::string>
       ball_overrides;  // "VIEW:BALL=X,Y,R": that ball of that view located there (pipeline/ball_override.h)
   std::string
@@ -72,10 +73,10 @@ struct ProcessOptions {
   // The chrome ball's Fresnel spec (YAML text), divided out of the probe; "" or "none": none (F L).
   std::string chrome_fresnel = kDefaultChromeFresnel;
   bool recover_sources = true;  // sources step: false writes the measured probe (lower bounds where clipped)
-  bool fill_unseen = true;      // sources step: directions no view saw filled (calib/probe_fill.h); false: 0
+  bool fill_unseen = true;      // sources step: directions no view saw filled (calib/probe/probe_fill.h); false: 0
   std::string glossy_brdf;      // the glossy balls' BRDF spec (YAML text); empty: they are not used
   double grey_albedo = 0.18;    // the grey ball's Lambert albedo (compare fits a gain anyway)
-  // extract: the light the photographer takes from each grey ball restored (calib/occluded_light.h),
+  // extract: the light the photographer takes from each grey ball restored (calib/extraction/occluded_light.h),
   // so its maps are those of the ball under the environment alone (docs/tradeoffs.md, "Robust
   // geometry": the shoots' worst grey view within 0.1 stop of the truth with it, 0.2 without).
   bool occluder_light = true;

@@ -2,7 +2,7 @@
 
 #include "pipeline/code_version.h"
 
-#include "core/atomic_file.h"
+#include "formats/atomic_file.h"
 
 #include <openssl/evp.h>
 

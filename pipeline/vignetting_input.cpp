@@ -1,6 +1,6 @@
 #include "pipeline/vignetting_input.h"
 
-#include "calib/photo_optics.h"
+#include "calib/lens/photo_optics.h"
 #include "pipeline/chessboard_problem.h"
 
 #include <fstream>

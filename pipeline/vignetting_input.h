@@ -2,14 +2,14 @@
 //   auto   estimated from the photo set's chessboard images (their corners found by mrgingham,
 //          their codes made linear by the recovered response), none when it has fewer than 3 boards;
 //          without boards, lensfun's profile of the lens the first photo's EXIF names
-//          (calib/photo_optics.h lensfun_vignetting), none when lensfun has none
+//          (calib/lens/photo_optics.h lensfun_vignetting), none when lensfun has none
 //   none   no correction
 //   FILE   a JSON model as vignetting.json holds it (e.g. from a lens database)
 // The principal point is the lens model's.
 #pragma once
 
 #include "core/lens_model.h"
-#include "core/photo_set.h"
+#include "formats/photo_set.h"
 #include "hdr/vignetting.h"
 
 #include <nlohmann/json.hpp>

@@ -73,7 +73,7 @@
 
 #include "bake/brdf.h"
 #include "core/env_map.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/view_set.h"
 
 #include <nlohmann/json.hpp>

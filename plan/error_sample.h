@@ -41,7 +41,7 @@
 
 #include "bake/brdf.h"
 #include "bake/integrator.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/vec.h"
 #include "core/view_set.h"
 #include "runtime/blend.h"

@@ -8,7 +8,7 @@
 // a direct bake is the bake's budget (plan/bake_plan.h).
 #pragma once
 
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/view_set.h"
 #include "runtime/blend.h"
 #include "runtime/make_warp.h"

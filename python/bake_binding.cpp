@@ -6,7 +6,7 @@
 #include "bake/integrator.h"
 #include "bake/map_set_bake.h"
 #include "core/env_map.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/view_set.h"
 
 #include <pybind11/eigen.h>

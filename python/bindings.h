@@ -20,7 +20,7 @@ void bind_compare(py::module_& m);      // ErrorMetrics, GainFit, PairComparison
 void bind_render(py::module_& m);       // Mesh, Camera, look_at, frame_bounds, orbit, Renderer, render
 void bind_colour(py::module_& m);       // display_encode
 
-// Inputs are checked as every verb checks them (core/input_file.h), and the failure becomes the
+// Inputs are checked as every verb checks them (formats/input_file.h), and the failure becomes the
 // matching OSError: FileNotFoundError, IsADirectoryError, or OSError for a FIFO or device; the
 // message names the file.
 void check_input_file(const std::string& path);

@@ -2,7 +2,7 @@
 #include "python/bindings.h"
 #include "python/numpy_mat.h"
 
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "runtime/blend.h"
 #include "runtime/blend_engine.h"
 #include "runtime/make_warp.h"

@@ -1,10 +1,10 @@
-// Environments (core/env_map.h) and their files (core/exr_io.h).
+// Environments (core/env_map.h) and their files (formats/exr_io.h).
 #include "python/bindings.h"
 #include "python/numpy_mat.h"
 
 #include "core/cell_centred_latlong.h"
 #include "core/env_map.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "core/texel_audit.h"
 
 #include <pybind11/eigen.h>
@@ -105,7 +105,7 @@ void bind_environment(py::module_& m) {
         if (report.texels.bad() && !sanitize)
           throw std::runtime_error(path + ": " + report.texels.describe() + "; pass sanitize=True to zero them");
         if (sanitize) sanitize_texels(env.pixels);
-        // The rule of the command line's environment inputs (core/exr_io.h).
+        // The rule of the command line's environment inputs (formats/exr_io.h).
         if (fold_ringing) {
           const std::string folded = fold_environment_ringing(env, path, report, sanitize);
           if (!folded.empty() && PyErr_WarnEx(PyExc_UserWarning, folded.c_str(), 1) != 0) throw py::error_already_set();

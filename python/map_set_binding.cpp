@@ -1,8 +1,8 @@
-// Map sets (core/map_set.h): one sphere map per view, with their attributes, and their files.
+// Map sets (formats/map_set.h): one sphere map per view, with their attributes, and their files.
 #include "python/bindings.h"
 #include "python/numpy_mat.h"
 
-#include "core/map_set.h"
+#include "formats/map_set.h"
 
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>

@@ -4,8 +4,8 @@
 // starts with the file's path) -> RuntimeError; missing inputs are OSErrors (python/bindings.h).
 #include "python/bindings.h"
 
-#include "core/file_error.h"
-#include "core/input_file.h"
+#include "formats/file_error.h"
+#include "formats/input_file.h"
 
 #include <cerrno>
 #include <filesystem>

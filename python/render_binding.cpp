@@ -4,7 +4,7 @@
 
 #include "core/camera.h"
 #include "core/env_map.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/mesh.h"
 #include "runtime/renderer.h"
 

@@ -41,7 +41,7 @@
 //      destination instead of being warped. A set reproduces each source at its own view either way.
 #pragma once
 
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/view_set.h"
 #include "runtime/warp.h"
 

@@ -48,7 +48,7 @@
 // Thread safety: every method is const and may be called from many threads at once.
 #pragma once
 
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/view_set.h"
 #include "runtime/blend.h"
 #include "runtime/warp.h"

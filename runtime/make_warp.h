@@ -2,7 +2,7 @@
 // and the Python module build their warp here, by name.
 #pragma once
 
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "runtime/warp.h"
 
 #include <memory>

@@ -34,7 +34,7 @@
 
 #include "core/camera.h"
 #include "core/env_map.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/mesh.h"
 #include "core/ray_scene.h"
 #include "runtime/blend.h"

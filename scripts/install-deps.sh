@@ -18,9 +18,9 @@ packages=(
   libqhull-dev
   libembree-dev libceres-dev libmrcal-dev libmrgingham-dev mrgingham mrcal libexiv2-dev
   libraw-dev libtiff-dev  # hdr/raw_image.cpp: RAW brackets (LibRaw); capture/: DNG written with libtiff
-  libheif-dev  # core/heif_image.cpp: HEIF/HEIC photos (phones' default), opened on first use
-  liblensfun-dev libglib2.0-dev  # calib/photo_optics.cpp: camera crop factors (lensfun database; its .pc needs glib)
-  libsuitesparse-dev  # calib/intrinsics.cpp: cholmod (mrcal's Jacobian for the intrinsics covariance)
+  libheif-dev  # formats/heif_image.cpp: HEIF/HEIC photos (phones' default), opened on first use
+  liblensfun-dev libglib2.0-dev  # calib/lens/photo_optics.cpp: camera crop factors (lensfun database; its .pc needs glib)
+  libsuitesparse-dev  # calib/lens/intrinsics.cpp: cholmod (mrcal's Jacobian for the intrinsics covariance)
   # viewer (runtime/viewer; optional at build time) and its CI test under Xvfb (Mesa llvmpipe)
   libglfw3-dev libimgui-dev libepoxy-dev xvfb xauth libgl1-mesa-dri
   # tests and benchmarks; clang's libFuzzer for the fuzz targets (fuzz/)

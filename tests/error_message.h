@@ -2,7 +2,7 @@
 // The message of the refusal a call throws (std::invalid_argument, or a FileError: a missing or
 // unreadable input), or "" when it throws none: tests of refusals compare against the one line a
 // user would read.
-#include "core/file_error.h"
+#include "formats/file_error.h"
 
 #include <functional>
 #include <stdexcept>

@@ -12,7 +12,7 @@
 #include "core/patterns.h"
 #include "core/sphere_map.h"
 #include "core/view_set.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>

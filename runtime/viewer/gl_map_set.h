@@ -6,7 +6,7 @@
 // warp.
 #pragma once
 
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/view_set.h"
 #include "runtime/blend.h"
 #include "runtime/blend_engine.h"

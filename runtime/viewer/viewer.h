@@ -9,7 +9,7 @@
 #pragma once
 
 #include "core/camera.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/mesh.h"
 #include "runtime/blend.h"
 #include "runtime/renderer.h"

@@ -6,7 +6,7 @@
 #include "tests/core/test_data.h"
 
 #include "bake/brdf_spec.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "core/resample.h"
 
 #include <gtest/gtest.h>

@@ -30,8 +30,8 @@
 #include "bake/ggx.h"
 #include "bake/reference_integrator.h"
 #include "core/cell_centred_latlong.h"
-#include "core/exr_file.h"
-#include "core/exr_io.h"
+#include "formats/exr_file.h"
+#include "formats/exr_io.h"
 #include "core/stopwatch.h"
 
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
-// calib/ball_cube_features.h: the cube faces show the world direction each texel names (compared
+// calib/orientation/ball_cube_features.h: the cube faces show the world direction each texel names (compared
 // with the environment the view was rendered from), keypoints map back to pixels that reflect their
 // directions exactly, and degenerate images give no features and no NaN.
-#include "calib/ball_cube_features.h"
+#include "calib/orientation/ball_cube_features.h"
 
 #include "calib_cases.h"
 

@@ -1,9 +1,9 @@
-// calib/ball_features.h + calib/orientation_solve.h end to end: four rendered views of a chrome ball
+// calib/orientation/ball_features.h + calib/orientation/orientation_solve.h end to end: four rendered views of a chrome ball
 // in a real environment (CC0 `lobby`, cache/), the ball located, SIFT features in it turned into
 // reflected directions, matched across views and solved for the views' orientations.
-#include "calib/ball_features.h"
+#include "calib/orientation/ball_features.h"
 
-#include "calib/ball_locator.h"
+#include "calib/balls/ball_locator.h"
 #include "calib_cases.h"
 
 #include <gtest/gtest.h>

@@ -1,11 +1,11 @@
-// Which ball is which (calib/ball_identification.h), on rendered views of a chrome and a grey ball
+// Which ball is which (calib/balls/ball_identification.h), on rendered views of a chrome and a grey ball
 // on stands in the CC0 lobby, with what real rooms add: a uniform disc and a ringed target behind
 // the rig, and an unlisted grey sphere of ball size. Views on a ring (from 90 degrees the grey ball
 // hides the chrome one, from 270 the chrome one hides the grey), one turned so the grey ball is cut
 // by the frame's edge. Checked against the
 // renderer's truth: every ball found where it is, nothing else taken for one.
-#include "calib/ball_identification.h"
-#include "calib/ball_locator.h"
+#include "calib/balls/ball_identification.h"
+#include "calib/balls/ball_locator.h"
 
 #include "calib_cases.h"
 

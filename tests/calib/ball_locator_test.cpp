@@ -1,6 +1,6 @@
-// calib/ball_cone.h and calib/ball_locator.h: the cone fit against exact cones, and ball
+// calib/balls/ball_cone.h and calib/balls/ball_locator.h: the cone fit against exact cones, and ball
 // localisation on rendered views against the true centre pixel.
-#include "calib/ball_locator.h"
+#include "calib/balls/ball_locator.h"
 
 #include "calib_cases.h"
 

@@ -1,6 +1,6 @@
 // A ball's offset from views whose cones' sizes are biased: the weighted estimate uses the views'
 // directions, the plain mean carries the depth errors.
-#include "calib/ball_offset.h"
+#include "calib/balls/ball_offset.h"
 
 #include <gtest/gtest.h>
 

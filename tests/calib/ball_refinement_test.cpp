@@ -1,10 +1,10 @@
-// calib/orientation_solve.h with ball centres refined jointly: the reflection geometry
+// calib/orientation/orientation_solve.h with ball centres refined jointly: the reflection geometry
 // (reflect_off_ball), the gradients of BallReflectionResidual, BallAxisPrior and HalfAnglePrior, and
 // on synthetic rigs with misplaced ball centres and radii, that the refinement makes the reported
 // uncertainty honest.
-#include "calib/orientation_solve.h"
+#include "calib/orientation/orientation_solve.h"
 
-#include "calib/sphere_map_extraction.h"
+#include "calib/extraction/sphere_map_extraction.h"
 #include "random_directions.h"
 
 #include <ceres/ceres.h>

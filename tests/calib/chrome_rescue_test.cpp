@@ -1,7 +1,7 @@
-// calib/ball_identification.h, rescue_chrome_balls: a chrome ball the appearance test missed is
+// calib/balls/ball_identification.h, rescue_chrome_balls: a chrome ball the appearance test missed is
 // taken from the rotation-invariant distance to another ball, and only when exactly one candidate
 // lies there.
-#include "calib/ball_identification.h"
+#include "calib/balls/ball_identification.h"
 
 #include <gtest/gtest.h>
 

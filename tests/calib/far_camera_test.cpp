@@ -1,12 +1,12 @@
-// calib/far_camera.h: crops of the ball. The crop test and the far lens's bound at their exact
+// calib/lens/far_camera.h: crops of the ball. The crop test and the far lens's bound at their exact
 // values; a view placed on a larger canvas keeps its pixels, gains no edge and flags what it
 // added; and a rendered chrome ball cropped as people crop them (the ball filling the frame, cut
 // by one edge) is found and taken as the crop's ball.
-#include "calib/far_camera.h"
+#include "calib/lens/far_camera.h"
 #include "core/test_data.h"  // tests/core/test_data.h
 
-#include "calib/ball_identification.h"
-#include "calib/sphere_map_extraction.h"
+#include "calib/balls/ball_identification.h"
+#include "calib/extraction/sphere_map_extraction.h"
 #include "calib_cases.h"
 #include "hdr/merge.h"
 

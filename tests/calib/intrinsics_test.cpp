@@ -1,6 +1,6 @@
-// calib/intrinsics.h: mrcal's solve recovers a known lens from noisy corners of boards posed by
+// calib/lens/intrinsics.h: mrcal's solve recovers a known lens from noisy corners of boards posed by
 // capture/chessboard.h; cross-validation picks the true model family; mrgingham finds the corners.
-#include "calib/intrinsics.h"
+#include "calib/lens/intrinsics.h"
 
 #include "capture/chessboard.h"
 

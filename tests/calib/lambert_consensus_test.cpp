@@ -1,6 +1,6 @@
-// The grey ball's cross-view consistency (calib/lambert_consensus.h): maps of one Lambertian ball
+// The grey ball's cross-view consistency (calib/extraction/lambert_consensus.h): maps of one Lambertian ball
 // from several views agree at every normal, except where one view alone is shadowed.
-#include "calib/lambert_consensus.h"
+#include "calib/extraction/lambert_consensus.h"
 
 #include "core/sphere_map.h"
 

@@ -1,6 +1,6 @@
-// The light an occluder takes from a grey ball, restored (calib/occluded_light.h): analytic caps
+// The light an occluder takes from a grey ball, restored (calib/extraction/occluded_light.h): analytic caps
 // under a uniform environment, occluders as bright as what they hide, unseen and hidden light.
-#include "calib/occluded_light.h"
+#include "calib/extraction/occluded_light.h"
 
 #include "core/sphere_map.h"
 

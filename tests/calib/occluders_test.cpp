@@ -1,6 +1,6 @@
-// Occluders by geometry (calib/occluders.h): analytic rays against spheres and capsules, and the
+// Occluders by geometry (calib/extraction/occluders.h): analytic rays against spheres and capsules, and the
 // rig's occluders as a chrome ball's view sees them.
-#include "calib/occluders.h"
+#include "calib/extraction/occluders.h"
 
 #include <gtest/gtest.h>
 

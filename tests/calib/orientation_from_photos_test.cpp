@@ -2,13 +2,13 @@
 // around a 200-px chrome ball on its stand (lobby, with the photographer's proxy), each view 5
 // bracketed 8-bit PNGs through the sensor model (shot and read noise, a measured-looking response,
 // vignetting, white balance; capture/), the response recovered and the brackets merged (hdr/), the
-// ball found and the views oriented from the merged images (calib/view_orientation.h), given only
+// ball found and the views oriented from the merged images (calib/orientation/view_orientation.h), given only
 // the true lens and the first view's up. Checked against the renderer's poses and balls.
-#include "calib/view_orientation.h"
+#include "calib/orientation/view_orientation.h"
 
 #include "calib_cases.h"
 #include "capture/camera_poses.h"
-#include "core/photo_set.h"
+#include "formats/photo_set.h"
 #include "capture/synth_capture.h"
 #include "capture/synth_scene.h"
 #include "hdr/photo_set_merge.h"

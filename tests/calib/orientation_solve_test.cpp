@@ -1,7 +1,7 @@
-// calib/orientation_solve.h: the cost's gradient, orientation accuracy with realistic noise and
+// calib/orientation/orientation_solve.h: the cost's gradient, orientation accuracy with realistic noise and
 // outliers, the reported uncertainty against the observed error, clear errors.
-#include "calib/orientation_solve.h"
-#include "calib/sphere_map_extraction.h"
+#include "calib/orientation/orientation_solve.h"
+#include "calib/extraction/sphere_map_extraction.h"
 #include "random_directions.h"
 
 #include <ceres/ceres.h>

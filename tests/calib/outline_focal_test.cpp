@@ -1,8 +1,8 @@
-// Self-calibration of the focal length from ball outlines (calib/outline_focal.h): outlines of true
+// Self-calibration of the focal length from ball outlines (calib/lens/outline_focal.h): outlines of true
 // cones through a known lens, with pixel noise, from a starting focal length that is wrong.
-#include "calib/outline_focal.h"
+#include "calib/lens/outline_focal.h"
 
-#include "calib/ball_cone.h"
+#include "calib/balls/ball_cone.h"
 
 #include <gtest/gtest.h>
 

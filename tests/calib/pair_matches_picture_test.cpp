@@ -1,6 +1,6 @@
-// calib/pair_matches_picture.h: two views side by side at the asked height, an inlier's line in
+// calib/orientation/pair_matches_picture.h: two views side by side at the asked height, an inlier's line in
 // green and an outlier's in red, between the right pixels.
-#include "calib/pair_matches_picture.h"
+#include "calib/orientation/pair_matches_picture.h"
 
 #include <gtest/gtest.h>
 

@@ -1,11 +1,11 @@
-// The lens from the photos' metadata (calib/photo_optics.h): EXIF focal lengths, lensfun's crop
+// The lens from the photos' metadata (calib/lens/photo_optics.h): EXIF focal lengths, lensfun's crop
 // factors, and the pinhole they give with its stated uncertainty.
-#include "calib/photo_optics.h"
+#include "calib/lens/photo_optics.h"
 
 #include "capture/synth_capture.h"
 #include "capture/synth_cases.h"
 #include "core/test_data.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <exiv2/exiv2.hpp>
 #include <gtest/gtest.h>

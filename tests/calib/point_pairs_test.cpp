@@ -1,6 +1,6 @@
-// calib/point_pairs.h: a file of points picked by hand reads back as written; every malformed
+// calib/orientation/point_pairs.h: a file of points picked by hand reads back as written; every malformed
 // entry is one error naming the file and the key.
-#include "calib/point_pairs.h"
+#include "calib/orientation/point_pairs.h"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
-// calib/pose_file.h: poses.yaml round trip (bit-exact) and strict reading (one error naming the file
+// calib/orientation/pose_file.h: poses.yaml round trip (bit-exact) and strict reading (one error naming the file
 // and the key).
-#include "calib/pose_file.h"
+#include "calib/orientation/pose_file.h"
 
-#include "core/file_error.h"
+#include "formats/file_error.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
-// calib/probe_fill.h: the directions no view saw, filled from the seen ones.
-#include "calib/probe_fill.h"
+// calib/probe/probe_fill.h: the directions no view saw, filled from the seen ones.
+#include "calib/probe/probe_fill.h"
 
 #include <gtest/gtest.h>
 

@@ -1,10 +1,10 @@
-// calib/probe.h: chrome views extracted by calib/ from rendered photos (photographer in the shot),
+// calib/probe/probe.h: chrome views extracted by calib/ from rendered photos (photographer in the shot),
 // blended into a lat-long probe and measured against the true environment.
-#include "calib/probe.h"
+#include "calib/probe/probe.h"
 
 #include "bake/brdf_spec.h"
-#include "calib/ball_locator.h"
-#include "calib/sphere_map_extraction.h"
+#include "calib/balls/ball_locator.h"
+#include "calib/extraction/sphere_map_extraction.h"
 #include "calib_cases.h"
 
 #include <gtest/gtest.h>

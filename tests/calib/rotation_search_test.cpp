@@ -1,7 +1,7 @@
-// calib/rotation_search.h: panoramas built from a known pattern of directions, turned by a known
+// calib/orientation/rotation_search.h: panoramas built from a known pattern of directions, turned by a known
 // rotation and changed in exposure, are found again; the panorama's texel <-> direction maps are
 // inverse; mismatched pyramids are a clear error.
-#include "calib/rotation_search.h"
+#include "calib/orientation/rotation_search.h"
 
 #include <gtest/gtest.h>
 

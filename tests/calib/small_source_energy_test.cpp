@@ -1,13 +1,13 @@
 // A sun smaller than a texel of the default 64-texel map keeps its energy through extraction
-// (calib/sphere_map_extraction.h: the texel's samples' mean where they differ, a feature smaller
-// than the texel) and through the probe (calib/probe.h), in every view, whatever the sub-pixel
+// (calib/extraction/sphere_map_extraction.h: the texel's samples' mean where they differ, a feature smaller
+// than the texel) and through the probe (calib/probe/probe.h), in every view, whatever the sub-pixel
 // phase of the sun's image. Photographs rendered by capture/ (unclipped: the radiance itself).
 // Measured (3 views): 0.99-1.01 of the sun's energy per view with the samples' mean, 0.21-3.1 at
 // the texel centres alone; the probe 1.00.
 #include "bake/brdf_spec.h"
-#include "calib/ball_locator.h"
-#include "calib/probe.h"
-#include "calib/sphere_map_extraction.h"
+#include "calib/balls/ball_locator.h"
+#include "calib/probe/probe.h"
+#include "calib/extraction/sphere_map_extraction.h"
 #include "calib_cases.h"
 #include "capture/true_sphere_map.h"
 #include "core/sphere_map.h"

@@ -1,8 +1,8 @@
-// calib/sphere_map_extraction.h: extracted sphere maps against the true maps of capture/
+// calib/extraction/sphere_map_extraction.h: extracted sphere maps against the true maps of capture/
 // (compare/map_compare.h), the reflection solve against the law of reflection, the confidence channel.
-#include "calib/sphere_map_extraction.h"
+#include "calib/extraction/sphere_map_extraction.h"
 
-#include "calib/ball_locator.h"
+#include "calib/balls/ball_locator.h"
 #include "calib_cases.h"
 #include "capture/true_sphere_map.h"
 #include "compare/map_compare.h"

@@ -1,6 +1,6 @@
-// The stand under a ball as a vertical line (calib/stand_line.h), on rendered views of a chrome ball
+// The stand under a ball as a vertical line (calib/orientation/stand_line.h), on rendered views of a chrome ball
 // on its pole in the CC0 lobby: the plane it gives contains the true up; without a stand, none.
-#include "calib/stand_line.h"
+#include "calib/orientation/stand_line.h"
 
 #include "calib_cases.h"
 

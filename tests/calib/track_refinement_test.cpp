@@ -1,9 +1,9 @@
-// calib/track_refinement.h: re-located tracks agree with the renderer's truth to hundredths of a
+// calib/orientation/track_refinement.h: re-located tracks agree with the renderer's truth to hundredths of a
 // pixel where SIFT's keypoints agree to tenths, with sigmas that say so; a track nothing re-locates
 // keeps its observations; inconsistent inputs are clear errors.
-#include "calib/track_refinement.h"
+#include "calib/orientation/track_refinement.h"
 
-#include "calib/ball_features.h"
+#include "calib/orientation/ball_features.h"
 #include "calib_cases.h"
 
 #include <gtest/gtest.h>
@@ -132,7 +132,7 @@ TEST(TrackRefinement, ATrackNothingReLocatesKeepsItsObservations) {
   EXPECT_EQ(rep.observations_dropped, 0);
 }
 
-// Clipped pixels are invalid texels (calib/ball_cube_features.h): with every texel of one view
+// Clipped pixels are invalid texels (calib/orientation/ball_cube_features.h): with every texel of one view
 // invalid (as if all its pixels were clipped), no patch there is sampled and every two-view track
 // keeps its SIFT observations.
 TEST(TrackRefinement, InvalidTexelsAreNeverSampledAndTheirTracksKeepTheirObservations) {

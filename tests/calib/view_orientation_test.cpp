@@ -1,8 +1,8 @@
-// calib/view_orientation.h: images in, poses out. Four rendered views of a chrome ball in a real
+// calib/orientation/view_orientation.h: images in, poses out. Four rendered views of a chrome ball in a real
 // environment (CC0 `lobby`, cache/) are oriented without any truth given (the balls detected, the
 // gauge by the up direction), and compared with the renderer's poses; one view, no ball and two
 // views sharing nothing give one clear error.
-#include "calib/view_orientation.h"
+#include "calib/orientation/view_orientation.h"
 
 #include "calib_cases.h"
 
@@ -149,7 +149,7 @@ TEST(ViewOrientation, ExtractionTakesThePoseFilesRefinedBallOnlyForTheSameBall) 
 // ball (an 800-px disc, a light probe's size in a photograph), 1% noise, nothing given but the lens
 // and the first view's up. The outline alone puts the centre ~0.1-3 px off and the radius 0.3-2 px
 // inside the limb; refined with the features (SIFT's keypoints re-located by patch alignment,
-// calib/track_refinement.h), centres and radii come within hundredths of a pixel and the
+// calib/orientation/track_refinement.h), centres and radii come within hundredths of a pixel and the
 // orientations within a hundredth of a degree. Guarded at half of 0.05 degrees.
 // Centre, radius and orientation are each checked against the renderer's truth.
 TEST(ViewOrientation, ARingOfViewsAroundALightProbeSizedBallIsOrientedToAHundredthOfADegreeAndHundredthsOfAPixel) {
@@ -192,7 +192,7 @@ TEST(ViewOrientation, ARingOfViewsAroundALightProbeSizedBallIsOrientedToAHundred
 }
 
 // Wide baselines: a world feature seen near the ball's centre in one view is near the rim,
-// compressed up to ~10x radially, in the other. On the cube faces (calib/ball_cube_features.h) it
+// compressed up to ~10x radially, in the other. On the cube faces (calib/orientation/ball_cube_features.h) it
 // looks the same in both. Measured (park, 120-px ball, noise 1%): 110-146 tracks, errors 0.33-0.47
 // degrees with SIFT's keypoints (4 seeds), 0.11 and 0.14 with the tracks re-located (this seed);
 // SIFT in the image itself finds 12-20 tracks here and fails at 60 px radius.
@@ -282,7 +282,7 @@ TEST(ViewOrientation, TwelveViewsOnTwoRingsOfAnInteriorAreAllOrientedWithinHalfA
       rep.tracks, worst, chi2, testing::median(errs), *std::max_element(errs.begin(), errs.end()));
 }
 
-// The agreement of two views (calib/view_agreement.h) at their true rotations and balls: a view
+// The agreement of two views (calib/orientation/view_agreement.h) at their true rotations and balls: a view
 // exposed twice as long shows the offset as -1 stop exactly; the mismatch is small at the truth
 // and grows when the second view is turned 5 degrees.
 TEST(ViewOrientation, TwoViewsAgreeAtTheTruthWithTheirExposureOffsetAndDisagreeWhenTurned) {

@@ -1,8 +1,8 @@
-// World up from the views (calib/world_up.h): the direction most perpendicular to every camera's x
+// World up from the views (calib/orientation/world_up.h): the direction most perpendicular to every camera's x
 // axis. Cameras from capture/'s view plans (handheld rings aimed down at the rig, jittered like a
 // hand), expressed in the first camera's frame as the orientation solve's first-view gauge leaves them.
-#include "calib/view_orientation.h"
-#include "calib/world_up.h"
+#include "calib/orientation/view_orientation.h"
+#include "calib/orientation/world_up.h"
 
 #include "capture/camera_poses.h"
 #include "capture/synth_scene.h"

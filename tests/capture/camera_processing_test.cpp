@@ -5,9 +5,9 @@
 
 #include "capture/synth_capture.h"
 #include "core/test_data.h"
-#include "core/truth_image.h"
+#include "formats/truth_image.h"
 #include "synth_cases.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>

@@ -4,7 +4,7 @@
 
 #include "capture/sensor_noise.h"
 #include "core/test_data.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <gtest/gtest.h>
 

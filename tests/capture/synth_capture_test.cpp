@@ -4,12 +4,12 @@
 #include "capture/camera_poses.h"
 #include "capture/camera_response.h"
 #include "core/lensfun_lens.h"
-#include "core/photo_set.h"
-#include "core/truth_image.h"
-#include "core/map_set.h"
+#include "formats/photo_set.h"
+#include "formats/truth_image.h"
+#include "formats/map_set.h"
 #include "core/test_data.h"
 #include "synth_cases.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>

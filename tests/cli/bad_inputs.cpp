@@ -2,8 +2,8 @@
 // cannot make: environments and map sets whose pixels hold NaN, +-Inf, FLT_MAX, negative values or
 // confidences outside [0, 1], and degenerate but well-formed shapes (1x1 maps, one view, two views
 // with one direction). Usage: rsibr_bad_inputs FOLDER
-#include "core/exr_io.h"
-#include "core/map_set.h"
+#include "formats/exr_io.h"
+#include "formats/map_set.h"
 #include "core/vec.h"
 #include "core/view_set.h"
 

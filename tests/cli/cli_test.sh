@@ -398,7 +398,7 @@ expect_error "extract: output folder missing" "nofolder" extract "$work/syn1/tru
 check "extract: no output after errors" bash -c "! ls -A '$work' | grep -q '^ext-e'"
 check "extract: no temporaries" no_temporaries "$work"
 
-# --- calibrate (calib/intrinsics.h): 8 chessboards of the minimal spec's pinhole (f = 700 px).
+# --- calibrate (calib/lens/intrinsics.h): 8 chessboards of the minimal spec's pinhole (f = 700 px).
 sed 's/chessboards: {count: 2,/chessboards: {count: 8,/' "$spec" >"$work/min8.yaml"
 "$rsibr" synth "$work/min8.yaml" --out "$work/syn8" -q
 "$rsibr" calibrate "$work/syn8/photos" --out "$work/cal1.cameramodel" --json "$work/cal.json" -q
@@ -414,7 +414,7 @@ expect_error "calibrate: missing photo set" "nothere" calibrate "$work/nothere" 
 expect_error "calibrate: unknown model" "LENSMODEL_FANCY" calibrate "$work/syn8/photos" --out "$work/cal-e3.cameramodel" --model LENSMODEL_FANCY
 check "calibrate: no output after errors" bash -c "! ls -A '$work' | grep -q '^cal-e'"
 
-# --- calibrate, lens branch: the splined candidate and the uncertainty (calib/intrinsics.h).
+# --- calibrate, lens branch: the splined candidate and the uncertainty (calib/lens/intrinsics.h).
 check "calibrate: splined scored, not chosen for a pinhole; f within 3 sigma; uncertainty reported" python3 -c "
 import json; j = json.load(open('$work/cal.json'))
 assert j['models'][3]['model'].startswith('LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=8_Ny=6_') and j['skipped_models'] == [], j
@@ -429,7 +429,7 @@ check "calibrate: splined skipped with a reason for 6 boards" python3 -c "
 import json; j = json.load(open('$work/cal6.json'))
 assert len(j['models']) == 3 and j['skipped_models'][0]['model'] == 'splined' and '6 boards' in j['skipped_models'][0]['reason'], j"
 
-# --- probe (calib/probe.h): the minimal spec's three chrome views (poses from the truth headers).
+# --- probe (calib/probe/probe.h): the minimal spec's three chrome views (poses from the truth headers).
 for v in 0 1 2; do
   "$rsibr" extract "$work/syn1/truth/views/view0${v}_radiance.exr" --lens "$lens" --out "$work/pv$v.exr" --size 64 --camera-mask-deg 40 -q
 done
@@ -449,7 +449,7 @@ check "probe: --fresnel none keeps F L, no clipped light in the minimal spec" py
 import json; j = json.load(open('$work/probe-fl.json')); assert j['fresnel'] == 'none' and j['light_sources']['regions'] == [], j"
 check "probe: no output after errors" bash -c "! ls -A '$work' | grep -q '^probe-e'"
 
-# --- orient (calib/view_orientation.h): three views 20 degrees apart of a chrome ball in a real
+# --- orient (calib/orientation/view_orientation.h): three views 20 degrees apart of a chrome ball in a real
 # environment (cache/, skipped without it); the relative rotation, determinism, extract --poses, errors.
 lobby="$(cd "$(dirname "$0")/../.." && pwd)/cache/assets/hdri/lobby.exr"
 if [ -f "$lobby" ]; then

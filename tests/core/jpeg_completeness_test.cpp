@@ -1,6 +1,6 @@
-// jpeg_is_complete (core/image_codecs.h): a JPEG cut short is told from a whole one, whatever
+// jpeg_is_complete (formats/image_codecs.h): a JPEG cut short is told from a whole one, whatever
 // comes after the end marker or inside the segments before the scan.
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
-// core/lazy_library.h and core/image_codecs.h: libraries opened on first use, with one clear error
+// core/lazy_library.h and formats/image_codecs.h: libraries opened on first use, with one clear error
 // when they cannot be; the codecs round-trip through the library opened that way.
 #include "core/lazy_library.h"
 
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <gtest/gtest.h>
 

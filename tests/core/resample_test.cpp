@@ -1,7 +1,7 @@
 // Resampling between layouts and the MIP pyramid.
 #include "core/resample.h"
 
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "core/mip_pyramid.h"
 #include "core/patterns.h"
 #include "test_data.h"

@@ -1,4 +1,4 @@
-#include "core/atomic_folder.h"
+#include "formats/atomic_folder.h"
 #include "core/safe_name.h"
 #include "core/text.h"
 

@@ -1,7 +1,7 @@
 #include "core/texel_audit.h"
 
 #include "core/env_map.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "test_data.h"
 
 #include <gtest/gtest.h>

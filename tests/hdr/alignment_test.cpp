@@ -6,7 +6,7 @@
 #include "hdr/response_curve.h"
 
 #include "core/test_data.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>

@@ -1,9 +1,9 @@
 // Exposure metadata (photoset.yaml, EXIF via exiv2) and bracket loading.
 #include "hdr/bracket_set.h"
 
-#include "core/photo_set.h"
+#include "formats/photo_set.h"
 #include "core/test_data.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <exiv2/exiv2.hpp>
 #include <gtest/gtest.h>

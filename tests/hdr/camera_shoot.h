@@ -17,7 +17,7 @@
 
 #include "capture/camera_processing.h"
 #include "capture/sensor_noise.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "hdr/bracket_set.h"
 #include "hdr/merge.h"
 

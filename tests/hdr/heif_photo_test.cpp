@@ -1,9 +1,9 @@
-// HEIF/HEIC photos (core/heif_image.h, hdr/photo_exif.h): a photo written by libheif with an Exif
+// HEIF/HEIC photos (formats/heif_image.h, hdr/photo_exif.h): a photo written by libheif with an Exif
 // block reads back as the JPEG path would give it, pixels (within the HEVC coding error) and EXIF
 // (exposure time, ISO, f-number, camera, focal lengths) alike; a file that is not HEIF is an error
 // naming it. The photo is encoded here with libheif's HEVC encoder (skipped where it has none).
-#include "core/heif_image.h"
-#include "core/image_codecs.h"
+#include "formats/heif_image.h"
+#include "formats/image_codecs.h"
 #include "hdr/exposure_metadata.h"
 #include "hdr/photo_exif.h"
 

@@ -1,7 +1,7 @@
 // hdr/photo_set_merge.h with one exposure per view: no response can be recovered from one photo,
 // so the sRGB curve is stated (its exact values at codes 0, 10, 188, 255), and the merge gives each
 // pixel the sRGB-decoded code over the exposure, with the top code flagged clipped (a lower bound).
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 #include "hdr/merge.h"
 #include "hdr/photo_set_merge.h"
 

@@ -5,12 +5,12 @@
 #include "capture/dng_file.h"
 #include "capture/synth_capture.h"
 #include "capture/synth_cases.h"
-#include "core/photo_set.h"
+#include "formats/photo_set.h"
 #include "core/test_data.h"
-#include "core/truth_image.h"
+#include "formats/truth_image.h"
 #include "hdr/bracket_set.h"
 #include "hdr/photo_set_merge.h"
-#include "core/image_codecs.h"
+#include "formats/image_codecs.h"
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>

@@ -5,7 +5,7 @@
 #include "hdr/noise_model.h"
 #include "hdr/response_recovery.h"
 
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "core/test_data.h"
 
 #include <gtest/gtest.h>

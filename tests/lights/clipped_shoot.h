@@ -12,11 +12,11 @@
 #pragma once
 
 #include "bake/brdf_spec.h"
-#include "calib/probe.h"
+#include "calib/probe/probe.h"
 #include "lights/clipped_regions.h"
 #include "capture/irradiance.h"
 #include "capture/true_sphere_map.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "core/patterns.h"
 #include "core/sphere_map.h"
 

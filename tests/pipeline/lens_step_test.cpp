@@ -5,8 +5,8 @@
 #include "pipeline/lens_step.h"
 
 #include "calib/calib_cases.h"
-#include "calib/far_camera.h"
-#include "core/image_codecs.h"
+#include "calib/lens/far_camera.h"
+#include "formats/image_codecs.h"
 #include "core/test_data.h"
 #include "hdr/merge.h"
 #include "hdr/merged_exr.h"
@@ -68,7 +68,7 @@ TEST(LensStep, NoFocalLengthAndNoOutlineIsAnErrorNamingTheWayOut) {
   }
 }
 
-// Crops of one rendered chrome ball (the far-camera model, calib/far_camera.h): views of different
+// Crops of one rendered chrome ball (the far-camera model, calib/lens/far_camera.h): views of different
 // sizes whose ball fills the frame get one far pinhole on the largest view's canvas, whatever the
 // metadata said; views of different sizes whose ball does not fill the frame are an error naming
 // their sizes; a ball whose pixels the brackets disagree on stops the step.

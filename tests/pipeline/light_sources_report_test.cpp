@@ -6,8 +6,8 @@
 #include "pipeline/light_sources_report.h"
 #include "pipeline/light_sources_step.h"
 
-#include "calib/probe.h"
-#include "core/exr_file.h"
+#include "calib/probe/probe.h"
+#include "formats/exr_file.h"
 #include "lights/clipped_shoot.h"
 
 #include <gtest/gtest.h>

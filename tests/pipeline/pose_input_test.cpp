@@ -1,4 +1,4 @@
-// Given poses (pipeline/pose_input.h): poses.yaml (through calib/pose_file.h) and synth truth.yaml
+// Given poses (pipeline/pose_input.h): poses.yaml (through calib/orientation/pose_file.h) and synth truth.yaml
 // read, bad matrices and duplicates refused with the file's name.
 #include "pipeline/pose_input.h"
 

@@ -9,11 +9,11 @@
 
 #include "capture/synth_capture.h"
 #include "capture/synth_scene.h"
-#include "core/exr_io.h"
+#include "formats/exr_io.h"
 #include "compare/map_compare.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/resample.h"
-#include "calib/pose_file.h"
+#include "calib/orientation/pose_file.h"
 #include "pipeline/step_record.h"
 
 #include <gtest/gtest.h>

@@ -3,18 +3,18 @@
 // ringed target, an unlisted grey sphere), strong vignetting (1.3 stops at the corner) with one view
 // turned so the grey ball sits toward a corner, one view turned so the frame cuts the grey ball.
 // Orientations solved, lens given (the chessboards still serve the vignetting). The photographer is
-// left out of the scene, so that restoring his light (on by default, calib/occluded_light.h) is
+// left out of the scene, so that restoring his light (on by default, calib/extraction/occluded_light.h) is
 // checked to change little where there is none; bench/geometry_robustness.py measures shoots with
 // one.
 // Checked against the truth: no wrong ball, the cut ball flagged, the world level within 1 degree,
 // the vignetting, the grey maps within 0.1 stop per view after the gain fit.
 #include "pipeline/process_pipeline.h"
 
-#include "calib/pose_file.h"
+#include "calib/orientation/pose_file.h"
 #include "capture/synth_capture.h"
 #include "capture/synth_scene.h"
 #include "compare/map_compare.h"
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "hdr/vignetting.h"
 #include "pipeline/pose_input.h"
 

@@ -3,7 +3,7 @@
 // radiance leaving a surface with normal T g_normal(p) toward a viewer along v.
 #pragma once
 
-#include "core/map_set.h"
+#include "formats/map_set.h"
 #include "core/sphere_map.h"
 #include "core/view_set.h"
 #include "runtime/blend.h"

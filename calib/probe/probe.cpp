@@ -1,0 +1,196 @@
+#include "calib/probe/probe.h"
+
+#include "formats/exr_io.h"
+#include "core/parallel.h"
+#include "core/sphere_map.h"
+#include "core/luminance.h"
+#include "core/resolution_mask.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace rsibr {
+
+namespace {
+
+// Views one probe texel's lookups are held for (on the stack).
+constexpr std::size_t kMaxProbeViews = 256;
+
+// One view's bilinear lookup at mirror direction r (view frame): the trusted taps' value and
+// confidence, and the clipped taps' weight and value.
+struct Lookup {
+  Vec3 value = Vec3::Zero();
+  double confidence = 0, weight = 0;  // weight: the trusted taps' bilinear weight
+  Vec3 clipped_value = Vec3::Zero();
+  double clipped = 0, clipped_weight = 0;
+};
+
+Lookup look_up(const MapView& mv, const Vec3& r) {
+  Lookup out;
+  const Vec2 px = sphere_map::pixel_from_disc(sphere_map::g_mirror_inv(r), mv.rgb.cols, mv.rgb.rows);
+  const int x0 = static_cast<int>(std::floor(px.x())), y0 = static_cast<int>(std::floor(px.y()));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= mv.rgb.cols || y0 + 1 >= mv.rgb.rows) return out;
+  const double fx = px.x() - x0, fy = px.y() - y0;
+  const double tw[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+  const int tx[4] = {x0, x0 + 1, x0, x0 + 1}, ty[4] = {y0, y0, y0 + 1, y0 + 1};
+  for (int k = 0; k < 4; ++k) {
+    const cv::Vec3f p = mv.rgb.at<cv::Vec3f>(ty[k], tx[k]);
+    const Vec3 c(p[0], p[1], p[2]);
+    // A tap without confidence gives nothing; the rest are renormalised (bilinear within the trusted texels).
+    if (const float cf = mv.confidence.at<float>(ty[k], tx[k]); cf > 0) {
+      out.value += tw[k] * c;
+      out.confidence += tw[k] * cf;
+      out.weight += tw[k];
+    } else if (!mv.clipped.empty()) {
+      if (const float cl = mv.clipped.at<float>(ty[k], tx[k]); cl > 0 && c.allFinite()) {
+        out.clipped_value += tw[k] * c;
+        out.clipped += tw[k] * cl;
+        out.clipped_weight += tw[k];
+      }
+    }
+  }
+  if (out.clipped_weight > 0) {
+    // A clipped tap's value is a lower bound, far above its neighbours' for a sun: renormalising
+    // over the trusted taps would fill the sun with sky. The whole lookup counts as clipped.
+    out.clipped_value /= out.clipped_weight;
+    out.value = Vec3::Zero();
+    out.confidence = out.weight = 0;
+    return out;
+  }
+  if (out.weight > 0) out.value /= out.weight;
+  return out;
+}
+
+}  // namespace
+
+Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
+  if (set.views.empty()) throw std::invalid_argument("probe: no views");
+  if (set.views.size() > kMaxProbeViews)
+    throw std::invalid_argument("probe: " + std::to_string(set.views.size()) + " views; at most " +
+                                std::to_string(kMaxProbeViews) + " are assembled into one probe");
+  for (std::size_t v = 0; v < set.views.size(); ++v) {
+    const MapView& mv = set.views[v];
+    if (mv.confidence.empty() || mv.rgb.type() != CV_32FC3)
+      throw std::invalid_argument("probe: view." + std::to_string(v) +
+                                  " has no confidence channel (not a captured map)");
+    if (!mv.clipped.empty() && (mv.clipped.type() != CV_32FC1 || mv.clipped.size() != mv.rgb.size()))
+      throw std::invalid_argument("probe: view." + std::to_string(v) +
+                                  " has a clipped channel of the wrong type or size");
+  }
+  if (options.width < 4 || options.width % 2) throw std::invalid_argument("probe: width must be even and >= 4");
+  const Layout layout(LayoutKind::LatLong, options.width, options.width / 2);
+  Probe probe;
+  probe.env = EnvMap::zeros(layout, 3);
+  probe.env.attributes["source"] = "probe";
+  probe.weight = cv::Mat(layout.height(), layout.width(), CV_32FC1, cv::Scalar(0));
+  probe.clipped = cv::Mat(layout.height(), layout.width(), CV_32FC1, cv::Scalar(0));
+  probe.lower_bound = cv::Mat(layout.height(), layout.width(), CV_32FC3, cv::Scalar::all(0));
+  // The finest map's texel angle (4 / size radians) against the probe's (latitude step).
+  int map_size = 0;
+  for (const MapView& mv : set.views) map_size = std::max(map_size, std::min(mv.rgb.cols, mv.rgb.rows));
+  const double map_texel = 4.0 / std::max(map_size, 1), probe_texel = kPi / (layout.height() - 1);
+  const int k = std::clamp(int(std::ceil(probe_texel / map_texel - 1e-9)), 1, 4);
+  // Views measured at different resolutions (core/resolution_mask.h): each lookup's confidence is
+  // scaled by s_i = m_i + 1 - max_j m_j, the views' authored masks at the lookup's level of detail
+  // (the probe's subsample spacing in the view's map texels), so the sharpest views give the detail
+  // wherever they fully cover. Views of one resolution: s_i = 1.
+  std::vector<double> detail;
+  for (std::size_t v = 0; v < set.views.size(); ++v) {
+    try {
+      detail.push_back(native_detail_level(set.views[v]));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("probe: view." + std::to_string(v) + ": " + e.what());
+    }
+  }
+  const bool mixed = mixed_resolution(detail);
+  std::vector<std::unique_ptr<MaskPyramid>> masks(set.views.size());
+  std::vector<double> lod(set.views.size(), 0.0);
+  if (mixed)
+    for (std::size_t v = 0; v < set.views.size(); ++v) {
+      masks[v] = resolution_mask(set.views[v].confidence, detail[v]);
+      const double spacing = probe_texel / k, texel = 4.0 / std::max(1, set.views[v].rgb.cols);
+      lod[v] = spacing > texel ? std::log2(spacing / texel) : 0.0;
+    }
+  std::vector<double> row_area(layout.height(), 0.0), row_covered(layout.height(), 0.0),
+      row_clipped(layout.height(), 0.0);
+  parallel_for_rows(layout.height(), [&](int row) {
+    for (int col = 0; col < layout.width(); ++col) {
+      const auto centre = layout.texel_direction(col, row);
+      if (!centre) continue;
+      const double area = std::sqrt(std::max(0.0, 1.0 - centre->y() * centre->y()));  // cos(latitude)
+      row_area[row] += area;
+      Vec3 sum = Vec3::Zero(), bound = Vec3::Zero();
+      double wsum = 0, csum = 0;
+      for (int a = 0; a < k; ++a)
+        for (int b = 0; b < k; ++b) {
+          const auto w = k == 1 ? centre : layout.direction(Vec2(col - 0.5 + (b + 0.5) / k, row - 0.5 + (a + 0.5) / k));
+          if (!w) continue;
+          Lookup looks[kMaxProbeViews];
+          float m[kMaxProbeViews];
+          float m_max = 0.0f;
+          const std::size_t nv = std::min(set.views.size(), kMaxProbeViews);
+          for (std::size_t v = 0; v < nv; ++v) {
+            const MapView& mv = set.views[v];
+            const Vec3 r = mv.world_from_view.transpose() * *w;
+            looks[v] = look_up(mv, r);
+            m[v] = 0.0f;
+            if (mixed && looks[v].confidence > 0) {
+              const Vec2 px = sphere_map::pixel_from_disc(sphere_map::g_mirror_inv(r), mv.rgb.cols, mv.rgb.rows);
+              m[v] = masks[v]->sample(px, lod[v]);
+              m_max = std::max(m_max, m[v]);
+            }
+          }
+          for (std::size_t v = 0; v < nv; ++v) {
+            const MapView& mv = set.views[v];
+            const Vec3 r = mv.world_from_view.transpose() * *w;
+            Lookup l = looks[v];
+            if (mixed) l.confidence *= m[v] + 1.0f - m_max;
+            Vec3 f = Vec3::Ones();
+            if (options.fresnel && (l.confidence > 0 || l.clipped > 0))
+              f = options.fresnel->eval(std::sqrt(std::clamp(0.5 * (1 + r.normalized().z()), 0.0, 1.0)))
+                      .cwiseMax(Vec3::Constant(1e-6));
+            if (l.confidence > 0) {
+              sum += l.confidence * l.value.cwiseQuotient(f);
+              wsum += l.confidence;
+            }
+            if (l.clipped > 0) {
+              csum += l.clipped;
+              bound = bound.cwiseMax(l.clipped_value.cwiseQuotient(f));
+            }
+          }
+        }
+      wsum /= k * k, csum /= k * k, sum /= k * k;
+      // A trusted estimate below a lower bound other views saw there contradicts them (a sun smeared
+      // over the stretched rim of a view that saw it unclipped): the lower bound wins when its
+      // views outweigh the trusted ones (else one view's misregistered clipped pixels would clip
+      // the sky the others saw).
+      if (wsum >= options.min_weight && csum > wsum && luminance(sum / wsum) < luminance(bound)) wsum = 0;
+      if (wsum < options.min_weight) {
+        if (csum >= options.min_weight) {
+          probe.clipped.at<float>(row, col) = static_cast<float>(csum);
+          probe.lower_bound.at<cv::Vec3f>(row, col) = cv::Vec3f(float(bound.x()), float(bound.y()), float(bound.z()));
+          row_clipped[row] += area;
+        }
+        continue;
+      }
+      const Vec3 l = sum / wsum;
+      probe.env.pixels.at<cv::Vec3f>(row, col) = cv::Vec3f(float(l.x()), float(l.y()), float(l.z()));
+      probe.weight.at<float>(row, col) = static_cast<float>(wsum);
+      row_covered[row] += area;
+    }
+  });
+  double a = 0, c = 0, cl = 0;
+  for (int r = 0; r < layout.height(); ++r) a += row_area[r], c += row_covered[r], cl += row_clipped[r];
+  probe.covered_fraction = a > 0 ? c / a : 0;
+  probe.clipped_fraction = a > 0 ? cl / a : 0;
+  return probe;
+}
+
+void write_probe(const std::string& path, const EnvMap& env, const cv::Mat& confidence, const cv::Mat& flags) {
+  cv::Mat f;
+  flags.convertTo(f, CV_32F);
+  write_environment(path, env, {}, {{"confidence", confidence}, {"flags", f}});
+}
+
+}  // namespace rsibr
