@@ -2,11 +2,13 @@
 
 #include <opencv2/imgproc.hpp>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <memory>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -125,7 +127,9 @@ void fold_step_sparse(cv::Mat& positive, std::vector<Deficit>& deficits, int rad
 }
 
 // The same step by box filters over the deficits' bounding box grown by 2r: linear in that box,
-// whatever the radius, so it serves many deficits at a large radius.
+// whatever the radius, so it serves many deficits at a large radius. Memory: three double planes of
+// the box at most (the asks, their box sum turned into what each texel honours in place, and its box
+// sum), since a 16K map's box is a gigabyte per plane.
 void fold_step_dense(cv::Mat& positive, std::vector<Deficit>& deficits, int radius) {
   cv::Rect box(deficits.front().col, deficits.front().row, 1, 1);
   for (const Deficit& d : deficits) box |= cv::Rect(d.col, d.row, 1, 1);
@@ -133,31 +137,32 @@ void fold_step_dense(cv::Mat& positive, std::vector<Deficit>& deficits, int radi
       cv::Rect(box.x - 2 * radius, box.y - 2 * radius, box.width + 4 * radius, box.height + 4 * radius) &
       cv::Rect(0, 0, positive.cols, positive.rows);
   cv::Mat p = positive(roi);
-  cv::Mat d64 = cv::Mat::zeros(roi.size(), CV_64F);
-  for (const Deficit& d : deficits) d64.at<double>(d.row - roi.y, d.col - roi.x) = d.amount;
   const cv::Size window(2 * radius + 1, 2 * radius + 1);
   const auto box_sum = [&](const cv::Mat& in) {
     cv::Mat out;
     cv::boxFilter(in, out, CV_64F, window, cv::Point(-1, -1), false, cv::BORDER_REFLECT);
     return out;
   };
-  cv::Mat p64;
-  p.convertTo(p64, CV_64F);
-  const cv::Mat window_positive = box_sum(p64);
   cv::Mat ask = cv::Mat::zeros(roi.size(), CV_64F);
-  for (const Deficit& d : deficits) {
-    const int r = d.row - roi.y, i = d.col - roi.x;
-    if (window_positive.at<double>(r, i) > 0) ask.at<double>(r, i) = d.amount / window_positive.at<double>(r, i);
-  }
-  const cv::Mat asked = box_sum(ask);
-  cv::Mat honoured(roi.size(), CV_64F);  // P_y h_y
-  for (int r = 0; r < roi.height; ++r)
-    for (int i = 0; i < roi.width; ++i) {
-      const double q = asked.at<double>(r, i), pv = p64.at<double>(r, i);
-      honoured.at<double>(r, i) = q > 1 ? pv / q : pv;
-      p.at<float>(r, i) = float(pv - pv * std::min(q, 1.0));
+  {
+    const cv::Mat window_positive = box_sum(p);  // float in, double sums
+    for (const Deficit& d : deficits) {
+      const int r = d.row - roi.y, i = d.col - roi.x;
+      if (window_positive.at<double>(r, i) > 0) ask.at<double>(r, i) = d.amount / window_positive.at<double>(r, i);
     }
+  }
+  cv::Mat honoured = box_sum(ask);  // q_y, then P_y h_y in place
+  for (int r = 0; r < roi.height; ++r) {
+    double* h = honoured.ptr<double>(r);
+    float* pr = p.ptr<float>(r);
+    for (int i = 0; i < roi.width; ++i) {
+      const double q = h[i], pv = pr[i];
+      h[i] = q > 1 ? pv / q : pv;
+      pr[i] = float(pv - pv * std::min(q, 1.0));
+    }
+  }
   const cv::Mat supply = box_sum(honoured);
+  honoured.release();
   std::vector<Deficit> left;
   for (const Deficit& d : deficits) {
     const int r = d.row - roi.y, i = d.col - roi.x;
@@ -168,7 +173,7 @@ void fold_step_dense(cv::Mat& positive, std::vector<Deficit>& deficits, int radi
   deficits = std::move(left);
 }
 
-void remove_negative_ringing_channel(cv::Mat& c, FoldMethod method) {
+void remove_negative_ringing_channel(cv::Mat& c, FoldMethod method, std::mutex& dense_step) {
   if (!c.isContinuous()) c = c.clone();
   std::vector<Deficit> deficits;
   for (int r = 0; r < c.rows; ++r) {
@@ -193,12 +198,17 @@ void remove_negative_ringing_channel(cv::Mat& c, FoldMethod method) {
     const double box = double(std::min<long>(c.rows, r1 - r0 + 1 + 4L * radius)) *
                        double(std::min<long>(c.cols, c1 - c0 + 1 + 4L * radius));
     const double sparse = 3.0 * double(deficits.size()) * double(2 * radius + 1) * double(2 * radius + 1);
-    // The dense step allocates and converts its whole box in double, so it pays only for many
+    // The dense step allocates its whole box in double, so it pays only for many
     // deficits at large radii; the factor weighs a window texel against a box texel.
     if (method == FoldMethod::Sparse || (method == FoldMethod::Auto && sparse <= 64.0 * box))
       fold_step_sparse(c, deficits, radius, field.get());
-    else
-      fold_step_dense(c, deficits, radius);
+    else {
+      // One dense step at a time across the channels: each holds three double planes of its box.
+      // Isolated: OpenCV's filters run on TBB too, and a thread waiting for them must not pick up
+      // another channel's task, which would wait for this very lock.
+      const std::lock_guard<std::mutex> lock(dense_step);
+      tbb::this_task_arena::isolate([&] { fold_step_dense(c, deficits, radius); });
+    }
   }
 }
 
@@ -214,9 +224,10 @@ long remove_negative_ringing(cv::Mat& m, FoldMethod method) {
   if (negative == 0) return 0;
   std::vector<cv::Mat> channels;
   cv::split(m, channels);
-  // Channels are independent: one task each.
+  // Channels are independent: one task each (their dense steps take turns).
+  std::mutex dense_step;
   tbb::parallel_for(std::size_t(0), channels.size(),
-                    [&](std::size_t k) { remove_negative_ringing_channel(channels[k], method); });
+                    [&](std::size_t k) { remove_negative_ringing_channel(channels[k], method, dense_step); });
   cv::merge(channels, m);
   return negative;
 }
