@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
 """Environments of real size through rsibr: the "Real-size inputs" section of docs/performance.md.
 
-For each size (lat-long width; default 2048 4096 8192) the CC0 esplanade (a sun, a lossy source
+For each size (lat-long width; default 2048 4096 8192 16384) the CC0 esplanade (a sun, a lossy source
 with ringing) is upsampled once by `rsibr convert`, then timed through:
   read      `rsibr convert`'s own read of the file (decode and texel audit): the baseline
   info      `rsibr info` (read, statistics)
   convert   to a cube of face width/4 (the same texel density), resample and write
-  bake      `rsibr bake --sanitize` setup (read, fold, MIS tables), 6 views of 16^2, 1 sample
+  bake      `rsibr bake --sanitize` setup (read, fold, then the MIS tables or the FIS pyramid), 6 views
+            of 16^2, 1 sample
 Each row gives seconds, the ratio to the read, and the peak resident memory of the process.
 
 Usage: bench/real_size.py [--rsibr build/release/rsibr] [--sizes 2048 4096 8192 16384]
@@ -43,7 +44,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--rsibr", default=os.path.join(ROOT, "build/release/rsibr"))
     ap.add_argument("--cache", default=os.path.join(ROOT, "cache/assets"))
-    ap.add_argument("--sizes", type=int, nargs="+", default=[2048, 4096, 8192])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[2048, 4096, 8192, 16384])
     ap.add_argument("--out", default=os.path.join(ROOT, "docs/performance.md"))
     args = ap.parse_args()
     source = os.path.join(args.cache, "hdri", "esplanade.exr")
@@ -66,19 +67,22 @@ def main():
             read = seconds["read"]
             info_s, info_mb = run([rsibr, "info", env])
             bake_json = os.path.join(tmp, "bake.json")
-            bake_s, bake_mb = run([rsibr, "bake", os.path.join(tmp, "b.exr"), "--env", env, "--brdf", brdf,
-                                   "--views", "octa", "--res", "16", "--method", "mis", "--samples", "1",
-                                   "--sanitize", "-q", "--json", bake_json])
-            with open(bake_json) as f:
-                setup = json.load(f)["seconds"]["setup"]
+            setups = {}
+            for method in ("mis", "fis"):
+                _, mb = run([rsibr, "bake", os.path.join(tmp, "b.exr"), "--env", env, "--brdf", brdf, "--views",
+                             "octa", "--res", "16", "--method", method, "--samples", "1", "--sanitize", "-q",
+                             "--json", bake_json])
+                with open(bake_json) as f:
+                    setups[method] = (json.load(f)["seconds"]["setup"], mb)
             rows.append((size, read, [
                 ("info", info_s, info_mb),
                 (f"convert to cube {size // 4} (resample {seconds['resample']:.1f} s, write {seconds['write']:.1f} s)",
                  convert_s, convert_mb),
-                ("bake --sanitize setup (mis)", setup, bake_mb),
+                ("bake --sanitize setup (mis)", *setups["mis"]),
+                ("bake --sanitize setup (fis)", *setups["fis"]),
             ]))
-            print(f"{size}: read {read:.2f} s, info {info_s:.1f}, convert {convert_s:.1f}, bake setup {setup:.1f}",
-                  flush=True)
+            print(f"{size}: read {read:.2f} s, info {info_s:.1f}, convert {convert_s:.1f}, bake setup mis "
+                  f"{setups['mis'][0]:.1f}, fis {setups['fis'][0]:.1f}", flush=True)
             for name in ("cube.exr", "b.exr", os.path.basename(env)):
                 path = os.path.join(tmp, name)
                 if os.path.exists(path):
@@ -88,7 +92,7 @@ def main():
         "upsampling spreads its ringing into wide negative lobes the fold must fill) upsampled to each",
         "width as a float lat-long; each row is one command's wall time against **read**, the time",
         "`rsibr convert` itself takes to decode and audit the file (OpenEXR on all cores), with the",
-        "command's peak resident memory. Convert and info include their own read; the bake row is its",
+        "command's peak resident memory. Convert and info include their own read; the bake rows are their",
         f"setup only. Machine: {platform.machine()}, {os.cpu_count()} cores, {platform.platform()}.",
         "",
         "| width | read s | command | s | / read | peak MiB |",
