@@ -129,8 +129,7 @@ class PeakPyramid {
 // pixels, unwrapped) and densities w in the order top-left, top-right, bottom-left, bottom-right,
 // the corner lines at pixel offsets y_top and y_bottom. The same taps as LatLongRipmap::bilinear,
 // with the level's constants hoisted out of the loop: along a row of taps the position and density
-// step by constants, and a row's n taps are summed in float (n <= 64 terms of one sign pattern,
-// then added in double). A cell whose corners lie inside the level (neither seam nor pole within
+// step by constants, and a row's n taps (n <= 64) are summed in float, the rows then in double. A cell whose corners lie inside the level (neither seam nor pole within
 // it) needs no wrapping or clamping per tap; the taps are convex combinations of the corners.
 void rgb_taps(const LatLongRipmap& ripmap, int level, int n, const double* x, const double* y, const double* w,
               double y_top, double y_bottom, float* px) {
