@@ -273,12 +273,8 @@ Vec3 centre_in_radii(const BallCone& c) { return c.axis.normalized() / std::sin(
 
 }  // namespace
 
-namespace {
-
-BallCandidate measure(const cv::Mat& image, const LensModel& lens, const BallLocation& loc,
-                      const std::vector<Disc>& ex) {
-  BallCandidate c;
-  c.loc = loc;
+void measure_outline(BallCandidate& c, const LensModel& lens) {
+  const BallLocation& loc = c.loc;
   // Inliers within the fit's threshold or 0.3% of the radius, whichever is larger: a large ball's
   // outline in a real photo (JPEG, demosaicing, a limb that reflects what lies behind it) scatters
   // by a fixed share of its size, not by a fixed pixel count.
@@ -287,17 +283,26 @@ BallCandidate measure(const cv::Mat& image, const LensModel& lens, const BallLoc
   for (double r : loc.fit.residual_px) inliers += std::abs(r) < tol;
   c.inlier_fraction = loc.outline_px.empty() ? 0 : double(inliers) / double(loc.outline_px.size());
   c.outline_support = loc.outline_support(tol);
+  const std::vector<Vec2> outline = cone_outline(loc.fit.cone, lens, 128);
+  int inside = 0;
+  for (const Vec2& q : outline) inside += q.allFinite() && lens.in_image(q, 0.5);
+  c.frame_fraction = double(inside) / double(outline.size());
+  c.cut = inside < int(outline.size());
+}
+
+namespace {
+
+BallCandidate measure(const cv::Mat& image, const LensModel& lens, const BallLocation& loc,
+                      const std::vector<Disc>& ex) {
+  BallCandidate c;
+  c.loc = loc;
+  measure_outline(c, lens);
   c.texture = disc_texture(image, loc.centre_px, loc.radius_px, ex);
   c.rim_texture = disc_rim_texture(image, loc.centre_px, loc.radius_px, ex);
   c.mirror_score = disc_mirror_score(image, loc.centre_px, loc.radius_px, ex);
   const LambertFit lf = lambert_fit(image, lens, loc, ex);
   c.diffuse_residual = lf.residual;
   c.shading_texture = lf.unexplained_texture;
-  const std::vector<Vec2> outline = cone_outline(loc.fit.cone, lens, 128);
-  int inside = 0;
-  for (const Vec2& q : outline) inside += q.allFinite() && lens.in_image(q, 0.5);
-  c.frame_fraction = double(inside) / double(outline.size());
-  c.cut = inside < int(outline.size());
   return c;
 }
 

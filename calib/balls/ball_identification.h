@@ -69,6 +69,10 @@ struct BallSearchOptions {
 // The measures above for a located ball (`image` CV_32FC3 RGB linear, the lens's size).
 BallCandidate measure_ball(const cv::Mat& image, const LensModel& lens, const BallLocation& loc);
 
+// The outline's measures of `c` from its location (inlier fraction, outline support, frame
+// fraction, cut); the appearance measures are left as they are.
+void measure_outline(BallCandidate& c, const LensModel& lens);
+
 // Whether a measured ball passes the outline and frame gates of `options`.
 bool acceptable_outline(const BallCandidate& c, const BallSearchOptions& options);
 

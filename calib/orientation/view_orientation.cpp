@@ -366,11 +366,24 @@ PoseSet orient_views_reporting(const std::vector<std::string>& all_names, const 
   // Candidates of the views whose chrome ball is searched for, then the cross-view rescue.
   const std::vector<ListedBall> balls = balls_or_one_chrome(options.listed);
   std::vector<std::optional<ViewCandidates>> searched(all_views.size());
-  for (std::size_t v = 0; v < all_views.size(); ++v) {
-    const bool given = (!options.given_chrome.empty() && options.given_chrome[v]) || !options.balls.empty();
-    if (!given) searched[v] = view_candidates(all_views[v].radiance, lens, balls, options.search);
+  std::vector<ChromeRescue> rescued(all_views.size());
+  if (!options.candidates.empty()) {
+    if (options.candidates.size() != all_views.size())
+      throw std::invalid_argument("orient: candidates must be given for every view or none");
+    for (std::size_t v = 0; v < all_views.size(); ++v) {
+      if (options.candidates[v].pick.size() != balls.size())
+        throw std::invalid_argument("orient: " + all_names[v] + ": candidates picked for " +
+                                    std::to_string(options.candidates[v].pick.size()) + " balls, " +
+                                    std::to_string(balls.size()) + " listed");
+      searched[v] = options.candidates[v];
+    }
+  } else {
+    for (std::size_t v = 0; v < all_views.size(); ++v) {
+      const bool given = (!options.given_chrome.empty() && options.given_chrome[v]) || !options.balls.empty();
+      if (!given) searched[v] = view_candidates(all_views[v].radiance, lens, balls, options.search);
+    }
+    rescued = rescue_chrome_balls(searched, balls, options.search);
   }
-  const auto rescued = rescue_chrome_balls(searched, balls, options.search);
   for (std::size_t v = 0; v < all_views.size(); ++v) {
     const cv::Mat& img = all_views[v].radiance;
     std::optional<BallCandidate> found;

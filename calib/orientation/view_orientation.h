@@ -54,7 +54,11 @@ struct ViewOrientationOptions {
   std::vector<BallGuess> balls;                        // per view, or empty: detected
   std::vector<std::optional<BallGuess>> given_chrome;  // per view or empty: a given chrome ball (--ball)
   std::vector<ListedBall> listed;                      // the photo set's balls (empty: one chrome ball)
-  BallSearchOptions search;                            // min/max radius 0: min(width, height) / 40 and / 2
+  // Per view or empty: the view's candidates and picks as the balls step found them
+  // (calib/balls/shoot_balls.h, through this lens; a rescued or given chrome ball is its pick), so
+  // nothing is searched here; empty: each view searched, then the chrome rescue.
+  std::vector<ViewCandidates> candidates;
+  BallSearchOptions search;  // min/max radius 0: min(width, height) / 40 and / 2
   // Known rotations (a pose file without balls), per view: the features refine only the balls.
   std::vector<Mat3> known_world_from_cam;
   // Denser than BallFeatureOptions' defaults: weaker SIFT features (contrast 0.01) and out to 0.95 of

@@ -1,0 +1,147 @@
+#include "calib/balls/shoot_balls.h"
+
+#include "hdr/merge.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace rsibr {
+
+const FoundView* ShootBalls::find(const std::string& view) const {
+  for (const FoundView& v : views)
+    if (v.name == view) return &v;
+  return nullptr;
+}
+
+int main_ball(const FoundView& view, const std::vector<ListedBall>& listed) {
+  int best = -1;
+  bool best_chrome = false;
+  for (std::size_t b = 0; b < listed.size() && b < view.balls.size(); ++b) {
+    const int k = view.balls[b].candidate;
+    if (k < 0) continue;
+    const bool chrome = listed[b].kind == BallKind::chrome;
+    const double r = view.candidates[std::size_t(k)].loc.radius_px;
+    if (best < 0 || (chrome && !best_chrome) ||
+        (!chrome && !best_chrome && r > view.candidates[std::size_t(best)].loc.radius_px))
+      best = k, best_chrome = best_chrome || chrome;
+  }
+  return best;
+}
+
+namespace {
+
+// The share of a disc's pixels that the merge flagged as ghosts.
+double ghost_share(const cv::Mat& flags, const Vec2& c, double radius) {
+  if (flags.empty()) return 0;
+  long disc = 0, ghost = 0;
+  for (int y = std::max(0, int(c.y() - radius)); y <= std::min(flags.rows - 1, int(c.y() + radius)); ++y)
+    for (int x = std::max(0, int(c.x() - radius)); x <= std::min(flags.cols - 1, int(c.x() + radius)); ++x)
+      if ((Vec2(x, y) - c).squaredNorm() <= radius * radius) {
+        ++disc;
+        ghost += (flags.at<unsigned char>(y, x) & kGhost) != 0;
+      }
+  return disc > 0 ? double(ghost) / double(disc) : 0.0;
+}
+
+}  // namespace
+
+ShootBalls find_shoot_balls(const ShootBallsInput& in) {
+  if (!in.read_view) throw std::invalid_argument("balls: no reader of the merged views");
+  ShootBalls out;
+  out.listed = in.listed.empty() ? std::vector<ListedBall>{{"chrome", BallKind::chrome, {}}} : in.listed;
+  const std::vector<ListedBall>& listed = out.listed;
+  std::vector<std::optional<ViewCandidates>> searched;
+  std::vector<std::vector<char>> given_flag;
+  for (std::size_t v = 0; v < in.views.size(); ++v) {
+    const ViewImage image = in.read_view(v);
+    FoundView fv;
+    fv.name = in.views[v];
+    fv.width = image.radiance.cols;
+    fv.height = image.radiance.rows;
+    // A view of another size than the lens (a crop): a pinhole of its diagonal, whose cones only
+    // the lens step's far camera will make sense of.
+    const bool fits = fv.width == in.lens.width() && fv.height == in.lens.height();
+    fv.lens = fits ? in.lens : LensModel::pinhole(std::hypot(double(fv.width), double(fv.height)), fv.width, fv.height);
+    ViewCandidates vc = view_candidates(image.radiance, fv.lens, listed, in.search);
+    given_flag.emplace_back(listed.size(), 0);
+    for (std::size_t b = 0; b < listed.size() && v < in.given.size() && b < in.given[v].size(); ++b)
+      if (const auto& g = in.given[v][b]) {
+        try {
+          vc.cands.push_back(given_ball(image.radiance, fv.lens, *g));
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument(fv.name + ": ball " + listed[b].name + " given by --ball: " + e.what());
+        }
+        vc.pick[b] = int(vc.cands.size()) - 1;
+        given_flag.back()[b] = 1;
+      }
+    if (in.seen) in.seen(v, image.radiance, vc);
+    fv.candidates = vc.cands;
+    fv.balls.resize(listed.size());
+    for (std::size_t b = 0; b < listed.size(); ++b)
+      if (vc.pick[b] >= 0) fv.balls[b] = {given_flag.back()[b] ? "given" : "found", vc.pick[b], ""};
+    // A ball whose pixels the brackets disagree on has a ghost outline in the merge: found there,
+    // it would be found wrong.
+    if (const int k = main_ball(fv, listed); k >= 0) {
+      const BallLocation& loc = fv.candidates[std::size_t(k)].loc;
+      const double share = ghost_share(image.flags, loc.centre_px, loc.radius_px);
+      if (share > 0.02) {
+        const std::string suspect = v < in.suspect_bracket.size() ? in.suspect_bracket[v] : "";
+        throw std::invalid_argument(
+            "view " + fv.name + ": " + std::to_string(int(std::lround(100 * share))) +
+            "% of its ball's pixels disagree between brackets (a ghost: a bracket taken from another place, or cropped "
+            "elsewhere); leave that bracket out of photoset.yaml" +
+            (suspect.empty() ? "" : " (the one registration left furthest off: " + suspect + ")"));
+      }
+    }
+    searched.push_back(std::move(vc));
+    out.views.push_back(std::move(fv));
+  }
+  // A chrome ball no appearance test accepted, placed by its distance from another ball.
+  const std::vector<ChromeRescue> rescued = rescue_chrome_balls(searched, listed, in.search);
+  for (std::size_t b = 0; b < listed.size(); ++b) {
+    if (listed[b].kind != BallKind::chrome) continue;
+    for (std::size_t v = 0; v < out.views.size(); ++v)
+      if (out.views[v].balls[b].candidate < 0 && rescued[v].candidate >= 0)
+        out.views[v].balls[b] = {"rescued", rescued[v].candidate, rescued[v].note};
+    break;  // the rescue places the first listed chrome ball
+  }
+  return out;
+}
+
+BallCandidate candidate_with_lens(const BallCandidate& c, const LensModel& lens) {
+  BallCandidate out = c;
+  std::vector<Vec3> rays(c.loc.outline_px.size());
+  lens.unproject(c.loc.outline_px.data(), int(rays.size()), rays.data());
+  // As the locator's last pass fits them: no RANSAC (the points are the outline's), Huber loss.
+  ConeFitOptions fit;
+  fit.ransac_iterations = 0;
+  out.loc.fit = fit_cone(rays, lens, fit);
+  out.loc.centre_px = lens.project(out.loc.fit.cone.axis);
+  double sum = 0;
+  const std::vector<Vec2> outline = cone_outline(out.loc.fit.cone, lens, 64);
+  for (const Vec2& q : outline) sum += (q - out.loc.centre_px).norm();
+  out.loc.radius_px = sum / double(outline.size());
+  measure_outline(out, lens);
+  return out;
+}
+
+ViewCandidates candidates_for_lens(const FoundView& view, const LensModel& lens) {
+  ViewCandidates vc;
+  const bool same = view.lens == lens;
+  for (const BallCandidate& c : view.candidates) {
+    if (same) {
+      vc.cands.push_back(c);
+      continue;
+    }
+    try {
+      vc.cands.push_back(candidate_with_lens(c, lens));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(view.name + ": a ball at (" + std::to_string(c.loc.centre_px.x()) + ", " +
+                                  std::to_string(c.loc.centre_px.y()) + ") fits no cone through the lens: " + e.what());
+    }
+  }
+  for (const FoundBall& b : view.balls) vc.pick.push_back(b.candidate);
+  return vc;
+}
+
+}  // namespace rsibr
