@@ -8,6 +8,7 @@
 
 #include "calib/balls/ball_identification.h"
 #include "calib/balls/ball_locator.h"
+#include "calib/balls/balls_file.h"
 #include "calib/orientation/pose_file.h"
 #include "calib/orientation/view_orientation.h"
 #include "calib/extraction/sphere_map_extraction.h"
@@ -44,7 +45,8 @@ struct ExtractArgs {
   bool quiet = false, no_stand = false;
   // The rig mode (--photoset).
   std::string photoset, merged, chrome_fresnel = kDefaultChromeFresnel;
-  std::vector<std::string> balls;  // --ball VIEW:BALL=X,Y,R
+  std::vector<std::string> balls;  // --view-ball VIEW:BALL=X,Y,R
+  std::string balls_file;          // --balls: rsibr process's DIR/balls.json
   bool size_given = false, no_occluder_light = false, no_recover = false;
   int probe_width = 0;
   double grey_albedo = 0.18;
@@ -63,7 +65,6 @@ int run_extract_rig(const ExtractArgs& a) {
   ExtractStep s;
   s.lens = &lens;
   s.poses = read_pose_file(a.poses);
-  s.balls = listed_balls(set);
   std::vector<BallOverride> overrides;
   try {
     overrides = parse_ball_overrides(a.balls, set);
@@ -72,17 +73,29 @@ int run_extract_rig(const ExtractArgs& a) {
     const std::string what = e.what();
     throw std::invalid_argument(what.rfind("--ball ", 0) == 0 ? "--view-ball " + what.substr(7) : what);
   }
+  if (!a.balls_file.empty() && !overrides.empty())
+    throw std::invalid_argument("--view-ball: not with --balls (the file's balls are used)");
   std::vector<std::filesystem::path> inputs = {a.lens, a.poses};
+  // The balls of the posed views: from the file, else found here as the balls step finds them.
+  ShootBallsInput found;
+  found.lens = lens;
+  found.listed = listed_balls(set);
   for (const PhotoView& v : set.views) {
     s.views.push_back(v.name);
-    s.given.emplace_back();
-    for (const ListedBall& b : s.balls) s.given.back().push_back(find_override(overrides, v.name, b.name));
     const std::filesystem::path file = std::filesystem::path(a.merged) / (v.name + ".exr");
     if (s.poses.find(v.name)) {
       if (!std::filesystem::is_regular_file(file))
         throw std::invalid_argument(file.string() + ": missing (the merged view of posed view '" + v.name + "')");
       inputs.push_back(file);
+      found.views.push_back(v.name);
+      found.given.emplace_back();
+      for (const ListedBall& b : found.listed) found.given.back().push_back(find_override(overrides, v.name, b.name));
     }
+  }
+  if (!a.balls_file.empty()) {
+    inputs.push_back(a.balls_file);
+    s.found = read_balls_file(a.balls_file);
+    check_listed_balls(s.found, found.listed, a.balls_file);
   }
   // A view of the lens's size as it is; crops of the ball on a far camera's canvas (calib/lens/far_camera.h).
   // Any other lens of another size is the wrong lens: refused, as rsibr process refuses it.
@@ -96,6 +109,12 @@ int run_extract_rig(const ExtractArgs& a) {
                                   std::to_string(lens.width()) + "x" + std::to_string(lens.height()));
     return on_lens_canvas(std::move(img), lens, file);
   };
+  if (a.balls_file.empty()) {
+    found.read_view = [&](std::size_t v) {
+      return read_view_image((std::filesystem::path(a.merged) / (found.views[v] + ".exr")).string());
+    };
+    s.found = find_shoot_balls(found);
+  }
   s.map_size = a.size_given ? a.size : 0;
   s.probe_width = a.probe_width;
   s.occluder_light = !a.no_occluder_light;
@@ -320,6 +339,8 @@ Runner add_extract(CLI::App& app) {
                 "process's extract step; --out is then a folder (captured-<ball>.exr, mask-<view>[-<ball>].png)");
   c->add_option("--merged", a->merged, "Rig mode: the folder of merged views <view>.exr (rsibr hdr --out)");
   c->add_option("--view-ball", a->balls, "Rig mode: VIEW:BALL=X,Y,R gives one ball of one view by hand (repeatable)");
+  c->add_option("--balls", a->balls_file,
+                "Rig mode: the balls as rsibr process's balls step found them (DIR/balls.json); default: found here");
   c->add_option("--chrome-fresnel", a->chrome_fresnel,
                 "Rig mode: the chrome ball's Fresnel spec, for the grey balls' occluded light");
   c->add_option("--grey-albedo", a->grey_albedo, "Rig mode: the grey ball's albedo")->check(CLI::Range(0.001, 1.0));

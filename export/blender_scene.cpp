@@ -2,6 +2,7 @@
 
 #include "bake/brdf_spec.h"
 #include "calib/balls/ball_offset.h"
+#include "calib/balls/balls_file.h"
 #include "calib/lens/far_camera.h"
 #include "calib/orientation/pose_file.h"
 #include "calib/view_image.h"
@@ -200,7 +201,6 @@ BlenderExport export_from_run(const fs::path& run, const BlenderExportOptions& o
   const fs::path extract_file = run / "steps" / "extract.json";
   json_file = extract_file;
   const StepRecord extract = record_of(run, "extract");
-  const nlohmann::json& settings = extract.settings;
   const nlohmann::json& summary = extract.summary;
   const double chrome_radius = field(summary, "chrome_radius_m", extract_file).get<double>();
 
@@ -210,15 +210,15 @@ BlenderExport export_from_run(const fs::path& run, const BlenderExportOptions& o
                                 " has no pinhole core (fx, fy, cx, cy) for Blender's camera");
   const PoseSet poses = read_pose_file(existing(run / "poses.yaml").string());
 
-  // The balls: (name, kind) from the extract step's settings, places from its rig; a ball the
-  // views saw is placed from their circles by calib/balls/ball_offset.h (the rig's offset is their mean,
-  // which carries each view's weak depth).
+  // The balls: names and kinds as the balls step listed them (DIR/balls.json), places from the
+  // extract step's rig; a ball the views saw is placed from their circles by calib/balls/ball_offset.h
+  // (the rig's offset is their mean, which carries each view's weak depth).
   const nlohmann::json& rig = field(summary, "rig", extract_file);
-  const nlohmann::json& listed = field(settings, "balls", extract_file);
+  const std::vector<ListedBall> listed = read_balls_file(existing(run / "balls.json")).listed;
   Vec3 chrome_centre = Vec3::Zero();
   bool have_chrome = false;
   for (std::size_t b = 0; b < listed.size(); ++b) {
-    const std::string name = listed[b].at(0).get<std::string>(), kind = listed[b].at(1).get<std::string>();
+    const std::string name = listed[b].name, kind = to_string(listed[b].kind);
     const nlohmann::json* member = nullptr;
     for (const auto& m : rig)
       if (m.at("ball").get<std::string>() == name) member = &m;

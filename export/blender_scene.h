@@ -64,7 +64,7 @@ struct BlenderExportOptions {
   int samples = 256;
 };
 
-// Reads the run's poses.yaml, lens.cameramodel, probe.exr, hdr/<view>.exr, maps/computed-*.exr
+// Reads the run's poses.yaml, lens.cameramodel, balls.json, probe.exr, hdr/<view>.exr, maps/computed-*.exr
 // and steps/{extract,probe,render}.json. Throws std::invalid_argument("<file>: <problem>") when
 // the run lacks what the scene needs (a run that has not reached its bake step).
 BlenderExport blender_export_from_run(const std::filesystem::path& run, const BlenderExportOptions& options = {});

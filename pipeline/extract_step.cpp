@@ -45,11 +45,10 @@ nlohmann::json finding_json(const std::string& ball, const BallFinding& f) {
 ExtractedMaps run_extract_step(const ExtractStep& s) {
   if (!s.lens) throw std::invalid_argument("extract: no lens");
   if (!s.read_view) throw std::invalid_argument("extract: no reader of the merged views");
-  if (s.given.size() != s.views.size()) throw std::invalid_argument("extract: given balls for a different view count");
   ExtractedMaps out;
   const LensModel& lens = *s.lens;
   const PoseSet& poses = s.poses;
-  const std::vector<ListedBall>& listed = s.balls;
+  const std::vector<ListedBall>& listed = s.found.listed;
   // World down for the stands and the photographer: -Y when the world is +Y up, else the first camera's +y.
   const Vec3 world_down = poses.gauge != "first-view" ? Vec3(0, -1, 0) : Vec3(0, 1, 0);
   int chrome_index = -1;
@@ -60,7 +59,9 @@ ExtractedMaps run_extract_step(const ExtractStep& s) {
                                      : 0.05;
   // Pass 1: every view's candidates and its chrome ball (the anchor).
   std::vector<ViewBalls> vb;
-  std::vector<std::size_t> used;  // view indices
+  std::vector<std::size_t> used;           // view indices
+  std::vector<ViewCandidates> used_found;  // their candidates through the lens, and the balls step's picks
+  std::vector<const FoundView*> used_view;
   nlohmann::json views = nlohmann::json::array();
   Progress bar("extract", s.progress);
   const double steps = 2.0 * double(s.views.size());
@@ -73,24 +74,27 @@ ExtractedMaps run_extract_step(const ExtractStep& s) {
                        {"balls", nlohmann::json::array()}});
       continue;
     }
-    const ViewImage img = s.read_view(name);
+    const FoundView* fv = s.found.find(name);
+    if (!fv) throw std::invalid_argument("extract: the balls step found no view '" + name + "' (rerun it)");
+    ViewCandidates vc = candidates_for_lens(*fv, lens);
     ViewBalls one;
     one.name = name;
     one.world_from_cam = pose->world_from_cam;
-    one.candidates = find_ball_candidates(img.radiance, lens);
+    one.candidates = vc.cands;
     if (chrome_index >= 0) {
-      if (const auto& g = s.given[vi][std::size_t(chrome_index)]) {
-        one.chrome = given_ball(img.radiance, lens, *g).loc.fit.cone;
+      const int k = vc.pick[std::size_t(chrome_index)];
+      if (fv->balls[std::size_t(chrome_index)].status == "given") {
+        one.chrome = vc.cands[std::size_t(k)].loc.fit.cone;
       } else if (pose->ball) {
         one.chrome = pose->ball;  // refined with the orientations (the outline lies inside its limb)
-      } else {
-        const std::vector<int> pick = assign_balls_in_view(one.candidates, listed);
-        if (pick[std::size_t(chrome_index)] >= 0)
-          one.chrome = one.candidates[std::size_t(pick[std::size_t(chrome_index)])].loc.fit.cone;
+      } else if (k >= 0) {
+        one.chrome = vc.cands[std::size_t(k)].loc.fit.cone;
       }
     }
     vb.push_back(std::move(one));
     used.push_back(vi);
+    used_found.push_back(std::move(vc));
+    used_view.push_back(fv);
     bar.update(double(vi + 1) / steps);
   }
   const std::vector<RigMember> rig = fit_ball_rig(vb, listed);
@@ -141,11 +145,11 @@ ExtractedMaps run_extract_step(const ExtractStep& s) {
       if (int(b) != chrome_index && found[b].found() && found[b].disagreement > 0)
         view_disagreement[k] = std::max(view_disagreement[k], found[b].disagreement);
     for (std::size_t b = 0; b < listed.size(); ++b)
-      if (const auto& g = s.given[vi][b]) {
+      if (used_view[k]->balls[b].status == "given") {
         found[b] = BallFinding{};
         found[b].status = "given";
         found[b].note = "--ball";
-        found[b].ball = given_ball(img.radiance, lens, *g);
+        found[b].ball = used_found[k].cands[std::size_t(used_found[k].pick[b])];
         if (int(b) == chrome_index && vb[k].chrome) found[b].ball->loc.fit.cone = *vb[k].chrome;
       }
     const Mat3 world_from_cam = vb[k].world_from_cam;

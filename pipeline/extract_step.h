@@ -1,6 +1,7 @@
 // The `extract` step of rsibr process (pipeline/process_pipeline.h), after orient: every listed
 // ball of every posed view identified and checked across views (calib/balls/ball_identification.h: the
-// rig of balls fitted from every view's candidates, each view's balls decided against it), and
+// rig of balls fitted from every view's candidates, as the balls step found them, each view's balls
+// decided against it), and
 // extracted into the world frame (calib/extraction/sphere_map_extraction.h). A ball not found in a view is
 // left out of that ball's maps and reported. Chrome maps mask the other balls, the stands and the
 // photographer by geometry (calib/extraction/occluders.h); a chrome view whose other balls disagree with the
@@ -10,7 +11,7 @@
 // the caller writes the map sets and the masks.
 #pragma once
 
-#include "calib/balls/ball_identification.h"
+#include "calib/balls/shoot_balls.h"
 #include "calib/orientation/pose_file.h"
 #include "calib/view_image.h"
 #include "formats/atomic_folder.h"
@@ -33,9 +34,9 @@ struct ExtractStep {
   std::vector<std::string> views;   // the photo set's views, in order
   // A view's merged image, on the lens's canvas (read twice: the candidates, then the extraction).
   std::function<ViewImage(const std::string& view)> read_view;
-  std::vector<ListedBall> balls;  // the photo set's balls
-  // Per view, per listed ball: the ball given by hand (--ball), used instead of the detection.
-  std::vector<std::vector<std::optional<BallGuess>>> given;
+  // The balls step's findings (calib/balls/shoot_balls.h): the listed balls and every view's
+  // candidates, refitted here through `lens`; a ball given by hand (status "given") is taken as it is.
+  ShootBalls found;
   int map_size = 0;     // texels a side; 0: from the balls' pixel radii (pipeline/default_sizes.h)
   int probe_width = 0;  // of the probe the grey balls' occluded light is read from; 0: from the chrome map's size
   bool occluder_light = true;   // restore the light the photographer takes from the grey balls

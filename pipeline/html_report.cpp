@@ -269,7 +269,7 @@ void write_failed_step_section(std::ostringstream& h, const std::string& step, c
     write_orientation_notes(h, summary);
     write_orientation_pairs(h, summary, dir);
   }
-  if (step == "lens" || step == "orient" || step == "extract") {
+  if (step == "balls" || step == "lens" || step == "orient" || step == "extract") {
     std::vector<fs::path> pictures;
     std::error_code ec;
     for (const auto& e : fs::directory_iterator(dir / "balls", ec))

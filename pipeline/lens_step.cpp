@@ -1,10 +1,7 @@
 #include "pipeline/lens_step.h"
 
-#include "calib/balls/ball_candidates_picture.h"
 #include "calib/lens/far_camera.h"
 #include "calib/lens/outline_focal.h"
-#include "calib/view_image.h"
-#include "hdr/merge.h"
 
 #include <cmath>
 
@@ -35,14 +32,13 @@ nlohmann::json run_lens_step(const LensStep& s) {
                                 "the ball with --ball VIEW:BALL=X,Y,R where it was not found (" +
                                 candidates_hint() + ")");
   };
+  const std::vector<ListedBall>& listed = s.balls.listed;
   if (s.source != "exif" && s.source != "lensfun" && !outlines_only) {
-    for (std::size_t v = 0; v < s.views.size(); ++v) {
-      const ViewImage image = read_view_image(s.merged[v].string());
-      if (image.radiance.cols != lens.width() || image.radiance.rows != lens.height())
-        throw std::invalid_argument("lens: view " + s.views[v] + " is " + std::to_string(image.radiance.cols) + "x" +
-                                    std::to_string(image.radiance.rows) + " but the lens (" + s.source + ") is " +
+    for (const FoundView& v : s.balls.views)
+      if (v.width != lens.width() || v.height != lens.height())
+        throw std::invalid_argument("lens: view " + v.name + " is " + std::to_string(v.width) + "x" +
+                                    std::to_string(v.height) + " but the lens (" + s.source + ") is " +
                                     std::to_string(lens.width()) + "x" + std::to_string(lens.height()));
-    }
     return keep("the lens was measured (" + s.source + ")");
   }
 
@@ -52,86 +48,40 @@ nlohmann::json run_lens_step(const LensStep& s) {
   std::vector<std::vector<Vec2>> outlines;
   nlohmann::json found = nlohmann::json::array(), sizes_json = nlohmann::json::array();
   std::vector<std::pair<int, int>> sizes;
-  bool same_size = true, crops = !s.views.empty();
+  bool same_size = true, crops = !s.balls.views.empty();
   std::string crop_note;
-  nlohmann::json pictures = nlohmann::json::array();
-  for (std::size_t v = 0; v < s.views.size(); ++v) {
-    const ViewImage image = read_view_image(s.merged[v].string());
-    const int w = image.radiance.cols, h = image.radiance.rows;
+  for (const FoundView& v : s.balls.views) {
+    const int w = v.width, h = v.height;
     sizes.push_back({w, h});
     const bool fits = w == lens.width() && h == lens.height();
     same_size = same_size && fits;
-    const LensModel view_lens = fits ? lens : LensModel::pinhole(std::hypot(double(w), double(h)), w, h);
-    ViewCandidates vc = view_candidates(image.radiance, view_lens, s.balls);
-    bool ball_is_chrome = false;
-    for (std::size_t b = 0; b < s.balls.size() && v < s.given.size(); ++b)
-      if (b < s.given[v].size() && s.given[v][b]) {
-        vc.cands.push_back(given_ball(image.radiance, view_lens, *s.given[v][b]));
-        vc.pick[b] = int(vc.cands.size()) - 1;
-      }
-    if (!s.pictures.empty()) {
-      std::filesystem::create_directories(s.pictures);
-      write_ball_candidates_picture(s.pictures / (s.views[v] + ".png"), image.radiance, vc);
-      pictures.push_back(s.views[v] + ".png");
-    }
     // The view's evidence: its first listed chrome ball found, else its largest ball found.
-    const BallCandidate* ball = nullptr;
-    for (std::size_t b = 0; b < s.balls.size(); ++b) {
-      if (vc.pick[b] < 0) continue;
-      const BallCandidate& cand = vc.cands[std::size_t(vc.pick[b])];
-      const bool chrome = s.balls[b].kind == BallKind::chrome;
-      if (!ball || (chrome && !ball_is_chrome) ||
-          (!chrome && !ball_is_chrome && cand.loc.radius_px > ball->loc.radius_px))
-        ball = &cand, ball_is_chrome = ball_is_chrome || chrome;
-    }
+    const int main = main_ball(v, listed);
+    const BallCandidate* ball = main >= 0 ? &v.candidates[std::size_t(main)] : nullptr;
     const double radius = ball ? ball->loc.radius_px : -1.0;
-    // A ball whose pixels the brackets disagree on (hdr/merge.h kGhost: a bracket taken from
-    // another place, or cropped elsewhere) has a ghost outline in the merge: found there, it would
-    // be found wrong. More than 2% of its disc ghosted stops the run (a well registered shoot has
-    // under 0.1%).
-    if (ball && !image.flags.empty()) {
-      const Vec2 c = ball->loc.centre_px;
-      long disc = 0, ghost = 0;
-      for (int y = std::max(0, int(c.y() - radius)); y <= std::min(h - 1, int(c.y() + radius)); ++y)
-        for (int x = std::max(0, int(c.x() - radius)); x <= std::min(w - 1, int(c.x() + radius)); ++x)
-          if ((Vec2(x, y) - c).squaredNorm() <= radius * radius) {
-            ++disc;
-            ghost += (image.flags.at<unsigned char>(y, x) & kGhost) != 0;
-          }
-      const double share = disc > 0 ? double(ghost) / double(disc) : 0.0;
-      if (share > 0.02) {
-        const std::string suspect = v < s.suspect_bracket.size() ? s.suspect_bracket[v] : "";
-        throw std::invalid_argument(
-            "lens: view " + s.views[v] + ": " + std::to_string(int(std::lround(100 * share))) +
-            "% of its ball's pixels disagree between brackets (a ghost: a bracket taken from another place, or cropped "
-            "elsewhere); leave that bracket out of photoset.yaml" +
-            (suspect.empty() ? "" : " (the one registration left furthest off: " + suspect + ")"));
-      }
-    }
     const bool fills = radius > 0 && fills_frame(radius, w, h);
     crops = crops && fills;
-    sizes_json.push_back({{"view", s.views[v]}, {"size", {w, h}}, {"ball_radius_px", radius}, {"fills_frame", fills}});
+    sizes_json.push_back({{"view", v.name}, {"size", {w, h}}, {"ball_radius_px", radius}, {"fills_frame", fills}});
     if (ball) sizes_json.back()["ball_centre_px"] = {ball->loc.centre_px.x(), ball->loc.centre_px.y()};
     if (!fills && crop_note.empty())
-      crop_note = s.views[v] + (radius > 0 ? "'s ball does not fill its frame" : ": no ball found");
+      crop_note = v.name + (radius > 0 ? "'s ball does not fill its frame" : ": no ball found");
     if (!fits) continue;
-    for (std::size_t b = 0; b < s.balls.size(); ++b) {
-      const int pick = vc.pick[b];
+    for (std::size_t b = 0; b < listed.size(); ++b) {
+      const int pick = v.balls[b].candidate;
       if (pick < 0) continue;
-      const BallCandidate& cand = vc.cands[std::size_t(pick)];
+      const BallCandidate& cand = v.candidates[std::size_t(pick)];
       if (cand.cut) continue;
       std::vector<Vec2> pts;
       for (std::size_t i = 0; i < cand.loc.outline_px.size() && i < cand.loc.fit.residual_px.size(); ++i)
         if (std::abs(cand.loc.fit.residual_px[i]) < 1.0) pts.push_back(cand.loc.outline_px[i]);
       outlines.push_back(pts);
-      found.push_back({{"view", s.views[v]},
-                       {"ball", s.balls[b].name},
+      found.push_back({{"view", v.name},
+                       {"ball", listed[b].name},
                        {"centre_px", {cand.loc.centre_px.x(), cand.loc.centre_px.y()}},
                        {"radius_px", cand.loc.radius_px}});
     }
   }
   j["views"] = sizes_json;
-  if (!s.pictures.empty()) j["candidates_pictures"] = pictures;
   if (crops) {
     // Crops of the ball (calib/lens/far_camera.h): the metadata's focal length is the uncropped frame's.
     const LensModel far = far_camera_lens(sizes);
@@ -154,8 +104,8 @@ nlohmann::json run_lens_step(const LensStep& s) {
   if (!same_size) {
     std::string list;
     for (std::size_t v = 0; v < sizes.size(); ++v)
-      list +=
-          (v ? ", " : "") + s.views[v] + " " + std::to_string(sizes[v].first) + "x" + std::to_string(sizes[v].second);
+      list += (v ? ", " : "") + s.balls.views[v].name + " " + std::to_string(sizes[v].first) + "x" +
+              std::to_string(sizes[v].second);
     throw std::invalid_argument("lens: the views differ in size (" + list + ") but are not crops of the ball (" +
                                 crop_note +
                                 "); one lens serves views of one size: give each view's photos at the same size, or "

@@ -1,66 +1,39 @@
 #include "pipeline/process_pipeline.h"
 
 #include "bake/brdf_spec.h"
-#include "bake/integrator.h"
-#include "bake/map_set_bake.h"
-#include "plan/bake_plan.h"
-#include "calib/balls/ball_identification.h"
-#include "calib/balls/ball_locator.h"
+#include "calib/balls/ball_candidates_picture.h"
+#include "calib/balls/balls_file.h"
+#include "calib/balls/shoot_balls.h"
 #include "calib/lens/far_camera.h"
-#include "calib/lens/intrinsics.h"
-#include "calib/lens/photo_optics.h"
-#include "calib/extraction/lambert_consensus.h"
-#include "calib/extraction/occluded_light.h"
-#include "calib/extraction/occluders.h"
-#include "calib/probe/probe.h"
-#include "calib/extraction/sphere_map_extraction.h"
-#include "calib/view_image.h"
-#include "calib/orientation/view_orientation.h"
-#include "calib/orientation/pair_matches_picture.h"
+#include "calib/orientation/point_pairs.h"
 #include "calib/orientation/pose_file.h"
-#include "formats/atomic_file.h"
-#include "formats/atomic_folder.h"
-#include "core/camera.h"
-#include "formats/file_error.h"
+#include "calib/probe/probe.h"
+#include "calib/view_image.h"
 #include "core/colour.h"
-#include "compare/compare_pictures.h"
-#include "formats/exr_io.h"
 #include "core/lens_model.h"
-#include "compare/comparison_report.h"
-#include "compare/map_compare.h"
+#include "formats/atomic_folder.h"
+#include "formats/file_error.h"
 #include "formats/map_set.h"
-#include "core/mesh.h"
 #include "formats/photo_set.h"
-#include "core/preview_exposure.h"
-#include "core/progress.h"
-#include "core/resample.h"
-#include "core/view_set.h"
-#include "formats/yaml_spec.h"
-#include "hdr/bracket_set.h"
-#include "hdr/merge.h"
 #include "hdr/merged_colour.h"
-#include "hdr/merged_exr.h"
-#include "hdr/noise_model.h"
 #include "hdr/photo_set_merge.h"
-#include "hdr/response_recovery.h"
 #include "lights/recovered_probe.h"
 #include "pipeline/ball_override.h"
-#include "pipeline/chessboard_problem.h"
-#include "pipeline/default_sizes.h"
+#include "pipeline/bake_step.h"
+#include "pipeline/calibrate_step.h"
+#include "pipeline/compare_step.h"
 #include "pipeline/extract_step.h"
+#include "pipeline/hdr_step.h"
 #include "pipeline/html_report.h"
 #include "pipeline/lens_step.h"
+#include "pipeline/light_sources_report.h"
 #include "pipeline/light_sources_step.h"
-#include "pipeline/mask_picture.h"
-#include "pipeline/orientation_json.h"
+#include "pipeline/orient_step.h"
 #include "pipeline/pose_input.h"
+#include "pipeline/probe_step.h"
+#include "pipeline/render_step.h"
 #include "pipeline/step_record.h"
-#include "pipeline/torus_mesh.h"
 #include "pipeline/vignetting_input.h"
-#include "runtime/renderer.h"
-#include "formats/image_codecs.h"
-
-#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <chrono>
@@ -76,8 +49,6 @@ namespace rsibr {
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr double kPiD = 3.14159265358979323846;
 
 struct Context {
   const ProcessOptions& o;
@@ -171,7 +142,7 @@ fs::path computed_path(const Context& c, const BallSpec& b) {
   return file_in_folder(c.dir / "maps", "computed-" + b.name + ".exr");
 }
 
-// ---- calibrate: the lens model.
+// ---- calibrate: the lens model (pipeline/calibrate_step.h) -> DIR/camera.cameramodel.
 void step_calibrate(Context& c) {
   const fs::path out = c.dir / "camera.cameramodel";
   std::vector<fs::path> inputs;
@@ -181,7 +152,7 @@ void step_calibrate(Context& c) {
     settings = {{"source", "given"}};
   } else if (c.set.chessboards) {
     inputs = c.set.chessboards->files;
-    settings = {{"source", "chessboards"}, {"models", {"LENSMODEL_PINHOLE", "LENSMODEL_OPENCV4", "LENSMODEL_OPENCV8"}}};
+    settings = {{"source", "chessboards"}, {"models", kCalibrateModels}};
   } else if (c.set.camera_model) {
     inputs.push_back(*c.set.camera_model);
     settings = {{"source", "photo set"}};
@@ -193,266 +164,105 @@ void step_calibrate(Context& c) {
     settings = {{"source", "exif"}};
   }
   run_step(c, "calibrate", settings, inputs, [&](StepRecord& r) {
-    nlohmann::json s;
-    if (settings["source"] == "exif") {
-      const BracketSet b = load_brackets(c.set.views[0], true);
-      // lensfun's profile of the lens the EXIF names (distortion included), else a pinhole.
-      const std::optional<MetadataLens> meta = metadata_lens(inputs.front(), b.cols(), b.rows());
-      const PhotoOptics optics = meta ? meta->optics : read_photo_optics(inputs.front());
-      // Why no focal length in pixels: what the EXIF held and what was missing to convert it.
-      std::string lensfun_why = meta ? meta->lensfun_why : "the photo's metadata has no FocalLength";
-      if (!meta && optics.focal_mm) {
-        char mm[32];
-        std::snprintf(mm, sizeof mm, "%.3g mm", *optics.focal_mm);
-        lensfun_why = "FocalLength " + std::string(mm) +
-                      " but no FocalLengthIn35mmFilm, and lensfun knows no crop factor of the camera '" + optics.make +
-                      " " + optics.model + "' (its sensor size)";
-      }
-      const bool from_lensfun = meta && meta->source == "lensfun";
-      const std::optional<OpticsLens> guess = meta ? std::optional<OpticsLens>(meta->lens) : std::nullopt;
-      if (!guess) {
-        // No focal length in the metadata (stripped by an app, a scan): a pinhole of the image's
-        // diagonal (a normal lens) to start from; the lens step measures f from the balls' outlines.
-        const double f = std::hypot(double(b.cols()), double(b.rows()));
-        const LensModel lens = LensModel::pinhole(f, b.cols(), b.rows());
-        lens.write(out);
-        s = {{"source", "outlines"},
-             {"model", lens.name()},
-             {"intrinsics", lens.intrinsics()},
-             {"focal_px", f},
-             {"focal_from",
-              "none: no usable focal length in the photos' metadata (FocalLengthIn35mmFilm, or "
-              "FocalLength of a camera lensfun knows)"},
-             {"camera", optics.make + " " + optics.model},
-             {"lens", optics.lens},
-             {"lensfun", lensfun_why},
-             {"assumed",
-              "a pinhole: principal point at the image centre, no distortion, the focal length from the "
-              "balls' outlines (the lens step)"}};
-        r.outputs = {out};
-        r.summary = s;
-        return;
-      }
-      guess->lens.write(out);
-      s = {{"source", from_lensfun ? "lensfun" : "exif"},
-           {"model", guess->lens.name()},
-           {"intrinsics", guess->lens.intrinsics()},
-           {"focal_px", guess->focal_px},
-           {"focal_sigma_relative", guess->sigma_relative},
-           {"focal_from", guess->source},
-           {"camera", optics.make + " " + optics.model},
-           {"lens", optics.lens},
-           {"assumed", from_lensfun ? "lensfun's distortion profile of the lens, its centre at lensfun's"
-                                    : "a pinhole: principal point at the image centre, no distortion"}};
-      if (!from_lensfun) s["lensfun"] = lensfun_why;
-      if (optics.focal_mm) s["focal_mm"] = *optics.focal_mm;
-      if (optics.focal_35mm) s["focal_35mm"] = *optics.focal_35mm;
-    } else if (settings["source"] != "chessboards") {
-      const LensModel lens = LensModel::read(inputs.front());
-      lens.write(out);
-      s = {{"source", inputs.front().string()}, {"model", lens.name()}, {"intrinsics", lens.intrinsics()}};
-    } else {
-      std::vector<std::string> missed;
-      Progress bar("calibrate", c.o.progress);
-      const IntrinsicsProblem p = chessboard_problem(c.set, c.o.photoset, &missed, [&](double f) { bar.update(f); });
-      bar.done();
-      const std::vector<std::string> models = settings["models"];
-      int chosen = 0;
-      const std::vector<ModelScore> scores = cross_validate_models(p, models, &chosen);
-      const IntrinsicsFit fit = fit_intrinsics(p, models[chosen]);
-      fit.lens.write(out);
-      nlohmann::json sc = nlohmann::json::array();
-      for (const ModelScore& m : scores)
-        sc.push_back({{"model", m.model}, {"held_out_rms_px", m.held_out_rms_px}, {"fit_rms_px", m.fit_rms_px}});
-      s = {{"source", "chessboards"},
-           {"model", models[chosen]},
-           {"intrinsics", fit.lens.intrinsics()},
-           {"rms_px", fit.rms_px},
-           {"outliers", fit.outliers},
-           {"boards_found", p.boards.size()},
-           {"boards_missed", missed},
-           {"models", sc}};
-    }
+    CalibrateStep st;
+    st.set = &c.set;
+    st.photoset = c.o.photoset;
+    st.source = settings["source"].get<std::string>();
+    if (!inputs.empty() && st.source != "chessboards") st.file = inputs.front();
+    st.out = out;
+    st.progress = c.o.progress;
+    r.summary = run_calibrate_step(st);
     r.outputs = {out};
-    r.summary = s;
   });
 }
 
-// ---- hdr: response once (from the view with the most brackets), then every view's merge.
-// The stage swapped for given linear images (the truth of a synthetic capture, for the error
-// budget): DIR/<view>_radiance.exr or DIR/<view>.exr per view, written as merged views with zero
-// variance and no flags.
-void step_given_radiance(Context& c) {
-  std::vector<fs::path> inputs;
-  for (const PhotoView& v : c.set.views) {
-    const fs::path a = fs::path(c.o.radiance_dir) / (v.name + "_radiance.exr"),
-                   b = fs::path(c.o.radiance_dir) / (v.name + ".exr");
-    if (fs::is_regular_file(a))
-      inputs.push_back(a);
-    else if (fs::is_regular_file(b))
-      inputs.push_back(b);
-    else
-      throw std::invalid_argument(c.o.radiance_dir + ": no " + a.filename().string() + " or " + b.filename().string());
-  }
-  run_step(c, "hdr", {{"response", "given radiance"}, {"radiance", c.o.radiance_dir}}, inputs, [&](StepRecord& r) {
-    fs::create_directories(c.dir / "hdr");
-    nlohmann::json views = nlohmann::json::array();
-    for (std::size_t i = 0; i < c.set.views.size(); ++i) {
-      const ViewImage img = read_view_image(inputs[i].string());
-      MergedImage m;
-      m.radiance = img.radiance;
-      m.variance = cv::Mat::zeros(img.radiance.size(), CV_32FC3);
-      m.flags = cv::Mat::zeros(img.radiance.size(), CV_8UC1);
-      const fs::path exr = merged_path(c, c.set.views[i].name);
-      write_merged_exr(exr.string(), m,
-                       {{"version", RSIBR_VERSION},
-                        {"view", c.set.views[i].name},
-                        {"source", inputs[i].string()},
-                        {"producer", "rsibr process (given radiance)"}});
-      r.outputs.push_back(exr);
-      views.push_back(
-          {{"name", c.set.views[i].name}, {"brackets", 0}, {"clipped_fraction", 0.0}, {"ghost_fraction", 0.0}});
-    }
-    r.summary = {{"model", "given radiance (" + c.o.radiance_dir + ")"},
-                 {"recovered_from", "-"},
-                 {"curve", nlohmann::json::array()},
-                 {"views", views}};
-  });
-}
-
+// ---- hdr: response once, then every view's merge (pipeline/hdr_step.h) -> DIR/hdr/; or the given
+// radiance (--radiance-dir) as merged views.
 void step_hdr(Context& c) {
-  if (!c.o.radiance_dir.empty()) return step_given_radiance(c);
+  if (!c.o.radiance_dir.empty()) {
+    const std::vector<fs::path> inputs = given_radiance_files(c.set, c.o.radiance_dir);
+    run_step(c, "hdr", {{"response", "given radiance"}, {"radiance", c.o.radiance_dir}}, inputs, [&](StepRecord& r) {
+      StepOutputs m = run_given_radiance_step(c.set, inputs, c.o.radiance_dir, c.dir / "hdr");
+      r.outputs = std::move(m.files);
+      r.summary = std::move(m.summary);
+    });
+    return;
+  }
   std::vector<fs::path> inputs;
   for (const PhotoView& v : c.set.views)
     for (const BracketPhoto& b : v.brackets) inputs.push_back(b.file);
   // Vignetting (pipeline/vignetting_input.h): its inputs and the lens's principal point.
   for (const fs::path& f : vignetting_inputs(c.set, c.o.vignetting)) inputs.push_back(f);
   if (c.o.vignetting != "none") inputs.push_back(c.dir / "camera.cameramodel");
-  // The camera's colour space (hdr/merged_colour.h): the option, else the photo set's; RAW views
-  // are developed to linear Rec.709 (hdr/raw_image.h) whatever the photo set says.
+  HdrStep s;
+  s.set = &c.set;
+  s.vignetting = c.o.vignetting;
+  s.lens = c.dir / "camera.cameramodel";
+  s.input_colour_space = c.o.input_colour_space;
+  s.out = c.dir / "hdr";
+  s.progress = c.o.progress;
   const std::string input_space = !c.o.input_colour_space.empty() ? c.o.input_colour_space : c.set.camera_colour_space;
   run_step(c, "hdr", {{"response", "auto"}, {"vignetting", c.o.vignetting}, {"input_colour_space", input_space}},
            inputs, [&](StepRecord& r) {
-             fs::create_directories(c.dir / "hdr");
-             std::vector<const PhotoView*> all;
-             for (const PhotoView& v : c.set.views) all.push_back(&v);
-             const PhotoSetResponse psr = recover_photo_set_response(all, RecoveryOptions{}, Alignment::automatic);
-             const ResponseRecovery& rec = psr.recovery;
-             const std::string from = psr.from.empty()
-                                          ? std::string("none: one exposure per view, the sRGB response stated")
-                                          : std::to_string(psr.from.size()) + " views (all with brackets)";
-             const ResponseCurve& curve = rec.curve;
-             nlohmann::json cands = nlohmann::json::array();
-             for (const auto& k : rec.candidates)
-               cands.push_back({{"model", k.model},
-                                {"held_out_error", std::isfinite(k.held_out_error) ? nlohmann::json(k.held_out_error)
-                                                                                   : nlohmann::json("rejected")}});
-             const fs::path response = c.dir / "hdr" / "response.json";
-             save_response(response, curve,
-                           {{"camera", c.set.camera_name}, {"recovered_from", from}, {"recovery", recovery_json(rec)}});
-             nlohmann::json plot = nlohmann::json::array();
-             for (int k = 0; k <= 64; ++k) {
-               const double z = double(k) * curve.max_code / 64;
-               plot.push_back({z, curve.linear(0, z), curve.linear(1, z), curve.linear(2, z)});
-             }
-             r.outputs.push_back(response);
-             nlohmann::json vignetting;
-             const Vignetting vig = photo_set_vignetting(c.set, c.o.vignetting, curve,
-                                                         LensModel::read(c.dir / "camera.cameramodel"), &vignetting);
-             const fs::path vfile = c.dir / "hdr" / "vignetting.json";
-             write_text_atomically(vfile, vignetting["model"].dump(2) + "\n");
-             r.outputs.push_back(vfile);
-             nlohmann::json views = nlohmann::json::array();
-             Progress bar("hdr", c.o.progress);
-             for (std::size_t i = 0; i < c.set.views.size(); ++i) {
-               const PhotoView& v = c.set.views[i];
-               ViewMergeSettings vs;
-               vs.noise = psr.noise;
-               vs.vignetting = &vig;
-               vs.input_colour_space = c.o.input_colour_space;
-               vs.camera_colour_space = c.set.camera_colour_space;
-               ViewMerge vm = merge_view_radiance(v, curve, vs);
-               const BracketSet& b = vm.brackets;
-               const NoiseModel& noise = vm.noise;
-               MergedImage& m = vm.image;
-               const std::string& from = vm.input_colour_space;
-               const fs::path exr = merged_path(c, v.name);
-               write_merged_exr(exr.string(), m,
-                                {{"version", RSIBR_VERSION},
-                                 {"view", v.name},
-                                 {"responseModel", curve.model},
-                                 {"responseFile", "response.json (next to this file)"},
-                                 {"colourSpace", working_space()},
-                                 {"inputColourSpace", from.empty() ? working_space() : from},
-                                 {"radianceUnit", "X/e: signal over saturation per relative exposure t*iso/100/N^2"},
-                                 {"producer", "rsibr process (hdr step)"}});
-               r.outputs.push_back(exr);
-               const double px = double(m.radiance.total());
-               nlohmann::json shifts = nlohmann::json::array(), bracket_names = nlohmann::json::array();
-               for (const cv::Point& s : vm.shifts) shifts.push_back({s.x, s.y});
-               for (const std::string& f : b.files) bracket_names.push_back(fs::path(f).filename().string());
-               views.push_back({{"name", v.name},
-                                {"brackets", b.size()},
-                                {"clipped_fraction", m.clipped / px},
-                                {"clipped_pixels", m.clipped},
-                                {"ghost_fraction", m.ghost / px},
-                                {"noise_read", noise.read},
-                                {"noise_shot", noise.shot},
-                                {"alignment_shifts", shifts},
-                                {"alignment_rotations_deg", vm.alignment.rotation_deg},
-                                {"alignment_beyond_search", vm.alignment.beyond_search},
-                                {"alignment_mismatch_after", vm.alignment.mismatch_after},
-                                {"bracket_files", bracket_names},
-                                {"sizes_fitted", b.fitted_sizes}});
-               bar.update(double(i + 1) / double(c.set.views.size()));
-             }
-             bar.done();
-             r.summary = {{"model", curve.model},
-                          {"recovered_from", from},
-                          {"candidates", cands},
-                          {"recovery", recovery_json(rec)},
-                          {"curve", plot},
-                          {"max_code", curve.max_code},
-                          {"views", views},
-                          {"vignetting", vignetting},
-                          {"camera", c.set.camera_name},
-                          {"input_colour_space", input_space.empty() ? working_space() : input_space},
-                          {"colour_space", working_space()}};
+             StepOutputs m = run_hdr_step(s);
+             r.outputs = std::move(m.files);
+             r.summary = std::move(m.summary);
            });
 }
 
-// The bracket of a view that its registration left furthest from the middle one (the largest
-// disagreement of the threshold bitmaps after it), for an error about a ghost: "FILE (moved X,Y px;
-// P% of its bitmap disagrees)", or "" when the hdr step's summary does not tell.
-std::string suspect_bracket(const PhotoView& v, const nlohmann::json& hdr) {
-  if (!hdr.is_object() || !hdr.contains("views")) return "";
-  for (const auto& vj : hdr["views"]) {
-    if (vj.value("name", "") != v.name || !vj.contains("alignment_mismatch_after")) continue;
-    // In the merge's order (by exposure), the middle one the reference.
-    const auto& m = vj["alignment_mismatch_after"];
-    const auto& shifts = vj["alignment_shifts"];
-    const auto& files = vj.value("bracket_files", nlohmann::json::array());
-    const std::size_t n = std::min(m.size(), files.size());
-    std::size_t worst = n;
-    for (std::size_t j = 0; j < n; ++j)
-      if (j != n / 2 && (worst == n || m[j].get<double>() > m[worst].get<double>())) worst = j;
-    if (worst == n) return "";
-    std::string text = files[worst].get<std::string>();
-    if (worst < shifts.size())
-      text += " (moved " + std::to_string(shifts[worst][0].get<int>()) + "," +
-              std::to_string(shifts[worst][1].get<int>()) + " px; " +
-              std::to_string(int(std::lround(100 * m[worst].get<double>()))) + "% of its bitmap disagrees)";
-    return text;
+// ---- balls: every listed ball of every view found once (calib/balls/shoot_balls.h), through the
+// calibrated lens -> DIR/balls.json (calib/balls/balls_file.h), read by lens, orient and extract,
+// and each view's candidates circled and numbered in DIR/balls/<view>.png (what --ball is picked from).
+void step_balls(Context& c) {
+  std::vector<fs::path> inputs = hdr_files(c);
+  inputs.push_back(c.dir / "camera.cameramodel");
+  ShootBallsInput in;
+  in.listed = listed_balls(c.set);
+  const std::vector<BallOverride> overrides = parse_ball_overrides(c.o.ball_overrides, c.set);
+  nlohmann::json given = nlohmann::json::array(), balls = nlohmann::json::array();
+  const nlohmann::json& hdr = c.result.summary["hdr"];
+  for (const PhotoView& v : c.set.views) {
+    in.views.push_back(v.name);
+    in.suspect_bracket.push_back(suspect_bracket(v.name, hdr));
+    in.given.emplace_back();
+    for (const ListedBall& b : in.listed) {
+      in.given.back().push_back(find_override(overrides, v.name, b.name));
+      if (const auto& g = in.given.back().back())
+        given.push_back({v.name, b.name, g->centre_px.x(), g->centre_px.y(), g->radius_px});
+    }
   }
-  return "";
+  for (const ListedBall& b : in.listed) balls.push_back({b.name, to_string(b.kind), b.diameter_m.value_or(0.0)});
+  run_step(c, "balls", {{"balls", balls}, {"given", given}}, inputs, [&](StepRecord& r) {
+    in.lens = LensModel::read(c.dir / "camera.cameramodel");
+    in.read_view = [&](std::size_t v) { return read_view_image(merged_path(c, c.set.views[v].name).string()); };
+    nlohmann::json pictures = nlohmann::json::array();
+    in.seen = [&](std::size_t v, const cv::Mat& radiance, const ViewCandidates& vc) {
+      fs::create_directories(c.dir / "balls");
+      const fs::path f = file_in_folder(c.dir / "balls", c.set.views[v].name + ".png");
+      write_ball_candidates_picture(f, radiance, vc);
+      r.outputs.push_back(f);
+      pictures.push_back(fs::relative(f, c.dir).string());
+    };
+    const ShootBalls found = find_shoot_balls(in);
+    write_balls_file(c.dir / "balls.json", found);
+    r.outputs.push_back(c.dir / "balls.json");
+    r.summary = balls_summary_json(found);
+    r.summary["candidates_pictures"] = pictures;
+  });
+}
+
+// The balls step's findings, for the photo set's balls.
+ShootBalls read_found_balls(const Context& c) {
+  ShootBalls found = read_balls_file(c.dir / "balls.json");
+  check_listed_balls(found, listed_balls(c.set), (c.dir / "balls.json").string());
+  return found;
 }
 
 // ---- lens: the calibrated lens, its focal length refined from the balls' outlines when it came
 // from the photos' metadata (pipeline/lens_step.h) -> DIR/lens.cameramodel, the lens of every
 // later step.
 void step_lens(Context& c) {
-  std::vector<fs::path> inputs = hdr_files(c);
-  inputs.push_back(c.dir / "camera.cameramodel");
+  const std::vector<fs::path> inputs = {c.dir / "balls.json", c.dir / "camera.cameramodel"};
   LensStep s;
   s.calibrated = c.dir / "camera.cameramodel";
   s.source = recorded(c, "calibrate", "source").get<std::string>();
@@ -461,33 +271,16 @@ void step_lens(Context& c) {
     s.prior_sigma_relative = recorded(c, "calibrate", "focal_sigma_relative").get<double>();
   if (s.source == "outlines") s.metadata_note = recorded(c, "calibrate", "lensfun").get<std::string>();
   s.refine = c.o.self_calibrate;
-  s.balls = listed_balls(c.set);
   s.out = c.dir / "lens.cameramodel";
   s.pictures = c.dir / "balls";
-  const std::vector<BallOverride> overrides = parse_ball_overrides(c.o.ball_overrides, c.set);
-  nlohmann::json given = nlohmann::json::array();
-  const nlohmann::json& hdr = c.result.summary["hdr"];
-  for (const PhotoView& v : c.set.views) {
-    s.views.push_back(v.name);
-    s.merged.push_back(merged_path(c, v.name));
-    s.suspect_bracket.push_back(suspect_bracket(v, hdr));
-    s.given.emplace_back();
-    for (const ListedBall& b : s.balls) {
-      s.given.back().push_back(find_override(overrides, v.name, b.name));
-      if (const auto& g = s.given.back().back())
-        given.push_back({v.name, b.name, g->centre_px.x(), g->centre_px.y(), g->radius_px});
-    }
-  }
-  nlohmann::json balls = nlohmann::json::array();
-  for (const ListedBall& b : s.balls) balls.push_back({b.name, to_string(b.kind)});
-  const nlohmann::json settings = {
-      {"refine", s.refine}, {"source", s.source},    {"prior_sigma_relative", s.prior_sigma_relative},
-      {"balls", balls},     {"crops", "far camera"}, {"given", given}};
+  const nlohmann::json settings = {{"refine", s.refine},
+                                   {"source", s.source},
+                                   {"prior_sigma_relative", s.prior_sigma_relative},
+                                   {"crops", "far camera"}};
   run_step(c, "lens", settings, inputs, [&](StepRecord& r) {
+    s.balls = read_found_balls(c);
     r.summary = run_lens_step(s);
     r.outputs = {s.out};
-    for (const auto& name : r.summary.value("candidates_pictures", nlohmann::json::array()))
-      r.outputs.push_back(s.pictures / name.get<std::string>());
   });
 }
 
@@ -504,169 +297,47 @@ ViewImage read_merged_view(const Context& c, const PhotoView& v, const LensModel
   return img;
 }
 
-// ---- orient: world_from_cam per view, solved from the chrome ball's reflected features
-// (calib/orientation/view_orientation.h; world +Y up: estimated from the views, or `up` given in the first
-// camera's frame), or given (--poses: the file's chrome balls, refined here by the features with
-// the rotations held when the file has none; a first-view file levelled by the estimated up).
-nlohmann::json world_up_json(const WorldUp& w) {
-  return {{"up_in_first_camera", {w.up.x(), w.up.y(), w.up.z()}},
-          {"sigma_deg", w.sigma_deg},
-          {"roll_sigma_deg", w.roll_sigma_deg},
-          {"roll_sigma_estimated", w.roll_sigma_estimated},
-          {"roll_deg", w.roll_deg},
-          {"tilt_from_first_camera_deg", w.tilt_from_first_deg},
-          {"lines", w.lines}};
-}
-
+// ---- orient: world_from_cam per view (pipeline/orient_step.h) -> DIR/poses.yaml, and each pair's
+// matches drawn in DIR/orient/A--B.png.
 void step_orient(Context& c) {
   std::vector<fs::path> inputs = hdr_files(c);
   inputs.push_back(c.dir / "lens.cameramodel");
+  OrientStep s;
   if (!c.o.points.empty()) {
     if (!c.o.poses.empty()) throw std::invalid_argument("--points: not with --poses (the poses are given)");
     inputs.push_back(c.o.points);
   }
   if (!c.o.poses.empty()) {
     inputs.push_back(c.o.poses);
-    const PoseSet given = read_given_poses(c.o.poses);
+    s.given = read_given_poses(c.o.poses);
+    s.given_file = c.o.poses;
     for (const PhotoView& v : c.set.views)
-      if (!given.find(v.name)) throw std::invalid_argument(c.o.poses + ": no pose for view '" + v.name + "'");
+      if (!s.given->find(v.name)) throw std::invalid_argument(c.o.poses + ": no pose for view '" + v.name + "'");
   }
-  const std::vector<BallOverride> overrides = parse_ball_overrides(c.o.ball_overrides, c.set);
-  const std::vector<ListedBall> listed = listed_balls(c.set);
-  std::vector<std::optional<BallGuess>> given_chrome;
-  nlohmann::json chrome_overrides = nlohmann::json::array();
-  // The chrome ball given by hand in a view (the first listed chrome ball's --ball).
-  for (const PhotoView& v : c.set.views) {
-    std::optional<BallGuess> g;
-    for (const BallSpec& b : c.set.balls)
-      if (b.kind == BallKind::chrome && !g) g = find_override(overrides, v.name, b.name);
-    if (g) chrome_overrides.push_back({v.name, g->centre_px.x(), g->centre_px.y(), g->radius_px});
-    given_chrome.push_back(g);
-  }
-  nlohmann::json balls = nlohmann::json::array();
-  for (const BallSpec& b : c.set.balls) balls.push_back({b.name, to_string(b.kind), b.diameter_m.value_or(0.0)});
+  inputs.push_back(c.dir / "balls.json");
   const nlohmann::json settings = {{"source", c.o.poses.empty() ? "solve" : "given"},
                                    {"up", c.o.up ? nlohmann::json{c.o.up->x(), c.o.up->y(), c.o.up->z()}
-                                                 : nlohmann::json(c.o.estimate_up ? "auto" : "none")},
-                                   {"balls", balls},
-                                   {"chrome_overrides", chrome_overrides}};
+                                                 : nlohmann::json(c.o.estimate_up ? "auto" : "none")}};
   run_step(c, "orient", settings, inputs, [&](StepRecord& r) {
-    PoseSet poses;
-    std::string source;
-    nlohmann::json solve, left_out = nlohmann::json::array(), notes = nlohmann::json::array(), up = nullptr;
     const LensModel lens = LensModel::read(c.dir / "lens.cameramodel");
-    std::vector<std::string> names;
-    std::vector<ViewImage> images;
-    auto load_images = [&] {
-      for (const PhotoView& v : c.set.views) {
-        names.push_back(v.name);
-        images.push_back(read_merged_view(c, v, lens));
-      }
+    s.lens = &lens;
+    for (const PhotoView& v : c.set.views) s.views.push_back(v.name);
+    s.read_view = [&](const std::string& name) {
+      for (const PhotoView& v : c.set.views)
+        if (v.name == name) return read_merged_view(c, v, lens);
+      throw std::logic_error("orient: no view " + name);
     };
-    ViewOrientationOptions vo;
-    vo.listed = listed;
-    vo.given_chrome = given_chrome;
-    if (!c.o.points.empty()) vo.points = read_point_pairs(c.o.points);
-    ViewOrientationReport report;
-    if (!c.o.poses.empty()) {
-      poses = read_given_poses(c.o.poses);
-      source = "given (" + c.o.poses + ")";
-      PoseSet ordered;
-      ordered.gauge = poses.gauge;
-      for (const PhotoView& v : c.set.views) ordered.views.push_back(*poses.find(v.name));
-      poses = ordered;
-      bool all_balls = true;
-      for (const ViewPose& p : poses.views) all_balls = all_balls && p.ball.has_value();
-      if (!all_balls) {
-        // The chrome balls refined by the features with the file's rotations held.
-        load_images();
-        for (const ViewPose& p : poses.views) vo.known_world_from_cam.push_back(p.world_from_cam);
-        const PoseSet refined = orient_views(names, images, lens, vo, &report);
-        for (ViewPose& p : poses.views)
-          if (!p.ball)
-            if (const ViewPose* q = refined.find(p.name)) p.ball = q->ball;
-        source += ", chrome balls refined by the features with the rotations held";
-        for (const std::string& w : report.left_out) left_out.push_back(w);
-      }
-      if (poses.gauge == "first-view" && !c.o.up && c.o.estimate_up) {
-        up = world_up_json(level_pose_set(poses));
-        source += ", levelled by the estimated up";
-      }
-    } else {
-      load_images();
-      vo.up = c.o.up;
-      vo.estimate_up = c.o.estimate_up;
-      // Per pair, the features that tied the views (or failed to): DIR/orient/A--B.png.
-      const auto pair_pictures = [&] {
-        std::vector<fs::path> files;
-        for (const PairOrientation& p : report.pairs) {
-          const auto image = [&](const std::string& name) -> const cv::Mat& {
-            return images[std::size_t(std::find(names.begin(), names.end(), name) - names.begin())].radiance;
-          };
-          fs::create_directories(c.dir / "orient");
-          files.push_back(file_in_folder(c.dir / "orient", p.a + "--" + p.b + ".png"));
-          write_pair_matches_picture(files.back(), image(p.a), image(p.b), p);
-        }
-        return files;
-      };
-      try {
-        poses = orient_views(names, images, lens, vo, &report);
-      } catch (const std::exception&) {
-        // What the solve saw before it stopped, for steps/orient.failed.json and the pictures.
-        nlohmann::json pictures = nlohmann::json::array();
-        for (const fs::path& f : pair_pictures()) pictures.push_back(fs::relative(f, c.dir).string());
-        r.summary = {{"left_out", report.left_out},
-                     {"notes", report.notes},
-                     {"solve",
-                      {{"features", report.features},
-                       {"pairs", pair_orientation_json(report.pairs)},
-                       {"pair_pictures", pictures}}}};
-        throw;
-      }
-      nlohmann::json pictures = nlohmann::json::array();
-      for (const fs::path& f : pair_pictures()) {
-        r.outputs.push_back(f);
-        pictures.push_back(fs::relative(f, c.dir).string());
-      }
-      source = "solved (chrome-ball features)";
-      solve = {{"tracks", report.tracks},
-               {"observations", report.observations},
-               {"inliers", report.inliers},
-               {"rms_sigmas", report.rms_sigmas},
-               {"features", report.features},
-               {"tracks_relocated", report.track_refinement.tracks_refined},
-               {"rig_disagreement_radii", report.rig_disagreement},
-               {"pairs", pair_orientation_json(report.pairs)},
-               {"pair_pictures", pictures}};
-      std::vector<std::string> suspects;
-      for (std::size_t v = 0; v < report.rig_suspect.size(); ++v)
-        if (report.rig_suspect[v]) suspects.push_back(report.names[v]);
-      solve["left_out_of_up"] = suspects;
-      for (const std::string& w : report.left_out) left_out.push_back(w);
-      for (const std::string& w : report.notes) notes.push_back(w);
-      if (report.world_up) up = world_up_json(*report.world_up);
-    }
-    // In the set's order, only its views (those left out have no pose).
-    PoseSet ordered;
-    ordered.gauge = poses.gauge;
-    for (const PhotoView& v : c.set.views)
-      if (const ViewPose* p = poses.find(v.name)) ordered.views.push_back(*p);
+    s.found = read_found_balls(c);
+    if (!c.o.points.empty()) s.points = read_point_pairs(c.o.points);
+    s.up = c.o.up;
+    s.estimate_up = c.o.estimate_up;
+    s.pictures = c.dir / "orient";
+    const OrientedViews o = run_orient_step(s, &r.summary);
     const fs::path out = c.dir / "poses.yaml";
-    write_pose_file(out.string(), ordered);
-    nlohmann::json views = nlohmann::json::array();
-    for (const ViewPose& p : ordered.views) {
-      const Vec3 forward = p.world_from_cam.col(2);
-      nlohmann::json vj = {
-          {"name", p.name}, {"sigma_deg", p.sigma_deg}, {"forward", {forward.x(), forward.y(), forward.z()}}};
-      if (p.ball) {
-        const Vec2 cp = lens.project(p.ball->axis);
-        vj["chrome_centre_px"] = {cp.x(), cp.y()};
-      }
-      views.push_back(vj);
-    }
+    write_pose_file(out.string(), o.poses);
+    r.outputs = o.pictures;
     r.outputs.push_back(out);
-    r.summary = {{"source", source},     {"gauge", ordered.gauge}, {"views", views}, {"solve", solve},
-                 {"left_out", left_out}, {"notes", notes},         {"world_up", up}};
+    r.summary = o.summary;
   });
 }
 
@@ -676,12 +347,8 @@ void step_extract(Context& c) {
   std::vector<fs::path> inputs = hdr_files(c);
   inputs.push_back(c.dir / "lens.cameramodel");
   inputs.push_back(c.dir / "poses.yaml");
-  const std::vector<BallOverride> overrides = parse_ball_overrides(c.o.ball_overrides, c.set);
-  nlohmann::json balls = nlohmann::json::array(), given = nlohmann::json::array();
-  for (const BallSpec& b : c.set.balls) balls.push_back({b.name, to_string(b.kind), b.diameter_m.value_or(0.0)});
-  for (const BallOverride& o : overrides)
-    given.push_back({o.view, o.ball, o.guess.centre_px.x(), o.guess.centre_px.y(), o.guess.radius_px});
-  nlohmann::json settings = {{"map_size", c.o.map_size}, {"balls", balls}, {"given", given}};
+  inputs.push_back(c.dir / "balls.json");
+  nlohmann::json settings = {{"map_size", c.o.map_size}};
   if (c.o.occluder_light)
     settings["occluder_light"] = {{"fresnel", c.o.chrome_fresnel},
                                   {"probe_width", c.o.probe_width},
@@ -694,12 +361,8 @@ void step_extract(Context& c) {
     ExtractStep s;
     s.lens = &lens;
     s.poses = read_pose_file((c.dir / "poses.yaml").string());
-    s.balls = listed_balls(c.set);
-    for (const PhotoView& v : c.set.views) {
-      s.views.push_back(v.name);
-      s.given.emplace_back();
-      for (const ListedBall& b : s.balls) s.given.back().push_back(find_override(overrides, v.name, b.name));
-    }
+    s.found = read_found_balls(c);
+    for (const PhotoView& v : c.set.views) s.views.push_back(v.name);
     s.read_view = [&](const std::string& name) {
       for (const PhotoView& v : c.set.views)
         if (v.name == name) return read_merged_view(c, v, lens);
@@ -734,66 +397,24 @@ int probe_width(const Context& c) {
   return recorded(c, "extract", "probe_width").get<int>();
 }
 
-// ---- probe: the chrome maps blended.
+// ---- probe: the chrome maps blended (pipeline/probe_step.h) -> DIR/probe-measured.exr.
 void step_probe(Context& c) {
-  const int width = probe_width(c);
+  ProbeStep s;
+  s.width = probe_width(c);
+  s.chrome_fresnel = c.o.chrome_fresnel;
+  s.given = c.o.probe_file;
+  s.out = c.dir / "probe-measured.exr";
   const auto chrome = balls_of(c, BallKind::chrome);
   if (chrome.empty()) throw std::invalid_argument(c.o.photoset + ": balls: no chrome ball (the probe needs one)");
-  std::vector<fs::path> inputs;
-  for (const BallSpec* b : chrome) inputs.push_back(captured_path(c, *b));
-  if (!c.o.probe_file.empty()) {
-    // The stage swapped for a given environment (the truth, for the error budget): resampled
-    // (area-weighted, core/resample.h) to the probe's lat-long size.
-    run_step(c, "probe", {{"width", width}, {"given", c.o.probe_file}}, {c.o.probe_file}, [&](StepRecord& r) {
-      EnvMap env = resample(read_environment(c.o.probe_file), Layout(LayoutKind::LatLong, width, width / 2));
-      env.attributes["producer"] = "rsibr process (given probe " + fs::path(c.o.probe_file).filename().string() + ")";
-      const fs::path out = c.dir / "probe-measured.exr";
-      write_environment(out.string(), env);
-      r.outputs = {out};
-      r.summary = {{"views", 0}, {"width", width}, {"covered_fraction", 1.0}, {"fresnel", "given: " + c.o.probe_file}};
-    });
-    return;
-  }
-  run_step(c, "probe", {{"width", width}, {"fresnel", c.o.chrome_fresnel}}, inputs, [&](StepRecord& r) {
-    MapSet all;
-    for (const fs::path& p : inputs)
-      for (MapView& v : read_map_set(p.string()).views) all.views.push_back(std::move(v));
-    ProbeOptions po;
-    po.width = width;
-    const auto fresnel = chrome_fresnel_from_spec(c.o.chrome_fresnel, "--chrome-fresnel");
-    po.fresnel = fresnel.get();
-    Probe p = assemble_probe(all, po);
-    // A chrome ball sees most of the sphere from one view (all but the cone behind it); a probe
-    // that saw almost nothing means a lens or a ball that is wrong, never a usable probe.
-    if (!(p.covered_fraction >= 0.1))
-      throw std::runtime_error(
-          "the chrome maps saw " + std::to_string(100 * p.covered_fraction).substr(0, 4) +
-          "% of the sphere (a chrome ball sees most of it): the lens (lens.cameramodel, see the lens step) or the "
-          "chrome ball is wrong; give the lens with --lens FILE or the ball with --ball VIEW:BALL=X,Y,R");
-    p.env.attributes["views"] = std::to_string(all.views.size());
-    p.env.attributes["producer"] = "rsibr process (probe step)";
-    p.env.attributes["version"] = RSIBR_VERSION;
-    if (fresnel) p.env.attributes["fresnel"] = fresnel->spec();
-    const fs::path out = c.dir / "probe-measured.exr";
-    write_environment(out.string(), p.env);
-    r.outputs = {out};
-    // Seen well: a summed confidence of at least one half (one view's centre to mid-disc; behind
-    // the ball a lone view sees only its stretched rim, where the confidence fades to 0).
-    double well = 0, all_sa = 0;
-    for (int y = 0; y < p.weight.rows; ++y) {
-      const double sa = std::cos((0.5 - (y + 0.5) / p.weight.rows) * kPiD);
-      for (int x = 0; x < p.weight.cols; ++x) {
-        all_sa += sa;
-        if (p.weight.at<float>(y, x) >= 0.5f) well += sa;
-      }
-    }
-    r.summary = {{"views", all.views.size()},
-                 {"width", width},
-                 {"memory_mb", double(probe_bytes(width)) / (1 << 20)},
-                 {"covered_fraction", p.covered_fraction},
-                 {"well_seen_fraction", all_sa > 0 ? well / all_sa : 0.0},
-                 {"clipped_fraction", p.clipped_fraction},
-                 {"fresnel", fresnel ? fresnel->spec() : "none (the probe holds F L)"}};
+  for (const BallSpec* b : chrome) s.chrome_maps.push_back(captured_path(c, *b));
+  // The stage swapped for a given environment (the truth, for the error budget).
+  const nlohmann::json settings = s.given.empty() ? nlohmann::json{{"width", s.width}, {"fresnel", s.chrome_fresnel}}
+                                                  : nlohmann::json{{"width", s.width}, {"given", s.given}};
+  const std::vector<fs::path> inputs = s.given.empty() ? s.chrome_maps : std::vector<fs::path>{s.given};
+  run_step(c, "probe", settings, inputs, [&](StepRecord& r) {
+    StepOutputs o = run_probe_step(s);
+    r.outputs = std::move(o.files);
+    r.summary = std::move(o.summary);
   });
 }
 
@@ -835,195 +456,80 @@ void step_sources(Context& c) {
   });
 }
 
-// ---- bake: computed maps of the grey balls from the probe, at the captured views.
+// ---- bake: computed maps of the grey balls from the probe, at the captured views
+// (pipeline/bake_step.h) -> DIR/maps/computed-<ball>.exr.
 void step_bake(Context& c) {
-  std::vector<fs::path> inputs = {c.dir / "probe.exr"};
-  const auto greys = balls_of(c, BallKind::grey);
-  for (const BallSpec* b : greys) inputs.push_back(captured_path(c, *b));
+  BakeStep s;
+  s.probe = c.dir / "probe.exr";
+  std::vector<fs::path> inputs = {s.probe};
+  for (const BallSpec* b : balls_of(c, BallKind::grey)) {
+    s.balls.push_back({b->name, captured_path(c, *b), computed_path(c, *b)});
+    inputs.push_back(s.balls.back().captured);
+  }
+  s.albedo = c.o.grey_albedo;
+  s.method = c.o.bake_method;
+  s.samples = c.o.bake_samples;
+  s.max_error = c.o.bake_max_error;
+  s.seed = c.o.seed;
+  s.log = c.o.log;
   nlohmann::json settings = {
       {"albedo", c.o.grey_albedo}, {"method", c.o.bake_method}, {"samples", c.o.bake_samples}, {"seed", c.o.seed}};
   if (c.o.bake_max_error > 0)
     settings = {{"albedo", c.o.grey_albedo}, {"max_error", c.o.bake_max_error}, {"seed", c.o.seed}};
   run_step(c, "bake", settings, inputs, [&](StepRecord& r) {
-    const EnvMap probe = read_environment((c.dir / "probe.exr").string());
-    std::ostringstream spec;
-    spec << std::setprecision(9) << "{type: lambert, albedo: [" << c.o.grey_albedo << ", " << c.o.grey_albedo << ", "
-         << c.o.grey_albedo << "]}";
-    const auto brdf = parse_brdf(spec.str());
-    std::string method = c.o.bake_method;
-    MapSetBakeOptions bo;
-    bo.integrator.samples = c.o.bake_samples;
-    nlohmann::json planned;
-    // Planned with the bake's own seed: a filtered-importance bake's error depends on it.
-    if (c.o.bake_max_error > 0) {
-      const IntegratorPlan plan =
-          plan_integrator(probe, *brdf, c.o.bake_max_error, default_integrator_settings(), c.o.seed);
-      if (!plan.chosen)
-        throw std::runtime_error("no integrator is predicted to reach --max-error " +
-                                 std::to_string(c.o.bake_max_error) + " on probe.exr");
-      method = plan.chosen->setting.method;
-      bo.integrator.samples = std::max(1, plan.chosen->setting.samples);
-      bo.integrator.reference_width = plan.chosen->setting.reference_width;
-      planned = plan.to_json();
-      if (c.o.log)
-        c.o.log("bake: planned " + plan.chosen->setting.label() + " (" + std::to_string(100 * plan.chosen->error) +
-                "% at the pilot texels)");
-    }
-    const auto integrator = make_integrator(method, probe);
-    bo.integrator.seed = c.o.seed;
-    bo.environment_name = "probe.exr";
-    nlohmann::json balls = nlohmann::json::array();
-    for (const BallSpec* b : greys) {
-      const MapSet captured = read_map_set(captured_path(c, *b).string());
-      // At the captured maps' own frames and size, so the comparison is texel for texel.
-      std::vector<BakeFrame> frames;
-      for (const MapView& cv : captured.views) frames.push_back({cv.view, cv.world_from_view});
-      bo.res = captured.width();
-      MapSet computed = bake_map_set(*brdf, *integrator, frames, bo);
-      for (std::size_t i = 0; i < computed.views.size(); ++i) {
-        computed.views[i].image = captured.views[i].image;
-      }
-      const fs::path out = computed_path(c, *b);
-      write_map_set(out.string(), computed);
-      r.outputs.push_back(out);
-      balls.push_back({{"ball", b->name}, {"views", computed.views.size()}});
-    }
-    r.summary = {{"material", brdf->spec()}, {"balls", balls}, {"method", method}};
-    if (!planned.is_null()) r.summary["plan"] = planned;
+    StepOutputs o = run_bake_step(s);
+    r.outputs = std::move(o.files);
+    r.summary = std::move(o.summary);
   });
 }
 
-// ---- compare: captured against computed, per grey ball.
+// ---- compare: captured against computed, per grey ball (pipeline/compare_step.h) -> DIR/compare/.
 void step_compare(Context& c) {
-  const auto greys = balls_of(c, BallKind::grey);
+  CompareStep s;
+  s.out = c.dir / "compare";
   std::vector<fs::path> inputs;
-  for (const BallSpec* b : greys) inputs.push_back(captured_path(c, *b)), inputs.push_back(computed_path(c, *b));
+  for (const BallSpec* b : balls_of(c, BallKind::grey)) {
+    s.balls.push_back({b->name, captured_path(c, *b), computed_path(c, *b)});
+    inputs.push_back(s.balls.back().captured), inputs.push_back(s.balls.back().computed);
+  }
   run_step(c, "compare", nlohmann::json::object(), inputs, [&](StepRecord& r) {
-    nlohmann::json balls = nlohmann::json::array();
-    for (const BallSpec* b : greys) {
-      MapSet captured = read_map_set(captured_path(c, *b).string());
-      MapSet computed = read_map_set(computed_path(c, *b).string());
-      // Views whose ball has no trusted texel (hidden behind another ball, or not found) cannot be
-      // compared: left out and listed (the bake made one computed view per captured one, in order).
-      std::vector<std::string> untrusted;
-      if (captured.views.size() == computed.views.size()) {
-        MapSet a, bset;
-        for (std::size_t i = 0; i < captured.views.size(); ++i) {
-          if (cv::countNonZero(captured.views[i].confidence > 0) == 0) {
-            untrusted.push_back(!captured.views[i].image.empty() ? captured.views[i].image
-                                                                 : "view." + std::to_string(i));
-            continue;
-          }
-          a.views.push_back(std::move(captured.views[i]));
-          bset.views.push_back(std::move(computed.views[i]));
-        }
-        if (a.views.empty()) {
-          balls.push_back({{"ball", b->name}, {"views", nlohmann::json::array()}, {"untrusted_views", untrusted}});
-          continue;
-        }
-        captured = std::move(a), computed = std::move(bset);
-      }
-      CompareOptions co;
-      co.name_a = captured_path(c, *b).string();
-      co.name_b = computed_path(c, *b).string();
-      const Comparison cmp = compare_map_sets(captured, computed, co);
-      // The same JSON and pictures as rsibr compare (compare/comparison_report.h), plus the ball,
-      // each view's image and the views left out.
-      const ComparisonImages images = comparison_images(cmp);
-      nlohmann::json bj = comparison_json(cmp, images, true);
-      FolderContents files;
-      for (std::size_t i = 0; i < cmp.pairs.size(); ++i) {
-        const PairComparison& p = cmp.pairs[i];
-        const std::string image = !captured.views[p.index_a].image.empty() ? captured.views[p.index_a].image : p.name;
-        const std::string name = p.name + ".png";
-        files[name] =
-            png_bytes(comparison_panel(cmp, images, i, b->name + " " + image, "captured x gains", "computed"), name);
-        bj["views"][i]["image"] = image;
-        bj["views"][i]["picture"] = name;
-      }
-      const fs::path folder = c.dir / "compare" / b->name;
-      fs::create_directories(folder.parent_path());
-      write_folder_atomically(folder, files);
-      for (const auto& [name, bytes] : files) r.outputs.push_back(folder / name);
-      bj["ball"] = b->name;
-      bj["folder"] = "compare/" + b->name;
-      bj["untrusted_views"] = untrusted;
-      bj["heat_max_stops"] = images.heat_max;
-      bj["log_epsilon"] = cmp.settings.log_epsilon;
-      balls.push_back(bj);
-    }
-    r.summary = {{"balls", balls}};
+    StepOutputs o = run_compare_step(s);
+    r.outputs = std::move(o.files);
+    r.summary = std::move(o.summary);
   });
 }
 
-// ---- render: a turntable of a mesh lit by the probe, through the runtime.
+// ---- render: a turntable of a mesh lit by the probe, through the runtime (pipeline/render_step.h)
+// -> DIR/render/.
 void step_render(Context& c) {
-  std::vector<fs::path> inputs = {c.dir / "probe.exr"};
+  RenderStep s;
+  s.probe = c.dir / "probe.exr";
+  s.mesh = c.o.mesh;
+  s.brdf = c.o.render_brdf;
+  s.views_res = c.o.render_views_res;
+  s.frames = c.o.turntable;
+  s.width = c.o.render_width;
+  s.height = c.o.render_height;
+  s.seed = c.o.seed;
+  s.progress = c.o.progress;
+  s.out = c.dir / "render";
+  std::vector<fs::path> inputs = {s.probe};
   if (!c.o.mesh.empty()) inputs.push_back(c.o.mesh);
   const nlohmann::json settings = {{"brdf", c.o.render_brdf}, {"res", c.o.render_views_res},
                                    {"frames", c.o.turntable}, {"size", {c.o.render_width, c.o.render_height}},
                                    {"seed", c.o.seed},        {"mesh", c.o.mesh.empty() ? "built-in torus" : c.o.mesh}};
   run_step(c, "render", settings, inputs, [&](StepRecord& r) {
-    const EnvMap probe = read_environment((c.dir / "probe.exr").string());
-    const auto brdf = parse_brdf(c.o.render_brdf);
-    // The render's maps are render_views_res texels of a glossy lobe: a probe wider than 512 adds
-    // nothing to them but the integrator's MIP pyramid (7 s of 9 for a 1472-wide probe on 2 cores).
-    // Area sampling keeps the energy; the full probe stays the background.
-    std::optional<EnvMap> smaller;
-    if (probe.layout.width() > 512) {
-      ResampleOptions rs;
-      rs.supersampling = 1;
-      smaller = resample(probe, Layout(LayoutKind::LatLong, 512, 256), rs);
-    }
-    const auto integrator = make_integrator("fis", smaller ? *smaller : probe);
-    MapSetBakeOptions bo;
-    bo.res = c.o.render_views_res;
-    bo.integrator.samples = 32;
-    bo.integrator.seed = c.o.seed;
-    bo.environment_name = "probe.exr";
-    const MapSet maps = bake_map_set(*brdf, *integrator, ViewSet::named("icosa"), bo);
-    const fs::path folder = c.dir / "render";
-    fs::create_directories(folder);
-    write_map_set((folder / "maps.exr").string(), maps);
-    const Mesh mesh = c.o.mesh.empty() ? torus_mesh() : load_mesh(c.o.mesh);
-    RenderOptions ro;
-    ro.environment = &probe;
-    const Renderer renderer(mesh, {&maps}, ro);
-    const Eigen::AlignedBox3f box = mesh.bounds();
-    const Vec3 pivot = box.center().cast<double>();
-    const Camera first = frame_bounds(box, Vec3(0, -0.4, -1), Vec3(0, 1, 0), 40, c.o.render_width, c.o.render_height);
-    // Display exposure: the probe's median at mid-grey (the object reflects the environment).
-    const float stops = preview_exposure(probe.pixels);
-    FolderContents files;
-    double seconds = 0;
-    Progress bar("render", c.o.progress);
-    for (int k = 0; k < c.o.turntable; ++k) {
-      RenderStats stats;
-      const cv::Mat rgba = renderer.render(orbit(first, pivot, Vec3(0, 1, 0), k, c.o.turntable), &stats);
-      seconds += stats.seconds;
-      std::ostringstream name;
-      name << "frame_" << std::setw(2) << std::setfill('0') << k << ".png";
-      files[name.str()] = png_bytes(display_encode(rgba, stops), name.str());
-      bar.update(double(k + 1) / c.o.turntable);
-    }
-    bar.done();
-    write_folder_atomically(folder, files);
-    r.outputs.push_back(folder / "maps.exr");
-    for (const auto& [name, bytes] : files) r.outputs.push_back(folder / name);
-    r.summary = {{"mesh", c.o.mesh.empty() ? "built-in torus" : c.o.mesh},
-                 {"triangles", mesh.triangles.size()},
-                 {"material", brdf->spec()},
-                 {"frames", c.o.turntable},
-                 {"seconds_per_frame", seconds / c.o.turntable},
-                 {"display_exposure_stops", stops}};
+    StepOutputs o = run_render_step(s);
+    r.outputs = std::move(o.files);
+    r.summary = std::move(o.summary);
   });
 }
 
 }  // namespace
 
 const std::vector<std::string>& process_steps() {
-  static const std::vector<std::string> steps = {"calibrate", "hdr",  "lens",    "orient", "extract", "probe",
-                                                 "sources",   "bake", "compare", "render", "report"};
+  static const std::vector<std::string> steps = {"calibrate", "hdr",     "balls", "lens",    "orient", "extract",
+                                                 "probe",     "sources", "bake",  "compare", "render", "report"};
   return steps;
 }
 
@@ -1031,7 +537,7 @@ ProcessResult run_process(const ProcessOptions& o) {
   for (const std::string& f : o.force)
     if (f != "all" && std::find(process_steps().begin(), process_steps().end(), f) == process_steps().end())
       throw std::invalid_argument("--force '" + f +
-                                  "': not a step (calibrate, hdr, lens, orient, extract, probe, sources, "
+                                  "': not a step (calibrate, hdr, balls, lens, orient, extract, probe, sources, "
                                   "bake, compare, render, report, all)");
   if (!o.lens.empty() && !fs::is_regular_file(o.lens)) throw std::invalid_argument(o.lens + ": no such file");
   if (!o.mesh.empty() && !fs::is_regular_file(o.mesh)) throw std::invalid_argument(o.mesh + ": no such file");
@@ -1086,6 +592,7 @@ ProcessResult run_process(const ProcessOptions& o) {
   try {
     step_calibrate(c);
     step_hdr(c);
+    step_balls(c);
     step_lens(c);
     step_orient(c);
     step_extract(c);

@@ -5,13 +5,18 @@
 //              or the photo set's model, or a pinhole from the photos' EXIF (calib/lens/photo_optics.h)
 //   hdr        brackets -> DIR/hdr/<view>.exr, DIR/hdr/response.json (response recovered once),
 //              DIR/hdr/vignetting.json (estimated from the chessboards, divided out of every view)
+//   balls      every listed ball of every view found once, through the calibrated lens
+//              (calib/balls/shoot_balls.h: candidates, the balls matched by appearance and size, a
+//              missed chrome ball rescued, --ball given ones) -> DIR/balls.json (calib/balls/balls_file.h),
+//              read by lens, orient and extract; each view's candidates numbered in DIR/balls/<view>.png
 //   lens       the calibrated lens, its focal length refined from the balls' outlines when it came
 //              from the photos' metadata (pipeline/lens_step.h) -> DIR/lens.cameramodel, the lens
-//              of every later step
+//              of every later step (which refits the balls' cones to their outline pixels through it)
 //   orient     -> DIR/poses.yaml (world_from_cam per view: solved from the chrome ball's features,
 //              calib/orientation/view_orientation.h, world +Y up estimated from the views or given; or --poses,
 //              whose chrome balls are refined here when the file has none)
-//   extract    every ball of every view, identified and checked across views
+//   extract    every ball of every view, identified and checked across views from the balls step's
+//              candidates
 //              (calib/balls/ball_identification.h) -> DIR/maps/captured-<ball>.exr, one part per view in
 //              the world frame (chrome: reflection indexing, mirror warp, the other balls, the stands
 //              and the photographer masked, calib/extraction/occluders.h; grey/glossy: orthographic), and each

@@ -168,14 +168,18 @@ expect_error "export: Blender fails" "Blender failed (exit 9)" export blender "$
 check "export: nothing left when Blender fails" bash -c "! ls -A '$work' | grep -q '^\.\?e3'"
 cp -r "$work/run" "$work/broken"
 python3 -c "
-import json; f = '$work/broken/steps/extract.json'; j = json.load(open(f)); j['settings']['balls'] = [[1, 2, 3]]
+import json; f = '$work/broken/steps/extract.json'; j = json.load(open(f)); j['summary']['rig'] = [[1, 2, 3]]
 json.dump(j, open(f, 'w'))"
 expect_error "export: a record of the wrong shape is named" "broken/steps/extract.json" export blender "$work/broken" \
   --out "$work/e4" --no-blend
+cp -r "$work/run" "$work/noballs"
+echo '{}' > "$work/noballs/balls.json"
+expect_error "export: a broken balls file is named" "noballs/balls.json" export blender "$work/noballs" \
+  --out "$work/e6" --no-blend
 cp -r "$work/run" "$work/noprobe"
 rm "$work/noprobe/probe.exr"
 expect_error "export: a run without its probe" "probe.exr: missing" export blender "$work/noprobe" --out "$work/e5" --no-blend
-check "export: nothing left after those" bash -c "! ls -A '$work' | grep -q '^\.\?e[45]'"
+check "export: nothing left after those" bash -c "! ls -A '$work' | grep -q '^\.\?e[456]'"
 "$rsibr" export blender "$work/run" --out "$work/nb" --no-blend -q
 check "export --no-blend: the scene and script, no .blend" bash -c "test -s '$work/nb/scene.json' && test ! -e '$work/nb/scene.blend'"
 check "export --help" bash -c "'$rsibr' export blender --help | grep -q Usage"

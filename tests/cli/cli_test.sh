@@ -547,6 +547,15 @@ expect_error "process: a record without a fact a later step needs is an error na
 check "extract --photoset writes process's extract maps to the byte, and its masks" bash -c "
 cmp -s '$work/prig/captured-grey.exr' '$work/pout/maps/captured-grey.exr' &&
 cmp -s '$work/prig/captured-chrome.exr' '$work/pout/maps/captured-chrome.exr' && test -s '$work/prig/mask-view00.png'"
+"$rsibr" extract --photoset "$work/psyn/photos" --merged "$work/pout/hdr" --lens "$work/pout/lens.cameramodel" \
+  --poses "$work/pout/poses.yaml" --balls "$work/pout/balls.json" --chrome-fresnel "$fres" --size 32 \
+  --out "$work/prig-balls" -q
+check "extract --photoset --balls (the run's balls.json) writes the same maps" bash -c "
+cmp -s '$work/prig-balls/captured-grey.exr' '$work/pout/maps/captured-grey.exr' &&
+cmp -s '$work/prig-balls/captured-chrome.exr' '$work/pout/maps/captured-chrome.exr'"
+expect_error "extract --photoset: --view-ball with --balls is refused" "not with --balls" extract --photoset \
+  "$work/psyn/photos" --merged "$work/pout/hdr" --lens "$work/pout/lens.cameramodel" --poses "$work/pout/poses.yaml" \
+  --balls "$work/pout/balls.json" --view-ball view00:chrome=1,2,3 --out "$work/prig-e6" -q
 check "extract --photoset: the JSON names its masks as written" python3 -c "
 import json, os; j = json.load(open('$work/prig.json'))
 masks = [b['mask'] for v in j['views'] for b in v['balls'] if 'mask' in b]
@@ -557,7 +566,7 @@ expect_error "extract --photoset: a missing merged view, named" "view00.exr: mis
   --merged "$work/psyn" --lens "$work/pout/lens.cameramodel" --poses "$work/pout/poses.yaml" --out "$work/prig-e2"
 expect_error "extract: neither an image nor a photo set" "give an IMAGE" extract --lens "$work/pout/lens.cameramodel" \
   --out "$work/prig-e3.exr"
-check "extract --photoset: nothing written after the errors" bash -c "test ! -e '$work/prig-e1' && test ! -e '$work/prig-e2'"
+check "extract --photoset: nothing written after the errors" bash -c "test ! -e '$work/prig-e1' && test ! -e '$work/prig-e2' && test ! -e '$work/prig-e6'"
 pinhole_lens "$work/small.cameramodel"
 expect_error "extract --photoset: a lens of another size than the views (not a far camera), named" \
   "but the lens model $work/small.cameramodel is 96x64" extract --photoset "$work/psyn/photos" --merged "$work/pout/hdr" \

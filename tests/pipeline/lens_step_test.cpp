@@ -1,8 +1,11 @@
 // The lens step (pipeline/lens_step.h) on the cases that need no ball: a measured lens passes
 // through byte for byte in its intrinsics, a metadata lens with nothing to refine it keeps its
 // focal length and says why, and a lens with no focal length at all is an error naming --lens;
-// crops of a rendered ball (the far camera, views of other sizes, a ghosted ball).
+// crops of a rendered ball as the balls step (calib/balls/shoot_balls.h) finds them (the far
+// camera, views of other sizes, a ghosted ball stopping the balls step).
 #include "pipeline/lens_step.h"
+
+#include "calib/balls/ball_candidates_picture.h"
 
 #include "calib/calib_cases.h"
 #include "calib/lens/far_camera.h"
@@ -108,11 +111,28 @@ std::filesystem::path view(const testing::TempDir& dir, const std::string& name,
   return p;
 }
 
-LensStep two_views(const testing::TempDir& dir, int side_a, int side_b, double ghost = 0) {
+// The balls of views a and b as the balls step finds them through the step's calibrated lens
+// (their candidates pictures in `pictures` when given).
+ShootBalls found_balls(const testing::TempDir& dir, double ghost, int side_a, int side_b,
+                       const std::filesystem::path& pictures = {}) {
+  const std::vector<std::filesystem::path> files = {view(dir, "a", side_a, ghost), view(dir, "b", side_b)};
+  ShootBallsInput in;
+  in.views = {"a", "b"};
+  in.read_view = [files](std::size_t v) { return read_view_image(files[v].string()); };
+  in.lens = LensModel::read(dir.path() / "camera.cameramodel");
+  in.listed = {{"chrome", BallKind::chrome, 0.1}};
+  if (!pictures.empty())
+    in.seen = [&](std::size_t v, const cv::Mat& radiance, const ViewCandidates& vc) {
+      std::filesystem::create_directories(pictures);
+      write_ball_candidates_picture(pictures / (in.views[v] + ".png"), radiance, vc);
+    };
+  return find_shoot_balls(in);
+}
+
+LensStep two_views(const testing::TempDir& dir, int side_a, int side_b, const std::filesystem::path& pictures = {}) {
   LensStep s = step_with(dir, "exif", 0.036);
-  s.balls = {{"chrome", BallKind::chrome, 0.1}};
-  s.views = {"a", "b"};
-  s.merged = {view(dir, "a", side_a, ghost), view(dir, "b", side_b)};
+  s.balls = found_balls(dir, 0, side_a, side_b, pictures);
+  s.pictures = pictures;
   return s;
 }
 
@@ -137,8 +157,7 @@ TEST(LensStep, CropsOfTheBallGetTheFarCameraOnTheLargestViewsCanvas) {
 TEST(LensStep, ViewsOfDifferentSizesThatAreNotCropsAreAnErrorNamingThem) {
   testing::TempDir dir;
   const int a = int(std::lround(crops::shoot().radius * 3.5));  // the ball fills 57%: no crop
-  LensStep s = crops::two_views(dir, a, a + 1);
-  s.pictures = dir.path() / "balls";
+  const LensStep s = crops::two_views(dir, a, a + 1, dir.path() / "balls");
   try {
     run_lens_step(s);
     FAIL() << "views of two sizes were given one lens";
@@ -155,12 +174,13 @@ TEST(LensStep, ViewsOfDifferentSizesThatAreNotCropsAreAnErrorNamingThem) {
   }
 }
 
-TEST(LensStep, ABallTheBracketsDisagreeOnStopsTheStepButAFewGhostPixelsDoNot) {
+TEST(BallsStep, ABallTheBracketsDisagreeOnStopsTheStepButAFewGhostPixelsDoNot) {
   testing::TempDir dir;
+  step_with(dir, "exif", 0.036);
   const int a = int(std::lround(2 * crops::shoot().radius / 0.9));
-  EXPECT_NO_THROW(run_lens_step(crops::two_views(dir, a, a, 0.01)));  // 1% of the disc: kept
+  EXPECT_NO_THROW(crops::found_balls(dir, 0.01, a, a));  // 1% of the disc: kept
   try {
-    run_lens_step(crops::two_views(dir, a, a, 0.05));
+    crops::found_balls(dir, 0.05, a, a);
     FAIL() << "a ghosted ball was taken";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("view a: "), std::string::npos) << e.what();

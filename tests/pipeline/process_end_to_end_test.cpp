@@ -7,6 +7,8 @@
 //   probe vs the true environment (both area-resampled to 32 x 16 lat-long): 30%, 0.45 stops log RMS.
 #include "pipeline/process_pipeline.h"
 
+#include "calib/balls/balls_file.h"
+
 #include "capture/synth_capture.h"
 #include "capture/synth_scene.h"
 #include "formats/exr_io.h"
@@ -182,6 +184,25 @@ TEST_F(ProcessEndToEnd, PosesWithoutBallsGetTheirChromeBallsFromTheOrientStep) {
   // Every listed ball found in every view, where the truth puts it.
   for (const auto& v : result_->summary["extract"]["views"])
     for (const auto& b : v["balls"]) EXPECT_EQ(b["status"], "found") << v["name"] << " " << b["ball"];
+}
+
+TEST_F(ProcessEndToEnd, BallsAreFoundOnceAndTheLaterStepsReadThem) {
+  // The balls step found every listed ball of every view; lens, orient and extract read its file.
+  const ShootBalls found = read_balls_file(root_ / "out" / "balls.json");
+  ASSERT_EQ(found.views.size(), 3u);
+  for (const FoundView& v : found.views)
+    for (std::size_t b = 0; b < found.listed.size(); ++b)
+      EXPECT_EQ(v.balls[b].status, "found") << v.name << " " << found.listed[b].name;
+  for (const char* step : {"lens", "orient", "extract"}) {
+    const StepRecord r = read_step_record(root_ / "out", step);
+    EXPECT_NE(std::find(r.inputs.begin(), r.inputs.end(), root_ / "out" / "balls.json"), r.inputs.end()) << step;
+  }
+  EXPECT_TRUE(fs::is_regular_file(root_ / "out" / "balls" / (found.views[0].name + ".png")));
+  // Found again, the same file: the steps that read it find their inputs unchanged and stay.
+  ProcessOptions o = options();
+  o.force = {"balls"};
+  const ProcessResult again = run_process(o);
+  for (const StepOutcome& s : again.steps) EXPECT_EQ(s.ran, s.step == "balls" || s.step == "report") << s.step;
 }
 
 TEST_F(ProcessEndToEnd, ChangedSettingsRerunOnlyTheStepsAfterAndReproduceTheBytes) {
