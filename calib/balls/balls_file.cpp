@@ -97,7 +97,11 @@ nlohmann::json view_json(const FoundView& v, const std::vector<ListedBall>& list
   nlohmann::json balls = nlohmann::json::array();
   for (std::size_t b = 0; b < listed.size(); ++b) {
     const FoundBall& f = v.balls[b];
-    nlohmann::json bj = {{"ball", listed[b].name}, {"status", f.status}, {"candidate", f.candidate}, {"note", f.note}};
+    nlohmann::json bj = {{"ball", listed[b].name},
+                         {"kind", to_string(listed[b].kind)},
+                         {"status", f.status},
+                         {"candidate", f.candidate},
+                         {"note", f.note}};
     if (f.candidate >= 0) {
       const BallCandidate& c = v.candidates[std::size_t(f.candidate)];
       bj.update({{"centre_px", {c.loc.centre_px.x(), c.loc.centre_px.y()}},

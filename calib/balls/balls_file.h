@@ -5,7 +5,7 @@
 //    "balls": [{"name", "kind", "diameter_m" (or null)}],       the listed balls
 //    "views": [{"name", "size": [w, h],
 //               "lens": {"model", "intrinsics", "size"},        what the cones were fitted through
-//               "balls": [{"ball", "status", "candidate", "note",          per listed ball
+//               "balls": [{"ball", "kind", "status", "candidate", "note",  per listed ball
 //                          "centre_px", "radius_px", "confidence",         when found
 //                          "offset_from_chrome"}],
 //               "candidates": [{"centre_px", "radius_px", "cone": {"axis", "half_angle"},

@@ -69,7 +69,8 @@ ShootBalls find_shoot_balls(const ShootBallsInput& in) {
         try {
           vc.cands.push_back(given_ball(image.radiance, fv.lens, *g));
         } catch (const std::invalid_argument& e) {
-          throw std::invalid_argument(fv.name + ": ball " + listed[b].name + " given by --ball: " + e.what());
+          throw std::invalid_argument("balls: view " + fv.name + ": ball " + listed[b].name +
+                                      " given by --ball: " + e.what());
         }
         vc.pick[b] = int(vc.cands.size()) - 1;
         given_flag.back()[b] = 1;
@@ -87,7 +88,7 @@ ShootBalls find_shoot_balls(const ShootBallsInput& in) {
       if (share > 0.02) {
         const std::string suspect = v < in.suspect_bracket.size() ? in.suspect_bracket[v] : "";
         throw std::invalid_argument(
-            "view " + fv.name + ": " + std::to_string(int(std::lround(100 * share))) +
+            "balls: view " + fv.name + ": " + std::to_string(int(std::lround(100 * share))) +
             "% of its ball's pixels disagree between brackets (a ghost: a bracket taken from another place, or cropped "
             "elsewhere); leave that bracket out of photoset.yaml" +
             (suspect.empty() ? "" : " (the one registration left furthest off: " + suspect + ")"));

@@ -67,7 +67,7 @@ struct ShootBallsInput {
 // largest ball found; -1 when none is found.
 int main_ball(const FoundView& view, const std::vector<ListedBall>& listed);
 
-// Throws std::invalid_argument when a given ball is not found at its guess ("VIEW: ..."), and when
+// Throws std::invalid_argument when a given ball is not found at its guess ("balls: view VIEW: ..."), and when
 // more than 2% of a view's main ball's pixels are flagged as ghosts by the merge (hdr/merge.h kGhost:
 // a bracket taken from another place, or cropped elsewhere), whose outline would be found wrong
 // (a well registered shoot has under 0.1%).
