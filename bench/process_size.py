@@ -21,7 +21,6 @@ import glob
 import json
 import os
 import platform
-import subprocess
 import sys
 import tempfile
 import time
@@ -31,6 +30,7 @@ import cv2
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from doc_section import write_section  # noqa: E402
+from timed_command import timed_run  # noqa: E402
 
 SCENE = """rsibr_synth: 1
 seed: 21
@@ -59,16 +59,7 @@ truth_map_size: 48
 
 
 def run(cmd):
-    """Wall seconds and peak RSS (MiB) of one command (wait4's rusage of that child alone)."""
-    t0 = time.perf_counter()
-    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(p.pid, 0)
-    wall = time.perf_counter() - t0
-    err = p.stderr.read().decode()
-    p.stderr.close()
-    if os.waitstatus_to_exitcode(status) != 0:
-        sys.exit(f"process_size: {' '.join(cmd)} failed:\n{err}")
-    return wall, usage.ru_maxrss / 1024.0
+    return timed_run(cmd, "process_size")
 
 
 def decode_floor(photos):

@@ -115,6 +115,12 @@ void run_step(Context& c, const std::string& step, const nlohmann::json& setting
   c.result.steps.push_back(outcome);
 }
 
+// A step's files and summary into its record.
+void take(StepRecord& r, StepOutputs o) {
+  r.outputs = std::move(o.files);
+  r.summary = std::move(o.summary);
+}
+
 // A view's merged image; view names are safe file names (core/safe_name.h), checked again here.
 fs::path merged_path(const Context& c, const std::string& view) { return file_in_folder(c.dir / "hdr", view + ".exr"); }
 
@@ -177,11 +183,8 @@ void step_calibrate(Context& c) {
 void step_hdr(Context& c) {
   if (!c.o.radiance_dir.empty()) {
     const std::vector<fs::path> inputs = given_radiance_files(c.set, c.o.radiance_dir);
-    run_step(c, "hdr", {{"response", "given radiance"}, {"radiance", c.o.radiance_dir}}, inputs, [&](StepRecord& r) {
-      StepOutputs m = run_given_radiance_step(c.set, inputs, c.o.radiance_dir, c.dir / "hdr");
-      r.outputs = std::move(m.files);
-      r.summary = std::move(m.summary);
-    });
+    run_step(c, "hdr", {{"response", "given radiance"}, {"radiance", c.o.radiance_dir}}, inputs,
+             [&](StepRecord& r) { take(r, run_given_radiance_step(c.set, inputs, c.o.radiance_dir, c.dir / "hdr")); });
     return;
   }
   std::vector<fs::path> inputs;
@@ -199,11 +202,7 @@ void step_hdr(Context& c) {
   s.progress = c.o.progress;
   const std::string input_space = !c.o.input_colour_space.empty() ? c.o.input_colour_space : c.set.camera_colour_space;
   run_step(c, "hdr", {{"response", "auto"}, {"vignetting", c.o.vignetting}, {"input_colour_space", input_space}},
-           inputs, [&](StepRecord& r) {
-             StepOutputs m = run_hdr_step(s);
-             r.outputs = std::move(m.files);
-             r.summary = std::move(m.summary);
-           });
+           inputs, [&](StepRecord& r) { take(r, run_hdr_step(s)); });
 }
 
 // ---- balls: every listed ball of every view found once (calib/balls/shoot_balls.h), through the
@@ -407,11 +406,7 @@ void step_probe(Context& c) {
   const nlohmann::json settings = s.given.empty() ? nlohmann::json{{"width", s.width}, {"fresnel", s.chrome_fresnel}}
                                                   : nlohmann::json{{"width", s.width}, {"given", s.given}};
   const std::vector<fs::path> inputs = s.given.empty() ? s.chrome_maps : std::vector<fs::path>{s.given};
-  run_step(c, "probe", settings, inputs, [&](StepRecord& r) {
-    StepOutputs o = run_probe_step(s);
-    r.outputs = std::move(o.files);
-    r.summary = std::move(o.summary);
-  });
+  run_step(c, "probe", settings, inputs, [&](StepRecord& r) { take(r, run_probe_step(s)); });
 }
 
 // ---- sources: the clipped light recovered from the grey and glossy balls -> DIR/probe.exr.
@@ -472,11 +467,7 @@ void step_bake(Context& c) {
       {"albedo", c.o.grey_albedo}, {"method", c.o.bake_method}, {"samples", c.o.bake_samples}, {"seed", c.o.seed}};
   if (c.o.bake_max_error > 0)
     settings = {{"albedo", c.o.grey_albedo}, {"max_error", c.o.bake_max_error}, {"seed", c.o.seed}};
-  run_step(c, "bake", settings, inputs, [&](StepRecord& r) {
-    StepOutputs o = run_bake_step(s);
-    r.outputs = std::move(o.files);
-    r.summary = std::move(o.summary);
-  });
+  run_step(c, "bake", settings, inputs, [&](StepRecord& r) { take(r, run_bake_step(s)); });
 }
 
 // ---- compare: captured against computed, per grey ball (pipeline/compare_step.h) -> DIR/compare/.
@@ -488,11 +479,7 @@ void step_compare(Context& c) {
     s.balls.push_back({b->name, captured_path(c, *b), computed_path(c, *b)});
     inputs.push_back(s.balls.back().captured), inputs.push_back(s.balls.back().computed);
   }
-  run_step(c, "compare", nlohmann::json::object(), inputs, [&](StepRecord& r) {
-    StepOutputs o = run_compare_step(s);
-    r.outputs = std::move(o.files);
-    r.summary = std::move(o.summary);
-  });
+  run_step(c, "compare", nlohmann::json::object(), inputs, [&](StepRecord& r) { take(r, run_compare_step(s)); });
 }
 
 // ---- render: a turntable of a mesh lit by the probe, through the runtime (pipeline/render_step.h)
@@ -514,11 +501,7 @@ void step_render(Context& c) {
   const nlohmann::json settings = {{"brdf", c.o.render_brdf}, {"res", c.o.render_views_res},
                                    {"frames", c.o.turntable}, {"size", {c.o.render_width, c.o.render_height}},
                                    {"seed", c.o.seed},        {"mesh", c.o.mesh.empty() ? "built-in torus" : c.o.mesh}};
-  run_step(c, "render", settings, inputs, [&](StepRecord& r) {
-    StepOutputs o = run_render_step(s);
-    r.outputs = std::move(o.files);
-    r.summary = std::move(o.summary);
-  });
+  run_step(c, "render", settings, inputs, [&](StepRecord& r) { take(r, run_render_step(s)); });
 }
 
 }  // namespace
