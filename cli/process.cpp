@@ -79,7 +79,8 @@ Runner add_process(CLI::App& app) {
   c->footer(
       "Steps (each skipped when its inputs and outputs hold what its record says and its settings are unchanged; records in "
       "DIR/steps/<step>.json): calibrate (chessboards, --lens, or the photos' EXIF and the lensfun database) -> hdr "
-      "(response, vignetting, merge per view) -> lens (a lens from the EXIF: its focal length refined from the balls' "
+      "(response, vignetting, merge per view) -> balls (every listed ball of every view found once, DIR/balls.json, "
+      "candidates drawn in DIR/balls/<view>.png) -> lens (a lens from the EXIF: its focal length refined from the balls' "
       "outlines; --no-self-calibration: not) -> orient "
       "(solved from the chrome ball's features, world up estimated, or --poses) -> extract (every listed ball of every view, "
       "identified and checked across views; a ball not found in a view is left out and reported; chrome by reflection "

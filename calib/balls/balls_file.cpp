@@ -4,6 +4,7 @@
 #include "formats/atomic_file.h"
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -19,6 +20,16 @@ constexpr int kVersion = 1;
 nlohmann::json number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 double number(const nlohmann::json& j) {
   return j.is_null() ? std::numeric_limits<double>::infinity() : j.get<double>();
+}
+
+// An int field: a JSON integer in int's range (a float would be cast, out of range undefined).
+int integer(const nlohmann::json& j) {
+  if (!j.is_number_integer()) throw std::invalid_argument("expected an integer, got " + j.dump());
+  if (j.is_number_unsigned() ? j.get<std::uint64_t>() > std::uint64_t(std::numeric_limits<int>::max())
+                             : (j.get<std::int64_t>() < std::numeric_limits<int>::min() ||
+                                j.get<std::int64_t>() > std::numeric_limits<int>::max()))
+    throw std::invalid_argument("integer out of range: " + j.dump());
+  return int(j.get<std::int64_t>());
 }
 
 nlohmann::json candidate_json(const BallCandidate& c) {
@@ -55,8 +66,8 @@ BallCandidate candidate_from_json(const nlohmann::json& j) {
   l.fit.cone.axis = Vec3(a.at(0).get<double>(), a.at(1).get<double>(), a.at(2).get<double>());
   l.fit.cone.half_angle = j.at("cone").at("half_angle").get<double>();
   l.fit.rms_px = j.at("rms_px").get<double>();
-  l.fit.inliers = j.at("inliers").get<int>();
-  l.lines_inside = j.at("lines_inside").get<int>();
+  l.fit.inliers = integer(j.at("inliers"));
+  l.lines_inside = integer(j.at("lines_inside"));
   const nlohmann::json& o = j.at("outline_px");
   if (!o.is_array() || o.size() % 2) throw std::invalid_argument("outline_px: expected x, y pairs");
   for (std::size_t i = 0; i < o.size(); i += 2) l.outline_px.emplace_back(o[i].get<double>(), o[i + 1].get<double>());
@@ -180,8 +191,8 @@ ShootBalls read_balls_file(const std::filesystem::path& file) {
   try {
     const nlohmann::json j = nlohmann::json::parse(text.str());
     if (j.at("format").get<std::string>() != "rsibr-balls") throw std::invalid_argument("not an rsibr balls file");
-    if (j.at("version").get<int>() != kVersion)
-      throw std::invalid_argument("version " + std::to_string(j.at("version").get<int>()) + ", this rsibr reads " +
+    if (integer(j.at("version")) != kVersion)
+      throw std::invalid_argument("version " + std::to_string(integer(j.at("version"))) + ", this rsibr reads " +
                                   std::to_string(kVersion));
     ShootBalls out;
     for (const nlohmann::json& b : j.at("balls")) {
@@ -192,18 +203,19 @@ ShootBalls read_balls_file(const std::filesystem::path& file) {
     for (const nlohmann::json& vj : j.at("views")) {
       FoundView v;
       v.name = vj.at("name").get<std::string>();
-      v.width = vj.at("size").at(0).get<int>();
-      v.height = vj.at("size").at(1).get<int>();
+      v.width = integer(vj.at("size").at(0));
+      v.height = integer(vj.at("size").at(1));
+      if (v.width <= 0 || v.height <= 0) throw std::invalid_argument("view " + v.name + ": size must be positive");
       const nlohmann::json& lj = vj.at("lens");
       v.lens = LensModel(lj.at("model").get<std::string>(), lj.at("intrinsics").get<std::vector<double>>(),
-                         lj.at("size").at(0).get<int>(), lj.at("size").at(1).get<int>());
+                         integer(lj.at("size").at(0)), integer(lj.at("size").at(1)));
       for (const nlohmann::json& c : vj.at("candidates")) v.candidates.push_back(candidate_from_json(c));
       const nlohmann::json& bs = vj.at("balls");
       if (bs.size() != out.listed.size())
         throw std::invalid_argument("view " + v.name + ": " + std::to_string(bs.size()) + " balls, " +
                                     std::to_string(out.listed.size()) + " listed");
       for (std::size_t b = 0; b < bs.size(); ++b) {
-        FoundBall f{bs[b].at("status").get<std::string>(), bs[b].at("candidate").get<int>(),
+        FoundBall f{bs[b].at("status").get<std::string>(), integer(bs[b].at("candidate")),
                     bs[b].at("note").get<std::string>()};
         if (bs[b].at("ball").get<std::string>() != out.listed[b].name)
           throw std::invalid_argument("view " + v.name + ": ball " + std::to_string(b) + " is not " +
