@@ -230,15 +230,17 @@ void step_balls(Context& c) {
   run_step(c, "balls", {{"balls", balls}, {"given", given}}, inputs, [&](StepRecord& r) {
     in.lens = LensModel::read(c.dir / "camera.cameramodel");
     in.read_view = [&](std::size_t v) { return read_view_image(merged_path(c, c.set.views[v].name).string()); };
-    nlohmann::json pictures = nlohmann::json::array();
+    // Each view's candidates drawn as it is searched (views in parallel); listed in view order.
+    fs::create_directories(c.dir / "balls");
     in.seen = [&](std::size_t v, const cv::Mat& radiance, const ViewCandidates& vc) {
-      fs::create_directories(c.dir / "balls");
-      const fs::path f = file_in_folder(c.dir / "balls", c.set.views[v].name + ".png");
-      write_ball_candidates_picture(f, radiance, vc);
-      r.outputs.push_back(f);
-      pictures.push_back(fs::relative(f, c.dir).string());
+      write_ball_candidates_picture(file_in_folder(c.dir / "balls", c.set.views[v].name + ".png"), radiance, vc);
     };
     const ShootBalls found = find_shoot_balls(in);
+    nlohmann::json pictures = nlohmann::json::array();
+    for (const PhotoView& v : c.set.views) {
+      r.outputs.push_back(file_in_folder(c.dir / "balls", v.name + ".png"));
+      pictures.push_back(fs::relative(r.outputs.back(), c.dir).string());
+    }
     write_balls_file(c.dir / "balls.json", found);
     r.outputs.push_back(c.dir / "balls.json");
     r.summary = balls_summary_json(found);

@@ -2,8 +2,13 @@
 
 #include "hdr/merge.h"
 
+#include <tbb/parallel_for.h>
+
 #include <cmath>
+#include <exception>
+#include <mutex>
 #include <stdexcept>
+#include <utility>
 
 namespace rsibr {
 
@@ -45,57 +50,84 @@ double ghost_share(const cv::Mat& flags, const Vec2& c, double radius) {
 
 }  // namespace
 
+namespace {
+
+// One view's search: its candidates, the listed balls matched in it, the given ones located.
+std::pair<FoundView, ViewCandidates> find_view_balls(const ShootBallsInput& in, const std::vector<ListedBall>& listed,
+                                                     std::size_t v, std::mutex& seen_mutex) {
+  const ViewImage image = in.read_view(v);
+  FoundView fv;
+  fv.name = in.views[v];
+  fv.width = image.radiance.cols;
+  fv.height = image.radiance.rows;
+  // A view of another size than the lens (a crop): a pinhole of its diagonal, whose cones only
+  // the lens step's far camera will make sense of.
+  const bool fits = fv.width == in.lens.width() && fv.height == in.lens.height();
+  fv.lens = fits ? in.lens : LensModel::pinhole(std::hypot(double(fv.width), double(fv.height)), fv.width, fv.height);
+  ViewCandidates vc = view_candidates(image.radiance, fv.lens, listed, in.search);
+  std::vector<char> given(listed.size(), 0);
+  for (std::size_t b = 0; b < listed.size() && v < in.given.size() && b < in.given[v].size(); ++b)
+    if (const auto& g = in.given[v][b]) {
+      try {
+        vc.cands.push_back(given_ball(image.radiance, fv.lens, *g));
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument("balls: view " + fv.name + ": ball " + listed[b].name +
+                                    " given by --ball: " + e.what());
+      }
+      vc.pick[b] = int(vc.cands.size()) - 1;
+      given[b] = 1;
+    }
+  if (in.seen) {
+    const std::lock_guard<std::mutex> lock(seen_mutex);
+    in.seen(v, image.radiance, vc);
+  }
+  fv.candidates = vc.cands;
+  fv.balls.resize(listed.size());
+  for (std::size_t b = 0; b < listed.size(); ++b)
+    if (vc.pick[b] >= 0) fv.balls[b] = {given[b] ? "given" : "found", vc.pick[b], ""};
+  // A ball whose pixels the brackets disagree on has a ghost outline in the merge: found there,
+  // it would be found wrong.
+  if (const int k = main_ball(fv, listed); k >= 0) {
+    const BallLocation& loc = fv.candidates[std::size_t(k)].loc;
+    const double share = ghost_share(image.flags, loc.centre_px, loc.radius_px);
+    if (share > 0.02) {
+      const std::string suspect = v < in.suspect_bracket.size() ? in.suspect_bracket[v] : "";
+      throw std::invalid_argument(
+          "balls: view " + fv.name + ": " + std::to_string(int(std::lround(100 * share))) +
+          "% of its ball's pixels disagree between brackets (a ghost: a bracket taken from another place, or cropped "
+          "elsewhere); leave that bracket out of photoset.yaml" +
+          (suspect.empty() ? "" : " (the one registration left furthest off: " + suspect + ")"));
+    }
+  }
+  return {std::move(fv), std::move(vc)};
+}
+
+}  // namespace
+
 ShootBalls find_shoot_balls(const ShootBallsInput& in) {
   if (!in.read_view) throw std::invalid_argument("balls: no reader of the merged views");
   ShootBalls out;
   out.listed = in.listed.empty() ? std::vector<ListedBall>{{"chrome", BallKind::chrome, {}}} : in.listed;
   const std::vector<ListedBall>& listed = out.listed;
-  std::vector<std::optional<ViewCandidates>> searched;
-  std::vector<std::vector<char>> given_flag;
-  for (std::size_t v = 0; v < in.views.size(); ++v) {
-    const ViewImage image = in.read_view(v);
-    FoundView fv;
-    fv.name = in.views[v];
-    fv.width = image.radiance.cols;
-    fv.height = image.radiance.rows;
-    // A view of another size than the lens (a crop): a pinhole of its diagonal, whose cones only
-    // the lens step's far camera will make sense of.
-    const bool fits = fv.width == in.lens.width() && fv.height == in.lens.height();
-    fv.lens = fits ? in.lens : LensModel::pinhole(std::hypot(double(fv.width), double(fv.height)), fv.width, fv.height);
-    ViewCandidates vc = view_candidates(image.radiance, fv.lens, listed, in.search);
-    given_flag.emplace_back(listed.size(), 0);
-    for (std::size_t b = 0; b < listed.size() && v < in.given.size() && b < in.given[v].size(); ++b)
-      if (const auto& g = in.given[v][b]) {
-        try {
-          vc.cands.push_back(given_ball(image.radiance, fv.lens, *g));
-        } catch (const std::invalid_argument& e) {
-          throw std::invalid_argument("balls: view " + fv.name + ": ball " + listed[b].name +
-                                      " given by --ball: " + e.what());
-        }
-        vc.pick[b] = int(vc.cands.size()) - 1;
-        given_flag.back()[b] = 1;
-      }
-    if (in.seen) in.seen(v, image.radiance, vc);
-    fv.candidates = vc.cands;
-    fv.balls.resize(listed.size());
-    for (std::size_t b = 0; b < listed.size(); ++b)
-      if (vc.pick[b] >= 0) fv.balls[b] = {given_flag.back()[b] ? "given" : "found", vc.pick[b], ""};
-    // A ball whose pixels the brackets disagree on has a ghost outline in the merge: found there,
-    // it would be found wrong.
-    if (const int k = main_ball(fv, listed); k >= 0) {
-      const BallLocation& loc = fv.candidates[std::size_t(k)].loc;
-      const double share = ghost_share(image.flags, loc.centre_px, loc.radius_px);
-      if (share > 0.02) {
-        const std::string suspect = v < in.suspect_bracket.size() ? in.suspect_bracket[v] : "";
-        throw std::invalid_argument(
-            "balls: view " + fv.name + ": " + std::to_string(int(std::lround(100 * share))) +
-            "% of its ball's pixels disagree between brackets (a ghost: a bracket taken from another place, or cropped "
-            "elsewhere); leave that bracket out of photoset.yaml" +
-            (suspect.empty() ? "" : " (the one registration left furthest off: " + suspect + ")"));
-      }
+  // The views in parallel (one view's search is mostly serial); the first error in view order is
+  // the one reported, whichever thread met it first.
+  const std::size_t n = in.views.size();
+  std::vector<std::optional<std::pair<FoundView, ViewCandidates>>> found(n);
+  std::vector<std::exception_ptr> errors(n);
+  std::mutex seen_mutex;
+  tbb::parallel_for(std::size_t(0), n, [&](std::size_t v) {
+    try {
+      found[v] = find_view_balls(in, listed, v, seen_mutex);
+    } catch (...) {
+      errors[v] = std::current_exception();
     }
-    searched.push_back(std::move(vc));
-    out.views.push_back(std::move(fv));
+  });
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
+  std::vector<std::optional<ViewCandidates>> searched;
+  for (auto& f : found) {
+    out.views.push_back(std::move(f->first));
+    searched.push_back(std::move(f->second));
   }
   // A chrome ball no appearance test accepted, placed by its distance from another ball.
   const std::vector<ChromeRescue> rescued = rescue_chrome_balls(searched, listed, in.search);

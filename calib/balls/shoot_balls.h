@@ -59,7 +59,8 @@ struct ShootBallsInput {
   // Per view: the bracket its registration left furthest off (for a ghost's error), or "".
   std::vector<std::string> suspect_bracket;
   BallSearchOptions search;
-  // Called once per view with its image and candidates (for the candidates picture); may be empty.
+  // Called once per view with its image and candidates (for the candidates picture), one call at a
+  // time; may be empty.
   std::function<void(std::size_t view, const cv::Mat& radiance, const ViewCandidates& found)> seen;
 };
 
@@ -67,7 +68,10 @@ struct ShootBallsInput {
 // largest ball found; -1 when none is found.
 int main_ball(const FoundView& view, const std::vector<ListedBall>& listed);
 
-// Throws std::invalid_argument when a given ball is not found at its guess ("balls: view VIEW: ..."), and when
+// The views are searched in parallel, as many at once as there are threads (each holds its image);
+// `read_view` must be safe to call from several threads, and `seen` is called under a lock, in no
+// particular order. The result does not depend on the threads. Throws std::invalid_argument when a
+// given ball is not found at its guess ("balls: view VIEW: ..."), and when
 // more than 2% of a view's main ball's pixels are flagged as ghosts by the merge (hdr/merge.h kGhost:
 // a bracket taken from another place, or cropped elsewhere), whose outline would be found wrong
 // (a well registered shoot has under 0.1%).
