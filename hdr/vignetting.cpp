@@ -1,5 +1,6 @@
 #include "hdr/vignetting.h"
 
+#include "formats/json_error.h"
 #include "hdr/raw_image.h"
 #include "formats/image_codecs.h"
 
@@ -307,11 +308,8 @@ Vignetting vignetting_from_json(const nlohmann::json& j, const std::string& what
         throw std::invalid_argument("the polynomial falls below 0.05 inside the image");
     return v;
   } catch (const nlohmann::json::exception& e) {
-    // nlohmann's "[json.exception.KIND.N] " prefix says nothing to a user.
-    std::string why = e.what();
-    if (const std::size_t end = why.find("] "); !why.empty() && why[0] == '[' && end != std::string::npos)
-      why = why.substr(end + 2);
-    throw std::invalid_argument(what + ": not a vignetting model ({model: pa, centre_px, r_corner_px, k}): " + why);
+    throw std::invalid_argument(
+        what + ": not a vignetting model ({model: pa, centre_px, r_corner_px, k}): " + json_error_text(e));
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(what + ": " + e.what());
   }

@@ -1,5 +1,6 @@
 #include "calib/balls/balls_file.h"
 
+#include "formats/json_error.h"
 #include "core/vec.h"
 #include "formats/atomic_file.h"
 
@@ -231,11 +232,7 @@ ShootBalls read_balls_file(const std::filesystem::path& file) {
     }
     return out;
   } catch (const nlohmann::json::exception& e) {
-    // nlohmann's "[json.exception.KIND.N] " prefix says nothing to a user.
-    std::string why = e.what();
-    if (const std::size_t end = why.find("] "); !why.empty() && why[0] == '[' && end != std::string::npos)
-      why = why.substr(end + 2);
-    throw std::invalid_argument(what + ": not an rsibr balls file: " + why);
+    throw std::invalid_argument(what + ": not an rsibr balls file: " + json_error_text(e));
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(what + ": " + e.what());
   }
