@@ -143,4 +143,14 @@ ConeFit fit_cone(const std::vector<Vec3>& rays, const LensModel& lens, const Con
   return fit;
 }
 
+ConeCircle cone_circle(const BallCone& cone, const LensModel& lens) {
+  ConeCircle c;
+  c.centre_px = lens.project(cone.axis);
+  const std::vector<Vec2> outline = cone_outline(cone, lens, 64);
+  double sum = 0;
+  for (const Vec2& q : outline) sum += (q - c.centre_px).norm();
+  c.radius_px = sum / double(outline.size());
+  return c;
+}
+
 }  // namespace rsibr

@@ -64,4 +64,12 @@ double pixels_per_radian(const LensModel& lens, const Vec3& axis, const Vec3& d)
 // The cone's outline as n pixel positions (rays at angle alpha around the axis, projected).
 std::vector<Vec2> cone_outline(const BallCone& cone, const LensModel& lens, int n);
 
+// The ball's circle in the image: its centre pixel (lens.project(axis)) and the mean distance of
+// its outline (64 points) from it.
+struct ConeCircle {
+  Vec2 centre_px = Vec2::Zero();
+  double radius_px = 0;
+};
+ConeCircle cone_circle(const BallCone& cone, const LensModel& lens);
+
 }  // namespace rsibr

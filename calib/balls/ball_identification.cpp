@@ -748,11 +748,9 @@ BallLocation refit_outline_excluding(const BallLocation& ball, const LensModel& 
     return ball;
   }
   out.outline_px = kept;
-  out.centre_px = lens.project(out.fit.cone.axis);
-  double sum = 0;
-  const std::vector<Vec2> outline = cone_outline(out.fit.cone, lens, 64);
-  for (const Vec2& q : outline) sum += (q - out.centre_px).norm();
-  out.radius_px = sum / double(outline.size());
+  const ConeCircle circle = cone_circle(out.fit.cone, lens);
+  out.centre_px = circle.centre_px;
+  out.radius_px = circle.radius_px;
   return out;
 }
 
@@ -848,11 +846,9 @@ std::vector<BallFinding> identify_view_balls(const ViewBalls& view, const std::v
       if (!have) {
         BallLocation loc;
         loc.fit.cone = *view.chrome;
-        loc.centre_px = lens.project(view.chrome->axis);
-        const std::vector<Vec2> o = cone_outline(*view.chrome, lens, 64);
-        double s = 0;
-        for (const Vec2& q : o) s += (q - loc.centre_px).norm();
-        loc.radius_px = s / double(o.size());
+        const ConeCircle circle = cone_circle(*view.chrome, lens);
+        loc.centre_px = circle.centre_px;
+        loc.radius_px = circle.radius_px;
         c = measure_ball(image, lens, loc);
         c.inlier_fraction = 1;
       }
@@ -874,13 +870,9 @@ std::vector<BallFinding> identify_view_balls(const ViewBalls& view, const std::v
       continue;
     }
     const BallCone pred = predicted_cone(*view.chrome, view.world_from_cam, m.offset, m.scale);
-    const Vec2 pc = lens.project(pred.axis);
-    double pr = 0;
-    {
-      const std::vector<Vec2> o = cone_outline(pred, lens, 64);
-      for (const Vec2& q : o) pr += (q - pc).norm();
-      pr /= double(o.size());
-    }
+    const ConeCircle predicted = cone_circle(pred, lens);
+    const Vec2 pc = predicted.centre_px;
+    const double pr = predicted.radius_px;
     f.predicted_px = pc;
     f.predicted_radius_px = pr;
     const double tol = tolerance(ro, view, pred, m.scale);

@@ -201,11 +201,9 @@ BallLocation locate_ball(const cv::Mat& image, const LensModel& lens, const Ball
     }
   }
   loc.fit = fit;
-  loc.centre_px = lens.project(fit.cone.axis);
-  double sum = 0;
-  const std::vector<Vec2> outline = cone_outline(fit.cone, lens, 64);
-  for (const Vec2& q : outline) sum += (q - loc.centre_px).norm();
-  loc.radius_px = sum / outline.size();
+  const ConeCircle circle = cone_circle(fit.cone, lens);
+  loc.centre_px = circle.centre_px;
+  loc.radius_px = circle.radius_px;
   return loc;
 }
 

@@ -149,11 +149,9 @@ BallCandidate candidate_with_lens(const BallCandidate& c, const LensModel& lens)
   ConeFitOptions fit;
   fit.ransac_iterations = 0;
   out.loc.fit = fit_cone(rays, lens, fit);
-  out.loc.centre_px = lens.project(out.loc.fit.cone.axis);
-  double sum = 0;
-  const std::vector<Vec2> outline = cone_outline(out.loc.fit.cone, lens, 64);
-  for (const Vec2& q : outline) sum += (q - out.loc.centre_px).norm();
-  out.loc.radius_px = sum / double(outline.size());
+  const ConeCircle circle = cone_circle(out.loc.fit.cone, lens);
+  out.loc.centre_px = circle.centre_px;
+  out.loc.radius_px = circle.radius_px;
   measure_outline(out, lens);
   return out;
 }
