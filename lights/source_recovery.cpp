@@ -8,6 +8,7 @@
 #include "core/parallel.h"
 #include "core/sphere_map.h"
 #include "hdr/nnls.h"
+#include "lights/grey_source_cost.h"
 
 #include <ceres/ceres.h>
 
@@ -25,15 +26,10 @@ namespace {
 
 constexpr int kBlock = 6;  // per source: u1, u2 (direction offset), P (RGB), rho
 
-// One trusted texel of a captured ball map.
-struct Texel {
-  Vec3 n;          // world normal
-  Vec3 v;          // world view direction (glossy)
-  Vec3 obs;        // captured value O
-  Vec3 known;      // the known part's prediction
-  Vec3 inv_scale;  // 1 / max(O, floor) per channel
-  Vec3 gain;       // grey: albedo / pi; glossy: 1
-  double sqrt_w = 1;
+// One trusted texel of a captured ball map (the grey residual's fields, lights/grey_source_cost.h,
+// and the glossy ones).
+struct Texel : GreyObservation {
+  Vec3 v;                      // world view direction (glossy)
   int ball = 0;                // index over grey then glossy balls
   int view = 0;                // index over distinct image names
   const Brdf* brdf = nullptr;  // glossy only
@@ -41,30 +37,9 @@ struct Texel {
   double lobe = 0;             // glossy: the lobe's width (rad, bake/brdf.h), 0 for a normal lobe
 };
 
-// A source's direction as a bounded offset in the tangent plane of its region's centroid:
-// d(u) = normalize(d0 + u1 t1 + u2 t2), |u_k| <= bound = tan(region radius).
-struct Frame {
-  Vec3 d0, t1, t2;
-  double bound = 0, max_radius = 0;
-};
+using Frame = SourceFrame;
 
-template <typename T>
-void direction_of(const Frame& f, const T* x, T* d) {
-  T len2(0);
-  for (int k = 0; k < 3; ++k) {
-    d[k] = T(f.d0[k]) + x[0] * T(f.t1[k]) + x[1] * T(f.t2[k]);
-    len2 += d[k] * d[k];
-  }
-  using std::sqrt;
-  const T len = sqrt(len2);
-  for (int k = 0; k < 3; ++k) d[k] /= len;
-}
-
-Vec3 direction_of(const Frame& f, const double* x) {
-  double d[3];
-  direction_of(f, x, d);
-  return Vec3(d[0], d[1], d[2]);
-}
+Vec3 direction_of(const Frame& f, const double* x) { return source_direction(f, x); }
 
 // The glossy ball's kernel: the mean over the cap of eval (cosine included), per channel.
 Vec3 glossy_kernel(const Texel& t, const Vec3& d, double rho) {
@@ -90,24 +65,6 @@ Vec3 kernel(const Texel& t, const Vec3& d, double rho) {
   if (t.brdf) return glossy_kernel(t, d, rho);
   return t.gain * light_kernels::mean_clamped_cosine(t.n.dot(d), rho);
 }
-
-struct GreyCost {
-  const Texel* t;
-  const std::vector<Frame>* frames;
-  template <typename T>
-  bool operator()(T const* const* x, T* r) const {
-    T m[3] = {T(t->known[0]), T(t->known[1]), T(t->known[2])};
-    for (std::size_t s = 0; s < frames->size(); ++s) {
-      T d[3];
-      direction_of((*frames)[s], x[s], d);
-      const T c = T(t->n[0]) * d[0] + T(t->n[1]) * d[1] + T(t->n[2]) * d[2];
-      const T k = light_kernels::mean_clamped_cosine(c, x[s][5]);
-      for (int ch = 0; ch < 3; ++ch) m[ch] += x[s][2 + ch] * T(t->gain[ch]) * k;
-    }
-    for (int ch = 0; ch < 3; ++ch) r[ch] = T(t->sqrt_w * t->inv_scale[ch]) * (T(t->obs[ch]) - m[ch]);
-    return true;
-  }
-};
 
 struct GlossyCost {
   const Texel* t;
@@ -221,23 +178,22 @@ Fit refine(const std::vector<Texel>& texels, const std::vector<Frame>& frames,
       if (angle_between(t.mirror, f.d0) <= f.max_radius + f.max_radius + 2 * t.lobe) return true;
     return false;
   };
+  // The grey texels in one block (lights/grey_source_cost.h: Huber per texel inside it); each
+  // glossy texel its own, numerically differentiated.
+  std::vector<const GreyObservation*> grey;
   for (std::size_t i = 0; i < texels.size(); ++i) {
     if ((!use.empty() && !use[i]) || !reachable(texels[i])) continue;
-    ceres::CostFunction* cost = nullptr;
-    if (texels[i].brdf) {
-      auto* c = new ceres::DynamicNumericDiffCostFunction<GlossyCost>(new GlossyCost{&texels[i], &frames});
-      for (int s = 0; s < S; ++s) c->AddParameterBlock(kBlock);
-      c->SetNumResiduals(3);
-      cost = c;
-    } else {
-      auto* c = new ceres::DynamicAutoDiffCostFunction<GreyCost, kBlock>(new GreyCost{&texels[i], &frames});
-      for (int s = 0; s < S; ++s) c->AddParameterBlock(kBlock);
-      c->SetNumResiduals(3);
-      cost = c;
-    }
-    problem.AddResidualBlock(cost, delta > 0 ? new ceres::HuberLoss(delta) : nullptr, blocks);
     ++used;
+    if (!texels[i].brdf) {
+      grey.push_back(&texels[i]);
+      continue;
+    }
+    auto* c = new ceres::DynamicNumericDiffCostFunction<GlossyCost>(new GlossyCost{&texels[i], &frames});
+    for (int s = 0; s < S; ++s) c->AddParameterBlock(kBlock);
+    c->SetNumResiduals(3);
+    problem.AddResidualBlock(c, delta > 0 ? new ceres::HuberLoss(delta) : nullptr, blocks);
   }
+  if (!grey.empty()) problem.AddResidualBlock(new GreySourceCost(std::move(grey), &frames, delta), nullptr, blocks);
   if (used == 0) {
     fit.x = x;
     return fit;
@@ -259,7 +215,7 @@ Fit refine(const std::vector<Texel>& texels, const std::vector<Frame>& frames,
     }
   }
   ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
+  so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   so.max_num_iterations = iterations;
   so.function_tolerance = 1e-10;
   so.parameter_tolerance = 1e-10;
@@ -519,13 +475,14 @@ std::vector<std::vector<std::array<double, kBlock>>> jackknife_folds(
     const TrustedTexels& all, const std::vector<Frame>& frames, const std::vector<std::array<double, kBlock>>& x,
     double delta, bool fit_radius, const SourceRecoveryOptions& options,
     const std::map<std::string, EnvMap>& known_without) {
-  std::vector<std::vector<std::array<double, kBlock>>> folds;
   const std::vector<Texel>& texels = all.texels;
-  for (std::size_t v = 0; v < all.view_names.size(); ++v) {
+  // The folds are independent problems: solved in parallel, each into its own slot.
+  std::vector<std::vector<std::array<double, kBlock>>> folds(all.view_names.size());
+  parallel_for_rows(int(all.view_names.size()), [&](int v) {
     std::vector<char> use(texels.size());
-    for (std::size_t i = 0; i < texels.size(); ++i) use[i] = texels[i].view != int(v);
+    for (std::size_t i = 0; i < texels.size(); ++i) use[i] = texels[i].view != v;
     std::vector<Texel> refolded;
-    if (const auto it = known_without.find(all.view_names[v]); it != known_without.end()) {
+    if (const auto it = known_without.find(all.view_names[std::size_t(v)]); it != known_without.end()) {
       const KnownIrradiance fold_irradiance(it->second, options.known_width);
       refolded = texels;
       parallel_for_rows(int(refolded.size()), [&](int i) {
@@ -533,9 +490,9 @@ std::vector<std::vector<std::array<double, kBlock>>> jackknife_folds(
         if (!t.brdf) t.known = t.gain.cwiseProduct(fold_irradiance(t.n));
       });
     }
-    folds.push_back(
-        refine(refolded.empty() ? texels : refolded, frames, x, delta, options.refine, fit_radius, false, use, 8).x);
-  }
+    folds[std::size_t(v)] =
+        refine(refolded.empty() ? texels : refolded, frames, x, delta, options.refine, fit_radius, false, use, 8).x;
+  });
   return folds;
 }
 
