@@ -541,6 +541,9 @@ SourceSigmas source_sigmas(int s, const Fit& fit, const std::vector<std::vector<
     sd = std::max(sd, std::sqrt(k * jd));
     sr = std::max(sr, std::sqrt(k * jr));
   }
+  // The direction is bounded to its clipped region: where the balls barely see the source (its
+  // power near 0) the covariance's angle is unbounded, but the region's radius bounds it.
+  sd = std::min(sd, f.max_radius);
   Vec3 num = Vec3::Zero(), den = Vec3::Zero(), share = Vec3::Zero();
   double count = 0;
   for (const Texel& t : texels) {

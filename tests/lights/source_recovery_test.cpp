@@ -53,6 +53,7 @@ void expect_recovered(const LightSource& s, const std::pair<Vec3, Vec3>& truth, 
   }
   EXPECT_LT(angle, 1.0) << what;
   EXPECT_LT(angle, 3 * s.direction_sigma * 180 / kPi + 0.1) << what;
+  EXPECT_LE(s.direction_sigma, s.region_radius) << what;  // the direction is bounded to its region
 }
 
 class SunElevation : public ::testing::TestWithParam<double> {};
