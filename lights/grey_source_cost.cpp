@@ -49,6 +49,7 @@ void grey_texel_residuals(const GreyObservation& t, const std::vector<SourceFram
     }
   }
   for (int c = 0; c < 3; ++c) r[c] = w[c] * (t.obs[c] - m[c]);
+  delta *= t.stride;
   const double sq = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
   if (!(delta > 0) || sq <= delta * delta) return;
   // Beyond the Huber scale: r' = f r with f = sqrt(rho(s) / s) (the header's derivation).

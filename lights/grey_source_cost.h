@@ -23,7 +23,8 @@
 //
 //   dr'/dx = f J + r (df/ds) 2 r^T J,   df/ds = (delta^2 / s^2 - delta / s^1.5) / (2 f),
 //
-// which is continuous with f = 1, df/ds = 0 at s = delta^2.
+// which is continuous with f = 1, df/ds = 0 at s = delta^2. A texel standing for stride^2 of the
+// map's (a sub-grid) has the scale delta * stride: its loss is stride^2 times one map texel's.
 //
 // The block Ceres sees is compressed. Its Gauss-Newton model at x needs only the cost, J^T J and
 // J^T r, so with J^T J = R^T R (R square, from the eigen-decomposition of J^T J scaled to a unit
@@ -81,6 +82,9 @@ struct GreyObservation {
   Vec3 gain;       // albedo / pi
   Vec3 inv_scale;  // 1 / max(O, floor)
   double sqrt_w = 1;
+  // A texel of a sub-grid standing for stride^2 of the map's (sqrt_w includes the factor stride):
+  // its Huber scale is delta * stride, so its loss is stride^2 times that of one map texel.
+  double stride = 1;
 };
 
 // One texel's three residuals r' at x (one block of 6 per frame) and, when J is not null, their

@@ -131,7 +131,8 @@ RecoveredProbe recover_probe_sources(const MapSet& chrome, const ProbeOptions& p
                  {"lower_bound_fraction", vec(ratio(bounds, measured_integral + bounds))},
                  {"residuals", residuals},
                  {"robust_sigma", out.recovery.robust_sigma},
-                 {"texels", out.recovery.texels}};
+                 {"texels", out.recovery.texels},
+                 {"fitted_texels", out.recovery.fitted_texels}};
   return out;
 }
 

@@ -35,6 +35,7 @@ struct Texel : GreyObservation {
   const Brdf* brdf = nullptr;  // glossy only
   Vec3 mirror = Vec3::Zero();  // glossy: the mirror direction of v about n
   double lobe = 0;             // glossy: the lobe's width (rad, bake/brdf.h), 0 for a normal lobe
+  long count = 1;              // the map's texels it stands for (a grey ball's sub-grid, stride^2)
 };
 
 using Frame = SourceFrame;
@@ -91,7 +92,9 @@ void residuals(const std::vector<Texel>& texels, const std::vector<Frame>& frame
     Vec3 m = t.known;
     for (std::size_t s = 0; s < frames.size(); ++s)
       m += kernel(t, dirs[s], x[s][5]).cwiseProduct(Vec3(x[s][2], x[s][3], x[s][4]));
-    for (int ch = 0; ch < 3; ++ch) (*out)[3 * std::size_t(i) + ch] = t.sqrt_w * t.inv_scale[ch] * (t.obs[ch] - m[ch]);
+    // Per map texel: a sub-grid texel's weight for the texels it stands for is left out.
+    for (int ch = 0; ch < 3; ++ch)
+      (*out)[3 * std::size_t(i) + ch] = t.sqrt_w / t.stride * t.inv_scale[ch] * (t.obs[ch] - m[ch]);
   });
 }
 
@@ -147,7 +150,7 @@ void solve_powers(const std::vector<Texel>& texels, const std::vector<Frame>& fr
       for (int s = 0; s < S; ++s)
         m += k[i][std::size_t(s)].cwiseProduct(Vec3(x[std::size_t(s)][2], x[std::size_t(s)][3], x[std::size_t(s)][4]));
       const double norm = (t.sqrt_w * t.inv_scale.cwiseProduct(t.obs - m)).norm();
-      h[i] = norm <= delta ? 1.0 : delta / norm;
+      h[i] = norm <= delta * t.stride ? 1.0 : delta * t.stride / norm;
     }
   }
 }
@@ -347,20 +350,38 @@ void add_ball_texels(TrustedTexels& all, const std::string& name, const MapSet& 
       glossy_known = fis->radiance_map(*brdf, mv.view, mv.world_from_view, mv.rgb.cols, io);
     }
     const int W = mv.rgb.cols, H = mv.rgb.rows;
+    auto trusted = [&](int r, int c) {
+      const float conf = mv.confidence.at<float>(r, c);
+      const cv::Vec3f o = mv.rgb.at<cv::Vec3f>(r, c);
+      return conf > 0 && std::isfinite(conf) && std::isfinite(o[0]) && std::isfinite(o[1]) && std::isfinite(o[2]) &&
+             sphere_map::disc_from_pixel(Vec2(c, r), W, H).squaredNorm() < 1;
+    };
+    // A grey ball's shading is smooth (a clamped cosine of the sources, band-limited sky light): a
+    // regular sub-grid of at most texels_per_view trusted texels fits it as well as every texel, at
+    // a cost that does not grow with the photos' resolution. Each stands for stride^2 texels (its
+    // weight and its count), so the fit's objective and the thresholds stay those of the map.
+    int stride = 1;
+    if (!brdf && options.texels_per_view > 0) {
+      long n = 0;
+      for (int r = 0; r < H; ++r)
+        for (int c = 0; c < W; ++c) n += trusted(r, c);
+      while (n > long(options.texels_per_view) * stride * stride) ++stride;
+    }
     std::vector<std::vector<Texel>> rows(static_cast<std::size_t>(H));
     parallel_for_rows(H, [&](int r) {
-      for (int c = 0; c < W; ++c) {
+      if (r % stride) return;
+      for (int c = 0; c < W; c += stride) {
+        if (!trusted(r, c)) continue;
         const float conf = mv.confidence.at<float>(r, c);
         const cv::Vec3f o = mv.rgb.at<cv::Vec3f>(r, c);
-        if (!(conf > 0) || !std::isfinite(conf) || !(std::isfinite(o[0]) && std::isfinite(o[1]) && std::isfinite(o[2])))
-          continue;
         const Vec2 xy = sphere_map::disc_from_pixel(Vec2(c, r), W, H);
-        if (xy.squaredNorm() >= 1) continue;
         Texel t;
         t.n = (mv.world_from_view * sphere_map::g_normal(xy)).normalized();
         t.v = mv.view.normalized();
         t.obs = Vec3(std::max(0.f, o[0]), std::max(0.f, o[1]), std::max(0.f, o[2]));
-        t.sqrt_w = std::sqrt(double(conf));
+        t.sqrt_w = std::sqrt(double(conf)) * stride;
+        t.count = long(stride) * stride;
+        t.stride = stride;
         t.ball = ball;
         t.view = it->second;
         if (brdf) {
@@ -408,7 +429,7 @@ std::vector<int> constrained_regions(const std::vector<ClippedRegion>& regions, 
     }
     long lit = 0;
     for (const Texel& t : texels)
-      lit += light_kernels::mean_clamped_cosine(t.n.dot(g.direction), 0.0) > options.min_lit_kernel;
+      if (light_kernels::mean_clamped_cosine(t.n.dot(g.direction), 0.0) > options.min_lit_kernel) lit += t.count;
     if (lit < options.min_lit_texels) {
       out.unrecovered.push_back(int(ri));
       out.notes.push_back(describe(g) + ": not recovered: " +
@@ -446,7 +467,7 @@ void record_ball_residuals(const TrustedTexels& all, const std::vector<Frame>& f
   for (const Texel& t : all.texels) {
     const Vec3 m = after ? model_value(t, frames, params) : t.known;
     const double w = t.sqrt_w * t.sqrt_w, e = (t.obs - m).squaredNorm(), o = t.obs.squaredNorm();
-    num[std::size_t(t.ball)] += w * e, den[std::size_t(t.ball)] += w * o, ++count[std::size_t(t.ball)];
+    num[std::size_t(t.ball)] += w * e, den[std::size_t(t.ball)] += w * o, count[std::size_t(t.ball)] += t.count;
     auto& pv = per_view[std::size_t(t.ball)][t.view];
     pv.first += w * e, pv.second += w * o;
   }
@@ -586,7 +607,9 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
         add_ball_texels(all, g.name, *g.maps, Vec3::Ones(), g.brdf, known, irradiance, fis, options);
   }
   const std::vector<Texel>& texels = all.texels;
-  out.texels = long(texels.size());
+  out.texels = 0;
+  for (const Texel& t : texels) out.texels += t.count;
+  out.fitted_texels = long(texels.size());
 
   const std::vector<int> chosen = constrained_regions(regions, texels, options, out);
   const int S = int(chosen.size());
@@ -660,7 +683,7 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
     std::vector<char> lit_balls(all.ball_names.size(), 0);
     for (const Texel& t : texels)
       if (light_kernels::mean_clamped_cosine(t.n.dot(src.direction), 0.0) > options.min_lit_kernel)
-        ++lit_views[t.view], lit_balls[std::size_t(t.ball)] = 1;
+        lit_views[t.view] += t.count, lit_balls[std::size_t(t.ball)] = 1;
     for (const auto& [v, count] : lit_views)
       if (count >= 10) src.views.push_back(all.view_names[std::size_t(v)]);
     for (std::size_t b = 0; b < all.ball_names.size(); ++b)

@@ -19,6 +19,10 @@
 // sigma of the first solve), so texels the model cannot explain (a photographer's shadow, a
 // stand) do not pull the sources.
 //
+// A grey ball's map is fitted on a regular sub-grid of at most `texels_per_view` trusted texels per
+// view, each weighted by the texels it stands for (its shading is smooth; the cost then does not
+// grow with the photos' resolution).
+//
 // Solve: P by non-negative least squares (hdr/nnls.h; iteratively reweighted for the loss) at the
 // regions' centroids; then d (and rho, when a glossy ball is seen: a grey ball cannot tell a disc
 // from a point) refined jointly with P by Ceres, each d bounded to its clipped region, P >= 0.
@@ -69,6 +73,10 @@ struct SourceRecoveryOptions {
   double min_lit_kernel = 0.1;
   int known_width = 64;
   int glossy_samples = 64;  // FIS samples per texel for the glossy ball's known part
+  // A grey ball's texels fitted per view: at most this many on a regular sub-grid, each weighted
+  // for the texels it stands for (0: every texel). Glossy balls keep every texel (their highlights
+  // are sharp).
+  int texels_per_view = 4096;
   std::uint64_t seed = 0;
   bool jackknife = true;  // the leave-one-view-out spread in the sigmas
 };
@@ -89,7 +97,8 @@ struct SourceRecovery {
   std::vector<std::string> notes;    // one line per region not recovered or left out
   std::vector<BallResidual> residuals;
   double robust_sigma = 0;  // the relative residuals' MAD sigma after the first solve
-  long texels = 0;          // trusted texels used
+  long texels = 0;          // trusted texels of the maps
+  long fitted_texels = 0;   // of them, those fitted (texels_per_view)
 };
 
 // `known`: the probe without the clipped texels (they are 0), lat-long, L (the chrome ball's

@@ -77,6 +77,7 @@ Problem make_problem(int texels, unsigned seed) {
     t.gain = Vec3(0.18, 0.2, 0.16) / kPi;
     t.inv_scale = Vec3(1 / (0.1 + t.obs[0]), 1 / (0.1 + t.obs[1]), 1 / (0.1 + t.obs[2]));
     t.sqrt_w = 0.5 + 0.5 * o(rng);
+    if (i % 3 == 0) t.stride = 2, t.sqrt_w *= 2;  // a sub-grid texel standing for 4
     pr.texels.push_back(t);
   }
   return pr;
@@ -166,7 +167,6 @@ TEST(GreySourceCost, SquaredResidualOfEachTexelIsItsHuberCost) {
   const Problem pr = make_problem(300, 5);
   const double delta = median_norm(pr);
   const Evaluated plain = evaluate(pr, 0), robust = evaluate(pr, delta);
-  const ceres::HuberLoss huber(delta);
   int beyond = 0;
   for (std::size_t i = 0; i < pr.texels.size(); ++i) {
     double sq = 0, robust_sq = 0;
@@ -174,6 +174,8 @@ TEST(GreySourceCost, SquaredResidualOfEachTexelIsItsHuberCost) {
       sq += plain.r[3 * i + std::size_t(c)] * plain.r[3 * i + std::size_t(c)];
       robust_sq += robust.r[3 * i + std::size_t(c)] * robust.r[3 * i + std::size_t(c)];
     }
+    // A sub-grid texel's scale is delta * stride: its loss is stride^2 that of one map texel.
+    const ceres::HuberLoss huber(delta * pr.texels[i].stride);
     double rho[3];
     huber.Evaluate(sq, rho);
     EXPECT_NEAR(robust_sq, rho[0], 1e-12 * (1 + rho[0]));

@@ -23,11 +23,12 @@ struct Outcome {
   std::vector<std::pair<Vec3, Vec3>> truth;  // per source: the power it had to supply, its true direction
 };
 
-Outcome run(const EnvMap& env, double clip, int views = 6, double elevation_deg = 10) {
+Outcome run(const EnvMap& env, double clip, int views = 6, double elevation_deg = 10,
+            const SourceRecoveryOptions& options = {}) {
   const testing::ClippedShoot shoot = testing::clipped_shoot(env, clip, views, elevation_deg);
   Outcome o{{}, testing::shoot_probe(shoot), {}};
   GreyBallMaps grey{"grey", &shoot.grey, Vec3::Constant(0.18)};
-  o.recovered = recover_probe_sources(shoot.chrome, testing::probe_options(), {grey}, {}, SourceRecoveryOptions{});
+  o.recovered = recover_probe_sources(shoot.chrome, testing::probe_options(), {grey}, {}, options);
   for (const LightSource& s : o.recovered.recovery.sources)
     o.truth.push_back(testing::truth_needed(env, o.measured.env, o.recovered.regions[std::size_t(s.region)]));
   return o;
@@ -112,6 +113,36 @@ TEST(SourceRecovery, TwoClippedStudioLightsAreRecoveredSeparately) {
   ASSERT_EQ(o.recovered.recovery.sources.size(), 2u);
   for (std::size_t i = 0; i < 2; ++i)
     expect_recovered(o.recovered.recovery.sources[i], o.truth[i], "light " + std::to_string(i));
+}
+
+// The grey maps fitted on sub-grids (every 2nd and every 3rd texel in each direction, each texel
+// weighted for those it stands for): the two studio lights are recovered to the same tolerances,
+// the thresholds still count the maps' texels, and the powers stay within a third of a sigma of
+// the fit on every texel.
+TEST(SourceRecovery, AGreyBallFittedOnASubGridRecoversTheSameLights) {
+  const Vec3 a = direction_at(30, 40), b = direction_at(-40, 25);
+  const EnvMap env =
+      testing::environment_with(std::nullopt, {{a, 1.0, Vec3(3000, 3000, 3000)}, {b, 2.0, Vec3(800, 700, 600)}}, 256,
+                                Vec3(0.3, 0.3, 0.3), Vec3(0.2, 0.2, 0.2));
+  SourceRecoveryOptions every;
+  every.texels_per_view = 0;
+  const Outcome full = run(env, 50, 6, 10, every);
+  ASSERT_EQ(full.recovered.recovery.sources.size(), 2u);
+  const long per_view = full.recovered.recovery.texels / 6;
+  for (const int stride : {2, 3}) {
+    SourceRecoveryOptions sub;
+    sub.texels_per_view = int(per_view / (stride * stride)) + 1;
+    const Outcome o = run(env, 50, 6, 10, sub);
+    const SourceRecovery& r = o.recovered.recovery;
+    EXPECT_LT(r.fitted_texels, full.recovered.recovery.texels / (stride * stride - 1)) << stride;
+    EXPECT_NEAR(double(r.texels), double(full.recovered.recovery.texels), 0.05 * double(r.texels)) << stride;
+    ASSERT_EQ(r.sources.size(), 2u) << stride;
+    for (std::size_t i = 0; i < 2; ++i) {
+      const LightSource &s = r.sources[i], &f = full.recovered.recovery.sources[i];
+      expect_recovered(s, o.truth[i], "stride " + std::to_string(stride) + " light " + std::to_string(i));
+      for (int k = 0; k < 3; ++k) EXPECT_LT(std::abs(s.power[k] - f.power[k]), f.power_sigma[k] / 3) << stride << k;
+    }
+  }
 }
 
 // A glossy ball (GGX 0.05) beside the grey one: its highlight fits the light's size as well (a
