@@ -302,16 +302,27 @@ RayTable::RayTable(const LensModel& lens, int step) : step_(step) {
   if (step < 1) throw std::invalid_argument("RayTable: step must be >= 1");
   if (lens.can_project_behind_camera())
     throw std::invalid_argument(lens.name() + ": RayTable needs a model that cannot see behind the camera");
-  // Grid points at x0 + i*step covering [-1, width] (and the same in y) with two border cells
-  // (the cubic interpolation reads one point beyond its cell).
-  x0_ = -1.0 - 2.0 * step;
-  y0_ = -1.0 - 2.0 * step;
-  cols_ = int(std::ceil((lens.width() + 1.0 + 4.0 * step) / step)) + 1;
-  rows_ = int(std::ceil((lens.height() + 1.0 + 4.0 * step) / step)) + 1;
+  build(lens, Vec2(-1, -1), Vec2(lens.width(), lens.height()));
+}
+
+RayTable::RayTable(const LensModel& lens, int step, const Vec2& lo, const Vec2& hi) : step_(step) {
+  if (step < 1) throw std::invalid_argument("RayTable: step must be >= 1");
+  if (!(hi.x() >= lo.x() && hi.y() >= lo.y()) || !lo.allFinite() || !hi.allFinite())
+    throw std::invalid_argument("RayTable: an empty or non-finite region");
+  build(lens, lo, hi);
+}
+
+void RayTable::build(const LensModel& lens, const Vec2& lo, const Vec2& hi) {
+  // Grid points at x0 + i*step covering [lo, hi] with two border cells (the cubic interpolation
+  // reads one point beyond its cell).
+  x0_ = lo.x() - 2.0 * step_;
+  y0_ = lo.y() - 2.0 * step_;
+  cols_ = int(std::ceil((hi.x() - lo.x() + 4.0 * step_) / step_)) + 1;
+  rows_ = int(std::ceil((hi.y() - lo.y() + 4.0 * step_) / step_)) + 1;
   std::vector<Vec2> pix(std::size_t(cols_) * std::size_t(rows_));
   for (int r = 0; r < rows_; ++r)
     for (int c = 0; c < cols_; ++c)
-      pix[std::size_t(r) * std::size_t(cols_) + std::size_t(c)] = Vec2(x0_ + c * step, y0_ + r * step);
+      pix[std::size_t(r) * std::size_t(cols_) + std::size_t(c)] = Vec2(x0_ + c * step_, y0_ + r * step_);
   std::vector<Vec3> d(pix.size());
   lens.unproject(pix.data(), int(pix.size()), d.data());
   xy_.resize(pix.size());
@@ -319,7 +330,7 @@ RayTable::RayTable(const LensModel& lens, int step) : step_(step) {
     if (!(d[i].z() > 0))
       throw std::invalid_argument(lens.name() + ": RayTable: the model cannot unproject pixel (" +
                                   std::to_string(pix[i].x()) + ", " + std::to_string(pix[i].y()) +
-                                  ") (distortion not invertible there)");
+                                  ") (distortion not invertible there, or behind the camera)");
     xy_[i] = Vec2(d[i].x() / d[i].z(), d[i].y() / d[i].z());
   }
 }

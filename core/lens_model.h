@@ -87,14 +87,20 @@ class LensModel {
 // are not supported (throws std::invalid_argument): their normalised coordinates are unbounded.
 // Accuracy (tests/capture/lens_model_test.cpp): the interpolated ray reprojects to within 1e-3 px
 // of its pixel for an OPENCV8 lens with 8% barrel distortion at step 8.
+//
+// A table over a part of the image (pixels lo to hi, e.g. around one ball) costs its area instead of
+// the whole image's and is made for any model, as long as every ray of its grid is in front of the
+// camera (else it throws std::invalid_argument, and the caller unprojects exactly).
 class RayTable {
  public:
   RayTable(const LensModel& lens, int step = 8);
+  RayTable(const LensModel& lens, int step, const Vec2& lo, const Vec2& hi);
   Vec3 direction(double px, double py) const;  // unit, camera frame
 
  private:
-  int step_, cols_, rows_;
-  double x0_, y0_;
+  void build(const LensModel& lens, const Vec2& lo, const Vec2& hi);
+  int step_, cols_ = 0, rows_ = 0;
+  double x0_ = 0, y0_ = 0;
   std::vector<Vec2> xy_;  // normalised (x/z, y/z) at the grid points
 };
 

@@ -149,5 +149,35 @@ TEST(RayTable, InterpolatedRaysReprojectToTheirPixels) {
   }
 }
 
+// A table over a part of the image (a ball's box), at step 4 as the ball identification makes
+// one: its rays reproject to their pixels, for a model that can see behind the camera too (the
+// whole-image table refuses it), and a box reaching behind the camera is refused.
+TEST(RayTable, ATableOverAPartReprojectsAndWorksForEveryModel) {
+  const std::string splined =
+      "{ 'lensmodel': 'LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=5_Ny=4_fov_x_deg=100',"
+      "  'intrinsics': [ 500, 500, 319.5, 239.5" +
+      [] {
+        std::string s;
+        for (int i = 0; i < 2 * 5 * 4; ++i) s += ", 0";
+        return s;
+      }() +
+      " ], 'imagersize': [ 640, 480 ], 'extrinsics': [0,0,0,0,0,0] }";
+  const LensModel fisheye = LensModel::parse(splined);
+  EXPECT_THROW(RayTable(fisheye, 8), std::invalid_argument);
+  for (const LensModel& lens : {wide_opencv8(), fisheye}) {
+    const Vec2 lo(430.3, 20.7), hi(611.9, 190.2);  // a corner, where the distortion is strongest
+    const RayTable table(lens, 4, lo, hi);
+    double worst = 0;
+    for (double y = lo.y(); y <= hi.y(); y += 1.37)
+      for (double x = lo.x(); x <= hi.x(); x += 1.13)
+        worst = std::max(worst, (lens.project(table.direction(x, y)) - Vec2(x, y)).norm());
+    EXPECT_LT(worst, 1e-4) << lens.name();
+  }
+  // 20000 px from the centre of a stereographic lens of focal length 500 px is 174 degrees off
+  // its axis: behind the camera.
+  EXPECT_THROW(RayTable(fisheye, 4, Vec2(-20000, 200), Vec2(-19900, 300)), std::invalid_argument);
+  EXPECT_THROW(RayTable(fisheye, 4, Vec2(10, 10), Vec2(5, 20)), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace rsibr
