@@ -78,7 +78,17 @@ ConeFit fit_cone(const std::vector<Vec3>& rays, const LensModel& lens, const Con
   std::vector<double> s = pixel_scales(lens, start->axis, rays);
 
   // RANSAC: the 3-ray cone with the most rays within inlier_px (scales from the all-ray fit).
+  // Ray m is an inlier of the cone (a, alpha) when |theta_m - alpha| < delta_m = inlier_px / s_m,
+  // i.e. cos(alpha + delta_m) < d_m.a < cos(alpha - delta_m) (the upper bound only when
+  // alpha > delta_m): a dot product and the bounds' sums of products per ray and sample, instead
+  // of an angle.
   if (options.ransac_iterations > 0 && n > 3) {
+    std::vector<double> dx(n), dy(n), dz(n), delta(n), cd(n), sd(n);
+    for (int m = 0; m < n; ++m) {
+      dx[m] = rays[m].x(), dy[m] = rays[m].y(), dz[m] = rays[m].z();
+      delta[m] = s[m] > 0 ? options.inlier_px / s[m] : 0;
+      cd[m] = std::cos(delta[m]), sd[m] = std::sin(delta[m]);
+    }
     std::mt19937_64 rng(options.seed);
     std::uniform_int_distribution<int> pick(0, n - 1);
     int best = -1;
@@ -87,9 +97,14 @@ ConeFit fit_cone(const std::vector<Vec3>& rays, const LensModel& lens, const Con
       if (i == j || j == k || i == k) continue;
       const auto c = fit_cone_algebraic({rays[i], rays[j], rays[k]});
       if (!c) continue;
+      const double ax = c->axis.x(), ay = c->axis.y(), az = c->axis.z();
+      const double ca = std::cos(c->half_angle), sa = std::sin(c->half_angle), alpha = c->half_angle;
       int count = 0;
-      for (int m = 0; m < n; ++m)
-        if (std::abs(cone_residual(*c, rays[m])) * s[m] < options.inlier_px) ++count;
+      for (int m = 0; m < n; ++m) {
+        const double dot = dx[m] * ax + dy[m] * ay + dz[m] * az;
+        const double lo = ca * cd[m] - sa * sd[m], hi = alpha > delta[m] ? ca * cd[m] + sa * sd[m] : 2.0;
+        count += dot > lo && dot < hi;
+      }
       if (count > best) {
         best = count;
         start = c;
