@@ -17,9 +17,14 @@ namespace rsibr {
 
 cv::Mat ball_candidates_picture(const cv::Mat& image, const std::vector<BallCandidate>& candidates,
                                 const std::vector<int>& chosen, int max_side) {
-  cv::Mat shown = display_encode(image, preview_exposure(image));
-  const double scale = std::min(1.0, double(max_side) / double(std::max(shown.cols, shown.rows)));
-  if (scale < 1) cv::resize(shown, shown, cv::Size(), scale, scale, cv::INTER_AREA);
+  // Shrunk in linear light, then encoded: the encoding costs the picture's pixels, not the photo's.
+  const double scale = std::min(1.0, double(max_side) / double(std::max(image.cols, image.rows)));
+  cv::Mat shown;
+  if (scale < 1)
+    cv::resize(image, shown, cv::Size(), scale, scale, cv::INTER_AREA);
+  else
+    shown = image;
+  shown = display_encode(shown, preview_exposure(image));
   // Lines and numbers sized to the picture, not the photo: readable on a 12 MP frame and a crop.
   const int thick = std::max(1, int(std::lround(std::max(shown.cols, shown.rows) / 500.0)));
   const double font = std::max(0.5, std::max(shown.cols, shown.rows) / 900.0);

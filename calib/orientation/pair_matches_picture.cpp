@@ -17,10 +17,14 @@ namespace rsibr {
 
 cv::Mat pair_matches_picture(const cv::Mat& a, const cv::Mat& b, const PairOrientation& pair, int height) {
   if (a.empty() || b.empty() || height < 16) throw std::invalid_argument("pair matches picture: empty views");
-  cv::Mat sa = display_encode(a, preview_exposure(a)), sb = display_encode(b, preview_exposure(b));
-  const double ka = double(height) / sa.rows, kb = double(height) / sb.rows;
-  cv::resize(sa, sa, cv::Size(std::max(1, int(std::lround(sa.cols * ka))), height), 0, 0, cv::INTER_AREA);
-  cv::resize(sb, sb, cv::Size(std::max(1, int(std::lround(sb.cols * kb))), height), 0, 0, cv::INTER_AREA);
+  // Shrunk in linear light (area averages of radiance), then encoded for display: the encoding
+  // costs the picture's pixels, not the photo's. The exposure is the whole photo's.
+  const double ka = double(height) / a.rows, kb = double(height) / b.rows;
+  cv::Mat sa, sb;
+  cv::resize(a, sa, cv::Size(std::max(1, int(std::lround(a.cols * ka))), height), 0, 0, cv::INTER_AREA);
+  cv::resize(b, sb, cv::Size(std::max(1, int(std::lround(b.cols * kb))), height), 0, 0, cv::INTER_AREA);
+  sa = display_encode(sa, preview_exposure(a));
+  sb = display_encode(sb, preview_exposure(b));
   cv::Mat shown;
   cv::hconcat(sa, sb, shown);
   const int thick = std::max(1, height / 400);
