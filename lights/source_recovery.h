@@ -75,7 +75,7 @@ struct SourceRecoveryOptions {
   int glossy_samples = 64;  // FIS samples per texel for the glossy ball's known part
   // A grey ball's texels fitted per view: at most this many on a regular sub-grid, each weighted
   // for the texels it stands for (0: every texel). Glossy balls keep every texel (their highlights
-  // are sharp).
+  // are sharp). The default's measurement: docs/tradeoffs.md, "Measured choices in the code".
   int texels_per_view = 4096;
   std::uint64_t seed = 0;
   bool jackknife = true;  // the leave-one-view-out spread in the sigmas
