@@ -89,7 +89,9 @@ truth_map_size: 64
 
 def process(rsibr, photos, out, extra):
     j = os.path.join(out + ".json")
-    run([rsibr, "process", photos, "--out", out, "--json", j, "-q"] + extra, "rsibr process " + out)
+    # The truth's map size (the default follows each ball's pixel radius, which the truth's cannot).
+    run([rsibr, "process", photos, "--out", out, "--json", j, "-q", "--map-size", "64"] + extra,
+        "rsibr process " + out)
     return json.load(open(j))
 
 
