@@ -60,16 +60,17 @@ TEST(LensModel, WrittenFileReadsBackIdentical) {
   }
 }
 
+// A splined stereographic model (100 degrees across, zero spline), as mrcal writes one.
+std::string splined_text() {
+  std::string zeros;
+  for (int i = 0; i < 2 * 5 * 4; ++i) zeros += ", 0";
+  return "{ 'lensmodel': 'LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=5_Ny=4_fov_x_deg=100',"
+         "  'intrinsics': [ 500, 500, 319.5, 239.5" +
+         zeros + " ], 'imagersize': [ 640, 480 ], 'extrinsics': [0,0,0,0,0,0] }";
+}
+
 TEST(LensModel, ReadsSplinedModelText) {
-  const std::string text =
-      "{ 'lensmodel': 'LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=5_Ny=4_fov_x_deg=100',"
-      "  'intrinsics': [ 500, 500, 319.5, 239.5" +
-      [] {
-        std::string s;
-        for (int i = 0; i < 2 * 5 * 4; ++i) s += ", 0";
-        return s;
-      }() +
-      " ], 'imagersize': [ 640, 480 ], 'extrinsics': [0,0,0,0,0,0] }";
+  const std::string text = splined_text();
   const LensModel lens = LensModel::parse(text);
   EXPECT_EQ(lens.name(), "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=5_Ny=4_fov_x_deg=100");
   EXPECT_EQ(lens.intrinsics().size(), 4u + 40u);
@@ -153,16 +154,7 @@ TEST(RayTable, InterpolatedRaysReprojectToTheirPixels) {
 // one: its rays reproject to their pixels, for a model that can see behind the camera too (the
 // whole-image table refuses it), and a box reaching behind the camera is refused.
 TEST(RayTable, ATableOverAPartReprojectsAndWorksForEveryModel) {
-  const std::string splined =
-      "{ 'lensmodel': 'LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=5_Ny=4_fov_x_deg=100',"
-      "  'intrinsics': [ 500, 500, 319.5, 239.5" +
-      [] {
-        std::string s;
-        for (int i = 0; i < 2 * 5 * 4; ++i) s += ", 0";
-        return s;
-      }() +
-      " ], 'imagersize': [ 640, 480 ], 'extrinsics': [0,0,0,0,0,0] }";
-  const LensModel fisheye = LensModel::parse(splined);
+  const LensModel fisheye = LensModel::parse(splined_text());
   EXPECT_THROW(RayTable(fisheye, 8), std::invalid_argument);
   for (const LensModel& lens : {wide_opencv8(), fisheye}) {
     const Vec2 lo(430.3, 20.7), hi(611.9, 190.2);  // a corner, where the distortion is strongest
