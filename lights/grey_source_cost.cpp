@@ -12,7 +12,6 @@ namespace rsibr {
 
 namespace {
 
-constexpr int kBlock = 6;    // u1, u2, P (RGB), rho
 constexpr int kChunk = 256;  // texels per partial sum; fixed, so the sums do not depend on the threads
 
 }  // namespace
@@ -20,7 +19,7 @@ constexpr int kChunk = 256;  // texels per partial sum; fixed, so the sums do no
 void grey_texel_residuals(const GreyObservation& t, const std::vector<SourceFrame>& frames, double const* const* x,
                           double delta, double* r, double* J) {
   const std::size_t S = frames.size();
-  const std::size_t P = kBlock * S;
+  const std::size_t P = kSourceBlock * S;
   double m[3] = {t.known[0], t.known[1], t.known[2]};
   double w[3];
   for (int c = 0; c < 3; ++c) w[c] = t.sqrt_w * t.inv_scale[c];
@@ -38,7 +37,7 @@ void grey_texel_residuals(const GreyObservation& t, const std::vector<SourceFram
     // n.(dd/du_k) = (n.t_k - (n.d)(d.t_k)) / |v|
     const double dc[2] = {(t.n.dot(f.t1) - nd * d.dot(f.t1)) / len, (t.n.dot(f.t2) - nd * d.dot(f.t2)) / len};
     for (int c = 0; c < 3; ++c) {
-      double* row = J + std::size_t(c) * P + kBlock * s;
+      double* row = J + std::size_t(c) * P + kSourceBlock * s;
       const double a = -w[c] * t.gain[c];
       const double p = xs[2 + c];
       row[0] = a * p * k.v[0] * dc[0];
@@ -66,12 +65,12 @@ void grey_texel_residuals(const GreyObservation& t, const std::vector<SourceFram
 GreySourceCost::GreySourceCost(std::vector<const GreyObservation*> texels, const std::vector<SourceFrame>* frames,
                                double huber_delta)
     : texels_(std::move(texels)), frames_(frames), delta_(huber_delta) {
-  set_num_residuals(kBlock * int(frames->size()) + 1);
-  for (std::size_t s = 0; s < frames->size(); ++s) mutable_parameter_block_sizes()->push_back(kBlock);
+  set_num_residuals(kSourceBlock * int(frames->size()) + 1);
+  for (std::size_t s = 0; s < frames->size(); ++s) mutable_parameter_block_sizes()->push_back(kSourceBlock);
 }
 
 bool GreySourceCost::Evaluate(double const* const* x, double* residuals, double** jacobians) const {
-  const int P = kBlock * int(frames_->size());
+  const int P = kSourceBlock * int(frames_->size());
   const int N = int(texels_.size());
   const int chunks = (N + kChunk - 1) / kChunk;
   if (!jacobians) {
@@ -139,8 +138,8 @@ bool GreySourceCost::Evaluate(double const* const* x, double* residuals, double*
     if (!jacobians[s]) continue;
     double* Js = jacobians[s];  // (P + 1) x 6, row-major
     for (int k = 0; k < P; ++k)
-      for (int j = 0; j < kBlock; ++j) Js[k * kBlock + j] = R(k, kBlock * int(s) + j);
-    for (int j = 0; j < kBlock; ++j) Js[P * kBlock + j] = 0;
+      for (int j = 0; j < kSourceBlock; ++j) Js[k * kSourceBlock + j] = R(k, kSourceBlock * int(s) + j);
+    for (int j = 0; j < kSourceBlock; ++j) Js[P * kSourceBlock + j] = 0;
   }
   return true;
 }

@@ -49,6 +49,9 @@
 
 namespace rsibr {
 
+// Parameters per source: u1, u2 (the direction's offset), P (RGB), rho.
+inline constexpr int kSourceBlock = 6;
+
 // A source's direction frame: d(u) = normalize(d0 + u1 t1 + u2 t2), |u_k| <= bound = tan(region
 // radius); max_radius bounds rho.
 struct SourceFrame {

@@ -24,8 +24,6 @@ namespace rsibr {
 
 namespace {
 
-constexpr int kBlock = 6;  // per source: u1, u2 (direction offset), P (RGB), rho
-
 // One trusted texel of a captured ball map (the grey residual's fields, lights/grey_source_cost.h,
 // and the glossy ones).
 struct Texel : GreyObservation {
@@ -83,7 +81,7 @@ struct GlossyCost {
 
 // The model's residual vector (3 per texel) at parameters x.
 void residuals(const std::vector<Texel>& texels, const std::vector<Frame>& frames,
-               const std::vector<std::array<double, kBlock>>& x, std::vector<double>* out) {
+               const std::vector<std::array<double, kSourceBlock>>& x, std::vector<double>* out) {
   out->assign(texels.size() * 3, 0.0);
   std::vector<Vec3> dirs;
   for (std::size_t s = 0; s < frames.size(); ++s) dirs.push_back(direction_of(frames[s], x[s].data()));
@@ -110,7 +108,7 @@ double mad_sigma(const std::vector<double>& r) {
 // reweighted for the Huber loss of scale `delta` on each texel's residual norm (delta <= 0: plain
 // least squares). `use` selects the texels (empty: all).
 void solve_powers(const std::vector<Texel>& texels, const std::vector<Frame>& frames,
-                  std::vector<std::array<double, kBlock>>& x, double delta, const std::vector<char>& use) {
+                  std::vector<std::array<double, kSourceBlock>>& x, double delta, const std::vector<char>& use) {
   const int S = int(frames.size());
   if (S == 0) return;
   std::vector<Vec3> dirs;
@@ -156,14 +154,14 @@ void solve_powers(const std::vector<Texel>& texels, const std::vector<Frame>& fr
 }
 
 struct Fit {
-  std::vector<std::array<double, kBlock>> x;
-  std::vector<Eigen::Matrix<double, kBlock, kBlock>> covariance;  // scaled by the residual variance
+  std::vector<std::array<double, kSourceBlock>> x;
+  std::vector<Eigen::Matrix<double, kSourceBlock, kSourceBlock>> covariance;  // scaled by the residual variance
   bool covariance_ok = false;
 };
 
 // The joint Ceres refinement from x (directions within their bounds, P >= 0, rho when fitted).
 Fit refine(const std::vector<Texel>& texels, const std::vector<Frame>& frames,
-           std::vector<std::array<double, kBlock>> x, double delta, bool move_directions, bool fit_radius,
+           std::vector<std::array<double, kSourceBlock>> x, double delta, bool move_directions, bool fit_radius,
            bool want_covariance, const std::vector<char>& use, int iterations = 50) {
   Fit fit;
   const int S = int(frames.size());
@@ -192,7 +190,7 @@ Fit refine(const std::vector<Texel>& texels, const std::vector<Frame>& frames,
       continue;
     }
     auto* c = new ceres::DynamicNumericDiffCostFunction<GlossyCost>(new GlossyCost{&texels[i], &frames});
-    for (int s = 0; s < S; ++s) c->AddParameterBlock(kBlock);
+    for (int s = 0; s < S; ++s) c->AddParameterBlock(kSourceBlock);
     c->SetNumResiduals(3);
     problem.AddResidualBlock(c, delta > 0 ? new ceres::HuberLoss(delta) : nullptr, blocks);
   }
@@ -207,7 +205,7 @@ Fit refine(const std::vector<Texel>& texels, const std::vector<Frame>& frames,
     std::vector<int> constant;
     if (!move_directions) constant = {0, 1};
     if (!fit_radius) constant.push_back(5);
-    if (!constant.empty()) problem.SetManifold(b, new ceres::SubsetManifold(kBlock, constant));
+    if (!constant.empty()) problem.SetManifold(b, new ceres::SubsetManifold(kSourceBlock, constant));
     if (move_directions)
       for (int k = 0; k < 2; ++k)
         problem.SetParameterLowerBound(b, k, -f.bound), problem.SetParameterUpperBound(b, k, f.bound);
@@ -256,7 +254,7 @@ Fit refine(const std::vector<Texel>& texels, const std::vector<Frame>& frames,
   if (cov.Compute(pairs, &problem)) {
     fit.covariance_ok = true;
     for (int s = 0; s < S; ++s) {
-      Eigen::Matrix<double, kBlock, kBlock, Eigen::RowMajor> c;
+      Eigen::Matrix<double, kSourceBlock, kSourceBlock, Eigen::RowMajor> c;
       cov.GetCovarianceBlock(blocks[std::size_t(s)], blocks[std::size_t(s)], c.data());
       fit.covariance.push_back(variance * c);
     }
@@ -447,7 +445,8 @@ std::vector<int> constrained_regions(const std::vector<ClippedRegion>& regions, 
 }
 
 // The model M = K + sum_s P_s G_s at a texel (params: one block per source).
-Vec3 model_value(const Texel& t, const std::vector<Frame>& frames, const std::vector<std::array<double, kBlock>>& x) {
+Vec3 model_value(const Texel& t, const std::vector<Frame>& frames,
+                 const std::vector<std::array<double, kSourceBlock>>& x) {
   Vec3 m = t.known;
   for (std::size_t s = 0; s < frames.size(); ++s)
     m += kernel(t, direction_of(frames[s], x[s].data()), x[s][5]).cwiseProduct(Vec3(x[s][2], x[s][3], x[s][4]));
@@ -458,7 +457,7 @@ Vec3 model_value(const Texel& t, const std::vector<Frame>& frames, const std::ve
 // false) or with the sources (after = true), into `residuals` (one entry per ball, made on the
 // first call).
 void record_ball_residuals(const TrustedTexels& all, const std::vector<Frame>& frames,
-                           const std::vector<std::array<double, kBlock>>& params, bool after,
+                           const std::vector<std::array<double, kSourceBlock>>& params, bool after,
                            std::vector<BallResidual>& residuals) {
   const std::size_t balls = all.ball_names.size();
   std::vector<double> num(balls, 0), den(balls, 0);
@@ -492,13 +491,13 @@ void record_ball_residuals(const TrustedTexels& all, const std::vector<Frame>& f
 // Leave-one-view-out solves from the full solution x, one per view (the known part without that
 // view's chrome map too, when `known_without` has it: the grey balls' texels re-predicted from it;
 // the glossy balls keep the full probe's bake). A fold moves the solution little: a few iterations.
-std::vector<std::vector<std::array<double, kBlock>>> jackknife_folds(
-    const TrustedTexels& all, const std::vector<Frame>& frames, const std::vector<std::array<double, kBlock>>& x,
+std::vector<std::vector<std::array<double, kSourceBlock>>> jackknife_folds(
+    const TrustedTexels& all, const std::vector<Frame>& frames, const std::vector<std::array<double, kSourceBlock>>& x,
     double delta, bool fit_radius, const SourceRecoveryOptions& options,
     const std::map<std::string, EnvMap>& known_without) {
   const std::vector<Texel>& texels = all.texels;
   // The folds are independent problems: solved in parallel, each into its own slot.
-  std::vector<std::vector<std::array<double, kBlock>>> folds(all.view_names.size());
+  std::vector<std::vector<std::array<double, kSourceBlock>>> folds(all.view_names.size());
   parallel_for_rows(int(all.view_names.size()), [&](int v) {
     std::vector<char> use(texels.size());
     for (std::size_t i = 0; i < texels.size(); ++i) use[i] = texels[i].view != v;
@@ -529,9 +528,10 @@ struct SourceSigmas {
 // sigma >= r P / f with f the source's mean share of M there. (The errors the views share, e.g.
 // the probe's known part near the source, escape the covariance and the jackknife; this is where
 // they show.)
-SourceSigmas source_sigmas(int s, const Fit& fit, const std::vector<std::vector<std::array<double, kBlock>>>& folds,
+SourceSigmas source_sigmas(int s, const Fit& fit,
+                           const std::vector<std::vector<std::array<double, kSourceBlock>>>& folds,
                            const std::vector<Texel>& texels, const std::vector<Frame>& frames,
-                           const std::vector<std::array<double, kBlock>>& x, const LightSource& src,
+                           const std::vector<std::array<double, kSourceBlock>>& x, const LightSource& src,
                            const SourceRecoveryOptions& options) {
   SourceSigmas out;
   const Frame& f = frames[std::size_t(s)];
@@ -616,7 +616,7 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
   // Each source starts at its region's centroid, its radius the option's (at least a quarter of
   // the region's when glossy balls fit it).
   std::vector<Frame> frames;
-  std::vector<std::array<double, kBlock>> x;
+  std::vector<std::array<double, kSourceBlock>> x;
   for (int ri : chosen) {
     const ClippedRegion& g = regions[std::size_t(ri)];
     Frame f;
@@ -656,7 +656,7 @@ SourceRecovery recover_sources(const EnvMap& known, const std::vector<ClippedReg
     fit = refine(texels, frames, x, delta, false, false, true, {});
   x = fit.x;
 
-  std::vector<std::vector<std::array<double, kBlock>>> folds;
+  std::vector<std::vector<std::array<double, kSourceBlock>>> folds;
   if (options.jackknife && all.view_names.size() >= 3)
     folds = jackknife_folds(all, frames, x, delta, fit_radius, options, known_without);
   record_ball_residuals(all, frames, x, true, out.residuals);

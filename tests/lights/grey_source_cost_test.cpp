@@ -15,8 +15,6 @@
 namespace rsibr {
 namespace {
 
-constexpr int kBlock = 6;
-
 // The model of the header, for Ceres' automatic differentiation (one texel, no loss).
 struct ReferenceCost {
   const GreyObservation* t;
@@ -38,7 +36,7 @@ struct ReferenceCost {
 
 struct Problem {
   std::vector<SourceFrame> frames;
-  std::vector<std::array<double, kBlock>> x;
+  std::vector<std::array<double, kSourceBlock>> x;
   std::vector<GreyObservation> texels;
   std::vector<const double*> params() const {
     std::vector<const double*> p;
@@ -105,7 +103,7 @@ double median_norm(const Problem& pr) {
 
 Evaluated evaluate(const Problem& pr, double delta) {
   Evaluated e;
-  e.P = kBlock * int(pr.x.size());
+  e.P = kSourceBlock * int(pr.x.size());
   e.r.resize(3 * pr.texels.size());
   e.J.resize(e.r.size() * std::size_t(e.P));
   for (std::size_t i = 0; i < pr.texels.size(); ++i)
@@ -124,16 +122,17 @@ Compressed compressed(const Problem& pr, double delta) {
   std::vector<const GreyObservation*> ptrs;
   for (const auto& t : pr.texels) ptrs.push_back(&t);
   const GreySourceCost cost(ptrs, &pr.frames, delta);
-  const int P = kBlock * int(pr.x.size());
+  const int P = kSourceBlock * int(pr.x.size());
   EXPECT_EQ(cost.num_residuals(), P + 1);
-  std::vector<std::vector<double>> blocks(pr.x.size(), std::vector<double>(std::size_t((P + 1) * kBlock)));
+  std::vector<std::vector<double>> blocks(pr.x.size(), std::vector<double>(std::size_t((P + 1) * kSourceBlock)));
   std::vector<double*> jac;
   for (auto& b : blocks) jac.push_back(b.data());
   Compressed c{Eigen::VectorXd(P + 1), Eigen::MatrixXd(P + 1, P)};
   EXPECT_TRUE(cost.Evaluate(pr.params().data(), c.r.data(), jac.data()));
   for (int row = 0; row <= P; ++row)
     for (std::size_t s = 0; s < pr.x.size(); ++s)
-      for (int k = 0; k < kBlock; ++k) c.J(row, kBlock * int(s) + k) = blocks[s][std::size_t(row * kBlock + k)];
+      for (int k = 0; k < kSourceBlock; ++k)
+        c.J(row, kSourceBlock * int(s) + k) = blocks[s][std::size_t(row * kSourceBlock + k)];
   return c;
 }
 
@@ -142,18 +141,19 @@ TEST(GreySourceCost, JacobianEqualsAutomaticDifferentiationOfTheModel) {
   const Evaluated e = evaluate(pr, 0);
   int crossing = 0;
   for (std::size_t i = 0; i < pr.texels.size(); ++i) {
-    ceres::DynamicAutoDiffCostFunction<ReferenceCost, kBlock> ref(new ReferenceCost{&pr.texels[i], &pr.frames});
-    for (std::size_t s = 0; s < pr.x.size(); ++s) ref.AddParameterBlock(kBlock);
+    ceres::DynamicAutoDiffCostFunction<ReferenceCost, kSourceBlock> ref(new ReferenceCost{&pr.texels[i], &pr.frames});
+    for (std::size_t s = 0; s < pr.x.size(); ++s) ref.AddParameterBlock(kSourceBlock);
     ref.SetNumResiduals(3);
     double r[3];
-    std::vector<std::array<double, 3 * kBlock>> J(pr.x.size());
+    std::vector<std::array<double, 3 * kSourceBlock>> J(pr.x.size());
     std::vector<double*> jac;
     for (auto& j : J) jac.push_back(j.data());
     ASSERT_TRUE(ref.Evaluate(pr.params().data(), r, jac.data()));
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(e.r[3 * i + std::size_t(c)], r[c], 1e-12 * (1 + std::abs(r[c])));
     for (std::size_t s = 0; s < pr.x.size(); ++s)
-      for (int k = 0; k < 3 * kBlock; ++k) {
-        const double want = J[s][std::size_t(k)], got = e.jac(3 * i + std::size_t(k / kBlock), int(s), k % kBlock);
+      for (int k = 0; k < 3 * kSourceBlock; ++k) {
+        const double want = J[s][std::size_t(k)],
+                     got = e.jac(3 * i + std::size_t(k / kSourceBlock), int(s), k % kSourceBlock);
         ASSERT_NEAR(got, want, 1e-10 * (1 + std::abs(want))) << "texel " << i << " source " << s << " entry " << k;
       }
     // Texels whose normal is within the disc's radius of its horizon: the kernel's quadrature branch.
@@ -191,7 +191,7 @@ TEST(GreySourceCost, RobustJacobianEqualsCentralDifferences) {
   const Evaluated e = evaluate(pr, delta);
   const double h = 1e-6;
   for (std::size_t s = 0; s < pr.x.size(); ++s)
-    for (int k = 0; k < kBlock; ++k) {
+    for (int k = 0; k < kSourceBlock; ++k) {
       if (s == 1 && k == 5) continue;  // a point source: rho = 0 sits on the kernel's lower branch
       const double keep = pr.x[s][std::size_t(k)];
       pr.x[s][std::size_t(k)] = keep + h;
@@ -259,8 +259,8 @@ TEST(GreySourceCost, ASourceWithoutPowerLeavesItsDirectionOut) {
   const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(
       e.J.data(), long(e.r.size()), e.P);
   EXPECT_NEAR(c.r.squaredNorm(), r.squaredNorm(), 1e-12 * r.squaredNorm());
-  EXPECT_EQ(c.J.col(kBlock + 0).norm(), 0.0);  // u1 of the dark source
-  EXPECT_EQ(c.J.col(kBlock + 1).norm(), 0.0);
+  EXPECT_EQ(c.J.col(kSourceBlock + 0).norm(), 0.0);  // u1 of the dark source
+  EXPECT_EQ(c.J.col(kSourceBlock + 1).norm(), 0.0);
   const Eigen::VectorXd g = J.transpose() * r, gc = c.J.transpose() * c.r;
   EXPECT_LT((gc - g).norm(), 1e-9 * g.norm());
 }
