@@ -79,14 +79,20 @@ ConeFit fit_cone(const std::vector<Vec3>& rays, const LensModel& lens, const Con
 
   // RANSAC: the 3-ray cone with the most rays within inlier_px (scales from the all-ray fit).
   // Ray m is an inlier of the cone (a, alpha) when |theta_m - alpha| < delta_m = inlier_px / s_m,
-  // i.e. cos(alpha + delta_m) < d_m.a < cos(alpha - delta_m) (the upper bound only when
-  // alpha > delta_m): a dot product and the bounds' sums of products per ray and sample, instead
-  // of an angle.
+  // i.e. cos(alpha + delta_m) < d_m.a < cos(alpha - delta_m) (the lower bound only when
+  // alpha + delta_m < pi, the upper only when alpha > delta_m): a dot product and the bounds' sums
+  // of products per ray and sample, instead of an angle. A ray of scale 0 is always an inlier and
+  // one of no finite scale never, as |theta - alpha| s < inlier_px has them.
   if (options.ransac_iterations > 0 && n > 3) {
     std::vector<double> dx(n), dy(n), dz(n), delta(n), cd(n), sd(n);
     for (int m = 0; m < n; ++m) {
       dx[m] = rays[m].x(), dy[m] = rays[m].y(), dz[m] = rays[m].z();
-      delta[m] = s[m] > 0 ? options.inlier_px / s[m] : 0;
+      if (s[m] == 0)
+        delta[m] = kPi;
+      else if (!(std::isfinite(s[m]) && s[m] > 0))
+        delta[m] = -1;
+      else
+        delta[m] = options.inlier_px / s[m];
       cd[m] = std::cos(delta[m]), sd[m] = std::sin(delta[m]);
     }
     std::mt19937_64 rng(options.seed);
@@ -102,8 +108,9 @@ ConeFit fit_cone(const std::vector<Vec3>& rays, const LensModel& lens, const Con
       int count = 0;
       for (int m = 0; m < n; ++m) {
         const double dot = dx[m] * ax + dy[m] * ay + dz[m] * az;
-        const double lo = ca * cd[m] - sa * sd[m], hi = alpha > delta[m] ? ca * cd[m] + sa * sd[m] : 2.0;
-        count += dot > lo && dot < hi;
+        const double lo = alpha + delta[m] < kPi ? ca * cd[m] - sa * sd[m] : -2.0;
+        const double hi = alpha > delta[m] ? ca * cd[m] + sa * sd[m] : 2.0;
+        count += delta[m] >= 0 && dot > lo && dot < hi;
       }
       if (count > best) {
         best = count;
