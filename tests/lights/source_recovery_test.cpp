@@ -115,6 +115,34 @@ TEST(SourceRecovery, TwoClippedStudioLightsAreRecoveredSeparately) {
     expect_recovered(o.recovered.recovery.sources[i], o.truth[i], "light " + std::to_string(i));
 }
 
+// A studio light only just above the clip level: the probe's lower bound holds nearly all of it,
+// so its source gets little power and the grey ball barely sees its direction; the fit's angle
+// (1.45 degrees on this shoot) is wider than the 1-degree region the direction is bounded to.
+// Its sigma is the region's radius; the bright light beside it is recovered as usual.
+TEST(SourceRecovery, ADimSourceHasItsDirectionSigmaBoundedByItsRegion) {
+  const Vec3 a = direction_at(30, 40), b = direction_at(-40, 25);
+  const EnvMap env =
+      testing::environment_with(std::nullopt, {{a, 1.0, Vec3(3000, 3000, 3000)}, {b, 3.0, Vec3(89, 89, 89)}}, 256,
+                                Vec3(0.3, 0.3, 0.3), Vec3(0.2, 0.2, 0.2));
+  const Outcome o = run(env, 50);
+  ASSERT_EQ(o.recovered.recovery.sources.size(), 2u);
+  int dim = 0;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const LightSource& s = o.recovered.recovery.sources[i];
+    std::printf("  source %zu: power %.4g, direction sigma %.3g deg, region radius %.3g deg\n", i, s.power[1],
+                s.direction_sigma * 180 / kPi, s.region_radius * 180 / kPi);
+    EXPECT_TRUE(std::isfinite(s.direction_sigma));
+    EXPECT_LE(s.direction_sigma, s.region_radius) << i;
+    if (s.power[1] < 0.05 * o.recovered.recovery.sources[1 - i].power[1]) {
+      ++dim;
+      EXPECT_NEAR(s.direction_sigma, s.region_radius, 1e-12) << "the dim source's direction is barely seen";
+    } else {
+      expect_recovered(s, o.truth[i], "the bright light");
+    }
+  }
+  EXPECT_EQ(dim, 1) << "the light just above the clip level should carry little recovered power";
+}
+
 // The grey maps fitted on sub-grids (every 2nd and every 3rd texel in each direction, each texel
 // weighted for those it stands for): the two studio lights are recovered to the same tolerances,
 // the thresholds still count the maps' texels, and the powers stay within a third of a sigma of
