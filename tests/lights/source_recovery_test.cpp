@@ -101,13 +101,19 @@ TEST_P(RealSky, ASunAddedToARealSkyIsRecovered) {
 
 INSTANTIATE_TEST_SUITE_P(Skies, RealSky, ::testing::Values("forest.exr", "city.exr"));
 
+// A studio: a light 2 degrees across (3000 x the room) at azimuth 30, elevation 40, and a second
+// one (radius_deg, radiance) at azimuth -40, elevation 25, in a dim grey room.
+EnvMap studio(double radius_deg, const Vec3& radiance) {
+  return testing::environment_with(
+      std::nullopt,
+      {{direction_at(30, 40), 1.0, Vec3(3000, 3000, 3000)}, {direction_at(-40, 25), radius_deg, radiance}}, 256,
+      Vec3(0.3, 0.3, 0.3), Vec3(0.2, 0.2, 0.2));
+}
+
 // A studio: two lights (2 and 4 degrees across) clipped in every view, 70 degrees apart: two
 // regions, two sources, each within 10% and 1 degree.
 TEST(SourceRecovery, TwoClippedStudioLightsAreRecoveredSeparately) {
-  const Vec3 a = direction_at(30, 40), b = direction_at(-40, 25);
-  const EnvMap env =
-      testing::environment_with(std::nullopt, {{a, 1.0, Vec3(3000, 3000, 3000)}, {b, 2.0, Vec3(800, 700, 600)}}, 256,
-                                Vec3(0.3, 0.3, 0.3), Vec3(0.2, 0.2, 0.2));
+  const EnvMap env = studio(2.0, Vec3(800, 700, 600));
   const Outcome o = run(env, 50);
   ASSERT_EQ(o.recovered.regions.size(), 2u);
   ASSERT_EQ(o.recovered.recovery.sources.size(), 2u);
@@ -120,10 +126,7 @@ TEST(SourceRecovery, TwoClippedStudioLightsAreRecoveredSeparately) {
 // (1.45 degrees on this shoot) is wider than the 1-degree region the direction is bounded to.
 // Its sigma is the region's radius; the bright light beside it is recovered as usual.
 TEST(SourceRecovery, ADimSourceHasItsDirectionSigmaBoundedByItsRegion) {
-  const Vec3 a = direction_at(30, 40), b = direction_at(-40, 25);
-  const EnvMap env =
-      testing::environment_with(std::nullopt, {{a, 1.0, Vec3(3000, 3000, 3000)}, {b, 3.0, Vec3(89, 89, 89)}}, 256,
-                                Vec3(0.3, 0.3, 0.3), Vec3(0.2, 0.2, 0.2));
+  const EnvMap env = studio(3.0, Vec3(89, 89, 89));
   const Outcome o = run(env, 50);
   ASSERT_EQ(o.recovered.recovery.sources.size(), 2u);
   int dim = 0;
@@ -148,10 +151,7 @@ TEST(SourceRecovery, ADimSourceHasItsDirectionSigmaBoundedByItsRegion) {
 // the thresholds still count the maps' texels, and the powers stay within a third of a sigma of
 // the fit on every texel.
 TEST(SourceRecovery, AGreyBallFittedOnASubGridRecoversTheSameLights) {
-  const Vec3 a = direction_at(30, 40), b = direction_at(-40, 25);
-  const EnvMap env =
-      testing::environment_with(std::nullopt, {{a, 1.0, Vec3(3000, 3000, 3000)}, {b, 2.0, Vec3(800, 700, 600)}}, 256,
-                                Vec3(0.3, 0.3, 0.3), Vec3(0.2, 0.2, 0.2));
+  const EnvMap env = studio(2.0, Vec3(800, 700, 600));
   SourceRecoveryOptions every;
   every.texels_per_view = 0;
   const Outcome full = run(env, 50, 6, 10, every);
