@@ -97,16 +97,16 @@ int run_balls(const BallsArgs& a) {
     vc = view_candidates(view.radiance, lens, listed);
   }
   nlohmann::json cands = nlohmann::json::array(), picks = nlohmann::json::array();
-  std::cout << "#  centre_x centre_y radius  inliers support rms_px frame  texture rim  diffuse  looks like\n";
+  std::cout << "#  centre_x centre_y radius  inliers support rms_px frame  texture rim  radial diffuse  looks like\n";
   for (std::size_t i = 0; i < vc.cands.size(); ++i) {
     const BallCandidate& c = vc.cands[i];
     std::string looks;
     for (BallKind k : {BallKind::chrome, BallKind::glossy, BallKind::grey})
       if (looks_like(c, k)) looks += std::string(looks.empty() ? "" : ",") + to_string(k);
     char line[256];
-    std::snprintf(line, sizeof line, "%-2zu %8.1f %8.1f %7.1f %6.2f %7.2f %6.2f %6.2f %7.3f %5.2f %7.3f  %s\n", i,
+    std::snprintf(line, sizeof line, "%-2zu %8.1f %8.1f %7.1f %6.2f %7.2f %6.2f %6.2f %7.3f %5.2f %6.2f %7.3f  %s\n", i,
                   c.loc.centre_px.x(), c.loc.centre_px.y(), c.loc.radius_px, c.inlier_fraction, c.outline_support,
-                  c.loc.fit.rms_px, c.frame_fraction, c.texture, c.rim_texture, c.diffuse_residual,
+                  c.loc.fit.rms_px, c.frame_fraction, c.texture, c.rim_texture, c.rim_radial, c.diffuse_residual,
                   looks.empty() ? "-" : looks.c_str());
     std::cout << line;
     cands.push_back({{"index", i},
@@ -118,6 +118,7 @@ int run_balls(const BallsArgs& a) {
                      {"frame_fraction", c.frame_fraction},
                      {"texture", c.texture},
                      {"rim_texture", c.rim_texture},
+                     {"rim_radial", c.rim_radial},
                      {"diffuse_residual", std::isfinite(c.diffuse_residual) ? c.diffuse_residual : -1.0},
                      {"looks_like", looks}});
   }

@@ -34,6 +34,7 @@ nlohmann::json finding_json(const std::string& ball, const BallFinding& f) {
             {"inlier_fraction", b.inlier_fraction},
             {"texture", b.texture},
             {"mirror_score", b.mirror_score},
+            {"rim_radial", b.rim_radial},
             {"diffuse_residual", std::isfinite(b.diffuse_residual) ? b.diffuse_residual : -1.0},
             {"frame_fraction", b.frame_fraction},
             {"cut", b.cut}});

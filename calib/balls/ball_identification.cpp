@@ -86,6 +86,34 @@ double disc_rim_texture(const cv::Mat& image, const Vec2& c, double r, const std
   return n >= 20 ? double(textured) / double(n) : 0;
 }
 
+// A mirror compresses the world radially toward its rim: what lies in a thin band of directions
+// there is drawn as a thin band along the rim, so the edges run along it and the log-luminance
+// gradient points across it (radially). At a distance rho (in radii) from the centre a mirror
+// stretches directions radially 2 / sqrt(1 - rho^2) and tangentially sin(2 asin rho) / rho: 2x more
+// radially at 0.7, 5x at 0.9, 10x at 0.95. Returned: sum (g_r^2 - g_t^2) / |g| over sum |g| for the
+// pixels between 0.8 and 0.96 radii, stopping 2 px plus the step short of the outline (whose own
+// edge is radial for any disc) and at least 4 px wide (a small ball), in [-1, 1]: about 0 for a patch of the scene, which has no reason to
+// line up with a circle drawn over it, and clearly positive for a mirror ball. The neighbour step
+// is r / 64 as for the rim texture.
+double disc_rim_radial(const cv::Mat& image, const Vec2& c, double r, const std::vector<Disc>& ex) {
+  const int d = std::max(1, int(std::lround(r / 64)));
+  const double outer = std::min(0.96 * r, r - 2.0 - d), inner = std::min(0.8 * r, outer - 4.0);
+  double along = 0, total = 0;
+  auto l = [&](int x, int y) { return std::log(std::max(1e-6, lum_of(image.at<cv::Vec3f>(y, x)))); };
+  for_disc(image, c, r, 0.96, ex, [&](int x, int y) {
+    const Vec2 u = Vec2(x, y) - c;
+    const double dist = u.norm();
+    if (dist < inner || dist > outer || x < d || y < d || x + d >= image.cols || y + d >= image.rows) return;
+    const double gx = l(x + d, y) - l(x - d, y), gy = l(x, y + d) - l(x, y - d);
+    const double g = std::hypot(gx, gy);
+    if (!(g > 1e-9)) return;
+    const double gr = (gx * u.x() + gy * u.y()) / dist, gt = (gy * u.x() - gx * u.y()) / dist;
+    along += (gr * gr - gt * gt) / g;
+    total += g;
+  });
+  return total > 0 ? along / total : 0;
+}
+
 // The 98th percentile, over the pixels within 0.9 radii, of |grad log2(L + eps)| in stops per ball
 // radius (central differences; eps = 1e-3 of the disc's mean): a grey ball scores a few stops, a
 // mirror tens (the environment's edges compressed toward its rim).
@@ -309,6 +337,7 @@ BallCandidate measure(const cv::Mat& image, const LensModel& lens, const BallLoc
   c.texture = disc_texture(image, loc.centre_px, loc.radius_px, ex);
   c.rim_texture = disc_rim_texture(image, loc.centre_px, loc.radius_px, ex);
   c.mirror_score = disc_mirror_score(image, loc.centre_px, loc.radius_px, ex);
+  c.rim_radial = disc_rim_radial(image, loc.centre_px, loc.radius_px, ex);
   const LambertFit lf = lambert_fit(image, lens, loc, ex);
   c.diffuse_residual = lf.residual;
   c.shading_texture = lf.unexplained_texture;
@@ -435,6 +464,7 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
       if (!looks_like(without, BallKind::chrome)) {
         balls[k].texture = without.texture, balls[k].rim_texture = without.rim_texture;
         balls[k].mirror_score = without.mirror_score, balls[k].diffuse_residual = without.diffuse_residual;
+        balls[k].rim_radial = without.rim_radial;
         balls[k].shading_texture = without.shading_texture;
         break;
       }
@@ -458,6 +488,7 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
     if (ex.empty()) continue;
     const BallCandidate m = measure(image, lens, kept[i].loc, ex);
     out[i].texture = m.texture, out[i].rim_texture = m.rim_texture, out[i].mirror_score = m.mirror_score;
+    out[i].rim_radial = m.rim_radial;
     out[i].diffuse_residual = m.diffuse_residual, out[i].shading_texture = m.shading_texture;
   }
   if (frame_out) *frame_out = frame_circle;
@@ -484,9 +515,12 @@ std::vector<ListedBall> listed_balls(const PhotoSet& set) {
 bool looks_like(const BallCandidate& c, BallKind kind) {
   if (!std::isfinite(c.diffuse_residual)) return false;  // too little of it visible to tell
   switch (kind) {
-    // A textured rim (the world compressed there), or a range no diffuse ball shows (a light
-    // source reflected: the sun in a smooth sky).
-    case BallKind::chrome: return (c.rim_texture >= 0.25 && c.diffuse_residual >= 0.12) || c.diffuse_residual >= 2.0;
+    // A textured rim with the world compressed across it (rim_radial: a circle drawn over a patch
+    // of the scene scores about 0, chrome balls on real photos 0.39-0.58), or a range no diffuse
+    // ball shows (a light source reflected: the sun in a smooth sky, which has no features to
+    // compress: its horizon crosses the ball as a line through the centre).
+    case BallKind::chrome:
+      return (c.rim_texture >= 0.25 && c.rim_radial >= 0.2 && c.diffuse_residual >= 0.12) || c.diffuse_residual >= 2.0;
     case BallKind::grey: return c.shading_texture < 0.05 && c.diffuse_residual < 0.15;
     case BallKind::glossy: return c.diffuse_residual >= 0.04;
   }
@@ -974,13 +1008,19 @@ ViewCandidates view_candidates(const cv::Mat& image, const LensModel& lens, cons
   }
   vc.pick = assign_balls_in_view(vc.cands, balls);
   // A photo cropped to its one listed ball (calib/lens/far_camera.h): the one circle with a clean
-  // outline that fills the frame is that ball whatever its appearance (a chrome ball reflecting a
-  // smooth table over half its disc looks glossy), and the circles inside it are reflections.
+  // outline that fills the frame is that ball whatever its texture (a chrome ball reflecting a
+  // smooth table over half its disc looks glossy), and the circles inside it are reflections. A
+  // crop is of the ball: the circle holds the frame's centre and lies mostly inside the frame (a
+  // huge arc through the furniture of a full frame, centred near its edge, is no crop's ball).
   if (balls.size() == 1) {
+    const Vec2 middle(0.5 * (image.cols - 1), 0.5 * (image.rows - 1));
     int fill = -1, n = 0;
-    for (std::size_t k = 0; k < vc.cands.size(); ++k)
-      if (fills_frame(vc.cands[k].loc.radius_px, image.cols, image.rows) && vc.cands[k].outline_support >= 0.5)
+    for (std::size_t k = 0; k < vc.cands.size(); ++k) {
+      const BallCandidate& c = vc.cands[k];
+      if (fills_frame(c.loc.radius_px, image.cols, image.rows) && c.outline_support >= 0.5 && c.frame_fraction >= 0.7 &&
+          (c.loc.centre_px - middle).norm() <= 0.5 * c.loc.radius_px)
         fill = int(k), ++n;
+    }
     if (n == 1) vc.pick[0] = fill;
   }
   return vc;

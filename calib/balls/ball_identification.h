@@ -46,7 +46,9 @@ struct BallCandidate {
   double texture = 0;          // mean |ln L| change between neighbouring pixels within 0.8 radii
   double rim_texture =
       0;  // fraction of the pixels between 0.5 and 0.9 radii whose ln L changes by > 0.06 to a neighbour
-  double mirror_score = 0;      // 98th percentile of |grad log2 L| within 0.9 radii, stops per radius
+  double mirror_score = 0;  // 98th percentile of |grad log2 L| within 0.9 radii, stops per radius
+  double rim_radial =
+      0;  // gradients across the rim over those along it, 0.8-0.96 radii, in [-1, 1] (a mirror's compression)
   double diffuse_residual = 0;  // RMS of a Lambert fit (order-2 spherical harmonics and one sun) over 0.9 radii / mean
   double shading_texture = 0;   // mean |ln(L / that fit)| change between neighbouring pixels within 0.8 radii
   double frame_fraction = 1;    // fraction of the fitted outline inside the image

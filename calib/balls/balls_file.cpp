@@ -52,6 +52,7 @@ nlohmann::json candidate_json(const BallCandidate& c) {
           {"texture", c.texture},
           {"rim_texture", c.rim_texture},
           {"mirror_score", c.mirror_score},
+          {"rim_radial", c.rim_radial},
           {"diffuse_residual", number(c.diffuse_residual)},
           {"shading_texture", number(c.shading_texture)},
           {"frame_fraction", c.frame_fraction},
@@ -80,6 +81,7 @@ BallCandidate candidate_from_json(const nlohmann::json& j) {
   c.texture = j.at("texture").get<double>();
   c.rim_texture = j.at("rim_texture").get<double>();
   c.mirror_score = j.at("mirror_score").get<double>();
+  c.rim_radial = j.at("rim_radial").get<double>();
   c.diffuse_residual = number(j.at("diffuse_residual"));
   c.shading_texture = number(j.at("shading_texture"));
   c.frame_fraction = j.at("frame_fraction").get<double>();

@@ -176,7 +176,7 @@ TEST(BallIdentification, AGivenBallIsLocatedAtTheGuess) {
   EXPECT_THROW(given_ball(r.views[0].radiance, r.scene.camera.lens, {truth, 0.5}), std::invalid_argument);
 }
 
-// Drawn balls (no renderer, quick): a mirror-like disc of random texture and a smoothly shaded
+// Drawn balls (no renderer, quick): a mirror reflecting a patchwork of random brightness and a smoothly shaded
 // sphere are told apart by appearance and matched to the listed kinds; a flat uniform disc (a
 // Lambert fit cannot tell it from a ball in uniform light) twice their size is not taken for the
 // grey ball: balls of one rig are at about the same distance.
@@ -185,21 +185,39 @@ TEST(BallIdentification, DrawnBallsAreMeasuredAndMatchedByAppearanceAndSize) {
   cv::Mat img(160, 240, CV_32FC3, cv::Scalar::all(0.3));
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<float> u(0.05f, 2.0f);
+  // The mirror's world: 15-degree cells of random brightness, all brighter than the background
+  // (an outline all round), seen along r = 2 (n . v) n - v.
+  std::uniform_real_distribution<float> bright(0.8f, 3.0f);
+  std::vector<float> cells(24 * 12);
+  for (float& c : cells) c = bright(rng);
+  auto world = [&](const Vec3& r) {
+    const double lon = std::atan2(r.x(), r.z()) + kPi, lat = std::acos(std::clamp(r.y(), -1.0, 1.0));
+    return cells[std::size_t(std::min(11, int(lat / kPi * 12)) * 24 + std::min(23, int(lon / (2 * kPi) * 24)))];
+  };
   auto draw = [&](const Vec2& c, double r, int kind) {
     for (int y = 0; y < img.rows; ++y)
       for (int x = 0; x < img.cols; ++x) {
         const Vec2 d = (Vec2(x, y) - c) / r;
         if (d.squaredNorm() > 1) continue;
         const double nz = std::sqrt(1 - d.squaredNorm());
-        const float v = kind == 0 ? u(rng) : kind == 1 ? float(0.2 - 0.12 * d.y() + 0.1 * nz) : 0.8f;
+        const Vec3 n(d.x(), d.y(), nz);
+        const float v = kind == 0   ? world(2 * nz * n - Vec3(0, 0, 1))
+                        : kind == 1 ? float(0.2 - 0.12 * d.y() + 0.1 * nz)
+                        : kind == 2 ? 0.8f
+                                    : u(rng);
         img.at<cv::Vec3f>(y, x) = cv::Vec3f(v, v, v);
       }
   };
   draw(Vec2(50, 90), 20, 0);   // "chrome"
   draw(Vec2(120, 95), 21, 1);  // grey
   draw(Vec2(195, 60), 40, 2);  // a flat disc
+  draw(Vec2(110, 32), 20, 3);  // a disc of noise (a printed pattern): textured, not compressed at its rim
   const std::vector<BallCandidate> c = find_ball_candidates(img, lens);
-  ASSERT_GE(c.size(), 3u);
+  ASSERT_GE(c.size(), 4u);
+  const auto noise = std::find_if(c.begin(), c.end(),
+                                  [](const BallCandidate& b) { return (b.loc.centre_px - Vec2(110, 32)).norm() < 2; });
+  ASSERT_NE(noise, c.end());
+  EXPECT_FALSE(looks_like(*noise, BallKind::chrome)) << "rim_radial " << noise->rim_radial;
   const std::vector<ListedBall> listed = {{"chrome", BallKind::chrome, 0.1}, {"grey", BallKind::grey, 0.1}};
   const std::vector<int> pick = assign_balls_in_view(c, listed);
   ASSERT_GE(pick[0], 0);

@@ -29,6 +29,7 @@ BallCandidate candidate(const Vec3& centre_m, double radius_m, double rim_textur
   c.rim_texture = rim_texture;
   c.diffuse_residual = diffuse_residual;
   c.shading_texture = shading_texture;
+  c.rim_radial = 0.45;  // a ball's rim, as chrome balls measure
   return c;
 }
 
