@@ -6,6 +6,8 @@
 #include "core/luminance.h"
 #include "core/resolution_mask.h"
 
+#include <opencv2/imgproc.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -24,9 +26,11 @@ struct Lookup {
   double confidence = 0, weight = 0;  // weight: the trusted taps' bilinear weight
   Vec3 clipped_value = Vec3::Zero();
   double clipped = 0, clipped_weight = 0;
+  bool near_clipped = false;  // a trusted tap lies within the registration error of the view's own clipped texels
 };
 
-Lookup look_up(const MapView& mv, const Vec3& r) {
+// `near`: empty, or CV_8UC1 of the map's size, non-zero within the registration error of a clipped texel.
+Lookup look_up(const MapView& mv, const cv::Mat& near, const Vec3& r) {
   Lookup out;
   const Vec2 px = sphere_map::pixel_from_disc(sphere_map::g_mirror_inv(r), mv.rgb.cols, mv.rgb.rows);
   const int x0 = static_cast<int>(std::floor(px.x())), y0 = static_cast<int>(std::floor(px.y()));
@@ -42,6 +46,7 @@ Lookup look_up(const MapView& mv, const Vec3& r) {
       out.value += tw[k] * c;
       out.confidence += tw[k] * cf;
       out.weight += tw[k];
+      out.near_clipped |= !near.empty() && near.at<unsigned char>(ty[k], tx[k]) != 0;
     } else if (!mv.clipped.empty()) {
       if (const float cl = mv.clipped.at<float>(ty[k], tx[k]); cl > 0 && c.allFinite()) {
         out.clipped_value += tw[k] * c;
@@ -56,6 +61,7 @@ Lookup look_up(const MapView& mv, const Vec3& r) {
     out.clipped_value /= out.clipped_weight;
     out.value = Vec3::Zero();
     out.confidence = out.weight = 0;
+    out.near_clipped = false;
     return out;
   }
   if (out.weight > 0) out.value /= out.weight;
@@ -112,6 +118,17 @@ Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
       const double spacing = probe_texel / k, texel = 4.0 / std::max(1, set.views[v].rgb.cols);
       lod[v] = spacing > texel ? std::log2(spacing / texel) : 0.0;
     }
+  // Per view, its clipped texels grown by the registration error (registration_deg; a map texel
+  // spans 4 / size radians), for the vote below.
+  std::vector<cv::Mat> near(set.views.size());
+  for (std::size_t v = 0; v < set.views.size(); ++v) {
+    const MapView& mv = set.views[v];
+    if (mv.clipped.empty() || !(options.registration_deg > 0)) continue;
+    cv::Mat mask = mv.clipped > 0.0f;
+    if (cv::countNonZero(mask) == 0) continue;
+    const int radius = int(std::ceil(options.registration_deg * kPi / 180 * std::max(mv.rgb.cols, mv.rgb.rows) / 4));
+    cv::dilate(mask, near[v], cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1)));
+  }
   std::vector<double> row_area(layout.height(), 0.0), row_covered(layout.height(), 0.0),
       row_clipped(layout.height(), 0.0);
   parallel_for_rows(layout.height(), [&](int row) {
@@ -121,7 +138,7 @@ Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
       const double area = std::sqrt(std::max(0.0, 1.0 - centre->y() * centre->y()));  // cos(latitude)
       row_area[row] += area;
       Vec3 sum = Vec3::Zero(), bound = Vec3::Zero();
-      double wsum = 0, csum = 0;
+      double wsum = 0, csum = 0, wnear = 0;
       for (int a = 0; a < k; ++a)
         for (int b = 0; b < k; ++b) {
           const auto w = k == 1 ? centre : layout.direction(Vec2(col - 0.5 + (b + 0.5) / k, row - 0.5 + (a + 0.5) / k));
@@ -133,7 +150,7 @@ Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
           for (std::size_t v = 0; v < nv; ++v) {
             const MapView& mv = set.views[v];
             const Vec3 r = mv.world_from_view.transpose() * *w;
-            looks[v] = look_up(mv, r);
+            looks[v] = look_up(mv, near[v], r);
             m[v] = 0.0f;
             if (mixed && looks[v].confidence > 0) {
               const Vec2 px = sphere_map::pixel_from_disc(sphere_map::g_mirror_inv(r), mv.rgb.cols, mv.rgb.rows);
@@ -153,6 +170,7 @@ Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
             if (l.confidence > 0) {
               sum += l.confidence * l.value.cwiseQuotient(f);
               wsum += l.confidence;
+              if (l.near_clipped) wnear += l.confidence;
             }
             if (l.clipped > 0) {
               csum += l.clipped;
@@ -160,12 +178,15 @@ Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
             }
           }
         }
-      wsum /= k * k, csum /= k * k, sum /= k * k;
+      wsum /= k * k, csum /= k * k, sum /= k * k, wnear /= k * k;
       // A trusted estimate below a lower bound other views saw there contradicts them (a sun smeared
       // over the stretched rim of a view that saw it unclipped): the lower bound wins when its
       // views outweigh the trusted ones (else one view's misregistered clipped pixels would clip
-      // the sky the others saw).
-      if (wsum >= options.min_weight && csum > wsum && luminance(sum / wsum) < luminance(bound)) wsum = 0;
+      // the sky the others saw). A trusted lookup within the registration error of its own view's
+      // clipped texels does not vote against it: that view saw the light clipped too, a little
+      // elsewhere (a sun a few texels wide in every view, each view registered to 1-2 degrees,
+      // would otherwise be outvoted everywhere and vanish from the probe).
+      if (wsum >= options.min_weight && csum > wsum - wnear && luminance(sum / wsum) < luminance(bound)) wsum = 0;
       if (wsum < options.min_weight) {
         if (csum >= options.min_weight) {
           probe.clipped.at<float>(row, col) = static_cast<float>(csum);

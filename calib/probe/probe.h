@@ -16,7 +16,8 @@
 // Clipped light: a view's lookup with a clipped tap (the map's `clipped` channel, formats/map_set.h)
 // counts as clipped as a whole (the tap's value is a lower bound; renormalising over its trusted
 // neighbours would fill a sun with sky). Where no view has an unclipped lookup but some view a
-// clipped one, or the clipped lookups outweigh the unclipped ones and the unclipped blend is darker
+// clipped one, or the clipped lookups outweigh the unclipped ones (those within registration_deg
+// of their own view's clipped texels abstain: they saw the light clipped nearby) and the unclipped blend is darker
 // than the largest lower bound (it contradicts them: a sun smeared over the stretched rim of a view
 // that saw it unclipped), the probe
 // texel is 0, `clipped` holds the summed weight of the clipped lookups (the direction counts as
@@ -49,6 +50,9 @@ struct ProbeOptions {
   int width = 256;                   // lat-long width (height = width / 2)
   const Fresnel* fresnel = nullptr;  // the ball's Fresnel, divided out; none: the probe is F L
   double min_weight = 1e-3;
+  // How far the views' frames may disagree (degrees): a trusted lookup this close to its own view's
+  // clipped texels abstains from the vote against the other views' lower bounds (probe.cpp).
+  double registration_deg = 2.0;
 };
 
 struct Probe {

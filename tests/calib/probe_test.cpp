@@ -6,6 +6,7 @@
 #include "calib/balls/ball_locator.h"
 #include "calib/extraction/sphere_map_extraction.h"
 #include "calib_cases.h"
+#include "core/sphere_map.h"
 
 #include <gtest/gtest.h>
 
@@ -72,6 +73,81 @@ TEST(Probe, FourChromeViewsGiveTheEnvironmentWithoutTheCamera) {
   EXPECT_GT(e.covered, single.covered_fraction + 0.03);  // the others fill view 0's camera
   for (auto it = all.env.pixels.begin<cv::Vec3f>(); it != all.env.pixels.end<cv::Vec3f>(); ++it)
     ASSERT_TRUE(std::isfinite((*it)[0]) && std::isfinite((*it)[1]) && std::isfinite((*it)[2]));
+}
+
+// A sun clipped in every view, a texel or two wide in each view's map, where each view's frame is
+// off by a degree or so (as solved orientations are): every view's clipped spot lies a little apart
+// from the others', so at each probe texel one view says "clipped" and the rest see sky there. The
+// sun must stay a lower bound in the probe: views that clipped it within the registration error do
+// not vote it away (without that rule no texel of the probe is clipped).
+TEST(Probe, ASunClippedInEveryViewSurvivesTheViewsRegistrationSpread) {
+  const int size = 128;
+  const Vec3 sun = Vec3(0.3, 0.8, 0.5).normalized();
+  const Vec3 axes[5] = {{1, 0, 0}, {0, 0, 1}, {-1, 0, 0}, {0, 0, -1}, {0.7, 0, 0.7}};
+  MapSet set;
+  for (int v = 0; v < 5; ++v) {
+    MapView mv;
+    mv.source = MapSource::Captured;
+    // The view's frame as registered: the true frame turned by 1.2 degrees about a horizontal axis.
+    const Mat3 err = Eigen::AngleAxisd(1.2 * kPi / 180, axes[v].normalized()).toRotationMatrix();
+    mv.world_from_view = Mat3::Identity();
+    mv.rgb = cv::Mat(size, size, CV_32FC3, cv::Scalar::all(1.0));
+    mv.confidence = cv::Mat(size, size, CV_32FC1, cv::Scalar(1.0));
+    mv.clipped = cv::Mat(size, size, CV_32FC1, cv::Scalar(0.0));
+    // Where this view saw the sun (its frame's error moves it); the texels within 1 degree clipped,
+    // at least the nearest.
+    const Vec3 seen = err * sun;
+    const Vec2 p = sphere_map::pixel_from_disc(sphere_map::g_mirror_inv(seen), size, size);
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x) {
+        const Vec2 d = sphere_map::disc_from_pixel(Vec2(x, y), size, size);
+        if (d.squaredNorm() >= 1) {
+          mv.confidence.at<float>(y, x) = 0;
+          continue;
+        }
+        const bool nearest = std::lround(p.x()) == x && std::lround(p.y()) == y;
+        if (nearest || angle_between(sphere_map::g_mirror(d), seen) < kPi / 180) {
+          mv.confidence.at<float>(y, x) = 0;
+          mv.clipped.at<float>(y, x) = 1;
+          mv.rgb.at<cv::Vec3f>(y, x) = cv::Vec3f(50, 50, 50);
+        }
+      }
+    set.views.push_back(mv);
+  }
+  ProbeOptions po;
+  po.width = 512;
+  const Probe p = assemble_probe(set, po);
+  // Solid angles: a lat-long texel (2 pi / W)(pi / H) cos(latitude); an equal-area sphere-map texel
+  // 16 / size^2 (the unit disc holds 4 pi sr).
+  auto lower_bound_sr = [](const Probe& q) {
+    double sr = 0;
+    for (int r = 0; r < q.clipped.rows; ++r)
+      for (int c = 0; c < q.clipped.cols; ++c)
+        if (q.clipped.at<float>(r, c) > 0)
+          sr += 2 * kPi / q.clipped.cols * kPi / q.clipped.rows *
+                std::sqrt(std::max(0.0, 1 - std::pow(q.env.layout.texel_direction(c, r)->y(), 2)));
+    return sr;
+  };
+  const double one_view_sr = cv::countNonZero(set.views[0].clipped > 0) * 16.0 / (size * size);
+  double nearest = 1e9;
+  for (int r = 0; r < p.clipped.rows; ++r)
+    for (int c = 0; c < p.clipped.cols; ++c)
+      if (p.clipped.at<float>(r, c) > 0) {
+        nearest = std::min(nearest, angle_between(*p.env.layout.texel_direction(c, r), sun));
+        EXPECT_GE(p.lower_bound.at<cv::Vec3f>(r, c)[0], 49.f);
+      }
+  EXPECT_GE(lower_bound_sr(p), one_view_sr) << "the sun was voted away";
+  EXPECT_LT(nearest * 180 / kPi, 1.0);
+  // The case this rule exists for: without it (every trusted lookup votes) the probe keeps only
+  // where the views' spots overlap, less than any one view saw.
+  ProbeOptions strict = po;
+  strict.registration_deg = 0;
+  EXPECT_LT(lower_bound_sr(assemble_probe(set, strict)), one_view_sr);
+  // The sky away from the sun is the views' trusted blend, never a lower bound.
+  for (int r = 0; r < p.clipped.rows; ++r)
+    for (int c = 0; c < p.clipped.cols; ++c)
+      if (angle_between(*p.env.layout.texel_direction(c, r), sun) > 6 * kPi / 180)
+        ASSERT_EQ(p.clipped.at<float>(r, c), 0.f) << "row " << r << " col " << c;
 }
 
 TEST(Probe, ComputedMapsOrNoViewsAreRefused) {
