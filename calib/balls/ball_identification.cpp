@@ -50,17 +50,37 @@ void for_disc(const cv::Mat& image, const Vec2& c, double r, double fraction, co
     }
 }
 
+// ln(max(1e-6, L)) over a disc's box (within `reach` px of the centre, clipped to the image), made
+// once per measurement: the texture measures read each pixel's log several times.
+struct LogLum {
+  int x0 = 0, y0 = 0;
+  cv::Mat ln;  // CV_64FC1
+  LogLum(const cv::Mat& image, const Vec2& c, double reach) {
+    x0 = std::max(0, int(std::floor(c.x() - reach)));
+    y0 = std::max(0, int(std::floor(c.y() - reach)));
+    const int x1 = std::min(image.cols - 1, int(std::ceil(c.x() + reach)));
+    const int y1 = std::min(image.rows - 1, int(std::ceil(c.y() + reach)));
+    ln = cv::Mat(std::max(0, y1 - y0 + 1), std::max(0, x1 - x0 + 1), CV_64FC1);
+    for (int y = 0; y < ln.rows; ++y) {
+      double* row = ln.ptr<double>(y);
+      const cv::Vec3f* in = image.ptr<cv::Vec3f>(y0 + y) + x0;
+      for (int x = 0; x < ln.cols; ++x) row[x] = std::log(std::max(1e-6, lum_of(in[x])));
+    }
+  }
+  // The caller keeps (x, y) inside the box.
+  double operator()(int x, int y) const { return ln.at<double>(y - y0, x - x0); }
+};
+
 // Mean |ln L| change between neighbouring pixels inside 0.8 radii: a chrome ball reflects the whole
 // world, edges compressed toward its rim; a grey ball's shading may span as many stops (sun and
 // shadow) but changes slowly, so the pixel-to-pixel change, not the spread, tells them apart.
-double disc_texture(const cv::Mat& image, const Vec2& c, double r, const std::vector<Disc>& ex) {
+double disc_texture(const cv::Mat& image, const LogLum& l, const Vec2& c, double r, const std::vector<Disc>& ex) {
   double s = 0;
   long n = 0;
   for_disc(image, c, r, 0.8, ex, [&](int x, int y) {
     if (x + 1 >= image.cols || y + 1 >= image.rows) return;
-    const double v = std::log(std::max(1e-6, lum_of(image.at<cv::Vec3f>(y, x))));
-    s += std::abs(std::log(std::max(1e-6, lum_of(image.at<cv::Vec3f>(y, x + 1)))) - v) +
-         std::abs(std::log(std::max(1e-6, lum_of(image.at<cv::Vec3f>(y + 1, x)))) - v);
+    const double v = l(x, y);
+    s += std::abs(l(x + 1, y) - v) + std::abs(l(x, y + 1) - v);
     n += 2;
   });
   return n > 0 ? s / double(n) : 0;
@@ -72,14 +92,14 @@ double disc_texture(const cv::Mat& image, const Vec2& c, double r, const std::ve
 // measure does not depend on the ball's size in pixels: a ball photographed 3x larger shows the
 // same world over 3x the pixels, and its neighbours one pixel apart differ 3x less (a 189 px chrome
 // ball in a 13 MP phone frame measured 0.23, under the chrome test's 0.25, at one pixel).
-double disc_rim_texture(const cv::Mat& image, const Vec2& c, double r, const std::vector<Disc>& ex) {
+double disc_rim_texture(const cv::Mat& image, const LogLum& l, const Vec2& c, double r, const std::vector<Disc>& ex) {
   long n = 0, textured = 0;
   const int d = std::max(1, int(std::lround(r / 64)));
   for_disc(image, c, r, 0.9, ex, [&](int x, int y) {
     if ((Vec2(x, y) - c).norm() < 0.5 * r || x + d >= image.cols || y + d >= image.rows) return;
-    const double v = std::log(std::max(1e-6, lum_of(image.at<cv::Vec3f>(y, x))));
-    const double dx = std::abs(std::log(std::max(1e-6, lum_of(image.at<cv::Vec3f>(y, x + d)))) - v);
-    const double dy = std::abs(std::log(std::max(1e-6, lum_of(image.at<cv::Vec3f>(y + d, x)))) - v);
+    const double v = l(x, y);
+    const double dx = std::abs(l(x + d, y) - v);
+    const double dy = std::abs(l(x, y + d) - v);
     ++n;
     textured += std::max(dx, dy) > 0.06;
   });
@@ -95,11 +115,10 @@ double disc_rim_texture(const cv::Mat& image, const Vec2& c, double r, const std
 // edge is radial for any disc) and at least 4 px wide (a small ball), in [-1, 1]: about 0 for a patch of the scene, which has no reason to
 // line up with a circle drawn over it, and clearly positive for a mirror ball. The neighbour step
 // is r / 64 as for the rim texture.
-double disc_rim_radial(const cv::Mat& image, const Vec2& c, double r, const std::vector<Disc>& ex) {
+double disc_rim_radial(const cv::Mat& image, const LogLum& l, const Vec2& c, double r, const std::vector<Disc>& ex) {
   const int d = std::max(1, int(std::lround(r / 64)));
   const double outer = std::min(0.96 * r, r - 2.0 - d), inner = std::min(0.8 * r, outer - 4.0);
   double along = 0, total = 0;
-  auto l = [&](int x, int y) { return std::log(std::max(1e-6, lum_of(image.at<cv::Vec3f>(y, x)))); };
   for_disc(image, c, r, 0.96, ex, [&](int x, int y) {
     const Vec2 u = Vec2(x, y) - c;
     const double dist = u.norm();
@@ -191,11 +210,17 @@ LambertFit lambert_fit(const cv::Mat& image, const LensModel& lens, const BallLo
   for (const Px& p : px) mean += p.v;
   mean /= double(px.size());
   if (!(mean > 0)) return out;
-  std::vector<std::size_t> sample;
+  // The sample's normals, basis rows and values (over the mean), made once for every l tried.
+  std::vector<Vec3> sn;
+  std::vector<Eigen::Matrix<double, 9, 1>> sy;
+  std::vector<double> sv;
+  double vv = 0;
   for (std::size_t i = 0; i < px.size(); i += stride) {
     const auto y = sh(px[i].n);
-    g += y * y.transpose(), gv += y * (px[i].v / mean);
-    sample.push_back(i);
+    const double v = px[i].v / mean;
+    g += y * y.transpose(), gv += y * v;
+    sn.push_back(px[i].n), sy.push_back(y), sv.push_back(v);
+    vv += v * v;
   }
   // Sum of squared residuals (in units of the mean) with the sun term along l.
   auto sse_along = [&](const Vec3& l) {
@@ -203,16 +228,15 @@ LambertFit lambert_fit(const cv::Mat& image, const LensModel& lens, const BallLo
     Eigen::Matrix<double, 10, 1> rhs = Eigen::Matrix<double, 10, 1>::Zero();
     a.topLeftCorner<9, 9>() = g;
     rhs.head<9>() = gv;
-    double vv = 0;
-    for (std::size_t i : sample) {
-      const double c = std::max(0.0, px[i].n.dot(l)), v = px[i].v / mean;
-      if (c > 0) {
-        a.block<9, 1>(0, 9) += sh(px[i].n) * c;
-        a(9, 9) += c * c;
-        rhs[9] += c * v;
-      }
-      vv += v * v;
+    Eigen::Matrix<double, 9, 1> cross = Eigen::Matrix<double, 9, 1>::Zero();
+    double cc = 0, cv = 0;
+    for (std::size_t i = 0; i < sn.size(); ++i) {
+      const double c = sn[i].dot(l);
+      if (c > 0) cross += sy[i] * c, cc += c * c, cv += c * sv[i];
     }
+    a.block<9, 1>(0, 9) = cross;
+    a(9, 9) = cc;
+    rhs[9] = cv;
     a.block<1, 9>(9, 0) = a.block<9, 1>(0, 9).transpose();
     if (!(a(9, 9) > 1e-9)) return std::numeric_limits<double>::infinity();
     const Eigen::Matrix<double, 10, 1> x = a.ldlt().solve(rhs);
@@ -243,16 +267,31 @@ LambertFit lambert_fit(const cv::Mat& image, const LensModel& lens, const BallLo
       }
     }
   }
-  Eigen::MatrixXd a(int(px.size()), 10);
-  Eigen::VectorXd v(int(px.size()));
-  for (std::size_t i = 0; i < px.size(); ++i) {
-    a.block<1, 9>(int(i), 0) = sh(px[i].n).transpose();
-    a(int(i), 9) = std::max(0.0, px[i].n.dot(best_l));
-    v[int(i)] = px[i].v;
+  // The final fit on every pixel, by its 10 x 10 normal equations in units of the mean (the basis
+  // is well conditioned over a visible hemisphere; a column-pivoting QR of the pixels x 10 matrix
+  // gave the same residual and cost a quarter of the candidates' measurement).
+  auto row = [&](const Px& p) {
+    Eigen::Matrix<double, 10, 1> r;
+    r.head<9>() = sh(p.n);
+    r[9] = std::max(0.0, p.n.dot(best_l));
+    return r;
+  };
+  Eigen::Matrix<double, 10, 10> ata = Eigen::Matrix<double, 10, 10>::Zero();
+  Eigen::Matrix<double, 10, 1> atv = Eigen::Matrix<double, 10, 1>::Zero();
+  for (const Px& p : px) {
+    const Eigen::Matrix<double, 10, 1> r = row(p);
+    ata.selfadjointView<Eigen::Lower>().rankUpdate(r);
+    atv += r * (p.v / mean);
   }
-  const Eigen::VectorXd x = a.colPivHouseholderQr().solve(v);
-  const Eigen::VectorXd fit = a * x;
-  out.residual = std::sqrt((fit - v).squaredNorm() / double(px.size())) / mean;
+  ata = ata.selfadjointView<Eigen::Lower>();
+  const Eigen::Matrix<double, 10, 1> x = ata.ldlt().solve(atv) * mean;
+  Eigen::VectorXd fit(int(px.size()));
+  double sq = 0;
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    fit[int(i)] = row(px[i]).dot(x);
+    sq += (fit[int(i)] - px[i].v) * (fit[int(i)] - px[i].v);
+  }
+  out.residual = std::sqrt(sq / double(px.size())) / mean;
   // ln(L / fit) on the pixels within 0.8 radii (the fit floored at 1e-3 of the mean: a shadow),
   // averaged over 3 x 3 neighbours (pixel noise, 2-6% in a merged HDR, is not texture; a mirror's
   // reflected edges survive the average), then its change between neighbours.
@@ -334,10 +373,12 @@ BallCandidate measure(const cv::Mat& image, const LensModel& lens, const BallLoc
   BallCandidate c;
   c.loc = loc;
   measure_outline(c, lens);
-  c.texture = disc_texture(image, loc.centre_px, loc.radius_px, ex);
-  c.rim_texture = disc_rim_texture(image, loc.centre_px, loc.radius_px, ex);
+  // The box reaches the farthest neighbour a measure reads: 0.96 radii plus its step, r / 64.
+  const LogLum l(image, loc.centre_px, loc.radius_px + std::lround(loc.radius_px / 64) + 3);
+  c.texture = disc_texture(image, l, loc.centre_px, loc.radius_px, ex);
+  c.rim_texture = disc_rim_texture(image, l, loc.centre_px, loc.radius_px, ex);
   c.mirror_score = disc_mirror_score(image, loc.centre_px, loc.radius_px, ex);
-  c.rim_radial = disc_rim_radial(image, loc.centre_px, loc.radius_px, ex);
+  c.rim_radial = disc_rim_radial(image, l, loc.centre_px, loc.radius_px, ex);
   const LambertFit lf = lambert_fit(image, lens, loc, ex);
   c.diffuse_residual = lf.residual;
   c.shading_texture = lf.unexplained_texture;
@@ -403,7 +444,11 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
         // A straight edge fits a huge circle: the radius must stay near the detection range and the
         // centre in the image.
         if (!(l.radius_px >= rmin / 1.25 && l.radius_px <= 1.25 * rmax) || !lens.in_image(l.centre_px)) continue;
-        BallCandidate lc = measure_ball(image, lens, l);
+        // The outline's measures choose; the appearance is measured below, once, for a circle whose
+        // outline passes (most guesses' do not).
+        BallCandidate lc;
+        lc.loc = l;
+        measure_outline(lc, lens);
         if (!best_c || lc.outline_support > best_c->outline_support) best = l, best_c = lc;
       }
       if (!best) continue;
@@ -419,6 +464,7 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
       // frame is left to the Hough guesses (their own starts locate it better).
       if (frame_guess && !fills_frame(loc.radius_px, lens.width(), lens.height())) continue;
       if (!acceptable_outline(c, o)) continue;
+      c = measure_ball(image, lens, loc);
       auto same =
           std::find_if(balls.begin(), balls.end(), [&](const BallCandidate& b) { return same_circle(b.loc, loc); });
       if (same == balls.end())
@@ -441,8 +487,12 @@ std::vector<BallCandidate> find_ball_candidates(const cv::Mat& image, const Lens
         continue;
       }
       if (!(loc.radius_px >= rmin / 1.25 && loc.radius_px <= 1.25 * rmax) || !lens.in_image(loc.centre_px)) continue;
-      BallCandidate c = measure_ball(image, lens, loc);
-      if (!acceptable_outline(c, o) || !looks_like(c, BallKind::chrome) || !inside_disc(balls[i], c)) continue;
+      BallCandidate c;
+      c.loc = loc;
+      measure_outline(c, lens);
+      if (!acceptable_outline(c, o)) continue;
+      c = measure_ball(image, lens, loc);
+      if (!looks_like(c, BallKind::chrome) || !inside_disc(balls[i], c)) continue;
       bool dup = false;
       for (const BallCandidate& b : balls) dup |= same_circle(b.loc, loc);
       if (!dup) balls.push_back(c);
