@@ -566,7 +566,8 @@ bool looks_like(const BallCandidate& c, BallKind kind) {
   if (!std::isfinite(c.diffuse_residual)) return false;  // too little of it visible to tell
   switch (kind) {
     // A textured rim with the world compressed across it (rim_radial: a circle drawn over a patch
-    // of the scene scores about 0, chrome balls on real photos 0.39-0.58), or a range no diffuse
+    // of the scene scores about 0, a chrome ball well above 0.2; docs/tradeoffs.md, "Measured
+    // choices in the code"), or a range no diffuse
     // ball shows (a light source reflected: the sun in a smooth sky, which has no features to
     // compress: its horizon crosses the ball as a line through the centre).
     case BallKind::chrome:

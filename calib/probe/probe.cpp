@@ -184,8 +184,9 @@ Probe assemble_probe(const MapSet& set, const ProbeOptions& options) {
       // views outweigh the trusted ones (else one view's misregistered clipped pixels would clip
       // the sky the others saw). A trusted lookup within the registration error of its own view's
       // clipped texels does not vote against it: that view saw the light clipped too, a little
-      // elsewhere (a sun a few texels wide in every view, each view registered to 1-2 degrees,
-      // would otherwise be outvoted everywhere and vanish from the probe).
+      // elsewhere (a sun a few texels wide in every view, the views registered a degree or two
+      // apart, would otherwise be outvoted everywhere and vanish from the probe; docs/tradeoffs.md,
+      // "Measured choices in the code").
       if (wsum >= options.min_weight && csum > wsum - wnear && luminance(sum / wsum) < luminance(bound)) wsum = 0;
       if (wsum < options.min_weight) {
         if (csum >= options.min_weight) {

@@ -51,7 +51,8 @@ struct ProbeOptions {
   const Fresnel* fresnel = nullptr;  // the ball's Fresnel, divided out; none: the probe is F L
   double min_weight = 1e-3;
   // How far the views' frames may disagree (degrees): a trusted lookup this close to its own view's
-  // clipped texels abstains from the vote against the other views' lower bounds (probe.cpp).
+  // clipped texels abstains from the vote against the other views' lower bounds (probe.cpp; why 2:
+  // docs/tradeoffs.md, "Measured choices in the code").
   double registration_deg = 2.0;
 };
 
