@@ -14,7 +14,7 @@ ViewImage read_view_image(const std::string& path) {
   const ExrPartIn& h = file.parts().front();
   ViewImage v;
   if (is_merged_view(h)) {
-    const MergedImage m = read_merged_exr(file);
+    const MergedImage m = read_merged_exr(file, nullptr, false);  // no variance: calibration does not use it
     v.radiance = m.radiance;
     v.flags = m.flags;
     v.merged = true;

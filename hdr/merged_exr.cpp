@@ -55,31 +55,35 @@ MergedImage read_merged_exr(const std::string& path, std::map<std::string, std::
   return read_merged_exr(ExrFileIn(path), attributes);
 }
 
-MergedImage read_merged_exr(const ExrFileIn& file, std::map<std::string, std::string>* attributes) {
+MergedImage read_merged_exr(const ExrFileIn& file, std::map<std::string, std::string>* attributes, bool variance) {
   const ExrPartIn& h = file.parts().front();
   for (const auto* names : {&kRadiance, &kVariance, &kFlags})
     for (const std::string& c : *names)
       if (!h.has_channel(c)) throw FileError(file.path(), "no channel " + c + " (not a merged view)");
-  // One read of all nine channels (the file is decoded once), then split.
+  // One read of the channels wanted (the file is decoded once), then split: R, G, B, [variance,]
+  // flags.
   std::vector<std::string> all = kRadiance;
-  all.insert(all.end(), kVariance.begin(), kVariance.end());
+  if (variance) all.insert(all.end(), kVariance.begin(), kVariance.end());
   all.insert(all.end(), kFlags.begin(), kFlags.end());
   const cv::Mat px = file.read(0, all);
+  const int n = int(all.size()), f0 = variance ? 6 : 3;
   MergedImage m;
   m.radiance.create(h.height, h.width, CV_32FC3);
-  m.variance.create(h.height, h.width, CV_32FC3);
+  if (variance) m.variance.create(h.height, h.width, CV_32FC3);
   m.flags.create(h.height, h.width, CV_8UC1);
   for (int r = 0; r < h.height; ++r) {
     const float* p = px.ptr<float>(r);
     float* rad = m.radiance.ptr<float>(r);
-    float* var = m.variance.ptr<float>(r);
+    float* var = variance ? m.variance.ptr<float>(r) : nullptr;
     unsigned char* out = m.flags.ptr<unsigned char>(r);
-    for (int x = 0; x < h.width; ++x, p += 9) {
-      for (int c = 0; c < 3; ++c) rad[3 * x + c] = p[c], var[3 * x + c] = p[3 + c];
+    for (int x = 0; x < h.width; ++x, p += n) {
+      for (int c = 0; c < 3; ++c) rad[3 * x + c] = p[c];
+      if (var)
+        for (int c = 0; c < 3; ++c) var[3 * x + c] = p[3 + c];
       unsigned char f = 0;
-      if (p[6] > 0.5f) f |= kClipped, ++m.clipped;
-      if (p[7] > 0.5f) f |= kBlack, ++m.black;
-      if (p[8] > 0.5f) f |= kGhost, ++m.ghost;
+      if (p[f0] > 0.5f) f |= kClipped, ++m.clipped;
+      if (p[f0 + 1] > 0.5f) f |= kBlack, ++m.black;
+      if (p[f0 + 2] > 0.5f) f |= kGhost, ++m.ghost;
       out[x] = f;
     }
   }

@@ -22,7 +22,9 @@ bool is_merged_view(const ExrPartIn& part);
 // Reads a file written by write_merged_exr (flags rebuilt from the flag channels); the rsibr.*
 // attributes go to `attributes` when given. Throws FileError(path, problem).
 MergedImage read_merged_exr(const std::string& path, std::map<std::string, std::string>* attributes = nullptr);
-// The same from a file already open (its first part).
-MergedImage read_merged_exr(const ExrFileIn& file, std::map<std::string, std::string>* attributes = nullptr);
+// The same from a file already open (its first part). Without `variance` its channels are not
+// copied out (the result's variance is empty): calibration reads radiance and flags only.
+MergedImage read_merged_exr(const ExrFileIn& file, std::map<std::string, std::string>* attributes = nullptr,
+                            bool variance = true);
 
 }  // namespace rsibr

@@ -289,6 +289,13 @@ TEST(MergedExr, RoundTripKeepsChannelsFlagsAndProvenance) {
   EXPECT_EQ(back.clipped, 1);
   EXPECT_EQ(back.ghost, 1);
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"v.exr"});  // no temporaries
+  // Without the variance (as calibration reads a view): the same radiance and flags, no variance.
+  const MergedImage lean = read_merged_exr(ExrFileIn(dir.file("v.exr")), nullptr, false);
+  EXPECT_TRUE(lean.variance.empty());
+  EXPECT_EQ(cv::norm(lean.radiance, back.radiance, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::countNonZero(lean.flags != back.flags), 0);
+  EXPECT_EQ(lean.clipped, 1);
+  EXPECT_EQ(lean.ghost, 1);
 }
 
 TEST(MergedExr, LongAttributeNameIsAnErrorAndWritesNothing) {
