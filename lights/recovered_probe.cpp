@@ -49,14 +49,11 @@ RecoveredProbe recover_probe_sources(const MapSet& chrome, const ProbeOptions& p
   if (recover && !out.regions.empty()) {
     // The probe without each view's chrome map (the jackknife's folds), by image name.
     std::map<std::string, EnvMap> without;
-    if (options.jackknife && chrome.views.size() >= 3)
-      for (std::size_t v = 0; v < chrome.views.size(); ++v) {
-        if (chrome.views[v].image.empty()) continue;
-        MapSet rest;
-        for (std::size_t u = 0; u < chrome.views.size(); ++u)
-          if (u != v) rest.views.push_back(chrome.views[u]);
-        without[chrome.views[v].image] = assemble_probe(rest, probe).env;
-      }
+    if (options.jackknife && chrome.views.size() >= 3) {
+      std::vector<EnvMap> folds = assemble_probe_folds(chrome, probe);
+      for (std::size_t v = 0; v < chrome.views.size(); ++v)
+        if (!chrome.views[v].image.empty()) without[chrome.views[v].image] = std::move(folds[v]);
+    }
     out.recovery = recover_sources(measured.env, out.regions, grey, glossy, options, without);
   }
   const std::vector<double> footprints = add_sources_to_probe(out.env, out.recovery.sources);

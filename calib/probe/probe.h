@@ -68,6 +68,11 @@ struct Probe {
 // Throws std::invalid_argument when the set is empty or has no confidence channel (not captured).
 Probe assemble_probe(const MapSet& chrome, const ProbeOptions& options = {});
 
+// The jackknife's probes: per view v, the env of assemble_probe(the set without view v), bit for bit,
+// made in one pass over the texels (each view's lookups made once; the views' folds reuse them).
+// With one view, its fold is an empty EnvMap. Throws as assemble_probe.
+std::vector<EnvMap> assemble_probe_folds(const MapSet& chrome, const ProbeOptions& options = {});
+
 // Writes a finished probe atomically: R, G, B and the `confidence` and `flags` channels (CV_32FC1
 // and CV_8UC1 of the map's size; ProbeFlag bits). Throws FileError(path, problem).
 void write_probe(const std::string& path, const EnvMap& env, const cv::Mat& confidence, const cv::Mat& flags);

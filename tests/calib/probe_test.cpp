@@ -75,18 +75,15 @@ TEST(Probe, FourChromeViewsGiveTheEnvironmentWithoutTheCamera) {
     ASSERT_TRUE(std::isfinite((*it)[0]) && std::isfinite((*it)[1]) && std::isfinite((*it)[2]));
 }
 
-// A sun clipped in every view, a texel or two wide in each view's map, where each view's frame is
-// off by a degree or so (as solved orientations are): every view's clipped spot lies a little apart
-// from the others', so at each probe texel one view says "clipped" and the rest see sky there. The
-// sun must stay a lower bound in the probe: views that clipped it within the registration error do
-// not vote it away (without that rule no texel of the probe is clipped).
-TEST(Probe, ASunClippedInEveryViewSurvivesTheViewsRegistrationSpread) {
-  const int size = 128;
-  const Vec3 sun = Vec3(0.3, 0.8, 0.5).normalized();
+// Five views of a sun clipped in every bracket, a texel or two wide in each view's map, each view's
+// frame off by 1.2 degrees about a different axis (as solved orientations are); the views' map sizes
+// `sizes` (default 128).
+MapSet clipped_sun_views(const Vec3& sun, const std::vector<int>& sizes = std::vector<int>(5, 128)) {
   const Vec3 axes[5] = {{1, 0, 0}, {0, 0, 1}, {-1, 0, 0}, {0, 0, -1}, {0.7, 0, 0.7}};
   MapSet set;
   for (int v = 0; v < 5; ++v) {
     MapView mv;
+    const int size = sizes[std::size_t(v)];
     mv.source = MapSource::Captured;
     // The view's frame as registered: the true frame turned by 1.2 degrees about a horizontal axis.
     const Mat3 err = Eigen::AngleAxisd(1.2 * kPi / 180, axes[v].normalized()).toRotationMatrix();
@@ -114,6 +111,18 @@ TEST(Probe, ASunClippedInEveryViewSurvivesTheViewsRegistrationSpread) {
       }
     set.views.push_back(mv);
   }
+  return set;
+}
+
+// A sun clipped in every view, a texel or two wide in each view's map, where each view's frame is
+// off by a degree or so (as solved orientations are): every view's clipped spot lies a little apart
+// from the others', so at each probe texel one view says "clipped" and the rest see sky there. The
+// sun must stay a lower bound in the probe: views that clipped it within the registration error do
+// not vote it away (without that rule no texel of the probe is clipped).
+TEST(Probe, ASunClippedInEveryViewSurvivesTheViewsRegistrationSpread) {
+  const int size = 128;
+  const Vec3 sun = Vec3(0.3, 0.8, 0.5).normalized();
+  const MapSet set = clipped_sun_views(sun);
   ProbeOptions po;
   po.width = 512;
   const Probe p = assemble_probe(set, po);
@@ -148,6 +157,35 @@ TEST(Probe, ASunClippedInEveryViewSurvivesTheViewsRegistrationSpread) {
     for (int c = 0; c < p.clipped.cols; ++c)
       if (angle_between(*p.env.layout.texel_direction(c, r), sun) > 6 * kPi / 180)
         ASSERT_EQ(p.clipped.at<float>(r, c), 0.f) << "row " << r << " col " << c;
+}
+
+// The jackknife's folds made in one pass are the probes of the views without each one, to the bit:
+// views of one size, one view coarser, and one view finer than the rest on a probe coarser than the
+// maps (without it the others' probe subsamples each texel less: that fold is made on its own).
+TEST(Probe, FoldsInOnePassAreTheProbesWithoutEachView) {
+  const Vec3 sun = Vec3(0.3, 0.8, 0.5).normalized();
+  const auto fresnel = make_fresnel(YAML::Load(kDefaultChromeFresnel));
+  const std::vector<std::vector<int>> cases = {
+      {128, 128, 128, 128, 128}, {128, 128, 64, 128, 128}, {128, 64, 64, 64, 64}};
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    MapSet set = clipped_sun_views(sun, cases[i]);
+    // Each view's own sky, so that leaving any one out changes the probe.
+    for (std::size_t v = 0; v < set.views.size(); ++v)
+      set.views[v].rgb.setTo(cv::Scalar::all(1.0 + 0.1 * double(v)), set.views[v].clipped == 0);
+    ProbeOptions po;
+    po.width = i == 2 ? 64 : 256;
+    po.fresnel = fresnel.get();
+    const std::vector<EnvMap> folds = assemble_probe_folds(set, po);
+    ASSERT_EQ(folds.size(), set.views.size());
+    for (std::size_t v = 0; v < set.views.size(); ++v) {
+      MapSet rest;
+      for (std::size_t u = 0; u < set.views.size(); ++u)
+        if (u != v) rest.views.push_back(set.views[u]);
+      const EnvMap alone = assemble_probe(rest, po).env;
+      EXPECT_EQ(cv::norm(folds[v].pixels, alone.pixels, cv::NORM_INF), 0.0) << "case " << i << ", view " << v;
+      EXPECT_GT(cv::norm(folds[v].pixels, assemble_probe(set, po).env.pixels, cv::NORM_INF), 0.0);
+    }
+  }
 }
 
 TEST(Probe, ComputedMapsOrNoViewsAreRefused) {
