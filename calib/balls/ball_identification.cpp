@@ -112,9 +112,9 @@ double disc_rim_texture(const cv::Mat& image, const LogLum& l, const Vec2& c, do
 // stretches directions radially 2 / sqrt(1 - rho^2) and tangentially sin(2 asin rho) / rho: 2x more
 // radially at 0.7, 5x at 0.9, 10x at 0.95. Returned: sum (g_r^2 - g_t^2) / |g| over sum |g| for the
 // pixels between 0.8 and 0.96 radii, stopping 2 px plus the step short of the outline (whose own
-// edge is radial for any disc) and at least 4 px wide (a small ball), in [-1, 1]: about 0 for a patch of the scene, which has no reason to
-// line up with a circle drawn over it, and clearly positive for a mirror ball. The neighbour step
-// is r / 64 as for the rim texture.
+// edge is radial for any disc) and at least 4 px wide (a small ball), in [-1, 1]: about 0 for a
+// patch of the scene, which has no reason to line up with a circle drawn over it, and clearly
+// positive for a mirror ball. The neighbour step is r / 64 as for the rim texture.
 double disc_rim_radial(const cv::Mat& image, const LogLum& l, const Vec2& c, double r, const std::vector<Disc>& ex) {
   const int d = std::max(1, int(std::lround(r / 64)));
   const double outer = std::min(0.96 * r, r - 2.0 - d), inner = std::min(0.8 * r, outer - 4.0);
