@@ -323,13 +323,6 @@ LambertFit lambert_fit(const cv::Mat& image, const LensModel& lens, const BallLo
   return out;
 }
 
-// Two fits of one circle: centres within half the smaller radius and radii within 30% (concentric
-// circles of different radii, a ball in front of a ringed disc, are different circles).
-bool same_circle(const BallLocation& a, const BallLocation& b) {
-  const double r = std::min(a.radius_px, b.radius_px);
-  return (a.centre_px - b.centre_px).norm() < 0.5 * r && std::abs(a.radius_px - b.radius_px) < 0.3 * r;
-}
-
 // `other` overlaps `ball` and is a ball-sized circle (radius within a factor 2): a ball that may
 // hide part of it (a large background circle behind the rig is no such thing).
 bool overlapping_ball(const BallLocation& other, const BallLocation& ball) {
@@ -846,6 +839,11 @@ BallLocation refit_outline_excluding(const BallLocation& ball, const LensModel& 
   out.centre_px = circle.centre_px;
   out.radius_px = circle.radius_px;
   return out;
+}
+
+bool same_circle(const BallLocation& a, const BallLocation& b) {
+  const double r = std::min(a.radius_px, b.radius_px);
+  return (a.centre_px - b.centre_px).norm() < 0.5 * r && std::abs(a.radius_px - b.radius_px) < 0.3 * r;
 }
 
 BallCandidate given_ball(const cv::Mat& image, const LensModel& lens, const BallGuess& guess) {

@@ -225,4 +225,8 @@ BallLocation refit_outline_excluding(const BallLocation& ball, const LensModel& 
 // when no band finds an outline.
 BallCandidate given_ball(const cv::Mat& image, const LensModel& lens, const BallGuess& guess);
 
+// Two fits of one circle: centres within half the smaller radius and radii within 30% of it
+// (concentric circles of different radii, a ball in front of a ringed disc, are different circles).
+bool same_circle(const BallLocation& a, const BallLocation& b);
+
 }  // namespace rsibr

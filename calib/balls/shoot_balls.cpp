@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <exception>
+#include <algorithm>
 #include <mutex>
 #include <stdexcept>
 #include <utility>
@@ -68,13 +69,25 @@ std::pair<FoundView, ViewCandidates> find_view_balls(const ShootBallsInput& in, 
   std::vector<char> given(listed.size(), 0);
   for (std::size_t b = 0; b < listed.size() && v < in.given.size() && b < in.given[v].size(); ++b)
     if (const auto& g = in.given[v][b]) {
+      BallCandidate c;
       try {
-        vc.cands.push_back(given_ball(image.radiance, fv.lens, *g));
+        c = given_ball(image.radiance, fv.lens, *g);
       } catch (const std::invalid_argument& e) {
         throw std::invalid_argument("balls: view " + fv.name + ": ball " + listed[b].name +
                                     " given by --ball: " + e.what());
       }
-      vc.pick[b] = int(vc.cands.size()) - 1;
+      // The search's own fit of the given circle is replaced by it: kept beside it, it would be
+      // another ball overlapping this one, whose disc hides all of it from the later steps.
+      const auto dup = std::find_if(vc.cands.begin(), vc.cands.end(),
+                                    [&](const BallCandidate& o) { return same_circle(o.loc, c.loc); });
+      const int k = dup == vc.cands.end() ? int(vc.cands.size()) : int(dup - vc.cands.begin());
+      if (dup == vc.cands.end())
+        vc.cands.push_back(std::move(c));
+      else
+        *dup = std::move(c);
+      for (std::size_t o = 0; o < listed.size(); ++o)
+        if (o != b && vc.pick[o] == k && !given[o]) vc.pick[o] = -1;
+      vc.pick[b] = k;
       given[b] = 1;
     }
   if (in.seen) {

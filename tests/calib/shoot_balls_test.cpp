@@ -87,6 +87,24 @@ TEST(ShootBalls, EveryListedBallHasAStatusAndAGivenBallIsTakenAsGiven) {
   EXPECT_EQ(main_ball(found.views[2], found.listed), -1);
 }
 
+// A ball given where the search also finds it is one ball: the given fit takes the found
+// candidate's place (a second circle there would be another ball overlapping it, whose disc
+// later steps mask).
+TEST(ShootBalls, ABallGivenWhereTheSearchFoundItIsOneCandidate) {
+  const ShootBalls searched = find_shoot_balls(input(kRig));
+  ShootBallsInput in = input(kRig);
+  in.given = {{truth(0, 0), std::nullopt}, {}};
+  const ShootBalls found = find_shoot_balls(in);
+  const FoundView& fv = found.views[0];
+  ASSERT_EQ(fv.candidates.size(), searched.views[0].candidates.size());
+  EXPECT_EQ(fv.balls[0].status, "given");
+  EXPECT_EQ(fv.balls[0].candidate, searched.views[0].balls[0].candidate);
+  EXPECT_EQ(fv.balls[1].candidate, searched.views[0].balls[1].candidate);
+  for (std::size_t i = 0; i < fv.candidates.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      EXPECT_FALSE(same_circle(fv.candidates[i].loc, fv.candidates[j].loc)) << i << " and " << j;
+}
+
 TEST(ShootBalls, NoBallListedMeansOneChromeBall) {
   const ShootBalls found = find_shoot_balls(input({}));
   ASSERT_EQ(found.listed.size(), 1u);
