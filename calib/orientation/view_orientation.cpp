@@ -1,5 +1,7 @@
 #include "calib/orientation/view_orientation.h"
 
+#include "calib/orientation/consensus_chance.h"
+
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -84,7 +86,8 @@ std::optional<BallCandidate> chrome_of(const ViewCandidates& vc, int k, std::vec
   if (overlapping)
     for (std::size_t i = 0; i < vc.cands.size(); ++i) {
       const BallLocation& o = vc.cands[i].loc;
-      if (int(i) != k && (o.centre_px - chrome.loc.centre_px).norm() < o.radius_px + chrome.loc.radius_px &&
+      if (int(i) != k && !same_circle(o, chrome.loc) &&
+          (o.centre_px - chrome.loc.centre_px).norm() < o.radius_px + chrome.loc.radius_px &&
           o.radius_px > 0.5 * chrome.loc.radius_px && o.radius_px < 2 * chrome.loc.radius_px)
         overlapping->push_back(o);
     }
@@ -151,65 +154,6 @@ std::vector<std::optional<Mat3>> chained_rotations(const std::vector<std::string
     w[to] = Mat3(*w[from] * b_from_a.transpose());
   }
   return w;
-}
-
-// Per view: how many of its observation pairs (with every other view, track by track) agree
-// within consensus_deg at the solve's rotations, and how many chance alone would make agree. A
-// pair inside the search's gate under the guess could have been paired by chance anywhere in that
-// disc: it agrees by chance with the share of the gate's disc that lies within consensus_deg of
-// where the solution puts it, (consensus / gate)^2 when guess and solution coincide, falling to 0
-// when they lie gate + consensus apart (approximated linearly between); any other pair, matched
-// over the whole sphere, with the share of the sphere a consensus cap covers. The p-value is the
-// Poisson tail of the agreeing count at the expected count (the Poisson's variance bounds the sum
-// of unequal Bernoullis', so it errs toward "chance").
-struct ChanceTest {
-  int matched = 0, agreeing = 0;
-  double expected = 0, p_value = 1;
-};
-
-double poisson_tail(double lambda, int k) {
-  if (k <= 0) return 1;
-  if (!(lambda > 0)) return 0;
-  // 1 - P(X <= k - 1), summed in log space.
-  double below = 0;
-  for (int i = 0; i < k; ++i) below += std::exp(i * std::log(lambda) - lambda - std::lgamma(i + 1.0));
-  return std::clamp(1 - below, 0.0, 1.0);
-}
-
-std::vector<ChanceTest> consensus_against_chance(const std::vector<DirectionObservation>& obs,
-                                                 const OrientationSolution& s,
-                                                 const std::vector<std::optional<Mat3>>& guess, double consensus_deg,
-                                                 double gate_deg) {
-  const std::size_t views = s.oriented.size();
-  std::map<int, std::vector<const DirectionObservation*>> tracks;
-  for (const DirectionObservation& o : obs) tracks[o.feature].push_back(&o);
-  const double c = consensus_deg * kPi / 180, g = gate_deg * kPi / 180;
-  const double p_in = std::min(1.0, std::pow(c / g, 2)), p_sphere = (1 - std::cos(c)) / 2;
-  std::vector<ChanceTest> out(views);
-  std::vector<double> lambda(views, 0);
-  for (const auto& [id, seen] : tracks)
-    for (const DirectionObservation* x : seen)
-      for (const DirectionObservation* y : seen) {
-        const std::size_t a = std::size_t(x->view), b = std::size_t(y->view);
-        if (a == b || !s.oriented[a] || !s.oriented[b]) continue;
-        ++out[a].matched;
-        const Vec3 solved = s.world_from_cam[b].transpose() * s.world_from_cam[a] * x->direction;
-        out[a].agreeing += angle_between(solved, y->direction) < c;
-        double p = p_sphere;
-        if (a < guess.size() && b < guess.size() && guess[a] && guess[b]) {
-          const Vec3 guessed = guess[b]->transpose() * *guess[a] * x->direction;
-          if (angle_between(guessed, y->direction) < g) {
-            const double apart = angle_between(guessed, solved);
-            p = std::max(p, p_in * std::clamp((g + c - apart) / (g + c - std::max(c, g - c)), 0.0, 1.0));
-          }
-        }
-        lambda[a] += p;
-      }
-  for (std::size_t v = 0; v < views; ++v) {
-    out[v].expected = lambda[v];
-    out[v].p_value = poisson_tail(lambda[v], out[v].agreeing);
-  }
-  return out;
 }
 
 // The picked points' observations in the views placed (`names`, their balls as located): the
@@ -515,10 +459,10 @@ PoseSet orient_views_reporting(const std::vector<std::string>& all_names, const 
     rep.pairs = pair_report(names, feats, pair_matches, searches, first, obs, so.inlier_deg,
                             options.gate_deg);  // kept if it stops
     std::vector<char> keep = first.oriented;
-    // Under searched rotations, a view whose matches agree no better than chance is not placed.
+    // A view whose matches agree no better than chance is not placed (ungated: then searched).
     const std::vector<ChanceTest> chance =
-        consensus_against_chance(obs, first, guess.world_from_cam, options.consensus_deg, options.gate_deg);
-    for (std::size_t v = 1; v < keep.size() && gated; ++v)
+        consensus_against_chance(obs, first, guess.world_from_cam, options.consensus_deg, options.gate_deg, !gated);
+    for (std::size_t v = 1; v < keep.size(); ++v)
       if (keep[v] && !picked[v] && chance[v].matched > 0 && !(chance[v].p_value <= options.max_chance)) {
         keep[v] = 0;
         char why[200];
