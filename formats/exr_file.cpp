@@ -199,7 +199,7 @@ Imf::Header header_for(const ExrPartOut& part, int W, int H, bool multipart, con
   Imf::Header h(W, H);
   if (multipart || !part.name.empty()) h.setName(part.name);
   if (multipart) h.setType(Imf::SCANLINEIMAGE);
-  h.compression() = Imf::ZIP_COMPRESSION;
+  h.compression() = part.compression == ExrCompression::Piz ? Imf::PIZ_COMPRESSION : Imf::ZIP_COMPRESSION;
   Imf::addChromaticities(h, Imf::Chromaticities());
   if (part.envmap == ExrEnvmap::LatLong) Imf::addEnvmap(h, Imf::ENVMAP_LATLONG);
   if (part.envmap == ExrEnvmap::Cube) Imf::addEnvmap(h, Imf::ENVMAP_CUBE);

@@ -35,6 +35,7 @@ void write_merged_exr(const std::string& path, const MergedImage& m,
     }
   }
   ExrPartOut part;
+  part.compression = ExrCompression::Piz;  // lossless, and half ZIP's write time on merged views
   for (int k = 0; k < 3; ++k) {
     part.channels.push_back({kRadiance[std::size_t(k)], m.radiance, k});
     part.channels.push_back({kVariance[std::size_t(k)], m.variance, k});

@@ -59,6 +59,7 @@ TEST(ExrFile, PartsChannelsAndEveryAttributeTypeRoundTripExactly) {
   ExrPartOut b;
   b.name = "second";
   b.channels = {{"u", other, 1}, {"v", other, 0}};
+  b.compression = ExrCompression::Piz;  // lossless too
   write_exr(path, {a, b});
 
   const ExrFileIn in(path);
@@ -81,6 +82,7 @@ TEST(ExrFile, PartsChannelsAndEveryAttributeTypeRoundTripExactly) {
   // Channels come back in the order asked, whatever order the file holds them in.
   const cv::Mat vu = in.read(1, {"v", "u"});
   EXPECT_TRUE(testing::bitwise_equal(vu, other));
+  EXPECT_EQ(in.parts()[1].compression, "piz");
 }
 
 TEST(ExrFile, StridedAndRegionOfInterestImagesAreWrittenAsTheirPixels) {
