@@ -117,11 +117,8 @@ void convert_colour_space(cv::Mat& rgb, const std::string& from, const std::stri
   cpu->apply(desc);
 }
 
-cv::Mat display_encode(const cv::Mat& linear_rgb, float exposure_stops, const std::string& display,
-                       const std::string& view) {
-  if (linear_rgb.type() != CV_32FC3 && linear_rgb.type() != CV_32FC4) {
-    throw std::runtime_error("rsibr: display_encode needs a CV_32FC3 or CV_32FC4 image");
-  }
+void apply_display_transform(cv::Mat& rgb, const std::string& display, const std::string& view) {
+  if (rgb.type() != CV_32FC3) throw std::runtime_error("rsibr: the display transform needs a CV_32FC3 image");
   const OCIO::ConstConfigRcPtr config = colour_config();
   const std::string disp = display.empty() ? std::string(config->getDefaultDisplay()) : display;
   bool display_known = false;
@@ -140,6 +137,21 @@ cv::Mat display_encode(const cv::Mat& linear_rgb, float exposure_stops, const st
     throw std::runtime_error("rsibr: unknown view '" + v + "' for display '" + disp + "' in the OpenColorIO config");
   }
 
+  if (!rgb.empty()) {
+    const OCIO::ConstCPUProcessorRcPtr cpu =
+        config->getProcessor(working_space().c_str(), disp.c_str(), v.c_str(), OCIO::TRANSFORM_DIR_FORWARD)
+            ->getDefaultCPUProcessor();
+    OCIO::PackedImageDesc desc(rgb.data, rgb.cols, rgb.rows, 3, OCIO::BIT_DEPTH_F32, sizeof(float), 3 * sizeof(float),
+                               static_cast<ptrdiff_t>(rgb.step[0]));
+    cpu->apply(desc);
+  }
+}
+
+cv::Mat display_encode(const cv::Mat& linear_rgb, float exposure_stops, const std::string& display,
+                       const std::string& view) {
+  if (linear_rgb.type() != CV_32FC3 && linear_rgb.type() != CV_32FC4) {
+    throw std::runtime_error("rsibr: display_encode needs a CV_32FC3 or CV_32FC4 image");
+  }
   // Scale and sanitise: NaN -> 0 and +-Inf -> +-max finite, so the transform sees finite input.
   const float gain = std::exp2(exposure_stops);
   const float big = std::numeric_limits<float>::max();
@@ -156,14 +168,7 @@ cv::Mat display_encode(const cv::Mat& linear_rgb, float exposure_stops, const st
     }
   }
 
-  if (!work.empty()) {
-    const OCIO::ConstCPUProcessorRcPtr cpu =
-        config->getProcessor(working_space().c_str(), disp.c_str(), v.c_str(), OCIO::TRANSFORM_DIR_FORWARD)
-            ->getDefaultCPUProcessor();
-    OCIO::PackedImageDesc desc(work.data, work.cols, work.rows, 3, OCIO::BIT_DEPTH_F32, sizeof(float),
-                               3 * sizeof(float), static_cast<ptrdiff_t>(work.step[0]));
-    cpu->apply(desc);
-  }
+  apply_display_transform(work, display, view);
 
   // Quantise with rounding, clamping, NaN -> 0, and RGB -> BGR.
   cv::Mat out(linear_rgb.size(), CV_8UC3);

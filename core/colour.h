@@ -37,6 +37,11 @@ void convert_colour_space(cv::Mat& rgb, const std::string& from, const std::stri
 cv::Mat display_encode(const cv::Mat& linear_rgb, float exposure_stops, const std::string& display = "",
                        const std::string& view = "");
 
+// display_encode's transform alone, in place, unquantised: CV_32FC3 working-space RGB (finite) to
+// the display's encoded values (0..1 in range). Throws std::runtime_error for an unknown display or
+// view, or another image type.
+void apply_display_transform(cv::Mat& rgb, const std::string& display = "", const std::string& view = "");
+
 // 3x3 matrix taking linear RGB with the given primaries and white (e.g. an EXR `chromaticities`
 // attribute) to the working space's linear Rec.709 primaries with D65 white, adapting the white
 // with the Bradford CAT when it differs from D65. Acts on column vectors: working = M * rgb.

@@ -6,15 +6,14 @@
 // gains, and the turntable frames.
 #pragma once
 
+#include "core/base64.h"
+
 #include <cstddef>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 namespace rsibr {
-
-// RFC 4648 base64 (with padding).
-std::string base64_encode(const std::vector<unsigned char>& bytes);
 
 // Minimal HTML escaping of text (&, <, >, ").
 std::string html_escape(const std::string& text);

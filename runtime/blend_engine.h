@@ -1,7 +1,7 @@
 // The blend engine: a map set and its blend rule (runtime/blend.h gives the rule's definition, steps
 // 1-6), evaluated by one per-texel kernel for a whole destination map (map) or for one (viewer
 // direction, normal) pair (radiance). Every CPU path uses it: the blend verb and Python's blend,
-// the renderer's two modes, the viewer's paper mode. The viewer's GLSL (runtime/viewer/map_shader.h)
+// the renderer's two modes, the viewer's paper mode. The viewer's GLSL (runtime/map_shader.h)
 // is the one deliberate second implementation, tested against it.
 //
 // Contract of radiance(v, n) (world frame, unit v from the surface toward the viewer, unit n):

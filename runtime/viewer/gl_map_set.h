@@ -1,4 +1,4 @@
-// A map set on the GPU for the viewer's mesh pass (runtime/viewer/map_shader.h): every view's map
+// A map set on the GPU for the viewer's mesh pass (runtime/map_shader.h): every view's map
 // in one RGBA32F texture array (RGB, A = confidence, 1 without one or when confidence is off), the
 // view frames and warps, the view-set triangulation (core/view_set.h), its edge planes and, for a
 // set that does not surround the sphere, the boundary arcs of the covered region. Also the

@@ -1,6 +1,6 @@
 #include "runtime/viewer/mesh_pass.h"
 
-#include "runtime/viewer/map_shader.h"
+#include "runtime/map_shader.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 // The viewer's mesh pass: draws a mesh lit by a map set for one camera, per pixel in the fragment
 // shader or from the CPU engine's destination map (paper mode), into the bound framebuffer
-// (runtime/viewer/map_shader.h states the formulas and how they match runtime/renderer.h).
+// (runtime/map_shader.h states the formulas and how they match runtime/renderer.h).
 #pragma once
 
 #include "core/camera.h"

@@ -3,7 +3,7 @@
 // executable through `xvfb-run -a`.
 //
 // Tolerance and why: the shader evaluates the renderer's definitions in float32 where the CPU uses
-// double (runtime/viewer/map_shader.h). Ray direction, warp and bilinear weights then differ by a few
+// double (runtime/map_shader.h). Ray direction, warp and bilinear weights then differ by a few
 // float ulps (~1e-7 relative), which moves a bilinear sample by ~1e-5 texel and changes the radiance
 // by (map gradient) x 1e-5 texel: < 1e-4 relative for these smooth maps. Larger differences are
 // allowed only where a decision is discontinuous and float and double may decide differently: a

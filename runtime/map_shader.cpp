@@ -1,6 +1,6 @@
-#include "runtime/viewer/map_shader.h"
+#include "runtime/map_shader.h"
 
-namespace rsibr::viewer {
+namespace rsibr {
 
 const char* const kMeshVertexShader = R"GLSL(#version 330 core
 layout(location = 0) in vec3 aPosition;
@@ -236,4 +236,16 @@ void main() {
 }
 )GLSL";
 
-}  // namespace rsibr::viewer
+std::string webgl2_vertex_shader() {
+  const std::string vs = kMeshVertexShader, desktop = "#version 330 core\n";
+  return "#version 300 es\nprecision highp float;\n" + vs.substr(vs.rfind(desktop, 0) == 0 ? desktop.size() : 0);
+}
+
+std::string webgl2_fragment_shader() {
+  return std::string(
+             "#version 300 es\nprecision highp float;\nprecision highp int;\nprecision highp sampler2D;\n"
+             "precision highp isampler2D;\nprecision highp sampler2DArray;\n#define RSIBR_PAPER 0\n") +
+         kMeshFragmentShader;
+}
+
+}  // namespace rsibr

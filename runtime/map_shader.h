@@ -1,4 +1,6 @@
-// The GLSL of the viewer's mesh pass: the runtime's formulas per fragment (OpenGL 3.3 core).
+// The GLSL of the viewer's mesh pass: the runtime's formulas per fragment (OpenGL 3.3 core), and the
+// same source for WebGL2 (GLSL ES 3.00: only the version line and default precisions differ), which
+// the report's page viewer runs (runtime/web_viewer_page.h): one rule, not a second copy.
 //
 // Vertex stage: world positions through the mrcal pinhole (core/camera.h) into clip space, so that
 // the fragment at window position (x, y) of a W x H frame is image pixel (x - 1/2, H - y - 1/2):
@@ -33,11 +35,18 @@
 // the same weights there); the measure-zero n = -v case takes another rim normal.
 #pragma once
 
-namespace rsibr::viewer {
+#include <string>
+
+namespace rsibr {
 
 extern const char* const kMeshVertexShader;
 // Without its "#version" line: compiled twice, after "#version 330 core\n#define RSIBR_PAPER 0" (per
 // pixel) and "... 1" (paper), so that each program holds one path only.
 extern const char* const kMeshFragmentShader;
 
-}  // namespace rsibr::viewer
+// The per-pixel program for WebGL2: the shaders above after "#version 300 es" and high precision
+// for floats, integers and every sampler type they use.
+std::string webgl2_vertex_shader();
+std::string webgl2_fragment_shader();
+
+}  // namespace rsibr
