@@ -16,6 +16,8 @@
 #include "core/text.h"
 #include "runtime/make_warp.h"
 #include "runtime/renderer.h"
+#include "runtime/web_viewer_page.h"
+#include "core/sphere_mesh.h"
 #if RSIBR_HAVE_VIEWER
 #include "runtime/viewer/viewer.h"
 #endif
@@ -24,6 +26,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <stdexcept>
 
@@ -32,15 +35,13 @@ namespace {
 
 struct ViewArgs {
   std::string maps, maps2, mesh, mode = "per-pixel", warp = "precomputed", compare = "wipe", display, view;
-  std::string screenshot, exr, json;
+  std::string screenshot, exr, json, html;
   CameraArgs camera;
   int map_size = 0, rings = 16, orbit = 0;
   double rim_fade = 0.4, wipe = 0.5;
   float exposure = 0.f;
   bool weights = false, benchmark = false, quiet = false, sanitize = false;
 };
-
-#if RSIBR_HAVE_VIEWER
 
 MapSet load_maps(const std::string& path, bool sanitize) {
   MapSet set = read_map_set(path, sanitize ? BadTexels::zero : BadTexels::refuse);
@@ -51,9 +52,54 @@ MapSet load_maps(const std::string& path, bool sanitize) {
   }
   return set;
 }
-#endif
+
+// --html: the page viewer (runtime/web_viewer_page.h), no OpenGL here.
+int run_view_html(const ViewArgs& a) {
+  if (!a.maps2.empty()) throw std::invalid_argument("--html: the page draws one map set (give --maps only)");
+  if (a.mode != "per-pixel") throw std::invalid_argument("--html: the page draws per pixel (no --mode paper)");
+  if (a.orbit > 0 || !a.screenshot.empty() || !a.exr.empty() || a.benchmark || a.weights)
+    throw std::invalid_argument("--html writes a page: no --orbit, --screenshot, --exr, --benchmark or --weights");
+  if (std::filesystem::path(a.html).extension() != ".html")
+    throw std::invalid_argument(a.html + ": --html must be a .html file");
+  std::vector<std::filesystem::path> inputs{a.maps};
+  if (!a.mesh.empty()) inputs.emplace_back(a.mesh);
+  OutputPlan outputs(inputs);
+  const std::string tmp = outputs.file(a.html);
+  const std::string json = outputs.file(a.json);
+  const MapSet set = load_maps(a.maps, a.sanitize);
+  // Without a mesh: the ball, a unit sphere.
+  const Mesh mesh = a.mesh.empty() ? sphere_mesh(Eigen::Vector3f::Zero(), 1.f) : load_mesh(a.mesh);
+  WebViewerPage page;
+  page.maps = &set;
+  page.mesh = &mesh;
+  page.blend.rim_fade = a.rim_fade;
+  page.camera = make_camera(a.camera, mesh.bounds(), 0);
+  page.pivot = a.camera.at.empty() ? Vec3(mesh.bounds().center().cast<double>()) : parse_vec3(a.camera.at, "--at");
+  page.up = parse_vec3(a.camera.up, "--up");
+  page.exposure = a.exposure;
+  page.display = a.display;
+  page.display_view = a.view;
+  page.title = "rsibr view: " + file_name(a.maps) + (a.mesh.empty() ? "" : " on " + file_name(a.mesh));
+  const std::string html = web_viewer_page(page);
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out << html;
+    if (!out.flush()) throw std::runtime_error(a.html + ": cannot write");
+  }
+  nlohmann::json j;
+  j["html"] = a.html;
+  j["bytes"] = html.size();
+  j["maps"] = a.maps;
+  j["mesh"] = a.mesh.empty() ? nlohmann::json("sphere") : nlohmann::json(a.mesh);
+  j["size"] = {page.camera.width, page.camera.height};
+  write_summary(json, j);
+  outputs.commit();
+  return 0;
+}
 
 int run_view(const ViewArgs& a) {
+  if (!a.html.empty()) return run_view_html(a);
+  if (a.mesh.empty()) throw std::invalid_argument("--mesh is required (without --html)");
   if (a.mode != "paper" && a.mode != "per-pixel")
     throw std::invalid_argument("--mode must be 'paper' or 'per-pixel', not '" + a.mode + "'");
   if (!is_warp_name(a.warp))
@@ -199,11 +245,16 @@ Runner add_view(CLI::App& app) {
       "Scripted mode (--orbit N): no interaction; N turntable frames (the frames of rsibr render --turntable N), "
       "--screenshot (PNG, as rsibr render's) and --exr (RGBA float) numbered like rsibr render's, --benchmark "
       "prints frame times. Needs a display: use `xvfb-run -a rsibr view ...` on a machine without one.\n"
+      "--html OUT.html writes the viewer as one self-contained web page (WebGL2, per pixel, the same shader; no "
+      "display needed) and exits.\n"
       "Example: rsibr view --maps maps.exr --mesh cache/assets/models/bunny.glb";
   c->footer(footer);
   c->add_option("--maps", a->maps, "Map set (.exr)")->required();
   c->add_option("--maps2", a->maps2, "A second map set to compare (wipe or side by side)");
-  c->add_option("--mesh", a->mesh, "Mesh (.glb, .gltf, .obj)")->required();
+  c->add_option("--mesh", a->mesh, "Mesh (.glb, .gltf, .obj); with --html optional (default: a sphere, the ball)");
+  c->add_option("--html", a->html,
+                "Write a self-contained web page (WebGL2) of the mesh lit by --maps, per pixel, and exit (no "
+                "display needed)");
   add_camera_options(c, a->camera);
   c->remove_option(c->get_option("--turntable"));  // --orbit here
   c->add_option("--mode", a->mode, "per-pixel (fragment shader) or paper (CPU destination map)")->capture_default_str();

@@ -27,6 +27,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev clang-14 libclang-rt-14-dev
   clang-format-14  # tests/style: the tree stays formatted with .clang-format
   blender  # rsibr export blender writes .blend files through it; Cycles referees the bakes (tests/blender)
+  chromium  # the page viewer's test (tests/viewer/web_viewer_test.py): headless, WebGL2 on SwiftShader
   # real-data fetch (npm registry) and docs plots
   python3 python3-numpy python3-matplotlib python3-yaml
   # the Python module (python/) and its tests (tests/python)

@@ -217,6 +217,18 @@ check "no temporaries after success" no_temporaries "$work"
 # (silhouette pixels whose centre lies within rounding of an edge), both at exposure 0 (render
 # would meter its first frame otherwise). Without the viewer built, the
 # verb must say so.
+# The page viewer (no display needed): one file written atomically, the mesh optional, errors in
+# one line (its drawing: tests/viewer/web_viewer_test.py in headless Chromium).
+"$rsibr" view --html "$work/view.html" --maps "$work/mirror.exr" --size 64x48 --json "$work/view-html.json"
+check "view --html writes one page that carries its data" bash -c "grep -q 'id=\"rsibr-data\"' '$work/view.html' && grep -q '#version 300 es' '$work/view.html'"
+check "view --html JSON names the page and the ball" python3 -c "import json; j=json.load(open('$work/view-html.json')); assert j['mesh'] == 'sphere' and j['bytes'] > 0, j"
+check "view --html leaves no temporary" no_temporaries "$work"
+expect_error "view --html: page type" "v.htm" view --html "$work/v.htm" --maps "$work/mirror.exr"
+expect_error "view --html: one map set" "one map set" view --html "$work/v.html" --maps "$work/mirror.exr" --maps2 "$work/grey.exr"
+expect_error "view --html: not a map set" "sky.exr" view --html "$work/v.html" --maps "$work/sky.exr"
+check "view --html: nothing left by a failed run" test ! -e "$work/v.html"
+expect_error "view: --mesh without --html" "mesh" view --maps "$work/mirror.exr" --orbit 1
+
 view_help=$("$rsibr" view --help)
 if ! grep -q "Keys:" <<<"$view_help"; then
   expect_error "view: built without the viewer" "without the viewer" view --maps "$work/mirror.exr" --mesh "$work/cube.obj"
