@@ -486,6 +486,15 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
     for (const fs::path& f : rec["render"].outputs)
       if (f.extension() == ".png") h << img_tag(read_bytes(dir, f), f.filename().string());
     h << "</div>";
+    // The turntable to orbit (WebGL2; the page says why where it cannot draw), in its own frame.
+    for (const fs::path& f : rec["render"].outputs)
+      if (f.filename() == "viewer.html") {
+        const std::vector<unsigned char> page = read_bytes(dir, f);
+        h << "<p>Drag to orbit, wheel to zoom (the same maps, drawn per pixel by WebGL2 in this page):</p>"
+          << "<iframe class=\"viewer\" title=\"turntable viewer\" style=\"border:0;width:100%;height:"
+          << (s.contains("size") ? s["size"][1].get<int>() : 240) + 160 << "px\" srcdoc=\""
+          << html_escape(std::string(page.begin(), page.end())) << "\"></iframe>";
+      }
   }
   h << "</body></html>\n";
   write_text_atomically(out, h.str());

@@ -16,6 +16,7 @@
 #include "formats/map_set.h"
 #include "pipeline/torus_mesh.h"
 #include "runtime/renderer.h"
+#include "runtime/web_viewer_page.h"
 
 #include <iomanip>
 #include <optional>
@@ -67,6 +68,17 @@ StepOutputs run_render_step(const RenderStep& s) {
     bar.update(double(k + 1) / s.frames);
   }
   bar.done();
+  // The same turntable to orbit in a browser: the first frame's camera, the same exposure (no
+  // background: the page draws the object).
+  WebViewerPage page;
+  page.maps = &maps;
+  page.mesh = &mesh;
+  page.camera = first;
+  page.pivot = pivot;
+  page.exposure = stops;
+  page.title = "rsibr: " + brdf->spec() + " on " + (s.mesh.empty() ? std::string("a torus") : s.mesh);
+  const std::string html = web_viewer_page(page);
+  files["viewer.html"] = std::vector<unsigned char>(html.begin(), html.end());
   write_folder_atomically(s.out, files);
   out.files.push_back(s.out / "maps.exr");
   for (const auto& [name, bytes] : files) out.files.push_back(s.out / name);
@@ -75,7 +87,10 @@ StepOutputs run_render_step(const RenderStep& s) {
                  {"material", brdf->spec()},
                  {"frames", s.frames},
                  {"seconds_per_frame", seconds / s.frames},
-                 {"display_exposure_stops", stops}};
+                 {"display_exposure_stops", stops},
+                 {"size", {s.width, s.height}},
+                 {"viewer", "viewer.html"},
+                 {"viewer_bytes", html.size()}};
   return out;
 }
 

@@ -1,7 +1,8 @@
 // The `render` step of rsibr process (pipeline/process_pipeline.h), the last before the report: the
 // probe baked into a map set of icosa views of a BRDF (bake/map_set_bake.h), then a turntable of a
 // mesh (or a built-in torus) rendered with it through the runtime (runtime/renderer.h) ->
-// OUT/maps.exr and OUT/frame_NN.png, exposed at the probe's median.
+// OUT/maps.exr and OUT/frame_NN.png, exposed at the probe's median, and OUT/viewer.html, the same
+// turntable to orbit in a browser (runtime/web_viewer_page.h).
 #pragma once
 
 #include "pipeline/step_outputs.h"
@@ -24,7 +25,8 @@ struct RenderStep {
   std::filesystem::path out;  // the render folder
 };
 
-// The summary: mesh, triangles, material, frames, seconds per frame, display exposure.
+// The summary: mesh, triangles, material, frames, seconds per frame, display exposure, the viewer
+// page and its size.
 StepOutputs run_render_step(const RenderStep& s);
 
 }  // namespace rsibr

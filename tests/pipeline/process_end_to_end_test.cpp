@@ -267,6 +267,11 @@ TEST_F(ProcessEndToEnd, ReportIsSelfContained) {
   for (const char* section :
        {"Camera response", "Orientations", "Light probe", "Captured vs computed", "Turntable", "Lens"})
     EXPECT_NE(html.find(section), std::string::npos) << section;
+  // The turntable to orbit: the render step's page in a frame, escaped (no script runs in the
+  // report itself; the page's data and code go with it).
+  EXPECT_NE(html.find("<iframe class=\"viewer\""), std::string::npos);
+  EXPECT_NE(html.find("&lt;script type=&quot;application/json&quot; id=&quot;rsibr-data&quot;&gt;"), std::string::npos);
+  EXPECT_TRUE(fs::exists(result_->report.parent_path() / "render" / "viewer.html"));
 }
 
 // The orientation solve needs features the views share; the minimal sky has too few for views
