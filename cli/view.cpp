@@ -28,6 +28,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 
 namespace rsibr::cli {
@@ -55,22 +56,27 @@ MapSet load_maps(const std::string& path, bool sanitize) {
 
 // --html: the page viewer (runtime/web_viewer_page.h), no OpenGL here.
 int run_view_html(const ViewArgs& a) {
-  if (!a.maps2.empty()) throw std::invalid_argument("--html: the page draws one map set (give --maps only)");
   if (a.mode != "per-pixel") throw std::invalid_argument("--html: the page draws per pixel (no --mode paper)");
   if (a.orbit > 0 || !a.screenshot.empty() || !a.exr.empty() || a.benchmark || a.weights)
     throw std::invalid_argument("--html writes a page: no --orbit, --screenshot, --exr, --benchmark or --weights");
   if (std::filesystem::path(a.html).extension() != ".html")
     throw std::invalid_argument(a.html + ": --html must be a .html file");
   std::vector<std::filesystem::path> inputs{a.maps};
+  if (!a.maps2.empty()) inputs.emplace_back(a.maps2);
   if (!a.mesh.empty()) inputs.emplace_back(a.mesh);
   OutputPlan outputs(inputs);
   const std::string tmp = outputs.file(a.html);
   const std::string json = outputs.file(a.json);
   const MapSet set = load_maps(a.maps, a.sanitize);
+  std::optional<MapSet> set2;
+  if (!a.maps2.empty()) set2 = load_maps(a.maps2, a.sanitize);
   // Without a mesh: the ball, a unit sphere.
   const Mesh mesh = a.mesh.empty() ? sphere_mesh(Eigen::Vector3f::Zero(), 1.f) : load_mesh(a.mesh);
   WebViewerPage page;
   page.maps = &set;
+  page.maps2 = set2 ? &*set2 : nullptr;
+  page.names[0] = file_name(a.maps);
+  page.names[1] = a.maps2.empty() ? "" : file_name(a.maps2);
   page.mesh = &mesh;
   page.blend.rim_fade = a.rim_fade;
   page.camera = make_camera(a.camera, mesh.bounds(), 0);
@@ -79,7 +85,8 @@ int run_view_html(const ViewArgs& a) {
   page.exposure = a.exposure;
   page.display = a.display;
   page.display_view = a.view;
-  page.title = "rsibr view: " + file_name(a.maps) + (a.mesh.empty() ? "" : " on " + file_name(a.mesh));
+  page.title = "rsibr view: " + file_name(a.maps) + (a.maps2.empty() ? "" : " | " + file_name(a.maps2)) +
+               (a.mesh.empty() ? "" : " on " + file_name(a.mesh));
   const std::string html = web_viewer_page(page);
   {
     std::ofstream out(tmp, std::ios::binary);
@@ -245,8 +252,8 @@ Runner add_view(CLI::App& app) {
       "Scripted mode (--orbit N): no interaction; N turntable frames (the frames of rsibr render --turntable N), "
       "--screenshot (PNG, as rsibr render's) and --exr (RGBA float) numbered like rsibr render's, --benchmark "
       "prints frame times. Needs a display: use `xvfb-run -a rsibr view ...` on a machine without one.\n"
-      "--html OUT.html writes the viewer as one self-contained web page (WebGL2, per pixel, the same shader; no "
-      "display needed) and exits.\n"
+      "--html OUT.html writes the viewer as one self-contained web page (WebGL2, per pixel, the same shader; with "
+      "--maps2 a wipe; no display needed) and exits.\n"
       "Example: rsibr view --maps maps.exr --mesh cache/assets/models/bunny.glb";
   c->footer(footer);
   c->add_option("--maps", a->maps, "Map set (.exr)")->required();

@@ -119,22 +119,31 @@ const char* const kScript = R"JS(
     display = program(D.display_vertex_shader, D.display_fragment_shader);
   } catch (e) { fail('the shaders do not build: ' + e.message); return; }
   // Units as the desktop viewer binds them (runtime/viewer/mesh_pass.cpp); 6: the display table.
-  const M = D.maps;
-  texture(0, gl.TEXTURE_2D_ARRAY, gl.RGBA16F, M.width, M.height, M.views, gl.RGBA, gl.HALF_FLOAT, u16(M.rgba), false);
-  texture(1, gl.TEXTURE_2D, gl.RGBA32F, M.views, 4, 1, gl.RGBA, gl.FLOAT, f32(D.view_data), false);
-  texture(2, gl.TEXTURE_2D, gl.RGBA32I, D.triangle_count, 1, 1, gl.RGBA_INTEGER, gl.INT, i32(D.triangles), false);
-  texture(3, gl.TEXTURE_2D, gl.RGBA32F, D.triangle_count, 3, 1, gl.RGBA, gl.FLOAT, f32(D.edge_planes), false);
-  texture(4, gl.TEXTURE_2D, gl.RGBA32F, 1, 1, 1, gl.RGBA, gl.FLOAT, new Float32Array(4), false);
-  texture(5, gl.TEXTURE_2D, gl.RGBA32I, Math.max(D.arc_count, 1), 1, 1, gl.RGBA_INTEGER, gl.INT, i32(D.arcs), false);
+  // Each set's textures, bound to units 0..5 before its draw.
+  const sets = D.sets.map(S => {
+    const M = S.maps;
+    return { S, t: [
+      texture(0, gl.TEXTURE_2D_ARRAY, gl.RGBA16F, M.width, M.height, M.views, gl.RGBA, gl.HALF_FLOAT, u16(M.rgba), false),
+      texture(1, gl.TEXTURE_2D, gl.RGBA32F, M.views, 4, 1, gl.RGBA, gl.FLOAT, f32(S.view_data), false),
+      texture(2, gl.TEXTURE_2D, gl.RGBA32I, S.triangle_count, 1, 1, gl.RGBA_INTEGER, gl.INT, i32(S.triangles), false),
+      texture(3, gl.TEXTURE_2D, gl.RGBA32F, S.triangle_count, 3, 1, gl.RGBA, gl.FLOAT, f32(S.edge_planes), false),
+      texture(4, gl.TEXTURE_2D, gl.RGBA32F, 1, 1, 1, gl.RGBA, gl.FLOAT, new Float32Array(4), false),
+      texture(5, gl.TEXTURE_2D, gl.RGBA32I, Math.max(S.arc_count, 1), 1, 1, gl.RGBA_INTEGER, gl.INT, i32(S.arcs), false)] };
+  });
+  const kinds = [gl.TEXTURE_2D_ARRAY, gl.TEXTURE_2D, gl.TEXTURE_2D, gl.TEXTURE_2D, gl.TEXTURE_2D, gl.TEXTURE_2D];
   const L = D.display;
   texture(6, gl.TEXTURE_3D, gl.RGBA16F, L.size, L.size, L.size, gl.RGBA, gl.HALF_FLOAT, u16(L.rgba), true);
   gl.useProgram(mesh);
   const um = n => gl.getUniformLocation(mesh, n);
   [['uMaps', 0], ['uViewData', 1], ['uTriangles', 2], ['uEdgePlanes', 3], ['uDest', 4], ['uArcs', 5]].forEach(([n, u]) => gl.uniform1i(um(n), u));
-  gl.uniform2i(um('uMapSize'), M.width, M.height);
   gl.uniform2i(um('uDestSize'), 1, 1);
-  gl.uniform1i(um('uTriangleCount'), D.triangle_count);
-  gl.uniform1i(um('uArcCount'), D.arc_count);
+  function useSet(k) {
+    const { S, t } = sets[k];
+    t.forEach((tex, unit) => { gl.activeTexture(gl.TEXTURE0 + unit); gl.bindTexture(kinds[unit], tex); });
+    gl.uniform2i(um('uMapSize'), S.maps.width, S.maps.height);
+    gl.uniform1i(um('uTriangleCount'), S.triangle_count);
+    gl.uniform1i(um('uArcCount'), S.arc_count);
+  }
   gl.uniform1i(um('uHint'), -1);
   gl.uniform1f(um('uRimFade'), D.rim_fade);
   gl.uniform1i(um('uShowWeight'), 0);
@@ -156,7 +165,7 @@ const char* const kScript = R"JS(
   gl.bindVertexArray(null);
   const quad = gl.createVertexArray();
 
-  let cam = D.camera, exposure = D.exposure;
+  let cam = D.camera, exposure = D.exposure, wipe = 0.5;
   function makeFrame(w, h) {
     if (frame && frame.w === w && frame.h === h) return;
     const t = gl.createTexture();
@@ -198,7 +207,17 @@ const char* const kScript = R"JS(
     gl.uniform2f(um('uSize'), cam.width, cam.height);
     gl.uniform2f(um('uDepth'), (far + near) / (far - near), -2 * far * near / (far - near));
     gl.bindVertexArray(vao);
-    gl.drawElements(gl.TRIANGLES, D.mesh.count, gl.UNSIGNED_INT, 0);
+    // Two sets: a wipe, the first left of the split, the second right of it (one camera).
+    const split = sets.length > 1 ? Math.round(wipe * cam.width) : cam.width;
+    for (let k = 0; k < sets.length; ++k) {
+      const x0 = k === 0 ? 0 : split, x1 = k === 0 ? split : cam.width;
+      if (x1 <= x0) continue;
+      useSet(k);
+      gl.enable(gl.SCISSOR_TEST);
+      gl.scissor(x0, 0, x1 - x0, cam.height);
+      gl.drawElements(gl.TRIANGLES, D.mesh.count, gl.UNSIGNED_INT, 0);
+      gl.disable(gl.SCISSOR_TEST);
+    }
     gl.bindVertexArray(null);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     gl.viewport(0, 0, cam.width, cam.height);
@@ -209,7 +228,7 @@ const char* const kScript = R"JS(
     gl.bindTexture(gl.TEXTURE_2D, frame.t);
     gl.uniform1i(ud('uFrame'), 7);
     gl.uniform1i(ud('uLut'), 6);
-    gl.uniform1f(ud('uScale'), Math.pow(2, exposure) * D.maps.scale);
+    gl.uniform1f(ud('uScale'), Math.pow(2, exposure) * D.scale);
     gl.uniform2f(ud('uLog2Range'), L.log2_lo, L.log2_hi);
     gl.bindVertexArray(quad);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
@@ -218,6 +237,7 @@ const char* const kScript = R"JS(
   }
   api.setCamera = c => { cam = c; draw(); };
   api.setExposure = s => { exposure = s; draw(); };
+  api.setWipe = f => { wipe = Math.min(Math.max(f, 0), 1); draw(); };
   api.radiance = () => {
     gl.bindFramebuffer(gl.FRAMEBUFFER, frame.fb);
     const px = new Float32Array(cam.width * cam.height * 4);
@@ -226,7 +246,7 @@ const char* const kScript = R"JS(
     // Bottom row first in GL: flipped to the image's top row first; RGB scaled back to radiance.
     const out = new Float32Array(px.length), row = cam.width * 4;
     for (let y = 0; y < cam.height; ++y)
-      for (let i = 0; i < row; ++i) out[y * row + i] = px[(cam.height - 1 - y) * row + i] * ((i & 3) === 3 ? 1 : D.maps.scale);
+      for (let i = 0; i < row; ++i) out[y * row + i] = px[(cam.height - 1 - y) * row + i] * ((i & 3) === 3 ? 1 : D.scale);
     return out;
   };
   api.displayed = () => {
@@ -280,6 +300,11 @@ const char* const kScript = R"JS(
     cam = lookAt([D.pivot[0] + k * off[0], D.pivot[1] + k * off[1], D.pivot[2] + k * off[2]]);
     draw();
   }, { passive: false });
+  const wiper = document.getElementById('rsibr-wipe');
+  if (sets.length > 1) {
+    wiper.parentElement.hidden = false;
+    wiper.addEventListener('input', () => { wipe = parseFloat(wiper.value); draw(); });
+  }
   const slider = document.getElementById('rsibr-exposure'), shown = document.getElementById('rsibr-exposure-value');
   slider.value = exposure;
   shown.textContent = exposure.toFixed(1);
@@ -319,19 +344,33 @@ void main() {
 
 std::string web_viewer_page(const WebViewerPage& page) {
   if (!page.maps || !page.mesh) throw std::invalid_argument("web viewer: a map set and a mesh are required");
-  const MapSet& maps = *page.maps;
-  const GpuMapData d = gpu_map_data(maps, maps.view_set(), page.blend);
-  // Half floats hold up to 65504: a brighter set is divided by a power of two.
+  // Half floats hold up to 65504: brighter sets are divided by one power of two (both sides of a
+  // wipe share the frame and its display scale).
+  std::vector<const MapSet*> sets{page.maps};
+  if (page.maps2) sets.push_back(page.maps2);
+  std::vector<GpuMapData> gpu;
   float peak = 0;
-  for (std::size_t i = 0; i < d.maps.size(); ++i)
-    if (i % 4 != 3) peak = std::max(peak, d.maps[i]);
+  for (const MapSet* m : sets) {
+    gpu.push_back(gpu_map_data(*m, m->view_set(), page.blend));
+    for (std::size_t i = 0; i < gpu.back().maps.size(); ++i)
+      if (i % 4 != 3) peak = std::max(peak, gpu.back().maps[i]);
+  }
   const double scale = peak > 6e4f ? std::exp2(std::ceil(std::log2(double(peak) / 6e4))) : 1.0;
-  cv::Mat f(1, int(d.maps.size()), CV_32F, const_cast<float*>(d.maps.data())), h;
-  cv::Mat scaled = f.clone();
-  for (std::size_t i = 0; i < d.maps.size(); ++i)
-    if (i % 4 != 3) scaled.ptr<float>()[i] = float(d.maps[i] / scale);
-  scaled.convertTo(h, CV_16F);
-  const std::vector<std::uint16_t> half(h.ptr<std::uint16_t>(), h.ptr<std::uint16_t>() + d.maps.size());
+  nlohmann::json jsets = nlohmann::json::array();
+  for (const GpuMapData& d : gpu) {
+    cv::Mat scaled(1, int(d.maps.size()), CV_32F), h;
+    for (std::size_t i = 0; i < d.maps.size(); ++i)
+      scaled.ptr<float>()[i] = i % 4 == 3 ? d.maps[i] : float(d.maps[i] / scale);
+    scaled.convertTo(h, CV_16F);
+    const std::vector<std::uint16_t> half(h.ptr<std::uint16_t>(), h.ptr<std::uint16_t>() + d.maps.size());
+    jsets.push_back({{"maps", {{"width", d.width}, {"height", d.height}, {"views", d.views}, {"rgba", b64(half)}}},
+                     {"view_data", b64(d.view_data)},
+                     {"triangles", b64(d.triangles)},
+                     {"triangle_count", d.triangle_count},
+                     {"edge_planes", b64(d.edge_planes)},
+                     {"arcs", b64(d.arcs)},
+                     {"arc_count", d.arc_count}});
+  }
 
   const Mesh& mesh = *page.mesh;
   std::vector<float> pos, nrm;
@@ -350,13 +389,8 @@ std::string web_viewer_page(const WebViewerPage& page) {
   for (int r = 0; r < 3; ++r)
     for (int k = 0; k < 3; ++k) R.push_back(c.world_from_cam(r, k));
   nlohmann::json j;
-  j["maps"] = {{"width", d.width}, {"height", d.height}, {"views", d.views}, {"scale", scale}, {"rgba", b64(half)}};
-  j["view_data"] = b64(d.view_data);
-  j["triangles"] = b64(d.triangles);
-  j["triangle_count"] = d.triangle_count;
-  j["edge_planes"] = b64(d.edge_planes);
-  j["arcs"] = b64(d.arcs);
-  j["arc_count"] = d.arc_count;
+  j["sets"] = jsets;
+  j["scale"] = scale;
   j["rim_fade"] = page.blend.rim_fade;
   j["mesh"] = {{"positions", b64(pos)}, {"normals", b64(nrm)}, {"indices", b64(idx)}, {"count", idx.size()}};
   j["bounds"] = {{"centre", {centre.x(), centre.y(), centre.z()}}, {"radius", 0.5 * double(box.diagonal().norm())}};
@@ -392,7 +426,10 @@ std::string web_viewer_page(const WebViewerPage& page) {
                      std::to_string(c.width) + "\" height=\"" + std::to_string(c.height) +
                      "\"></canvas>\n<div class=\"rsibr-controls\">Drag to orbit, wheel to zoom. Exposure <input "
                      "type=\"range\" id=\"rsibr-exposure\" min=\"-12\" max=\"12\" step=\"0.1\"> <span "
-                     "id=\"rsibr-exposure-value\"></span> stops</div></div>\n<div id=\"rsibr-fallback\" "
+                     "id=\"rsibr-exposure-value\"></span> stops<span hidden> | " +
+                     escape_html(page.names[0]) + " &#8592; wipe &#8594; " + escape_html(page.names[1]) +
+                     " <input type=\"range\" id=\"rsibr-wipe\" min=\"0\" max=\"1\" step=\"0.01\" "
+                     "value=\"0.5\"></span></div></div>\n<div id=\"rsibr-fallback\" "
                      "hidden><p>The live view needs WebGL2: <span id=\"rsibr-why\"></span>.</p>" +
                      page.fallback_html + "</div>\n<script type=\"application/json\" id=\"rsibr-data\">" + data +
                      "</script>\n<script>" + kScript + "</script>\n</body></html>\n";

@@ -8,7 +8,8 @@
 // of display_encode's transform (core/colour.h apply_display_transform; $OCIO honoured) over log2
 // radiance in [-14, 6] after exposure, read trilinearly.
 // The radiance is drawn into an RGBA32F frame (EXT_color_buffer_float), then shown through
-// 2^exposure and the table. Without WebGL2 the page says so and shows `fallback_html`.
+// 2^exposure and the table. A second set (captured against computed) is drawn with the same camera
+// right of a wipe the user drags. Without WebGL2 the page says so and shows `fallback_html`.
 //
 // Mouse: drag orbits about the pivot around world up, the wheel moves the camera closer or further;
 // the exposure slider is in stops. For tests and scripts, `window.rsibrViewer`:
@@ -17,7 +18,7 @@
 //   radiance() -> Float32Array, width x height x 4, top row first: the drawn RGBA radiance
 //     (alpha 1 where the mesh covers the pixel, 0 elsewhere);
 //   displayed() -> Uint8Array, the same layout: the canvas as shown (8-bit RGBA);
-//   setExposure(stops); camera() -> the camera drawn;
+//   setExposure(stops); setWipe(fraction of the width showing the first set); camera() -> the camera;
 //   ready: true once the first frame is drawn; error: the reason when WebGL2 is missing.
 #pragma once
 
@@ -32,6 +33,8 @@ namespace rsibr {
 
 struct WebViewerPage {
   const MapSet* maps = nullptr;       // required
+  const MapSet* maps2 = nullptr;      // optional: a second set, compared by a wipe (one camera)
+  std::string names[2];               // the sets' names, for the wipe's labels
   const Mesh* mesh = nullptr;         // required
   BlendOptions blend;                 // rim_fade, use_confidence (gnomonic weights)
   Camera camera;                      // the first view (canvas size too)

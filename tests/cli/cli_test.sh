@@ -224,7 +224,8 @@ check "view --html writes one page that carries its data" bash -c "grep -q 'id=\
 check "view --html JSON names the page and the ball" python3 -c "import json; j=json.load(open('$work/view-html.json')); assert j['mesh'] == 'sphere' and j['bytes'] > 0, j"
 check "view --html leaves no temporary" no_temporaries "$work"
 expect_error "view --html: page type" "v.htm" view --html "$work/v.htm" --maps "$work/mirror.exr"
-expect_error "view --html: one map set" "one map set" view --html "$work/v.html" --maps "$work/mirror.exr" --maps2 "$work/grey.exr"
+"$rsibr" view --html "$work/view2.html" --maps "$work/mirror.exr" --maps2 "$work/grey.exr" --size 64x48
+check "view --html with --maps2 labels its wipe" grep -q 'mirror.exr &#8592; wipe &#8594; grey.exr' "$work/view2.html"
 expect_error "view --html: not a map set" "sky.exr" view --html "$work/v.html" --maps "$work/sky.exr"
 check "view --html: nothing left by a failed run" test ! -e "$work/v.html"
 expect_error "view: --mesh without --html" "mesh" view --maps "$work/mirror.exr" --orbit 1

@@ -49,8 +49,9 @@ TEST(WebViewerPage, CarriesTheDesktopViewersShaderAsGlslEs3) {
   EXPECT_EQ(vs, webgl2_vertex_shader());
   EXPECT_NE(vs.find("uniform mat3 uCamFromWorld;"), std::string::npos);
   EXPECT_EQ(vs.find("#version 330"), std::string::npos);
-  EXPECT_EQ(d["maps"]["views"], 12);
-  EXPECT_EQ(d["maps"]["scale"], 1.0);
+  EXPECT_EQ(d["sets"].size(), 1u);
+  EXPECT_EQ(d["sets"][0]["maps"]["views"], 12);
+  EXPECT_EQ(d["scale"], 1.0);
   EXPECT_EQ(d["mesh"]["count"], mesh.triangles.size() * 3);
   // The title is escaped where it is HTML; no "</script>" ends the data early.
   EXPECT_NE(html.find("a &lt;title&gt; &amp; &quot;quotes&quot; &lt;/script&gt;"), std::string::npos);
@@ -60,8 +61,21 @@ TEST(WebViewerPage, ASetBrighterThanHalfFloatsIsScaledByAPowerOfTwo) {
   const MapSet set = bright_set(1e6f);
   const Mesh mesh = sphere_mesh(Eigen::Vector3f::Zero(), 1.f, 8, 16);
   const nlohmann::json d = page_data(web_viewer_page(page_of(set, mesh)));
-  const double scale = d["maps"]["scale"];
+  const double scale = d["scale"];
   EXPECT_EQ(scale, 32.0);  // 1e6 / 32 = 31250 <= 6e4 < 1e6 / 16
+}
+
+TEST(WebViewerPage, TwoSetsShareOneScaleForTheirWipe) {
+  const MapSet dim = bright_set(1.f), bright = bright_set(1e6f);
+  const Mesh mesh = sphere_mesh(Eigen::Vector3f::Zero(), 1.f, 8, 16);
+  WebViewerPage p = page_of(dim, mesh);
+  p.maps2 = &bright;
+  p.names[0] = "captured", p.names[1] = "computed";
+  const std::string html = web_viewer_page(p);
+  const nlohmann::json d = page_data(html);
+  EXPECT_EQ(d["sets"].size(), 2u);
+  EXPECT_EQ(d["scale"], 32.0);
+  EXPECT_NE(html.find("captured &#8592; wipe &#8594; computed"), std::string::npos);
 }
 
 TEST(WebViewerPage, NoMapsOrMeshIsAnError) {

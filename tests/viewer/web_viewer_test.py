@@ -150,6 +150,39 @@ for k, f in enumerate(frames):
     check("view %d matches rsibr render" % k, covered > 0.05 * w * h and frac <= 0.005 and bad <= 0.02 * covered,
           "%.3f%% of the pixels differ" % (100 * frac))
 
+# Two sets (--maps2): one camera, the first set left of the wipe, the second right of it; each side
+# matches rsibr render of its own set.
+grey, grey_brdf = os.path.join(work, "grey.exr"), os.path.join(work, "grey.yaml")
+open(grey_brdf, "w").write("type: lambert\nalbedo: [0.5, 0.4, 0.3]\n")
+run(rsibr, "bake", "--env", sky, "--brdf", grey_brdf, "--views", "icosa", "--res", "32", "--method", "sh", "-q", grey)
+wipe_page = os.path.join(work, "wipe.html")
+run(rsibr, "view", "--html", wipe_page, "--maps", maps, "--maps2", grey, "--mesh", mesh, "--size", size, "--from", views[0],
+    "--exposure", exposure)
+run(rsibr, "render", "--maps", grey, "--mesh", mesh, "--size", size, "--from", views[0], "--exposure", exposure, "-q",
+    "--out", os.path.join(work, "render-grey.png"))
+html, data = page_data(wipe_page)
+shown = base64.b64decode(in_chromium(html, """
+(function () {
+  const v = window.rsibrViewer, u = (v.setWipe(0.5), v.displayed());
+  let s = ''; for (let i = 0; i < u.length; ++i) s += String.fromCharCode(u[i]);
+  document.body.insertAdjacentHTML('beforeend', '<pre id="rsibr-' + 'test">' + btoa(s) + '</pre>');
+})();""", "wipe-probe.html"))
+w, h = map(int, size.split("x"))
+refs = [read_png(os.path.join(work, n))[2] for n in ("render0.png", "render-grey.png")]
+bad = [0, 0]
+covered = [0, 0]
+for y in range(h):
+    for x in range(w):
+        side = 0 if x < w // 2 else 1
+        ref = refs[side][y]
+        if ref[4 * x + 3] == 0:
+            continue
+        covered[side] += 1
+        bad[side] += max(abs(shown[4 * (y * w + x) + c] - ref[4 * x + c]) for c in range(3)) > 2
+print("wipe: %d / %d pixels covered left / right, %d / %d differ by > 2 codes" % (covered[0], covered[1], bad[0], bad[1]))
+check("a wipe shows each set on its side of one camera",
+      min(covered) > 0 and all(b <= 0.02 * c for b, c in zip(bad, covered)), "%s of %s" % (bad, covered))
+
 # The page without a mesh draws the ball (framed by its bounding box: a seventh of this frame).
 plain = os.path.join(work, "plain.html")
 run(rsibr, "view", "--html", plain, "--maps", maps, "--size", size)
