@@ -5,7 +5,10 @@
 #include "compare/compare_pictures.h"
 #include "formats/exr_io.h"
 #include "core/preview_exposure.h"
+#include "core/sphere_mesh.h"
 #include "core/text.h"
+#include "formats/map_set.h"
+#include "runtime/web_viewer_page.h"
 #include "pipeline/light_sources_report.h"
 #include "pipeline/process_pipeline.h"
 #include "pipeline/response_choice_html.h"
@@ -74,6 +77,38 @@ std::vector<unsigned char> read_bytes(const fs::path& dir, const fs::path& file)
   std::ifstream in(file, std::ios::binary);
   if (!in) throw std::runtime_error(file.string() + ": cannot read (listed in a step record)");
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The ball's captured and computed map sets on a sphere, one camera, a wipe between them
+// (runtime/web_viewer_page.h) in a frame; a note where the views hold no spherical triangle (fewer
+// than three, or all on one great circle), which the shader's point location needs.
+std::string captured_computed_viewer(const fs::path& dir, const std::string& ball) {
+  const fs::path captured = dir / "maps" / ("captured-" + ball + ".exr"),
+                 computed = dir / "maps" / ("computed-" + ball + ".exr");
+  if (!fs::exists(captured) || !fs::exists(computed)) return "";
+  try {
+    const MapSet a = read_map_set(captured.string()), b = read_map_set(computed.string());
+    const Mesh sphere = sphere_mesh(Eigen::Vector3f::Zero(), 1.f);
+    WebViewerPage page;
+    page.maps = &a;
+    page.maps2 = &b;
+    page.names[0] = "captured";
+    page.names[1] = "computed";
+    page.mesh = &sphere;
+    // From the first view's side (where the shoot saw the ball), exposed like the probe's pictures.
+    page.camera = frame_bounds(sphere.bounds(), -a.views.front().view, Vec3(0, 1, 0), 30, 320, 240);
+    std::vector<cv::Mat> rgb;
+    for (const MapView& v : a.views) rgb.push_back(v.rgb);
+    page.exposure = preview_exposure(rgb);
+    page.title = ball + ": captured | computed";
+    const std::string html = web_viewer_page(page);
+    return "<p>The two on one sphere, one camera: drag to orbit, the wipe slider to compare.</p><iframe "
+           "class=\"viewer\" title=\"" +
+           html_escape(ball) + " captured and computed\" style=\"border:0;width:100%;height:400px\" srcdoc=\"" +
+           html_escape(html) + "\"></iframe>";
+  } catch (const std::invalid_argument& e) {
+    return "<p>(No live view of the two: " + html_escape(e.what()) + ".)</p>";
+  }
 }
 
 // Hdr: the vignetting model divided out of the merge (hdr/vignetting.h).
@@ -475,6 +510,7 @@ void write_process_report(const fs::path& dir, const fs::path& out, const std::s
           << img_tag(read_bytes(dir, dir / fs::path(b["folder"].get<std::string>()) / v["picture"].get<std::string>()),
                      v["image"].get<std::string>())
           << "</p>";
+      h << captured_computed_viewer(dir, b["ball"].get<std::string>());
     }
   }
 

@@ -76,7 +76,8 @@ StepOutputs run_render_step(const RenderStep& s) {
   page.camera = first;
   page.pivot = pivot;
   page.exposure = stops;
-  page.title = "rsibr: " + brdf->spec() + " on " + (s.mesh.empty() ? std::string("a torus") : s.mesh);
+  page.title = "rsibr: " + brdf->spec() + " on " +
+               (s.mesh.empty() ? std::string("a torus") : std::filesystem::path(s.mesh).filename().string());
   const std::string html = web_viewer_page(page);
   files["viewer.html"] = std::vector<unsigned char>(html.begin(), html.end());
   write_folder_atomically(s.out, files);

@@ -306,6 +306,8 @@ const char* const kScript = R"JS(
     wiper.addEventListener('input', () => { wipe = parseFloat(wiper.value); draw(); });
   }
   const slider = document.getElementById('rsibr-exposure'), shown = document.getElementById('rsibr-exposure-value');
+  slider.min = Math.floor(exposure) - 12;
+  slider.max = Math.ceil(exposure) + 12;
   slider.value = exposure;
   shown.textContent = exposure.toFixed(1);
   slider.addEventListener('input', () => { exposure = parseFloat(slider.value); shown.textContent = exposure.toFixed(1); draw(); });
