@@ -16,7 +16,7 @@ using namespace rsibr::testing;
 
 // A UV sphere of radius `radius` at `centre` with exact (radial) vertex normals, counter-clockwise
 // seen from outside.
-Mesh sphere_mesh(int rings = 48, int segments = 96, double radius = 1.0, const Vec3& centre = Vec3::Zero()) {
+Mesh test_sphere(int rings = 48, int segments = 96, double radius = 1.0, const Vec3& centre = Vec3::Zero()) {
   Mesh m;
   auto add = [&](const Vec3& n) {
     m.positions.push_back((centre + radius * n).cast<float>());
@@ -149,7 +149,7 @@ struct Stats {
 
 // A view-independent set (Lambert, normal-warped): both modes give irradiance(n) up to resampling error.
 TEST(Renderer, LambertSetGivesTheAnalyticRadianceOfTheHitNormalInBothModes) {
-  const Mesh mesh = sphere_mesh();
+  const Mesh mesh = test_sphere();
   const MapSet set = analytic_map_set(ViewSet::icosahedron(), 64, 64, "normal", lambert_texel);
   const Camera cam = look_at(Vec3(1.5, 1.0, 3.0), Vec3::Zero(), Vec3(0, 1, 0), 40, 96, 80);
   for (RenderMode mode : {RenderMode::PerPixel, RenderMode::Paper}) {
@@ -178,7 +178,7 @@ TEST(Renderer, LambertSetGivesTheAnalyticRadianceOfTheHitNormalInBothModes) {
 // A mirror set without Fresnel (view independent in reflection space): per-pixel mode reflects each
 // pixel's own view direction; paper mode reflects the camera's central direction (its approximation).
 TEST(Renderer, MirrorSetGivesTheAnalyticReflectionPerPixelAndTheCentralOneInPaperMode) {
-  const Mesh mesh = sphere_mesh();
+  const Mesh mesh = test_sphere();
   const MapSet set = analytic_map_set(ViewSet::icosahedron(), 128, 128, "mirror", mirror_texel);
   const Camera cam = look_at(Vec3(-1.0, 2.0, 3.0), Vec3::Zero(), Vec3(0, 1, 0), 35, 96, 96);
   for (RenderMode mode : {RenderMode::PerPixel, RenderMode::Paper}) {
@@ -213,7 +213,7 @@ TEST(Renderer, MirrorSetGivesTheAnalyticReflectionPerPixelAndTheCentralOneInPape
 // The paper's approximation shades every pixel as seen from the image centre: its error against the
 // exact reflection grows with the field of view (the sphere framed alike), per-pixel mode's does not.
 TEST(Renderer, PaperModeErrorGrowsWithTheFieldOfView) {
-  const Mesh mesh = sphere_mesh();
+  const Mesh mesh = test_sphere();
   const MapSet set = analytic_map_set(ViewSet::icosahedron(), 128, 128, "mirror", mirror_texel);
   const Eigen::AlignedBox3f box(Eigen::Vector3f(-1, -1, -1), Eigen::Vector3f(1, 1, 1));
   double paper[2], exact[2];
@@ -272,7 +272,7 @@ TEST(Renderer, NoNanOrInfAtSilhouettesAndOutsideANonSurroundingSet) {
   for (const Vec3& v : all.views())
     if (v.y() > 0.3) up.push_back(v);
   const MapSet set = analytic_map_set(ViewSet(up), 32, 32, "mirror", fresnel_mirror_texel);
-  Mesh mesh = sphere_mesh(24, 48);
+  Mesh mesh = test_sphere(24, 48);
   // A second, open shape (a quad seen from behind) to get back faces.
   const Mesh quad = quad_mesh(Vec3(1, 0, 0), 1.5);
   const uint32_t base = uint32_t(mesh.positions.size());
@@ -308,7 +308,7 @@ TEST(Renderer, NoNanOrInfAtSilhouettesAndOutsideANonSurroundingSet) {
 
 // Multi-lobe maps: rendering two sets at once is the sum of rendering each.
 TEST(Renderer, SummingTwoMapSetsEqualsTheSumOfSeparateRenders) {
-  const Mesh mesh = sphere_mesh(24, 48);
+  const Mesh mesh = test_sphere(24, 48);
   const MapSet a = analytic_map_set(ViewSet::icosahedron(), 32, 32, "normal", lambert_texel);
   const MapSet b = analytic_map_set(ViewSet::geodesic(1), 48, 48, "mirror", fresnel_mirror_texel);
   const Camera cam = look_at(Vec3(2.0, 1.0, 2.5), Vec3::Zero(), Vec3(0, 1, 0), 45, 64, 48);
@@ -327,7 +327,7 @@ TEST(Renderer, SummingTwoMapSetsEqualsTheSumOfSeparateRenders) {
 }
 
 TEST(Renderer, RenderDoesNotDependOnTheThreadCount) {
-  const Mesh mesh = sphere_mesh(24, 48);
+  const Mesh mesh = test_sphere(24, 48);
   const MapSet set = analytic_map_set(ViewSet::icosahedron(), 32, 32, "mirror", fresnel_mirror_texel);
   const Camera cam = look_at(Vec3(0.4, 0.3, 3.0), Vec3::Zero(), Vec3(0, 1, 0), 50, 80, 60);
   for (RenderMode mode : {RenderMode::PerPixel, RenderMode::Paper}) {
@@ -346,7 +346,7 @@ TEST(Renderer, RenderDoesNotDependOnTheThreadCount) {
 // exactly what a fresh render gives, with nothing of the previous frame left (here a frame where the
 // sphere covers other pixels, then one of another size).
 TEST(Renderer, RenderingIntoAKeptBufferEqualsAFreshRenderAndReusesIt) {
-  const Mesh mesh = sphere_mesh(24, 48);
+  const Mesh mesh = test_sphere(24, 48);
   const MapSet set = analytic_map_set(ViewSet::icosahedron(), 32, 32, "mirror", fresnel_mirror_texel);
   const Camera a = look_at(Vec3(0.4, 0.3, 3.0), Vec3::Zero(), Vec3(0, 1, 0), 50, 80, 60);
   const Camera b = look_at(Vec3(-2.5, 1.0, 4.0), Vec3(0.6, 0, 0), Vec3(0, 1, 0), 30, 80, 60);
@@ -369,7 +369,7 @@ TEST(Renderer, RenderingIntoAKeptBufferEqualsAFreshRenderAndReusesIt) {
 }
 
 TEST(Renderer, MissesAreBlackWithAlphaZeroOrTheEnvironment) {
-  const Mesh mesh = sphere_mesh(12, 24);
+  const Mesh mesh = test_sphere(12, 24);
   const MapSet set = analytic_map_set(ViewSet::icosahedron(), 16, 16, "normal", lambert_texel);
   const Camera cam = look_at(Vec3(0, 0, 6), Vec3::Zero(), Vec3(0, 1, 0), 40, 32, 32);
   const cv::Mat plain = Renderer(mesh, {&set}).render(cam);
@@ -392,7 +392,7 @@ TEST(Renderer, MissesAreBlackWithAlphaZeroOrTheEnvironment) {
 // each pixel close to the pixel's mean, which a 64-sample supersampled render estimates.
 TEST(Renderer, LodBringsASmallObjectCloserToItsSupersampledSelf) {
   const MapSet set = checker_set("mirror", mirror_texel);
-  const LodErrors e = small_sphere_lod_errors(set, sphere_mesh(24, 48), RenderOptions{});
+  const LodErrors e = small_sphere_lod_errors(set, test_sphere(24, 48), RenderOptions{});
   std::printf("rms point %.4f lod %.4f\n", e.point, e.lod);
   EXPECT_LT(e.lod, std::sqrt(0.5) * e.point) << "rms point " << e.point << ", lod " << e.lod;
 }
@@ -402,7 +402,7 @@ TEST(Renderer, LodBringsASmallObjectCloserToItsSupersampledSelf) {
 // under a texel) the lookup stays the plain tap's value.
 TEST(Renderer, PaperModeLodBringsASmallObjectCloserToItsSupersampledSelf) {
   const MapSet set = checker_set("normal", lambert_texel);
-  const Mesh mesh = sphere_mesh(24, 48);
+  const Mesh mesh = test_sphere(24, 48);
   RenderOptions o = with_mode(RenderMode::Paper);
   {  // small: about 18 pixels across
     const LodErrors e = small_sphere_lod_errors(set, mesh, o);
@@ -423,7 +423,7 @@ TEST(Renderer, PaperModeLodBringsASmallObjectCloserToItsSupersampledSelf) {
 }
 
 TEST(Renderer, RejectsBadOptions) {
-  const Mesh mesh = sphere_mesh(8, 16);
+  const Mesh mesh = test_sphere(8, 16);
   const MapSet set = analytic_map_set(ViewSet::icosahedron(), 16, 16, "normal", lambert_texel);
   RenderOptions o;
   o.spp = 2;
@@ -437,7 +437,7 @@ TEST(Renderer, RejectsBadOptions) {
 
 // The packet path the renderer traces with finds what single rays find.
 TEST(Renderer, PacketHitsMatchSingleRays) {
-  const Mesh mesh = sphere_mesh(16, 32);
+  const Mesh mesh = test_sphere(16, 32);
   const RayScene scene(mesh);
   const Camera cam = look_at(Vec3(0.3, 0.2, 3.0), Vec3::Zero(), Vec3(0, 1, 0), 45, 61, 47);
   std::vector<Vec3> dirs;
