@@ -530,6 +530,14 @@ check "process prints the report's path" bash -c "[ \"\$(cat '$work/p1.out')\" =
 check "process: every step ran, captured grey within 10% of computed" python3 -c "
 import json; j = json.load(open('$work/p1.json')); assert all(s['ran'] for s in j['steps']), j['steps']
 b = j['results']['compare']['balls'][0]; assert b['ball'] == 'grey' and b['overall']['after']['relative_rms'] < 0.1, b['overall']"
+# The report's turntable orbits in a browser and matches the render step's frames (the page viewer
+# in the report's frame; tests/viewer/report_viewer_check.py).
+if command -v chromium >/dev/null; then
+  check "process: the report's turntable orbits in Chromium and matches its frames" \
+    python3 "$(dirname "$0")/../viewer/report_viewer_check.py" "$work/pout" chromium
+else
+  echo "FAILED: chromium not found (scripts/install-deps.sh installs it)"; fail=$((fail + 1))
+fi
 # rsibr hdr and process's hdr step are one merge (hdr/photo_set_merge.h): about the same lens, the
 # same radiance to the bit, vignetting (estimated from minimal-grey's chessboards) divided out by both.
 "$rsibr" hdr "$work/psyn/photos" --out "$work/phdr" --lens "$work/pout/camera.cameramodel" --json "$work/phdr.json" -q

@@ -21,12 +21,13 @@ def read_png(path):
         kind, body = data[pos + 4:pos + 8], data[pos + 8:pos + 8 + length]
         if kind == b"IHDR":
             width, height, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", body)
-            if depth != 8 or colour != 6 or interlace:
-                sys.exit(f"{path}: expected 8-bit RGBA, non-interlaced")
+            if depth != 8 or colour not in (2, 6) or interlace:
+                sys.exit(f"{path}: expected 8-bit RGB or RGBA, non-interlaced")
         elif kind == b"IDAT":
             idat += body
         pos += 12 + length
-    raw, stride, bpp = zlib.decompress(idat), width * 4, 4
+    bpp = 4 if colour == 6 else 3
+    raw, stride = zlib.decompress(idat), width * bpp
     rows, prev, i = [], bytearray(stride), 0
     for _ in range(height):
         f, line = raw[i], bytearray(raw[i + 1:i + 1 + stride])
@@ -41,8 +42,9 @@ def read_png(path):
                 p = a + b - c
                 pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
                 line[x] = (line[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        rows.append(line)
         prev = line
+        # RGB rows are returned as RGBA, alpha 255.
+        rows.append(line if bpp == 4 else bytearray(b for x in range(width) for b in (*line[3 * x:3 * x + 3], 255)))
     return width, height, rows
 
 
