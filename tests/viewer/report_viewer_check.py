@@ -24,6 +24,7 @@ import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from compare_png import read_png  # noqa: E402
+from page_probe import frames_script  # noqa: E402
 
 
 def orbit(cam, pivot, k, n):
@@ -48,26 +49,8 @@ def main():
     n = len(frames)
     views = list(range(0, n, max(1, n // 4)))[:4]
     cams = [orbit(data["camera"], data["pivot"], k, n) for k in views]
-    probe = """<script>
-window.addEventListener('load', () => {
-  const frame = document.querySelector('iframe[title="turntable viewer"]'), out = document.createElement('pre');
-  out.id = 'rsibr-' + 'check';
-  const v = frame && frame.contentWindow.rsibrViewer;
-  const b64 = u => { let s = ''; for (let i = 0; i < u.length; ++i) s += String.fromCharCode(u[i]); return btoa(s); };
-  if (!v || v.error || !v.ready) { out.textContent = 'ERROR ' + (v ? v.error || 'not drawn' : 'no viewer in the report'); }
-  else {
-    const res = [];
-    for (const c of %s) {
-      v.setCamera(c);
-      const r = v.radiance(), cover = new Uint8Array(r.length / 4);
-      for (let i = 0; i < cover.length; ++i) cover[i] = r[4 * i + 3] > 0 ? 1 : 0;
-      res.push({ shown: b64(v.displayed()), cover: b64(cover) });
-    }
-    out.textContent = JSON.stringify(res);
-  }
-  document.body.appendChild(out);
-});
-</script>""" % json.dumps(cams)
+    viewer = "(document.querySelector('iframe[title=\"turntable viewer\"]') || {}).contentWindow?.rsibrViewer"
+    probe = "<script>window.addEventListener('load', () => {%s});</script>" % frames_script(viewer, cams, "rsibr-check")
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "report.html")
         open(path, "w").write(report.replace("</body>", probe + "</body>"))

@@ -24,6 +24,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from compare_png import read_png  # noqa: E402
+from page_probe import frames_script  # noqa: E402
 
 rsibr, chromium, work = sys.argv[1:4]
 os.makedirs(work, exist_ok=True)
@@ -104,25 +105,7 @@ for k, d in enumerate(views):
         check("the page is one file: no network reference",
               not re.search(r'(src|href)\s*=\s*"(https?:)?//', html) and "fetch(" not in html)
 
-script = """
-(function () {
-  const v = window.rsibrViewer, out = document.createElement('pre');
-  out.id = 'rsibr-test';
-  const b64 = a => { let s = ''; const u = new Uint8Array(a.buffer); for (let i = 0; i < u.length; ++i) s += String.fromCharCode(u[i]); return btoa(s); };
-  if (!v || v.error) { out.textContent = 'ERROR ' + (v ? v.error : 'no viewer'); }
-  else {
-    const cams = %s, res = [];
-    for (const c of cams) {
-      v.setCamera(c);
-      const r = v.radiance(), cover = new Uint8Array(r.length / 4);
-      for (let i = 0; i < cover.length; ++i) cover[i] = r[4 * i + 3] > 0 ? 1 : 0;
-      res.push({ shown: b64(v.displayed()), cover: b64(cover) });
-    }
-    out.textContent = JSON.stringify(res);
-  }
-  document.body.appendChild(out);
-})();
-""" % json.dumps(cameras)
+script = frames_script("window.rsibrViewer", cameras, "rsibr-test")
 result = in_chromium(first, script, "probe.html")
 if result.startswith("ERROR"):
     sys.exit("the page did not draw: " + result)
