@@ -1,6 +1,7 @@
 #include "calib/orientation/view_orientation.h"
 
 #include "calib/orientation/consensus_chance.h"
+#include "core/keep_where.h"
 
 #include <opencv2/imgproc.hpp>
 
@@ -491,12 +492,7 @@ PoseSet orient_views_reporting(const std::vector<std::string>& all_names, const 
     }
     for (std::size_t v = 0; v < keep.size(); ++v)
       if (!keep[v]) rep.left_out.push_back(names[v] + ": its chrome ball " + first.left_out[v]);
-    auto filter = [&](auto& vec) {
-      std::size_t w = 0;
-      for (std::size_t v = 0; v < keep.size(); ++v)
-        if (keep[v] && w++ != v) vec[w - 1] = std::move(vec[v]);  // never moved onto itself (a vector would empty)
-      vec.resize(w);
-    };
+    auto filter = [&](auto& vec) { keep_where(vec, keep); };
     filter(feats), filter(detected_cones), filter(rep.balls), filter(rep.measured), filter(rep.features), filter(names);
     if (!sets.empty()) filter(sets);
     if (!panoramas.empty()) filter(panoramas);
