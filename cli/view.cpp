@@ -87,7 +87,12 @@ int run_view_html(const ViewArgs& a) {
   page.display_view = a.view;
   page.title = "rsibr view: " + file_name(a.maps) + (a.maps2.empty() ? "" : " | " + file_name(a.maps2)) +
                (a.mesh.empty() ? "" : " on " + file_name(a.mesh));
-  const std::string html = web_viewer_page(page);
+  std::string html;
+  try {
+    html = web_viewer_page(page);
+  } catch (const std::invalid_argument& e) {  // what the shader cannot draw: name the sets
+    throw std::invalid_argument(a.maps + (a.maps2.empty() ? "" : " / " + a.maps2) + ": " + e.what());
+  }
   {
     std::ofstream out(tmp, std::ios::binary);
     out << html;

@@ -227,6 +227,9 @@ expect_error "view --html: page type" "v.htm" view --html "$work/v.htm" --maps "
 "$rsibr" view --html "$work/view2.html" --maps "$work/mirror.exr" --maps2 "$work/grey.exr" --size 64x48
 check "view --html with --maps2 labels its wipe" grep -q 'mirror.exr &#8592; wipe &#8594; grey.exr' "$work/view2.html"
 expect_error "view --html: not a map set" "sky.exr" view --html "$work/v.html" --maps "$work/sky.exr"
+printf '0 0 1\n1 0 0\n' >"$work/two-views.txt"
+"$rsibr" pattern direction "$work/two.exr" --map-set "$work/two-views.txt" --size 16 >/dev/null
+expect_error "view --html: a set with no view triangle, named" "two.exr: viewer: .*no spherical triangle" view --html "$work/v.html" --maps "$work/two.exr"
 check "view --html: nothing left by a failed run" test ! -e "$work/v.html"
 expect_error "view: --mesh without --html" "mesh" view --maps "$work/mirror.exr" --orbit 1
 
